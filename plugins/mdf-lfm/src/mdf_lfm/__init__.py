@@ -1,0 +1,5 @@
+"""LFM pulse-Doppler radar waveform plugin for mdframework (kind ``lfm``)."""
+
+from .waveform import LfmPulseDoppler
+
+__all__ = ["LfmPulseDoppler"]

@@ -1,0 +1,102 @@
+"""Point scatterers at constant velocity, for calibration and tests.
+
+The source places each target at ``position + velocity * t`` [m] for ``0 <= t <= duration``,
+sampled at ``frame_rate`` (the motion is linear, so any interpolation of it is exact). The
+``points`` scatterer model turns each joint into an isotropic scatterer whose RCS is the target's.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+
+from mdframework import (
+    Motion,
+    MotionConfig,
+    MotionSource,
+    PluginConfig,
+    ScattererModel,
+    Scatterers,
+    Skeleton,
+)
+
+
+class Target(BaseModel):
+    """One point scatterer."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+    position: tuple[float, float, float] = Field(description="Position at t = 0 [m].")
+    velocity: tuple[float, float, float] = Field(
+        (0.0, 0.0, 0.0), description="Constant velocity [m/s]."
+    )
+    rcs: float = Field(1.0, ge=0, description="Radar cross section [m^2].")
+
+
+class PointTargetsConfig(MotionConfig):
+    """Point scatterers moving at constant velocity."""
+
+    kind: Literal["point_targets"] = "point_targets"
+    targets: list[Target] = Field(min_length=1, description="The scatterers.")
+    duration: float | None = Field(None, gt=0, description="Record length [s] (required).")
+    frame_rate: float = Field(100.0, gt=0, description="Sampling of the tracks [Hz].")
+    label: str = Field("point_targets", description="Activity label recorded with the run.")
+
+
+class PointTargets(MotionSource):
+    """Constant-velocity point targets."""
+
+    name = "point_targets"
+    Config = PointTargetsConfig
+    config: PointTargetsConfig
+
+    def load(self) -> Motion:
+        """Tracks of all targets; joints are named ``target0``, ``target1``, ..."""
+        c = self.config
+        if c.duration is None:
+            raise ValueError("point_targets needs a duration")
+        n = int(np.floor(c.duration * c.frame_rate + 1e-9)) + 1
+        t = np.arange(n) / c.frame_rate
+        if t[-1] < c.duration - 1e-12:
+            t = np.append(t, c.duration)
+        p0 = np.array([tg.position for tg in c.targets], dtype=np.float64)
+        v = np.array([tg.velocity for tg in c.targets], dtype=np.float64)
+        pos = p0[None, :, :] + t[:, None, None] * v[None, :, :]
+        names = tuple(f"target{i}" for i in range(len(c.targets)))
+        meta = {"source": "point_targets", "activity": c.label, "n_targets": len(c.targets)}
+        rcs = np.array([tg.rcs for tg in c.targets], dtype=np.float64)
+        return Motion(Skeleton(t, pos, names), meta, None, rcs)
+
+
+class IsotropicPointsConfig(PluginConfig):
+    """Every joint is an isotropic point scatterer."""
+
+    kind: Literal["points"] = "points"
+    rcs: float | None = Field(
+        None, ge=0, description="RCS of every point [m^2]; default: the source's, else 1 m^2."
+    )
+
+
+class IsotropicPoints(ScattererModel):
+    """Joints as isotropic point scatterers (angle-independent RCS)."""
+
+    name = "points"
+    Config = IsotropicPointsConfig
+    config: IsotropicPointsConfig
+    needs_canonical = False
+
+    def scatterers(
+        self, motion: Motion, skeleton: Skeleton, radar_position: np.ndarray, wavelength: float
+    ) -> Scatterers:
+        """One scatterer per joint with constant RCS."""
+        n_p, n_j = skeleton.positions.shape[:2]
+        if self.config.rcs is not None:
+            rcs = np.full(n_j, self.config.rcs)
+        elif motion.point_rcs is not None and motion.point_rcs.shape == (n_j,):
+            rcs = motion.point_rcs
+        else:
+            rcs = np.ones(n_j)
+        return Scatterers(
+            skeleton.positions, np.broadcast_to(rcs, (n_p, n_j)).copy(), skeleton.joint_names
+        )

@@ -1,0 +1,118 @@
+"""The ``mdf`` command line.
+
+Errors caused by input (config, data files, the scene) print one line and exit with code 2; add
+``--debug`` for the traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import traceback
+import warnings
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from .errors import MdfError
+from .plugins import INTERFACES, PluginError, default_registry
+
+EXIT_USAGE = 2
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    from .config import load_run_config
+    from .output import write_run
+    from .pipeline import simulate
+
+    config = load_run_config(args.config)
+    result = simulate(config)
+    resolved = json.loads(config.model_dump_json())
+    written = write_run(result, resolved, Path(args.out))
+    for path in written:
+        print(path)
+    return 0
+
+
+def _cmd_plugins(args: argparse.Namespace) -> int:
+    registry = default_registry()
+    for interface in INTERFACES:
+        print(f"{interface}:")
+        infos = registry.plugins[interface]
+        if not infos:
+            print("  (none installed)")
+        for name in registry.names(interface):
+            info = infos[name]
+            doc = (info.cls.__doc__ or "").strip().splitlines()
+            summary = doc[0] if doc else ""
+            print(f"  {name:<16} {info.provider:<28} {summary}")
+    return 0
+
+
+def _cmd_schema(args: argparse.Namespace) -> int:
+    from .config import run_config_model
+
+    print(json.dumps(run_config_model().model_json_schema(), indent=2))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of ``mdf``."""
+    parser = argparse.ArgumentParser(
+        prog="mdf", description="Radar micro-Doppler simulation of people in motion."
+    )
+    parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    run = sub.add_parser("run", help="run a config: motion -> radar -> spectrogram")
+    run.add_argument("config", help="run config file (.toml, .yaml or .json)")
+    run.add_argument("--out", required=True, help="output folder")
+    run.set_defaults(func=_cmd_run)
+
+    plugins = sub.add_parser("plugins", help="list installed plugins by interface")
+    plugins.set_defaults(func=_cmd_plugins)
+
+    config = sub.add_parser("config", help="config utilities")
+    config_sub = config.add_subparsers(dest="config_command", required=True)
+    schema = config_sub.add_parser("schema", help="print the JSON schema of run configs")
+    schema.set_defaults(func=_cmd_schema)
+    return parser
+
+
+def _one_line(message: str) -> str:
+    return " ".join(str(message).split())
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point; returns the exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+
+    def show_warning(message: Any, category: Any, *rest: Any, **kw: Any) -> None:
+        print(f"mdf: warning: {_one_line(str(message))}", file=sys.stderr)
+
+    warnings.showwarning = show_warning
+    try:
+        return int(args.func(args))
+    except (MdfError, PluginError) as exc:
+        if args.debug:
+            traceback.print_exc()
+        print(f"mdf: error: {_one_line(str(exc))}", file=sys.stderr)
+        return EXIT_USAGE
+    except KeyboardInterrupt:
+        print("mdf: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:
+        if args.debug:
+            raise
+        print(
+            f"mdf: internal error: {type(exc).__name__}: {_one_line(str(exc))} "
+            "(run with --debug for the traceback)",
+            file=sys.stderr,
+        )
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

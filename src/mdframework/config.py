@@ -1,0 +1,237 @@
+"""Run configs: pydantic models, read from TOML, YAML or JSON files.
+
+Every section that chooses a plugin has a ``kind`` field; the plugin's own ``Config`` model
+validates the rest. The full run model is assembled from the registered plugins
+(:func:`run_config_model`), so ``mdf config schema`` shows exactly what is installed.
+
+Relative paths inside a config are relative to the config file's folder.
+"""
+
+from __future__ import annotations
+
+import json
+import tomllib
+from pathlib import Path
+from typing import Annotated, Any, Literal, Union
+
+import yaml
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    ValidationInfo,
+    create_model,
+    model_validator,
+)
+
+from .errors import ConfigError
+from .interfaces import PluginConfig
+from .physics.interpolation import Method
+from .plugins import Registry, default_registry
+
+
+def _resolve_path(value: Path, info: ValidationInfo) -> Path:
+    base = (info.context or {}).get("base_dir")
+    path = Path(value).expanduser()
+    if not path.is_absolute() and base is not None:
+        path = Path(base) / path
+    if not path.exists():
+        raise ValueError(f"file not found: {path}")
+    return path
+
+
+#: A path to an existing file, relative to the config file's folder.
+DataPath = Annotated[Path, AfterValidator(_resolve_path)]
+
+
+class MotionConfig(PluginConfig):
+    """Base of motion-source configs: every source can be cut to a time window."""
+
+    start: float = Field(0.0, ge=0, description="Start of the window, s from the first frame.")
+    duration: float | None = Field(
+        None, gt=0, description="Length of the window [s]; default: to the end."
+    )
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class PersonConfig(_Strict):
+    """Where the person is and how they move."""
+
+    motion: Literal["recorded", "treadmill", "straight"] = Field(
+        "recorded",
+        description="recorded: keep the recording's translation; treadmill: remove it; "
+        "straight: replace it by a straight path at `speed`.",
+    )
+    position: tuple[float, float] = Field(
+        (0.0, 0.0), description="Horizontal position (x, y) of the hip centre at the start [m]."
+    )
+    heading_deg: float | None = Field(
+        None, description="Direction the person faces, degrees from +x toward +y."
+    )
+    aspect_deg: float | None = Field(
+        None,
+        description="Facing direction relative to the radar: 0 = toward it, 90 = crossing, "
+        "180 = away. Default 0 when neither this nor heading_deg is given.",
+    )
+    speed: float | None = Field(None, ge=0, description="Speed for motion = 'straight' [m/s].")
+
+    @model_validator(mode="after")
+    def _check(self) -> PersonConfig:
+        if self.heading_deg is not None and self.aspect_deg is not None:
+            raise ValueError("give heading_deg or aspect_deg, not both")
+        if self.motion == "straight" and self.speed is None:
+            raise ValueError("motion = 'straight' needs a speed")
+        if self.motion != "straight" and self.speed is not None:
+            raise ValueError("speed is used only with motion = 'straight'")
+        return self
+
+
+class SceneConfig(_Strict):
+    """The radar's position, the person's placement and the range gate."""
+
+    radar_position: tuple[float, float, float] = Field(
+        (10.0, 0.0, 2.0), description="Radar antenna position (x, y, z) [m]."
+    )
+    person: PersonConfig = Field(default_factory=PersonConfig)
+    gate: Literal["track"] | float = Field(
+        "track",
+        description="'track': the gate follows the hip centre (or the first point target); "
+        "a number: a fixed gate range [m].",
+    )
+    min_range: float = Field(
+        0.5, gt=0, description="Smallest allowed scatterer range [m]; closer is an error."
+    )
+
+
+class ProcessingConfig(_Strict):
+    """Resampling and spectrogram settings."""
+
+    interpolation: Method = Field(
+        "cubic", description="Joint resampling: cubic (C2 spline), pchip, akima, linear."
+    )
+    window: str = Field("hann", description="STFT window (any scipy.signal window name).")
+    window_length: int = Field(256, ge=2, description="STFT window length [pulses].")
+    hop: int = Field(32, ge=1, description="STFT hop [pulses].")
+    nfft: int = Field(1024, ge=2, description="FFT size (>= window_length).")
+    floor_db: float = Field(-60.0, lt=0, description="Spectrogram floor, dB below its peak.")
+    aliasing: Literal["warn", "error"] = Field(
+        "warn",
+        description="When a scatterer's radial speed exceeds lambda*PRF/4: warn, or stop.",
+    )
+
+    @model_validator(mode="after")
+    def _check(self) -> ProcessingConfig:
+        if self.nfft < self.window_length:
+            raise ValueError(f"nfft ({self.nfft}) must be >= window_length ({self.window_length})")
+        return self
+
+
+class RunConfigBase(_Strict):
+    """Fields every run config has besides the plugin sections."""
+
+    scene: SceneConfig = Field(default_factory=SceneConfig)
+    processing: ProcessingConfig = Field(default_factory=ProcessingConfig)
+
+
+def _union(registry: Registry, interface: str) -> Any:
+    models = [registry.plugins[interface][n].cls.Config for n in registry.names(interface)]
+    if not models:
+        return PluginConfig
+    if len(models) == 1:
+        return models[0]
+    return Annotated[Union[tuple(models)], Field(discriminator="kind")]  # noqa: UP007
+
+
+def run_config_model(registry: Registry | None = None) -> type[RunConfigBase]:
+    """The run-config model for the plugins in ``registry`` (default: the installed ones)."""
+    reg = registry or default_registry()
+
+    def default(interface: str, name: str) -> Any:
+        if name in reg.plugins[interface]:
+            return Field(default={"kind": name}, validate_default=True)
+        return ...
+
+    model = create_model(
+        "RunConfig",
+        __base__=RunConfigBase,
+        motion=(_union(reg, "motion"), ...),
+        scatterers=(_union(reg, "scatterers"), default("scatterers", "ellipsoid")),
+        radar=(_union(reg, "radar"), default("radar", "lfm")),
+    )
+    return model
+
+
+def read_config_file(path: str | Path) -> dict[str, Any]:
+    """Parse a TOML, YAML or JSON file into a dict; errors name the file and line."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ConfigError(f"{p}: cannot read: {exc.strerror or exc}") from None
+    suffix = p.suffix.lower()
+    try:
+        if suffix == ".toml":
+            data: Any = tomllib.loads(text)
+        elif suffix in (".yaml", ".yml"):
+            data = yaml.safe_load(text)
+        elif suffix == ".json":
+            data = json.loads(text)
+        else:
+            raise ConfigError(f"{p}: unknown config format {suffix!r} (use .toml, .yaml or .json)")
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{p}: invalid TOML: {exc}") from None
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f"line {mark.line + 1}: " if mark is not None else ""
+        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise ConfigError(f"{p}: invalid YAML: {where}{problem}") from None
+    except json.JSONDecodeError as exc:
+        raise ConfigError(f"{p}: invalid JSON: line {exc.lineno}: {exc.msg}") from None
+    if not isinstance(data, dict):
+        raise ConfigError(f"{p}: the top level must be a table of sections")
+    return data
+
+
+def format_validation_error(exc: ValidationError, source: str, data: Any = None) -> str:
+    """One line naming the file and the first invalid field (``section.field``)."""
+    errors = exc.errors(include_url=False)
+    first = errors[0]
+    parts: list[str] = []
+    node = data
+    for part in first["loc"]:
+        if isinstance(node, dict) and part not in node and node.get("kind") == part:
+            continue  # the discriminator tag pydantic inserts for plugin sections
+        parts.append(str(part))
+        node = node.get(part) if isinstance(node, dict) else None
+    more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
+    msg = first["msg"]
+    if first["type"] == "union_tag_invalid":
+        msg = f"unknown kind {first['input'].get('kind')!r}; " + msg.split(";")[-1].strip()
+    return f"{source}: {'.'.join(parts) or '(top level)'}: {msg}{more}"
+
+
+def load_run_config(path: str | Path, registry: Registry | None = None) -> RunConfigBase:
+    """Read and validate a run config file."""
+    p = Path(path)
+    data = read_config_file(p)
+    return validate_run_config(data, source=str(p), base_dir=p.parent, registry=registry)
+
+
+def validate_run_config(
+    data: dict[str, Any],
+    *,
+    source: str = "<config>",
+    base_dir: Path | None = None,
+    registry: Registry | None = None,
+) -> RunConfigBase:
+    """Validate a config dict; errors are :class:`ConfigError` naming ``source`` and the field."""
+    model = run_config_model(registry)
+    try:
+        return model.model_validate(data, context={"base_dir": base_dir})
+    except ValidationError as exc:
+        raise ConfigError(format_validation_error(exc, source, data)) from None

@@ -1,0 +1,54 @@
+"""pluggy hook specifications: one registration hook per interface.
+
+A plugin distribution declares an entry point in the ``mdframework`` group whose object is a module
+(or class) implementing some of these hooks with ``@mdframework.hookimpl``. Each hook returns a list
+of plugin classes; their ``name`` is the ``kind`` used in config files.
+
+Example ``pyproject.toml`` of a third-party plugin::
+
+    [project.entry-points.mdframework]
+    my_source = "my_package.plugin"
+
+and in ``my_package/plugin.py``::
+
+    from mdframework import hookimpl
+
+    @hookimpl
+    def mdframework_register_motion_sources():
+        return [MySource]
+"""
+
+from __future__ import annotations
+
+import pluggy
+
+from .interfaces import Classifier, Effect, MotionSource, RadarWaveform, ScattererModel
+
+PROJECT = "mdframework"
+hookspec = pluggy.HookspecMarker(PROJECT)
+hookimpl = pluggy.HookimplMarker(PROJECT)
+
+
+@hookspec
+def mdframework_register_motion_sources() -> list[type[MotionSource]]:  # type: ignore[empty-body]
+    """Return the :class:`~mdframework.interfaces.MotionSource` classes this plugin provides."""
+
+
+@hookspec
+def mdframework_register_scatterer_models() -> list[type[ScattererModel]]:  # type: ignore[empty-body]
+    """Return the :class:`~mdframework.interfaces.ScattererModel` classes this plugin provides."""
+
+
+@hookspec
+def mdframework_register_waveforms() -> list[type[RadarWaveform]]:  # type: ignore[empty-body]
+    """Return the :class:`~mdframework.interfaces.RadarWaveform` classes this plugin provides."""
+
+
+@hookspec
+def mdframework_register_classifiers() -> list[type[Classifier]]:  # type: ignore[empty-body]
+    """Return the :class:`~mdframework.interfaces.Classifier` classes this plugin provides."""
+
+
+@hookspec
+def mdframework_register_effects() -> list[type[Effect]]:  # type: ignore[empty-body]
+    """Return the :class:`~mdframework.interfaces.Effect` classes this plugin provides."""

@@ -1,0 +1,215 @@
+"""The interfaces every plugin implements.
+
+Each plugin is a class with a ``name`` (the ``kind`` a config file uses to choose it) and a nested
+pydantic ``Config`` model that validates its section of a run config. ``__init__`` takes that
+validated config and does no work.
+
+Data passed between stages (shapes, dtypes, units):
+
+- :class:`Motion`: a :class:`~mdframework.skeleton.Skeleton` plus metadata.
+- :class:`Scatterers`: ``positions`` ``(n_pulses, n_scatterers, 3)`` float64 [m] in the scene
+  frame and ``rcs`` ``(n_pulses, n_scatterers)`` float64 [m^2].
+- :class:`Received`: ``signal`` ``(n_pulses,)`` complex128, the pulse-compressed slow-time return
+  at the range gate, normalised so that a lone scatterer at the gate gives its range-equation
+  amplitude [sqrt(W)]; optional range-time data.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import BaseModel, ConfigDict
+
+from .skeleton import Skeleton, to_canonical
+
+FloatArray = NDArray[np.float64]
+ComplexArray = NDArray[np.complex128]
+
+
+class PluginConfig(BaseModel):
+    """Base of every plugin's config model: unknown fields are errors."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+    kind: str
+
+
+class Plugin(ABC):
+    """Common base: a registered name and a config model."""
+
+    #: The ``kind`` that selects this plugin in a config file.
+    name: ClassVar[str]
+    #: The pydantic model of this plugin's config section (with ``kind: Literal[name]``).
+    Config: ClassVar[type[PluginConfig]]
+
+    def __init__(self, config: PluginConfig) -> None:
+        self.config = config
+
+
+# --------------------------------------------------------------------------- motion sources
+
+
+@dataclass(frozen=True)
+class Motion:
+    """What a motion source yields.
+
+    ``skeleton`` is in the source's own joints (z up, metres, seconds). ``canonical_map`` maps each
+    canonical joint name to a source joint name, or is ``None`` for sources that are not human
+    bodies (point targets). ``point_rcs`` (n_joints,) [m^2] is set by sources whose joints are
+    isotropic point scatterers. ``metadata`` holds subject, activity label, source file, frame rate
+    and anything else worth recording with a run (JSON-serialisable values only).
+    """
+
+    skeleton: Skeleton
+    metadata: Mapping[str, Any] = field(default_factory=dict)
+    canonical_map: Mapping[str, str] | None = None
+    point_rcs: FloatArray | None = None
+
+    def canonical(self) -> Skeleton:
+        """The skeleton mapped to the canonical 17 joints; ``ValueError`` if there is no map."""
+        if self.canonical_map is None:
+            raise ValueError(
+                "this motion has no mapping to the canonical 17-joint body "
+                f"(source: {self.metadata.get('source', 'unknown')})"
+            )
+        return to_canonical(self.skeleton, self.canonical_map)
+
+
+class MotionSource(Plugin):
+    """Reads or generates motion."""
+
+    @abstractmethod
+    def load(self) -> Motion:
+        """Return the motion described by the config. Errors name the file and line."""
+
+
+# --------------------------------------------------------------------------- scatterer models
+
+
+@dataclass(frozen=True)
+class Scatterers:
+    """Point scatterers over slow time. See the module docstring for shapes and units."""
+
+    positions: FloatArray
+    rcs: FloatArray
+    names: tuple[str, ...]
+
+    def __post_init__(self) -> None:
+        if self.positions.ndim != 3 or self.positions.shape[2] != 3:
+            raise ValueError(
+                f"positions must be (n_pulses, n_scatterers, 3), got {self.positions.shape}"
+            )
+        if self.rcs.shape != self.positions.shape[:2]:
+            raise ValueError(f"rcs must be {self.positions.shape[:2]}, got {self.rcs.shape}")
+        if len(self.names) != self.positions.shape[1]:
+            raise ValueError("one name per scatterer is required")
+
+    def ranges(self, radar_position: FloatArray) -> FloatArray:
+        """Distance of every scatterer to the radar, (n_pulses, n_scatterers) float64 [m]."""
+        d = self.positions - np.asarray(radar_position, dtype=np.float64)
+        return np.asarray(np.sqrt(np.einsum("psk,psk->ps", d, d)), dtype=np.float64)
+
+
+class ScattererModel(Plugin):
+    """Turns a body (or a set of points) into scatterers with an RCS for each pulse."""
+
+    #: Whether this model needs the canonical 17-joint body.
+    needs_canonical: ClassVar[bool] = True
+
+    @abstractmethod
+    def scatterers(
+        self, motion: Motion, skeleton: Skeleton, radar_position: FloatArray, wavelength: float
+    ) -> Scatterers:
+        """Scatterers for every pulse.
+
+        ``skeleton`` is already resampled to the pulse times and placed in the scene frame
+        (canonical joints if ``needs_canonical``). ``radar_position`` is (3,) [m];
+        ``wavelength`` [m] is the radar's, for frequency-dependent RCS.
+        """
+
+
+# --------------------------------------------------------------------------- waveforms
+
+
+@dataclass(frozen=True)
+class Received:
+    """Radar data after pulse compression.
+
+    ``signal`` (n_pulses,) complex128: slow-time return at the range gate [sqrt(W)].
+    ``range_time`` (n_pulses, n_bins) complex128 and ``range_axis`` (n_bins,) float64 [m]: the
+    compressed output over a window of ranges, when the waveform computes it (else ``None``).
+    """
+
+    signal: ComplexArray
+    range_time: ComplexArray | None = None
+    range_axis: FloatArray | None = None
+
+
+class RadarWaveform(Plugin):
+    """A radar: its carrier, pulse rate, range equation and receive chain."""
+
+    @property
+    @abstractmethod
+    def carrier_frequency(self) -> float:
+        """Carrier (band-centre) frequency [Hz]."""
+
+    @property
+    @abstractmethod
+    def prf(self) -> float:
+        """Pulse repetition frequency, i.e. the slow-time sample rate [Hz]."""
+
+    @abstractmethod
+    def receive(self, ranges: FloatArray, rcs: FloatArray, gate_range: FloatArray) -> Received:
+        """Received, pulse-compressed data.
+
+        ``ranges`` and ``rcs``: (n_pulses, n_scatterers) float64 [m], [m^2].
+        ``gate_range``: (n_pulses,) float64 [m], the range gate to report in ``signal``.
+        """
+
+
+# --------------------------------------------------------------------------- classifiers
+
+
+class Classifier(Plugin):
+    """Learns activity labels from feature vectors (scikit-learn style)."""
+
+    @abstractmethod
+    def fit(self, features: FloatArray, labels: NDArray[Any]) -> Classifier:
+        """Fit on ``features`` (n_samples, n_features) and ``labels`` (n_samples,)."""
+
+    @abstractmethod
+    def predict(self, features: FloatArray) -> NDArray[Any]:
+        """Predicted labels, (n_samples,)."""
+
+
+# --------------------------------------------------------------------------- effects
+
+
+@dataclass(frozen=True)
+class SceneContext:
+    """What an effect may need to know about the scene: radar position (3,) [m], PRF [Hz],
+    carrier frequency [Hz], pulse times (n_pulses,) [s] and a seeded random generator."""
+
+    radar_position: FloatArray
+    prf: float
+    carrier_frequency: float
+    pulse_times: FloatArray
+    rng: np.random.Generator
+
+
+class Effect(Plugin):
+    """A scene effect (noise, clutter, multipath, antenna pattern, ...).
+
+    ``stage`` says where it acts: on the scatterers before the radar (``"scatterers"``) or on the
+    received data (``"received"``). The pipeline runs only the effects a scene names.
+    """
+
+    stage: ClassVar[Literal["scatterers", "received"]]
+
+    @abstractmethod
+    def apply(self, data: Any, context: SceneContext) -> Any:
+        """Return the modified ``Scatterers`` or ``Received``."""

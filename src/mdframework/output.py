@@ -1,0 +1,109 @@
+"""Writing a run's results: all files appear together or not at all.
+
+``DIR/result.npz`` arrays (all float64 unless noted):
+
+- ``signal`` (n_pulses,) complex128: compressed slow-time return at the gate [sqrt(W)]
+- ``pulse_time_s`` (n_pulses,): pulse times from the first pulse [s]
+- ``gate_range_m`` (n_pulses,): range gate [m]
+- ``spectrogram_db`` (n_doppler, n_frames) float32: power in dB re its peak, floored
+- ``doppler_hz`` (n_doppler,), ``velocity_mps`` (n_doppler,): axes (+ approaching)
+- ``time_s`` (n_frames,): STFT window centres [s from the first pulse]
+- ``scatterer_range_m`` (n_pulses, n_scatterers), ``scatterer_rcs_m2`` (same) float32
+- raw path only: ``range_time_db`` (n_slow, n_range) float32, |compressed output| in dB re peak,
+  decimated in slow time to at most 2000 rows; ``range_time_time_s`` (n_slow,);
+  ``range_m`` (n_range,)
+
+plus ``spectrogram.png``, ``range_time.png`` (raw path), ``config.resolved.json`` and
+``metadata.json``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .figures import plot_range_time, plot_spectrogram
+from .physics.spectrogram import power_to_db
+from .pipeline import RunResult
+
+MAX_RANGE_TIME_ROWS = 2000
+
+
+def result_arrays(result: RunResult) -> dict[str, np.ndarray]:
+    """The arrays stored in ``result.npz``."""
+    ranges = result.scatterers.ranges(np.asarray(result.metadata["radar_position_m"]))
+    arrays: dict[str, np.ndarray] = {
+        "signal": result.received.signal,
+        "pulse_time_s": result.pulse_times,
+        "gate_range_m": result.gate_range,
+        "spectrogram_db": result.spectrogram_db.astype(np.float32),
+        "doppler_hz": result.spectrogram.doppler,
+        "velocity_mps": result.velocity,
+        "time_s": result.spectrogram.time,
+        "scatterer_range_m": ranges,
+        "scatterer_rcs_m2": result.scatterers.rcs.astype(np.float32),
+    }
+    rt = result.received.range_time
+    if rt is not None and result.received.range_axis is not None:
+        step = max(1, int(np.ceil(rt.shape[0] / MAX_RANGE_TIME_ROWS)))
+        power = np.abs(rt[::step]) ** 2
+        arrays["range_time_db"] = power_to_db(power, -80.0).astype(np.float32)
+        arrays["range_time_time_s"] = result.pulse_times[::step]
+        arrays["range_m"] = result.received.range_axis
+    return arrays
+
+
+def write_run(result: RunResult, resolved_config: dict[str, Any], out_dir: Path) -> list[Path]:
+    """Write a run's files into ``out_dir`` atomically (staged in a temporary folder beside it,
+    then moved in). Returns the written paths."""
+    out_dir = Path(out_dir)
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
+    try:
+        arrays = result_arrays(result)
+        np.savez_compressed(stage / "result.npz", **arrays)  # type: ignore[arg-type]
+        title = str(result.metadata.get("motion", {}).get("activity", ""))
+        plot_spectrogram(
+            stage / "spectrogram.png",
+            arrays["spectrogram_db"],
+            arrays["time_s"],
+            arrays["velocity_mps"],
+            arrays["doppler_hz"],
+            title=title,
+        )
+        if "range_time_db" in arrays:
+            plot_range_time(
+                stage / "range_time.png",
+                arrays["range_time_db"],
+                arrays["range_time_time_s"],
+                arrays["range_m"],
+                title=title,
+            )
+        (stage / "config.resolved.json").write_text(json.dumps(resolved_config, indent=2) + "\n")
+        (stage / "metadata.json").write_text(
+            json.dumps(result.metadata, indent=2, default=_jsonable) + "\n"
+        )
+        out_dir.mkdir(parents=True, exist_ok=True)
+        written = []
+        for f in sorted(stage.iterdir()):
+            os.replace(f, out_dir / f.name)
+            written.append(out_dir / f.name)
+        return written
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, Path):
+        return str(value)
+    raise TypeError(f"not JSON-serialisable: {type(value).__name__}")

@@ -1,0 +1,89 @@
+"""Radar cross sections of the body-part shapes (``physics.md`` section 2).
+
+All RCS values are in m^2, lengths in m. Angles in radians.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy import special
+
+FloatArray = NDArray[np.float64]
+
+
+def sphere_rcs_optical(radius: ArrayLike) -> FloatArray:
+    """Optical-region (ka >> 1) RCS of a sphere: ``pi r^2``."""
+    r = np.asarray(radius, dtype=np.float64)
+    return np.asarray(np.pi * r * r, dtype=np.float64)
+
+
+def sphere_rcs_mie(radius: float, wavelength: float) -> float:
+    """Exact monostatic RCS of a perfectly conducting sphere (Mie series).
+
+    ``sigma = (lambda^2/pi) |sum_n (-1)^n (n + 1/2)(b_n - a_n)|^2`` with
+    ``a_n = j_n(ka)/h_n(ka)`` and
+    ``b_n = (ka j_{n-1}(ka) - n j_n(ka)) / (ka h_{n-1}(ka) - n h_n(ka))``, summed to convergence.
+    """
+    ka = 2.0 * np.pi * float(radius) / float(wavelength)
+    if ka <= 0:
+        raise ValueError("radius and wavelength must be positive")
+    n_max = int(ka + 4.05 * ka ** (1.0 / 3.0) + 10)
+    n = np.arange(1, n_max + 1)
+    jn = special.spherical_jn(n, ka)
+    jn1 = special.spherical_jn(n - 1, ka)
+    hn = jn + 1j * special.spherical_yn(n, ka)
+    hn1 = jn1 + 1j * special.spherical_yn(n - 1, ka)
+    a_n = jn / hn
+    b_n = (ka * jn1 - n * jn) / (ka * hn1 - n * hn)
+    total = np.sum((-1.0) ** n * (n + 0.5) * (b_n - a_n))
+    return float(wavelength**2 / np.pi * abs(total) ** 2)
+
+
+def ellipsoid_rcs_local(a: ArrayLike, b: ArrayLike, c: ArrayLike, u: ArrayLike) -> FloatArray:
+    """Geometric-optics RCS of an ellipsoid with semi-axes ``a`` (x), ``b`` (y), ``c`` (z) seen
+    along the unit vector ``u`` (..., 3), given in the ellipsoid's own frame.
+
+    ``sigma = pi a^2 b^2 c^2 / (a^2 u_x^2 + b^2 u_y^2 + c^2 u_z^2)^2``. The denominator is the
+    squared support function, a convex combination of a^2, b^2, c^2, hence never below
+    ``min(a, b, c)^2`` for positive semi-axes: no angle makes it singular.
+    """
+    uu = np.asarray(u, dtype=np.float64)
+    a2 = np.asarray(a, dtype=np.float64) ** 2
+    b2 = np.asarray(b, dtype=np.float64) ** 2
+    c2 = np.asarray(c, dtype=np.float64) ** 2
+    h2 = a2 * uu[..., 0] ** 2 + b2 * uu[..., 1] ** 2 + c2 * uu[..., 2] ** 2
+    return np.asarray(np.pi * a2 * b2 * c2 / (h2 * h2), dtype=np.float64)
+
+
+def ellipsoid_rcs_angles(
+    a: ArrayLike, b: ArrayLike, c: ArrayLike, theta: ArrayLike, phi: ArrayLike
+) -> FloatArray:
+    """The textbook (Mahafza) form: ``theta`` from the c-axis, ``phi`` about it from the a-axis."""
+    th = np.asarray(theta, dtype=np.float64)
+    ph = np.asarray(phi, dtype=np.float64)
+    u = np.stack(
+        [np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th) * np.ones_like(ph)],
+        axis=-1,
+    )
+    return ellipsoid_rcs_local(a, b, c, u)
+
+
+def spheroid_rcs(
+    a: ArrayLike, c: ArrayLike, axis: FloatArray, line_of_sight: FloatArray
+) -> FloatArray:
+    """RCS of a prolate/oblate spheroid (``a = b``) whose symmetry axis is ``axis`` (..., 3),
+    seen along ``line_of_sight`` (..., 3) (part -> radar). Neither vector needs unit length but
+    the aspect uses ``cos^2 theta = (A.B)^2/(|A|^2 |B|^2)`` and ``sin^2 = 1 - cos^2`` (no
+    arccos, no azimuth: it does not matter when ``a = b``). Where either vector is zero the aspect
+    is undefined and broadside is used, so the result is always finite; callers that can have
+    zero axes should hold the last valid orientation instead."""
+    dot = np.einsum("...k,...k->...", axis, line_of_sight)
+    n2 = np.einsum("...k,...k->...", axis, axis) * np.einsum(
+        "...k,...k->...", line_of_sight, line_of_sight
+    )
+    cos2 = np.clip(np.divide(dot * dot, n2, out=np.zeros_like(n2), where=n2 > 0), 0.0, 1.0)
+    a2 = np.asarray(a, dtype=np.float64) ** 2
+    c2 = np.asarray(c, dtype=np.float64) ** 2
+    h2 = a2 * (1.0 - cos2) + c2 * cos2
+    return np.asarray(np.pi * a2 * a2 * c2 / (h2 * h2), dtype=np.float64)

@@ -1,0 +1,76 @@
+"""Placing a recording in the scene (pure functions on joint arrays).
+
+Scene frame: right-handed, ``z`` up, metres. Headings are angles in the horizontal plane from
+``+x`` toward ``+y`` [rad]. A body's facing direction is the horizontal unit vector 90 degrees
+clockwise (seen from above) from its right-hip -> left-hip vector.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+
+
+def rotation_z(angle: float) -> FloatArray:
+    """Active rotation by ``angle`` [rad] about ``+z``, (3, 3)."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def facing_heading(left_hip: FloatArray, right_hip: FloatArray) -> float:
+    """Mean facing heading [rad] of a body from hip tracks (n_frames, 3) [m]."""
+    left = np.nanmean(left_hip - right_hip, axis=0)
+    if not np.all(np.isfinite(left)) or np.hypot(left[0], left[1]) < 1e-9:
+        raise ValueError("cannot find the body's facing direction: the hips coincide")
+    # forward = left rotated by -90 degrees about z: (lx, ly) -> (ly, -lx)
+    return float(np.arctan2(-left[0], left[1]))
+
+
+def linear_drift(time: FloatArray, track: FloatArray) -> FloatArray:
+    """Least-squares straight-line fit of a horizontal track: (n_frames, 2) [m], evaluated at
+    ``time`` and zero at the first frame (the translation a treadmill removes)."""
+    t = time - time[0]
+    a = np.stack([np.ones_like(t), t], axis=1)
+    coef, *_ = np.linalg.lstsq(a, track, rcond=None)
+    return np.asarray(np.outer(t, coef[1]), dtype=np.float64)
+
+
+def place(
+    time: FloatArray,
+    joints: FloatArray,
+    *,
+    base: FloatArray,
+    heading_now: float,
+    heading: float,
+    position: FloatArray,
+    mode: str,
+    speed: float = 0.0,
+) -> FloatArray:
+    """Rotate and translate joints (n_frames, n_joints, 3) [m] into the scene.
+
+    ``base`` (n_frames, 3) is the body's reference track (hip centre). The body is rotated about
+    the vertical through its first base position so that ``heading_now`` becomes ``heading``;
+    then, by ``mode``:
+
+    - ``recorded``: its own translation is kept; the first base position moves to ``position``
+      (x, y) [m] (its height is kept).
+    - ``treadmill``: the straight-line horizontal drift of the base is removed (sway remains),
+      and the base stays at ``position``.
+    - ``straight``: as ``treadmill``, then the body moves along ``heading`` at ``speed`` [m/s].
+    """
+    rot = rotation_z(heading - heading_now)
+    origin = np.array([base[0, 0], base[0, 1], 0.0])
+    moved = (joints - origin) @ rot.T
+    base_r = (base - origin) @ rot.T
+    if mode in ("treadmill", "straight"):
+        drift = linear_drift(time, base_r[:, :2])
+        moved[:, :, :2] -= drift[:, None, :]
+        if mode == "straight":
+            direction = np.array([np.cos(heading), np.sin(heading)])
+            moved[:, :, :2] += ((time - time[0]) * speed)[:, None, None] * direction
+    elif mode != "recorded":
+        raise ValueError(f"unknown motion mode {mode!r}")
+    moved[:, :, :2] += np.asarray(position, dtype=np.float64)[:2]
+    return np.asarray(moved, dtype=np.float64)

@@ -1,0 +1,188 @@
+"""Skeletons: joint tracks over time, and the canonical 17-point body.
+
+A :class:`Skeleton` is the common currency between motion sources and the rest of the pipeline.
+Arrays and units:
+
+- ``time``: shape ``(n_frames,)``, float64, seconds, strictly increasing.
+- ``positions``: shape ``(n_frames, n_joints, 3)``, float64, metres, in a right-handed frame with
+  ``z`` up (sources convert at their boundary, e.g. CMU's y-up to z-up).
+- ``valid``: shape ``(n_frames, n_joints)``, bool; ``False`` marks a joint that was not tracked in
+  that frame (its position must then not be used).
+- ``joint_names``: tuple of ``n_joints`` strings.
+
+The canonical body is Chen's 17-point set used with the Boulic walking model (``physics.md``
+section 2.3): base (hip centre), neck, head, left/right shoulder, elbow, hand, hip, knee, ankle,
+toe.
+Body axes: ``x`` forward, ``y`` to the subject's left, ``z`` up.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+
+#: Canonical joint names, in Chen's order.
+CANONICAL_JOINTS: tuple[str, ...] = (
+    "base",
+    "neck",
+    "head",
+    "l_shoulder",
+    "r_shoulder",
+    "l_elbow",
+    "r_elbow",
+    "l_hand",
+    "r_hand",
+    "l_hip",
+    "r_hip",
+    "l_knee",
+    "r_knee",
+    "l_ankle",
+    "r_ankle",
+    "l_toe",
+    "r_toe",
+)
+
+#: The 16 segments of the canonical tree as (proximal, distal) joint names.
+CANONICAL_SEGMENTS: tuple[tuple[str, str], ...] = (
+    ("base", "neck"),
+    ("neck", "head"),
+    ("neck", "l_shoulder"),
+    ("neck", "r_shoulder"),
+    ("l_shoulder", "l_elbow"),
+    ("r_shoulder", "r_elbow"),
+    ("l_elbow", "l_hand"),
+    ("r_elbow", "r_hand"),
+    ("base", "l_hip"),
+    ("base", "r_hip"),
+    ("l_hip", "l_knee"),
+    ("r_hip", "r_knee"),
+    ("l_knee", "l_ankle"),
+    ("r_knee", "r_ankle"),
+    ("l_ankle", "l_toe"),
+    ("r_ankle", "r_toe"),
+)
+
+
+class SkeletonError(ValueError):
+    """A skeleton's arrays are inconsistent (shapes, time stamps, NaN where valid)."""
+
+
+@dataclass(frozen=True)
+class Skeleton:
+    """Joint positions over time. See the module docstring for shapes and units."""
+
+    time: FloatArray
+    positions: FloatArray
+    joint_names: tuple[str, ...]
+    valid: BoolArray = field(default=None)  # type: ignore[arg-type]
+
+    def __post_init__(self) -> None:
+        time = np.asarray(self.time, dtype=np.float64)
+        pos = np.asarray(self.positions, dtype=np.float64)
+        names = tuple(self.joint_names)
+        if time.ndim != 1:
+            raise SkeletonError(f"time must have shape (n_frames,), got {time.shape}")
+        if pos.ndim != 3 or pos.shape[2] != 3:
+            raise SkeletonError(
+                f"positions must have shape (n_frames, n_joints, 3), got {pos.shape}"
+            )
+        if pos.shape[0] != time.shape[0]:
+            raise SkeletonError(
+                f"{time.shape[0]} time stamps but {pos.shape[0]} frames of positions"
+            )
+        if pos.shape[1] != len(names):
+            raise SkeletonError(f"{pos.shape[1]} joints but {len(names)} joint names")
+        if len(set(names)) != len(names):
+            raise SkeletonError("joint names must be unique")
+        if time.size and not np.all(np.isfinite(time)):
+            raise SkeletonError("time stamps must be finite")
+        if time.size > 1 and not np.all(np.diff(time) > 0):
+            bad = int(np.argmax(~(np.diff(time) > 0)))
+            raise SkeletonError(
+                f"time stamps must be strictly increasing (frame {bad + 1}: "
+                f"{time[bad + 1]!r} s after {time[bad]!r} s); sort them and drop duplicates first"
+            )
+        valid = (
+            np.all(np.isfinite(pos), axis=2)
+            if self.valid is None
+            else np.asarray(self.valid, dtype=bool)
+        )
+        if valid.shape != pos.shape[:2]:
+            raise SkeletonError(f"valid must have shape {pos.shape[:2]}, got {valid.shape}")
+        if not np.all(np.isfinite(pos[valid])):
+            raise SkeletonError("positions marked valid must be finite")
+        object.__setattr__(self, "time", time)
+        object.__setattr__(self, "positions", pos)
+        object.__setattr__(self, "joint_names", names)
+        object.__setattr__(self, "valid", valid)
+
+    @property
+    def n_frames(self) -> int:
+        """Number of frames."""
+        return int(self.time.shape[0])
+
+    @property
+    def n_joints(self) -> int:
+        """Number of joints."""
+        return len(self.joint_names)
+
+    @property
+    def duration(self) -> float:
+        """Time from the first to the last frame [s]."""
+        return float(self.time[-1] - self.time[0]) if self.n_frames else 0.0
+
+    def index(self, name: str) -> int:
+        """Index of joint ``name``; raises ``KeyError`` naming the known joints."""
+        try:
+            return self.joint_names.index(name)
+        except ValueError:
+            raise KeyError(f"no joint {name!r}; joints are {', '.join(self.joint_names)}") from None
+
+    def joint(self, name: str) -> FloatArray:
+        """Track of one joint, shape ``(n_frames, 3)`` [m]."""
+        return self.positions[:, self.index(name), :]
+
+    def select(self, names: Sequence[str]) -> Skeleton:
+        """A skeleton with only the named joints, in the given order."""
+        idx = [self.index(n) for n in names]
+        return Skeleton(self.time, self.positions[:, idx], tuple(names), self.valid[:, idx])
+
+    def window(self, start: float | None = None, duration: float | None = None) -> Skeleton:
+        """Frames with ``start <= t - time[0] <= start + duration`` (times relative to the first
+        frame, seconds). Raises ``ValueError`` if the window holds fewer than two frames."""
+        t_rel = self.time - self.time[0]
+        lo = 0.0 if start is None else float(start)
+        hi = np.inf if duration is None else lo + float(duration)
+        keep = (t_rel >= lo - 1e-9) & (t_rel <= hi + 1e-9)
+        if int(keep.sum()) < 2:
+            raise ValueError(
+                f"the window start={lo} s, duration={duration} s holds fewer than two frames "
+                f"of a {self.duration:.3f} s recording"
+            )
+        return Skeleton(self.time[keep], self.positions[keep], self.joint_names, self.valid[keep])
+
+    def renamed(self, names: Sequence[str]) -> Skeleton:
+        """Same data with new joint names (same count and order)."""
+        return Skeleton(self.time, self.positions, tuple(names), self.valid)
+
+    def with_positions(self, positions: FloatArray) -> Skeleton:
+        """Same time stamps, names and validity with new positions."""
+        return Skeleton(self.time, positions, self.joint_names, self.valid)
+
+
+def to_canonical(skeleton: Skeleton, mapping: Mapping[str, str]) -> Skeleton:
+    """Map a source skeleton to the canonical 17 joints.
+
+    ``mapping`` maps every canonical joint name to a source joint name. The result has
+    ``joint_names == CANONICAL_JOINTS``.
+    """
+    missing = [j for j in CANONICAL_JOINTS if j not in mapping]
+    if missing:
+        raise KeyError(f"joint mapping lacks canonical joints: {', '.join(missing)}")
+    return skeleton.select([mapping[j] for j in CANONICAL_JOINTS]).renamed(CANONICAL_JOINTS)

@@ -1,0 +1,184 @@
+"""End-to-end hard cases of physics.md section 6 that belong to the core path."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+import synthetic
+from helpers import phase_increment_doppler, point_run
+
+from mdframework.config import validate_run_config
+from mdframework.errors import SceneError
+from mdframework.pipeline import RunResult, simulate
+from mdframework.plugins import Registry, build_registry
+
+
+@pytest.fixture(scope="module")
+def registry() -> Registry:
+    return build_registry([synthetic], autoload=True)
+
+
+def walk(registry: Registry, **sections: Any) -> RunResult:
+    cfg: dict[str, Any] = {"motion": {"kind": "synthetic_walker"}}
+    for key, value in sections.items():
+        cfg[key] = value
+    return simulate(validate_run_config(cfg, registry=registry), registry)
+
+
+def test_large_range_same_doppler() -> None:
+    """10 km gives the same Doppler as 10 m (section 6.1), to < 1e-6 Hz."""
+    near = point_run([{"position": [10.0, 0, 0], "velocity": [-1.0, 0, 0]}], duration=1.0)
+    far = point_run([{"position": [10_000.0, 0, 0], "velocity": [-1.0, 0, 0]}], duration=1.0)
+    f_near = phase_increment_doppler(near.received.signal, 2400.0)
+    f_far = phase_increment_doppler(far.received.signal, 2400.0)
+    assert f_near == pytest.approx(100.069228559, rel=1e-8)
+    assert abs(f_far - f_near) < 1e-6
+
+
+@pytest.mark.parametrize("response", ["exact", "sinc", "phase_only"])
+def test_constant_range_shift_only_changes_a_global_phase(
+    rng: np.random.Generator, response: str
+) -> None:
+    """Shifting every range (and the gate) by 10 km leaves the slow-time signal unchanged but
+    for one global phase (section 6.1)."""
+    from mdframework.physics import radar
+
+    t = np.arange(2400) / 2400.0
+    ranges = 10.0 + rng.uniform(-0.5, 0.5, 17)[None, :] + np.outer(t, rng.uniform(-3, 3, 17))
+    amp = rng.uniform(0.1, 1.0, (1, 17)) * np.ones_like(ranges)
+    gate = ranges[:, 0]
+    kw: dict[str, Any] = {
+        "carrier_frequency": 15e9,
+        "pulse_width": 1e-6,
+        "bandwidth": 150e6,
+        "response": response,
+    }
+    ya = radar.compressed_return_at_gate(ranges, amp, gate, **kw)
+    yb = radar.compressed_return_at_gate(ranges + 10_000.0, amp, gate + 10_000.0, **kw)
+    ratio = yb / ya
+    assert np.allclose(np.abs(ratio), 1.0, atol=1e-9)
+    assert np.ptp(np.angle(ratio * np.conj(ratio[0]))) < 1e-6
+
+
+def test_target_at_the_radar_is_a_clear_error() -> None:
+    with pytest.raises(SceneError, match="comes within 0 m of the radar"):
+        point_run([{"position": [1.0, 0, 0], "velocity": [-1.0, 0, 0]}], duration=1.0)
+
+
+def test_body_walking_into_the_radar_is_a_clear_error(registry: Registry) -> None:
+    with pytest.raises(SceneError, match="of the radar"):
+        walk(registry, scene={"radar_position": [2.0, 0.0, 1.0]})
+
+
+def test_radar_straight_overhead_is_finite(registry: Registry) -> None:
+    res = walk(
+        registry,
+        motion={"kind": "synthetic_walker", "speed": 0.0},
+        scene={"radar_position": [0.0, 0.0, 8.0], "person": {"heading_deg": 0.0}},
+    )
+    assert np.all(np.isfinite(res.received.signal))
+    assert np.all(np.isfinite(res.scatterers.rcs)) and np.all(res.scatterers.rcs > 0)
+
+
+def test_aspect_needs_a_horizontal_direction(registry: Registry) -> None:
+    with pytest.raises(SceneError, match="straight above"):
+        walk(registry, scene={"radar_position": [0.0, 0.0, 8.0]})
+
+
+@pytest.mark.parametrize("collapse", ["l_forearm", "all"])
+@pytest.mark.parametrize("placement", ["joints17", "chen16"])
+def test_zero_length_segments_stay_finite(
+    registry: Registry, collapse: str, placement: str
+) -> None:
+    res = walk(
+        registry,
+        motion={"kind": "synthetic_walker", "collapse": collapse},
+        scatterers={"kind": "ellipsoid", "placement": placement, "height": 1.8},
+    )
+    assert np.all(np.isfinite(res.scatterers.rcs))
+    assert np.all(np.isfinite(res.received.signal))
+    assert np.all(np.isfinite(res.spectrogram_db))
+
+
+def test_held_orientation_for_collapsed_forearm(registry: Registry) -> None:
+    res = walk(
+        registry,
+        motion={
+            "kind": "synthetic_walker",
+            "collapse": "l_forearm",
+            "swing_deg": 0.0,
+            "speed": 0.0,
+        },
+        scatterers={"kind": "ellipsoid", "height": 1.8},
+    )
+    k = res.scatterers.names.index("l_hand")
+    rcs = res.scatterers.rcs[:, k]
+    # a still body: after the collapse (one third in) the forearm keeps its last valid
+    # orientation, so its RCS stays that of a hanging forearm seen from the radar
+    n = rcs.size
+    assert np.ptp(rcs[: n // 4]) / rcs[0] < 1e-4  # spline ringing from the jump only
+    assert np.ptp(rcs[n // 2 :]) / rcs[0] < 0.05
+
+
+def test_record_shorter_than_window_is_a_scene_error(registry: Registry) -> None:
+    with pytest.raises(SceneError, match="window_length"):
+        walk(registry, motion={"kind": "synthetic_walker", "length": 0.05})
+
+
+def test_window_past_the_end_is_an_error(registry: Registry) -> None:
+    with pytest.raises(SceneError, match="ends after the recording"):
+        walk(registry, motion={"kind": "synthetic_walker", "start": 2.0, "duration": 2.0})
+
+
+def test_aliasing_strict_refuses(registry: Registry) -> None:
+    with pytest.raises(SceneError, match="unambiguous"):
+        walk(
+            registry,
+            motion={"kind": "synthetic_walker", "speed": 3.0},
+            radar={"kind": "lfm", "prf": 500.0},
+            processing={"aliasing": "error"},
+        )
+
+
+def test_walker_torso_line_at_its_speed(registry: Registry) -> None:
+    """Walking straight at the radar at 1.2 m/s from 20 m: the spectrogram's strongest line
+    (the torso) sits at 1.2 m/s times the cosine of the small elevation angle."""
+    res = walk(
+        registry,
+        motion={"kind": "synthetic_walker", "speed": 1.2},
+        scene={"radar_position": [20.0, 0.0, 1.0]},
+    )
+    v_peak = res.velocity[np.argmax(res.spectrogram.power, axis=0)]
+    dv = res.velocity[1] - res.velocity[0]
+    assert np.median(v_peak) == pytest.approx(1.2, abs=2 * dv + 0.01)
+
+
+@pytest.mark.parametrize("aspect", [0.0, 90.0, 180.0])
+def test_aspect_angle_sets_the_torso_doppler(registry: Registry, aspect: float) -> None:
+    res = walk(
+        registry,
+        motion={"kind": "synthetic_walker", "speed": 1.0, "length": 2.0},
+        scene={"radar_position": [30.0, 0.0, 1.0], "person": {"aspect_deg": aspect}},
+    )
+    est = phase_increment_doppler(res.received.signal, 2400.0)
+    lam = res.metadata["wavelength_m"]
+    assert est * lam / 2 == pytest.approx(np.cos(np.deg2rad(aspect)), abs=0.05)
+
+
+def test_treadmill_removes_translation(registry: Registry) -> None:
+    res = walk(
+        registry,
+        motion={"kind": "synthetic_walker", "speed": 1.5},
+        scene={"person": {"motion": "treadmill"}},
+    )
+    gate = res.gate_range
+    assert np.ptp(gate) < 1e-6
+    straight = walk(
+        registry,
+        motion={"kind": "synthetic_walker", "speed": 1.5},
+        scene={"radar_position": [30.0, 0.0, 1.0], "person": {"motion": "straight", "speed": 0.7}},
+    )
+    v = -np.diff(straight.gate_range) * 2400.0
+    assert np.median(v) == pytest.approx(0.7, abs=0.01)

@@ -1,0 +1,93 @@
+"""Resampling and spectrogram, including the hard cases of physics.md 6.3, 6.4 and 6.8."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mdframework.physics import interpolation, spectrogram
+from mdframework.skeleton import Skeleton, SkeletonError
+
+
+def _swing(t: np.ndarray) -> np.ndarray:
+    """1 Hz, 0.4 m swing on a 1.1 m/s walk (physics.md 6.4)."""
+    return 1.1 * t + 0.2 * np.sin(2 * np.pi * t)
+
+
+def test_cubic_spline_accuracy_at_kinect_rate() -> None:
+    t = np.arange(0, 6.0 + 1e-9, 1 / 18)
+    y = _swing(t)[:, None, None] * np.ones((1, 1, 3))
+    tq = interpolation.pulse_times(t[0], t[-1], 2400.0)
+    out = interpolation.resample_tracks(t, y, np.ones((t.size, 1), bool), tq, "cubic")
+    err = np.abs(out[:, 0, 0] - _swing(tq))
+    assert err.max() < 0.2e-3  # section 6.4: about 0.1 mm for a cubic spline
+    lin = interpolation.resample_tracks(t, y, np.ones((t.size, 1), bool), tq, "linear")
+    # linear interpolation is an order of magnitude worse (kinks: spurious Doppler lines)
+    assert np.abs(lin[:, 0, 0] - _swing(tq)).max() > 10 * err.max()
+
+
+def test_pulse_times_never_extrapolate_and_use_time() -> None:
+    tq = interpolation.pulse_times(0.25, 1.0, 2400.0)
+    assert tq[0] == 0.25 and tq[-1] <= 1.0
+    assert tq.size == 1801
+    with pytest.raises(ValueError, match="never extrapolates"):
+        interpolation.resample_tracks(
+            np.array([0.0, 1.0, 2.0]),
+            np.zeros((3, 1, 3)),
+            np.ones((3, 1), bool),
+            np.array([0.0, 2.5]),
+        )
+
+
+def test_nan_gap_is_bridged() -> None:
+    t = np.arange(0, 3.0, 1 / 18)
+    y = _swing(t)
+    pos = np.repeat(y[:, None, None], 3, axis=2)
+    valid = np.ones((t.size, 1), bool)
+    valid[20:24] = False  # a 4-frame (0.22 s) gap
+    pos[20:24] = np.nan
+    tq = interpolation.pulse_times(t[0], t[-1], 2400.0)
+    out = interpolation.resample_tracks(t, pos, valid, tq)
+    assert np.all(np.isfinite(out))
+    assert np.abs(out[:, 0, 0] - _swing(tq)).max() < 0.013  # section 6.4: 12.8 mm
+
+
+def test_non_increasing_time_stamps_refused_and_sortable() -> None:
+    t = np.array([0.0, 0.05, 0.05, 0.04, 0.2])
+    pos = np.arange(15, dtype=float).reshape(5, 1, 3)
+    with pytest.raises(SkeletonError, match="strictly increasing"):
+        Skeleton(t, pos, ("a",))
+    ts, ps, idx = interpolation.sort_and_deduplicate(t, pos)
+    assert np.all(np.diff(ts) > 0)
+    assert list(idx) == [0, 3, 1, 4]
+    Skeleton(ts, ps, ("a",))
+
+
+def test_spectrogram_axes_and_frame_centres() -> None:
+    fs = 2400.0
+    y = np.exp(2j * np.pi * 300.0 * np.arange(4800) / fs)
+    s = spectrogram.spectrogram(y, fs, window_length=256, hop=64, nfft=512)
+    assert s.doppler[0] == -fs / 2 and s.doppler[-1] == pytest.approx(fs / 2 - fs / 512)
+    assert s.time[0] == pytest.approx(127.5 / fs)
+    assert np.allclose(np.diff(s.time), 64 / fs)
+    assert s.doppler[np.argmax(s.power[:, 3])] == pytest.approx(300.0, abs=fs / 512 / 2)
+    # Parseval per frame: sum over bins of |X|^2 / nfft = sum |w y|^2 (nfft >= window)
+    from scipy.signal import get_window
+
+    w = get_window("hann", 256)
+    assert s.power[:, 0].sum() / 512 == pytest.approx(np.sum(w**2), rel=1e-10)
+
+
+def test_record_shorter_than_window_is_an_error() -> None:
+    with pytest.raises(spectrogram.RecordTooShortError, match="needs 256"):
+        spectrogram.spectrogram(np.ones(100, complex), 2400.0, window_length=256)
+
+
+def test_db_floor_never_inf_or_nan() -> None:
+    p = np.array([[0.0, 1.0], [1e-30, 0.0]])
+    db = spectrogram.power_to_db(p, -60.0)
+    assert np.all(np.isfinite(db)) and db.max() == 0.0 and db.min() == -60.0
+    zero = spectrogram.power_to_db(np.zeros((4, 3)), -50.0)
+    assert np.all(zero == -50.0)
+    with pytest.raises(ValueError):
+        spectrogram.power_to_db(np.array([np.inf]), -60.0)

@@ -1,0 +1,153 @@
+"""RCS models and body scatterers (physics.md section 2)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mdframework.physics import body, rcs
+from mdframework.skeleton import CANONICAL_JOINTS
+
+LAMBDA_15GHZ = 0.019986163867
+
+
+def test_sphere_optical() -> None:
+    assert float(rcs.sphere_rcs_optical(0.1)) == pytest.approx(0.0314159265, rel=1e-8)
+
+
+@pytest.mark.parametrize(
+    ("ka", "ratio"), [(0.1, 0.000898), (1.0, 3.6376), (10.0, 0.9292), (100.0, 0.99903)]
+)
+def test_sphere_mie_reference_values(ka: float, ratio: float) -> None:
+    radius = 1.0
+    lam = 2 * np.pi * radius / ka
+    assert rcs.sphere_rcs_mie(radius, lam) / (np.pi * radius**2) == pytest.approx(ratio, rel=2e-3)
+
+
+def test_sphere_mie_rayleigh_limit_and_head() -> None:
+    ka = 0.05
+    lam = 2 * np.pi / ka
+    assert rcs.sphere_rcs_mie(1.0, lam) / np.pi == pytest.approx(9 * ka**4, rel=0.01)
+    assert rcs.sphere_rcs_mie(0.1, LAMBDA_15GHZ) == pytest.approx(0.032015, rel=1e-3)
+
+
+def test_ellipsoid_equal_axes_is_a_sphere(rng: np.random.Generator) -> None:
+    th = rng.uniform(0, np.pi, 100_000)
+    ph = rng.uniform(-np.pi, np.pi, 100_000)
+    s = rcs.ellipsoid_rcs_angles(0.3, 0.3, 0.3, th, ph)
+    assert np.ptp(s) < 1e-15
+    assert s[0] == pytest.approx(np.pi * 0.09, rel=1e-14)
+
+
+def test_ellipsoid_broadside_and_end_on() -> None:
+    assert float(rcs.ellipsoid_rcs_angles(0.06, 0.06, 0.2, 0.0, 0.0)) == pytest.approx(
+        1.017876e-3, rel=1e-6
+    )
+    assert float(rcs.ellipsoid_rcs_angles(0.06, 0.06, 0.2, np.pi / 2, 0.0)) == pytest.approx(
+        0.1256637, rel=1e-6
+    )
+    a, b, c = 0.05, 0.08, 0.2
+    assert float(rcs.ellipsoid_rcs_angles(a, b, c, np.pi / 2, 0.0)) == pytest.approx(
+        np.pi * b**2 * c**2 / a**2, rel=1e-12
+    )
+    # sigma(theta) = sigma(pi - theta)
+    th = np.linspace(0, np.pi, 7)
+    assert np.allclose(
+        rcs.ellipsoid_rcs_angles(a, b, c, th, 0.3),
+        rcs.ellipsoid_rcs_angles(a, b, c, np.pi - th, 0.3),
+        rtol=1e-12,
+    )
+
+
+def test_ellipsoid_denominator_never_below_min_axis(rng: np.random.Generator) -> None:
+    a, b, c = 0.05, 0.08, 0.2
+    u = rng.normal(size=(200_000, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    s = rcs.ellipsoid_rcs_local(a, b, c, u)
+    denominator = np.sqrt(np.pi * a**2 * b**2 * c**2 / s)
+    assert denominator.min() >= min(a, b, c) ** 2 * (1 - 1e-12)
+    assert np.all(np.isfinite(s))
+    assert s.max() <= np.pi * (b * c / a) ** 2 * (1 + 1e-12)
+
+
+def test_spheroid_from_vectors_matches_angle_form(rng: np.random.Generator) -> None:
+    axis = rng.normal(size=(1000, 3))
+    los = rng.normal(size=(1000, 3)) * 5
+    cos_t = (
+        np.einsum("ij,ij->i", axis, los)
+        / np.linalg.norm(axis, axis=1)
+        / np.linalg.norm(los, axis=1)
+    )
+    theta = np.arccos(np.clip(cos_t, -1, 1))
+    expected = rcs.ellipsoid_rcs_angles(0.07, 0.07, 0.22, theta, 0.0)
+    assert np.allclose(rcs.spheroid_rcs(0.07, 0.22, axis, los), expected, rtol=1e-10)
+
+
+def test_spheroid_zero_vectors_are_finite() -> None:
+    s = rcs.spheroid_rcs(0.07, 0.22, np.zeros((2, 3)), np.array([[1.0, 0, 0], [0, 0, 0]]))
+    assert np.all(np.isfinite(s))
+
+
+def test_spheroid_end_on_from_overhead() -> None:
+    """A vertical segment seen from straight above is the legitimate end-on value."""
+    s = rcs.spheroid_rcs(0.06, 0.2, np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 5.0]))
+    assert float(s) == pytest.approx(1.017876e-3, rel=1e-6)
+
+
+def test_segment_table_for_1_8_m() -> None:
+    h = 1.8
+    assert body.SEGMENT_FRACTIONS["torso"] * h == pytest.approx(0.5184)
+    assert body.SEGMENT_FRACTIONS["foot"] * h == pytest.approx(0.2574)
+    assert body.LEG_FRACTION * h == pytest.approx(0.8838)
+
+
+@pytest.mark.parametrize("placement", ["chen16", "joints17"])
+def test_placements_count_and_rcs_table(placement: str) -> None:
+    parts = body.body_parts(placement, "sphere")  # type: ignore[arg-type]
+    assert len(parts) == (16 if placement == "chen16" else 17)
+    a, c = body.part_semi_axes(parts, 1.8)
+    names = [p.name for p in parts]
+    # physics.md 2.3 RCS table at H = 1.8: thigh broadside pi c^2 = 0.1528, end-on 0.00155
+    thigh = names.index("l_upper_leg" if placement == "chen16" else "l_knee")
+    assert np.pi * c[thigh] ** 2 == pytest.approx(0.1528, abs=1e-4)
+    assert np.pi * a[thigh] ** 4 / c[thigh] ** 2 == pytest.approx(0.00155, abs=1e-5)
+    torso = names.index("torso" if placement == "chen16" else "neck")
+    assert np.pi * c[torso] ** 2 == pytest.approx(0.2111, abs=1e-4)
+
+
+def _standing_body(height: float = 1.8) -> np.ndarray:
+    f = body.SEGMENT_FRACTIONS
+    z_hip = (f["upper_leg"] + f["lower_leg"]) * height
+    p = {
+        "base": (0, 0, z_hip),
+        "neck": (0, 0, z_hip + f["torso"] * height),
+        "head": (0, 0, z_hip + (f["torso"] + f["head"]) * height),
+    }
+    for s, y in (("l", 1.0), ("r", -1.0)):
+        sh = y * f["shoulder"] * height
+        hp = y * f["hip"] * height
+        top = z_hip + f["torso"] * height
+        p[f"{s}_shoulder"] = (0, sh, top)
+        p[f"{s}_elbow"] = (0, sh, top - f["upper_arm"] * height)
+        p[f"{s}_hand"] = (0, sh, top - (f["upper_arm"] + f["lower_arm"]) * height)
+        p[f"{s}_hip"] = (0, hp, z_hip)
+        p[f"{s}_knee"] = (0, hp, z_hip - f["upper_leg"] * height)
+        p[f"{s}_ankle"] = (0, hp, 0.0)
+        p[f"{s}_toe"] = (f["foot"] * height, hp, 0.0)
+    return np.array([p[j] for j in CANONICAL_JOINTS], dtype=float)[None]
+
+
+def test_height_estimate_of_a_standing_body() -> None:
+    assert body.estimate_height(_standing_body(1.7)) == pytest.approx(1.7, rel=1e-12)
+
+
+def test_chen16_positions_follow_the_table() -> None:
+    joints = _standing_body()
+    parts = body.body_parts("chen16")
+    pos, axes = body.part_geometry(parts, joints)
+    names = [p.name for p in parts]
+    j = {n: joints[0, i] for i, n in enumerate(CANONICAL_JOINTS)}
+    assert np.allclose(pos[0, names.index("torso")], (j["neck"] + j["base"]) / 2)
+    assert np.allclose(pos[0, names.index("r_lower_arm")], j["r_hand"])
+    assert np.allclose(pos[0, names.index("l_foot")], j["l_toe"])
+    assert np.allclose(axes[0, names.index("l_upper_leg")], j["l_knee"] - j["l_hip"])
