@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from .errors import MdfError
+from .errors import ConfigError, DataFileError, MdfError
 from .plugins import INTERFACES, PluginError, default_registry
 
 EXIT_USAGE = 2
@@ -27,7 +27,12 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from .pipeline import simulate
 
     config = load_run_config(args.config)
-    result = simulate(config)
+    try:
+        result = simulate(config)
+    except MdfError as exc:
+        if isinstance(exc, ConfigError | DataFileError):
+            raise
+        raise type(exc)(f"{args.config}: {exc}") from exc
     resolved = json.loads(config.model_dump_json())
     written = write_run(result, resolved, Path(args.out))
     for path in written:

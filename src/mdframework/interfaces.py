@@ -111,7 +111,7 @@ class Scatterers:
     def ranges(self, radar_position: FloatArray) -> FloatArray:
         """Distance of every scatterer to the radar, (n_pulses, n_scatterers) float64 [m]."""
         d = self.positions - np.asarray(radar_position, dtype=np.float64)
-        return np.asarray(np.sqrt(np.einsum("psk,psk->ps", d, d)), dtype=np.float64)
+        return np.asarray(np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2 + d[..., 2] ** 2), np.float64)
 
 
 class ScattererModel(Plugin):

@@ -121,6 +121,11 @@ def simulate_motion(
     lam = radar.wavelength(wf.carrier_frequency)
 
     clock = time.perf_counter()
+    if stages.model.needs_canonical and motion.canonical_map is None:
+        raise SceneError(
+            f"scatterers.kind: the {stages.model.name!r} model needs a human body, but this "
+            f"motion ({motion.metadata.get('source', 'unknown')}) has no canonical joints"
+        )
     body = motion.canonical() if stages.model.needs_canonical else motion.skeleton
     body = _window(body, cfg.motion.start, cfg.motion.duration)
     if stages.model.needs_canonical:

@@ -108,15 +108,15 @@ class Skeleton:
                 f"time stamps must be strictly increasing (frame {bad + 1}: "
                 f"{time[bad + 1]!r} s after {time[bad]!r} s); sort them and drop duplicates first"
             )
-        valid = (
-            np.all(np.isfinite(pos), axis=2)
-            if self.valid is None
-            else np.asarray(self.valid, dtype=bool)
-        )
-        if valid.shape != pos.shape[:2]:
-            raise SkeletonError(f"valid must have shape {pos.shape[:2]}, got {valid.shape}")
-        if not np.all(np.isfinite(pos[valid])):
-            raise SkeletonError("positions marked valid must be finite")
+        finite = np.isfinite(pos)
+        if self.valid is None:
+            valid = np.all(finite, axis=2)
+        else:
+            valid = np.asarray(self.valid, dtype=bool)
+            if valid.shape != pos.shape[:2]:
+                raise SkeletonError(f"valid must have shape {pos.shape[:2]}, got {valid.shape}")
+            if not np.all(finite | ~valid[:, :, None]):
+                raise SkeletonError("positions marked valid must be finite")
         object.__setattr__(self, "time", time)
         object.__setattr__(self, "positions", pos)
         object.__setattr__(self, "joint_names", names)

@@ -187,16 +187,18 @@ def part_geometry(parts: tuple[BodyPart, ...], joints: FloatArray) -> tuple[Floa
     ``joints`` (n_pulses, 17, 3) [m]. Returns ``positions`` and ``axes``, both
     (n_pulses, n_parts, 3) [m]; axes are not normalised and may be zero for coincident joints.
     """
-    weights = np.zeros((len(parts), len(CANONICAL_JOINTS)))
-    tails = np.zeros_like(weights)
+    n_terms = max(len(p.position) for p in parts)
+    index = np.zeros((n_terms, len(parts)), dtype=np.intp)
+    weight = np.zeros((n_terms, len(parts)))
     for i, p in enumerate(parts):
-        for joint, w in p.position:
-            weights[i, _J[joint]] += w
-        tails[i, _J[p.axis[1]]] += 1.0
-        tails[i, _J[p.axis[0]]] -= 1.0
-    positions = np.einsum("pj,njk->npk", weights, joints)
-    axes = np.einsum("pj,njk->npk", tails, joints)
-    return positions, axes
+        for k, (joint, w) in enumerate(p.position):
+            index[k, i], weight[k, i] = _J[joint], w
+    positions = weight[0][None, :, None] * joints[:, index[0]]
+    for k in range(1, n_terms):
+        positions += weight[k][None, :, None] * joints[:, index[k]]
+    tail = [_J[p.axis[0]] for p in parts]
+    tip = [_J[p.axis[1]] for p in parts]
+    return positions, joints[:, tip] - joints[:, tail]
 
 
 def estimate_height(joints: FloatArray) -> float:

@@ -89,8 +89,11 @@ def carrier_cycles_fraction(ranges: ArrayLike, carrier_frequency: float) -> Floa
 
 def carrier_phasor(ranges: ArrayLike, carrier_frequency: float) -> ComplexArray:
     """``exp(-j 4 pi f_c R / c)`` for ranges [m], computed from the float64 fraction of a cycle."""
-    frac = carrier_cycles_fraction(ranges, carrier_frequency)
-    return np.asarray(np.exp(-2j * np.pi * frac), dtype=np.complex128)
+    phase = (-2.0 * np.pi) * carrier_cycles_fraction(ranges, carrier_frequency)
+    out = np.empty(phase.shape, dtype=np.complex128)
+    out.real = np.cos(phase)  # cos + j sin is several times faster than a complex exp
+    out.imag = np.sin(phase)
+    return out
 
 
 def lfm_chirp(fast_time: ArrayLike, pulse_width: float, bandwidth: float) -> ComplexArray:

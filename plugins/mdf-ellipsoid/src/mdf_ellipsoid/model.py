@@ -75,7 +75,8 @@ class EllipsoidBody(ScattererModel):
         height = c.height if c.height is not None else body.estimate_height(joints)
         a, semi_c = body.part_semi_axes(parts, height)
         pos, axes = body.part_geometry(parts, joints)
-        ok = np.linalg.norm(axes, axis=-1) > MIN_SEGMENT_FRACTION * 2.0 * semi_c
+        length2 = axes[..., 0] ** 2 + axes[..., 1] ** 2 + axes[..., 2] ** 2
+        ok = length2 > (MIN_SEGMENT_FRACTION * 2.0 * semi_c) ** 2
         if not np.all(ok):
             axes, never = hold_last_valid(axes, ok)
             semi_c = np.where(never, a, semi_c)

@@ -1,0 +1,500 @@
+"""Tests of the ``cmu`` motion source (plugin ``mdf-cmu``) on real CMU trials.
+
+The data are the copies shipped in ``examples/data/cmu`` (see its PROVENANCE.md). Oracles:
+
+- BVH: the independent ``bvhio`` library (its own parser, Euler -> quaternion conversion and
+  hierarchy transforms, in PyGLM float32, hence agreement to 1e-6 m rather than 1e-12).
+- ASF/AMC: a small per-frame implementation below, with its own parsing and scipy's ``Rotation``.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from mdf_cmu import (
+    ACKNOWLEDGEMENT,
+    CMU_UNIT_M,
+    CmuConfig,
+    CmuSource,
+    bvh_forward_kinematics,
+    read_asf,
+    read_bvh,
+)
+from scipy.spatial.transform import Rotation
+
+from mdframework import CANONICAL_JOINTS, ConfigError, DataFileError
+from mdframework.physics.body import estimate_height
+
+DATA = Path(__file__).parents[1] / "examples" / "data" / "cmu"
+AMC = DATA / "asf-amc"
+BVH = DATA / "bvh"
+UNIT = (1 / 0.45) * 2.54 / 100
+
+
+def load(path: Path, **kw: object):
+    """Load a trial through the plugin."""
+    return CmuSource(CmuConfig(file=path, **kw)).load()
+
+
+def cmu_to_project(p: np.ndarray) -> np.ndarray:
+    """(X, Y, Z) CMU units -> (Z, X, Y) metres, written independently of the plugin."""
+    p = np.asarray(p, dtype=float)
+    return np.stack([p[..., 2], p[..., 0], p[..., 1]], axis=-1) * UNIT
+
+
+# --------------------------------------------------------------------------- BVH vs bvhio
+
+
+def bvhio_world_positions(path: Path) -> dict[str, np.ndarray]:
+    """World positions of every joint and end site from bvhio, (n_frames, 3) CMU units each."""
+    bvhio = pytest.importorskip("bvhio")
+    glm = pytest.importorskip("glm")
+    raw = bvhio.readAsBvh(str(path))
+    # bvhio's hierarchy rotates each joint's local space so that its bone points along +y (the
+    # rest rotation from BvhJoint.getRotation); an End Site offset must be rotated the same way.
+    ends = {
+        j.Name: glm.inverse(j.getRotation()) * j.EndSite
+        for j, _, _ in raw.Root.layout()
+        if not j.Children
+    }
+    root = bvhio.readAsHierarchy(str(path))
+    joints = [j for j, _, _ in root.layout()]
+    out: dict[str, list[list[float]]] = {}
+    for frame in range(raw.FrameCount):
+        root.loadPose(frame, recursive=True)
+        for j in joints:
+            out.setdefault(j.Name, []).append(list(j.PositionWorld))
+            if j.Name in ends:
+                out.setdefault(f"{j.Name}_end", []).append(list(j.pointToWorld(ends[j.Name])))
+    return {k: np.asarray(v) for k, v in out.items()}
+
+
+@pytest.mark.parametrize("trial", ["16_21", "09_03", "80_10"])
+def test_bvh_forward_kinematics_matches_bvhio(trial: str) -> None:
+    path = BVH / f"{trial}.bvh"
+    motion = load(path, keep_first_frame=True, frame_rate=120.0)
+    ref = bvhio_world_positions(path)
+    sk = motion.skeleton
+    assert set(ref) == set(sk.joint_names)
+    assert len(sk.joint_names) == 38  # 31 joints + 7 end sites
+    worst = 0.0
+    for name, track in ref.items():
+        assert track.shape == (sk.n_frames, 3)
+        worst = max(worst, float(np.abs(cmu_to_project(track) - sk.joint(name)).max()))
+    assert worst < 1e-6, f"max deviation from bvhio {worst:.3g} m"
+
+
+def test_bvh_rotation_order_matters() -> None:
+    """The oracle comparison can fail: the wrong Euler order moves joints by centimetres."""
+    bvh = read_bvh(BVH / "09_03.bvh")
+    good = bvh_forward_kinematics(bvh)
+    swapped = tuple(
+        type(j)(
+            j.name,
+            j.parent,
+            j.offset,
+            tuple(reversed(j.channels)) if len(j.channels) == 3 else j.channels,
+            j.first_channel,
+            j.end_site,
+            j.line,
+        )
+        for j in bvh.joints
+    )
+    bad = bvh_forward_kinematics(type(bvh)(bvh.path, swapped, bvh.values, bvh.frame_time))
+    assert np.abs(bad - good).max() * CMU_UNIT_M > 0.01
+
+
+# --------------------------------------------------------------------------- ASF/AMC oracle
+
+
+def simple_asf(path: Path) -> tuple[dict[str, dict], dict[str, str], list[str]]:
+    """Bones (direction, length, axis, dof), parent of each bone, and bone order from an ASF."""
+    text = path.read_text().replace("\r", "")
+    bonedata = text.split(":bonedata")[1].split(":hierarchy")[0]
+    bones: dict[str, dict] = {}
+    for block in re.findall(r"begin(.*?)\n\s*end", bonedata, flags=re.S):
+        fields = {ln.split()[0]: ln.split()[1:] for ln in block.strip().splitlines() if ln.split()}
+        bones[fields["name"][0]] = {
+            "direction": np.array(fields["direction"], dtype=float),
+            "length": float(fields["length"][0]),
+            "axis": np.array(fields["axis"][:3], dtype=float),
+            "dof": fields.get("dof", []),
+        }
+    parent: dict[str, str] = {}
+    order: list[str] = []
+    hierarchy = text.split(":hierarchy")[1].split("begin")[1].split("end")[0]
+    for ln in hierarchy.strip().splitlines():
+        first, *kids = ln.split()
+        for k in kids:
+            parent[k] = first
+            order.append(k)  # the CMU hierarchy lists parents before children
+    return bones, parent, order
+
+
+def simple_amc_frames(path: Path, wanted: set[int]) -> dict[int, dict[str, list[float]]]:
+    """The values of the wanted frame numbers of an AMC file."""
+    frames: dict[int, dict[str, list[float]]] = {}
+    current = None
+    for ln in path.read_text().replace("\r", "").splitlines():
+        parts = ln.split()
+        if not parts or parts[0].startswith((":", "#")):
+            continue
+        if len(parts) == 1 and parts[0].isdigit():
+            current = int(parts[0])
+            continue
+        if current in wanted:
+            frames.setdefault(current, {})[parts[0]] = [float(v) for v in parts[1:]]
+    return frames
+
+
+def oracle_asf_positions(asf: Path, amc: Path, frame_numbers: list[int]) -> dict[int, dict]:
+    """Per-frame forward kinematics with scipy rotations ('xyz' extrinsic = Rz Ry Rx)."""
+    bones, parent, order = simple_asf(asf)
+    frames = simple_amc_frames(amc, set(frame_numbers))
+    result = {}
+    for fno in frame_numbers:
+        vals = frames[fno]
+        root = vals["root"]
+        rot = {"root": Rotation.from_euler("xyz", root[3:6], degrees=True)}
+        pos = {"root": np.array(root[:3])}
+        for name in order:
+            b = bones[name]
+            c = Rotation.from_euler("xyz", b["axis"], degrees=True)
+            angles = dict(zip(b["dof"], vals.get(name, []), strict=True))
+            m = Rotation.from_euler(
+                "xyz",
+                [angles.get("rx", 0.0), angles.get("ry", 0.0), angles.get("rz", 0.0)],
+                degrees=True,
+            )
+            rot[name] = rot[parent[name]] * c * m * c.inv()
+            pos[name] = pos[parent[name]] + b["length"] * rot[name].apply(b["direction"])
+        result[fno] = pos
+    return result
+
+
+@pytest.mark.parametrize("trial", ["02_01", "09_06"])
+def test_asf_amc_matches_independent_implementation(trial: str) -> None:
+    subject = trial.split("_")[0]
+    motion = load(AMC / f"{trial}.amc")
+    sk = motion.skeleton
+    first = int(motion.metadata["amc_first_frame_number"])
+    picks = [0, 1, 37, sk.n_frames // 2, sk.n_frames - 1]
+    ref = oracle_asf_positions(
+        AMC / f"{subject}.asf", AMC / f"{trial}.amc", [first + k for k in picks]
+    )
+    assert set(ref[first]) == set(sk.joint_names)
+    for k in picks:
+        for name, p in ref[first + k].items():
+            np.testing.assert_allclose(
+                sk.positions[k, sk.index(name)], cmu_to_project(p), atol=1e-9
+            )
+
+
+# --------------------------------------------------------------------------- rigid bones
+
+
+def test_asf_bone_lengths_are_constant_and_equal_the_asf() -> None:
+    for trial in ("02_01", "09_06"):
+        motion = load(AMC / f"{trial}.amc")
+        asf = read_asf(AMC / f"{trial.split('_')[0]}.asf")
+        sk = motion.skeleton
+        for bone in asf.bones:
+            seg = np.linalg.norm(sk.joint(bone.name) - sk.joint(bone.parent), axis=1)
+            assert np.ptp(seg) < 1e-9, bone.name
+            # directions are unit vectors to the file's 6 digits
+            assert seg[0] == pytest.approx(bone.length * UNIT, rel=1e-5), bone.name
+
+
+def test_bvh_bone_lengths_are_constant_and_equal_the_offsets() -> None:
+    for trial in ("16_21", "80_10"):
+        bvh = read_bvh(BVH / f"{trial}.bvh")
+        sk = load(BVH / f"{trial}.bvh").skeleton
+        for j in bvh.joints:
+            if j.parent < 0:
+                continue
+            seg = np.linalg.norm(sk.joint(j.name) - sk.joint(bvh.joints[j.parent].name), axis=1)
+            assert np.ptp(seg) < 1e-9, j.name
+            assert seg[0] == pytest.approx(np.linalg.norm(j.offset) * UNIT, abs=1e-9), j.name
+
+
+# --------------------------------------------------------------------------- speeds, frames
+
+
+@pytest.mark.parametrize(("trial", "expected"), [("02_01", 1.2), ("09_06", 3.6)])
+def test_hip_speed(trial: str, expected: float) -> None:
+    """Mean horizontal speed of the base over the whole trial: walk ~1.2 m/s, run ~3.6 m/s
+    (measured 1.18 and 3.64 m/s); tolerance +/-15 %."""
+    motion = load(AMC / f"{trial}.amc")
+    base = motion.canonical().joint("base")
+    rate = motion.metadata["frame_rate_hz"]
+    assert rate == 120.0
+    speed = np.linalg.norm(np.diff(base[:, :2], axis=0), axis=1) * rate
+    assert speed.mean() == pytest.approx(expected, rel=0.15)
+    # height of the hip centre is that of a standing adult (z is up)
+    assert 0.8 < np.median(base[:, 2]) < 1.2
+
+
+def test_bvh_tpose_dropped_and_rates() -> None:
+    header = int(re.search(r"Frames:\s*(\d+)", (BVH / "16_21.bvh").read_text())[1])
+    dropped = load(BVH / "16_21.bvh")
+    kept = load(BVH / "16_21.bvh", keep_first_frame=True)
+    assert dropped.skeleton.n_frames == header - 1
+    assert kept.skeleton.n_frames == header
+    np.testing.assert_array_equal(kept.skeleton.positions[1:], dropped.skeleton.positions)
+    assert dropped.skeleton.time[0] == 0.0
+    assert np.allclose(np.diff(dropped.skeleton.time), 1 / 120)
+    # frame 0 is the T-pose: arms out (hands within 0.1 m of shoulder height), while in the
+    # walk the hands hang well below the shoulders
+    idx = {n: i for i, n in enumerate(CANONICAL_JOINTS)}
+    for sk, lo, hi in ((kept.canonical(), -0.1, 0.1), (dropped.canonical(), -0.7, -0.35)):
+        drop = sk.positions[0, idx["l_hand"], 2] - sk.positions[0, idx["l_shoulder"], 2]
+        assert lo < drop < hi
+
+    m80 = load(BVH / "80_10.bvh")
+    assert m80.metadata["frame_rate_hz"] == 60.0
+    assert m80.metadata["frame_rate_from"] == "subject table"
+    assert m80.metadata["bvh_frame_time_s"] == pytest.approx(1 / 120, rel=1e-3)
+    assert np.allclose(np.diff(m80.skeleton.time), 1 / 60)
+    assert m80.skeleton.duration == pytest.approx((m80.skeleton.n_frames - 1) / 60)
+    forced = load(BVH / "80_10.bvh", frame_rate=30.0)
+    assert forced.metadata["frame_rate_from"] == "config"
+    assert forced.skeleton.time[1] == pytest.approx(1 / 30)
+
+
+def test_metadata() -> None:
+    m = load(AMC / "02_01.amc")
+    md = m.metadata
+    assert md["source"] == "cmu" and md["format"] == "asf/amc" and md["units"] == "m"
+    assert (md["subject"], md["trial"], md["activity"]) == (2, 1, "walk")
+    assert md["n_frames"] == m.skeleton.n_frames
+    assert md["acknowledgement"] == ACKNOWLEDGEMENT
+    assert "mocap.cs.cmu.edu" in ACKNOWLEDGEMENT and "EIA-0196217" in ACKNOWLEDGEMENT
+    b = load(BVH / "13_41.bvh", activity="jumping jacks")
+    assert (b.metadata["format"], b.metadata["activity"]) == ("bvh", "jumping jacks")
+    import json
+
+    json.dumps(dict(md))
+    json.dumps(dict(b.metadata))
+
+
+def test_frame_rate_table() -> None:
+    """Rates from CMU's index (cmu-index.csv, framerate column; checked against it when the table
+    was written): 60 Hz subjects, 120 Hz otherwise; subject 136 is 120 Hz except trial 19."""
+    from mdf_cmu.source import subject_frame_rate
+
+    sixty = {33, 34, 42, 60, 61, 62, 74, 75, 77, 79, 80, 87, 88, 89}
+    for subject in range(1, 145):
+        expected = 60.0 if subject in sixty else 120.0
+        assert subject_frame_rate(subject, 1) == expected, subject
+    assert subject_frame_rate(136, 19) == 60.0
+    assert subject_frame_rate(136, 20) == 120.0
+
+
+# --------------------------------------------------------------------------- canonical body
+
+
+TRIALS = [AMC / "02_01.amc", AMC / "09_06.amc", AMC / "13_18.amc", *sorted(BVH.glob("*.bvh"))]
+
+
+@pytest.mark.parametrize("path", TRIALS, ids=lambda p: p.name)
+def test_canonical_body_is_anatomical(path: Path) -> None:
+    motion = load(path)
+    assert set(motion.canonical_map) == set(CANONICAL_JOINTS)
+    c = motion.canonical()
+    j = {n: c.joint(n) for n in CANONICAL_JOINTS}
+    # facing direction from the feet (ankle -> toe), independent of the left/right labels' sides
+    fwd = (j["l_toe"] - j["l_ankle"] + j["r_toe"] - j["r_ankle"])[:, :2]
+    fwd /= np.linalg.norm(fwd, axis=1, keepdims=True)
+    left = np.stack([-fwd[:, 1], fwd[:, 0]], axis=1)  # z x forward
+    for part in ("hip", "shoulder"):
+        side = np.einsum("ij,ij->i", (j[f"l_{part}"] - j[f"r_{part}"])[:, :2], left)
+        assert np.all(side > 0), part
+
+    def length(a: str, b: str) -> float:
+        return float(np.median(np.linalg.norm(j[a] - j[b], axis=1)))
+
+    for s in ("l", "r"):
+        assert 0.35 < length(f"{s}_hip", f"{s}_knee") < 0.5
+        assert 0.35 < length(f"{s}_knee", f"{s}_ankle") < 0.5
+        assert 0.24 < length(f"{s}_shoulder", f"{s}_elbow") < 0.36
+        assert 0.17 < length(f"{s}_elbow", f"{s}_hand") < 0.3
+        assert 0.12 < length(f"{s}_ankle", f"{s}_toe") < 0.25
+    assert 0.14 < length("l_hip", "r_hip") < 0.25
+    assert 0.3 < length("l_shoulder", "r_shoulder") < 0.45
+    # head above neck above base, by plausible amounts
+    assert 0.15 < np.median(j["neck"][:, 2] - j["base"][:, 2]) < 0.45
+    assert 0.2 < np.median(j["head"][:, 2] - j["neck"][:, 2]) < 0.35
+    assert 1.5 < estimate_height(c.positions) < 2.0
+
+
+# --------------------------------------------------------------------------- malformed files
+
+
+def write(path: Path, lines: list[str], eol: str = "\n") -> Path:
+    path.write_bytes((eol.join(lines) + eol).encode())
+    return path
+
+
+def bvh_lines() -> list[str]:
+    return (BVH / "09_03.bvh").read_bytes().decode().replace("\r\n", "\n").split("\n")[:-1]
+
+
+def first_frame_line(lines: list[str]) -> int:
+    """1-based line number of frame 0."""
+    return next(i for i, ln in enumerate(lines) if ln.startswith("Frame Time")) + 2
+
+
+def test_truncated_bvh(tmp_path: Path) -> None:
+    lines = bvh_lines()
+    f0 = first_frame_line(lines)
+    # cut in the middle of frame 20's line
+    cut = [*lines[: f0 + 19], lines[f0 + 19][: len(lines[f0 + 19]) // 2]]
+    path = write(tmp_path / "09_03.bvh", cut)
+    with pytest.raises(DataFileError) as err:
+        load(path)
+    assert err.value.path == path and err.value.line == f0 + 20
+    assert f"09_03.bvh:{f0 + 20}:" in str(err.value) and "frame 20" in str(err.value)
+    # cut at a line end: fewer frames than the header says
+    path = write(tmp_path / "09_03.bvh", lines[: f0 + 9])
+    with pytest.raises(DataFileError, match="truncated") as err:
+        load(path)
+    assert err.value.line == f0 + 9
+    # cut inside the hierarchy
+    path = write(tmp_path / "09_03.bvh", lines[:40])
+    with pytest.raises(DataFileError, match="ends inside the hierarchy") as err:
+        load(path)
+    assert err.value.line == 40
+
+
+def test_bvh_frame_with_missing_value(tmp_path: Path) -> None:
+    lines = bvh_lines()
+    f0 = first_frame_line(lines)
+    bad = list(lines)
+    bad[f0 + 49] = " ".join(bad[f0 + 49].split()[:-1])
+    path = write(tmp_path / "09_03.bvh", bad, eol="\r\n")
+    with pytest.raises(DataFileError, match="frame 50 has 95 values, expected 96") as err:
+        load(path)
+    assert err.value.path == path and err.value.line == f0 + 50
+
+
+def test_bvh_bad_number_keyword_and_zero_frames(tmp_path: Path) -> None:
+    lines = bvh_lines()
+    f0 = first_frame_line(lines)
+    bad = list(lines)
+    bad[f0 + 3] = bad[f0 + 3].replace(" ", " 1.2.3 ", 1).rsplit(" ", 1)[0]
+    with pytest.raises(DataFileError, match=re.escape("bad number '1.2.3' in frame 4")) as err:
+        load(write(tmp_path / "a_1.bvh", bad))
+    assert err.value.line == f0 + 4
+    bad = list(lines)
+    bad[11] = bad[11].replace("OFFSET", "OFFSETS")
+    with pytest.raises(DataFileError, match=r"expected OFFSET .* found 'OFFSETS'") as err:
+        load(write(tmp_path / "b_1.bvh", bad))
+    assert err.value.line == 12
+    bad = list(lines)
+    bad.insert(21, "\t\t\t\tMUSCLE Soleus")  # before "JOINT LeftToeBase"
+    with pytest.raises(DataFileError, match="unknown keyword 'MUSCLE'") as err:
+        load(write(tmp_path / "c_1.bvh", bad))
+    assert err.value.line == 22
+    zero = [*lines[: f0 - 4], "MOTION", "Frames: 0", "Frame Time: .0083333"]
+    with pytest.raises(DataFileError, match="zero frames") as err:
+        load(write(tmp_path / "d_1.bvh", zero))
+    assert err.value.line == f0 - 2
+
+
+def test_crlf_bvh_parses_like_original(tmp_path: Path) -> None:
+    path = write(tmp_path / "09_03.bvh", bvh_lines(), eol="\r\n")
+    a = load(path).skeleton
+    b = load(BVH / "09_03.bvh").skeleton
+    np.testing.assert_array_equal(a.positions, b.positions)
+
+
+def amc_sample(n_frames: int) -> list[str]:
+    """Header and the first n_frames frames of 02_01.amc."""
+    lines = (AMC / "02_01.amc").read_text().split("\n")
+    end = next(i for i, ln in enumerate(lines) if ln.strip() == str(n_frames + 1))
+    return lines[:end]
+
+
+def test_amc_unknown_bone(tmp_path: Path) -> None:
+    (tmp_path / "02.asf").write_bytes((AMC / "02.asf").read_bytes())
+    lines = amc_sample(3)
+    k = next(i for i, ln in enumerate(lines) if ln.startswith("ltibia"))
+    lines[k] = lines[k].replace("ltibia", "lshin")
+    path = write(tmp_path / "02_01.amc", lines)
+    with pytest.raises(
+        DataFileError, match=re.escape("bone 'lshin' is not in the skeleton 02.asf")
+    ) as err:
+        load(path)
+    assert err.value.path == path and err.value.line == k + 1
+
+
+def test_amc_value_count_and_frame_numbers(tmp_path: Path) -> None:
+    (tmp_path / "02.asf").write_bytes((AMC / "02.asf").read_bytes())
+    lines = amc_sample(3)
+    k = next(i for i, ln in enumerate(lines) if ln.startswith("lfemur"))
+    lines[k] = "lfemur 1.0 2.0"
+    with pytest.raises(DataFileError, match="needs 3 numbers, found 2") as err:
+        load(write(tmp_path / "02_01.amc", lines))
+    assert err.value.line == k + 1
+    lines = amc_sample(3)
+    k = next(i for i, ln in enumerate(lines) if ln.strip() == "3")
+    lines[k] = "4"
+    with pytest.raises(DataFileError, match="frame number 4 follows 2") as err:
+        load(write(tmp_path / "02_01.amc", lines))
+    assert err.value.line == k + 1
+    with pytest.raises(DataFileError, match="zero frames"):
+        load(write(tmp_path / "02_01.amc", amc_sample(3)[:3]))
+
+
+def test_crlf_asf_amc_parse(tmp_path: Path) -> None:
+    """02.asf and 02_01.amc have LF endings; the same content with CRLF gives the same motion."""
+    lf = (AMC / "02.asf").read_text().split("\n")
+    write(tmp_path / "02.asf", lf[:-1] if lf[-1] == "" else lf, eol="\r\n")
+    path = write(tmp_path / "02_01.amc", amc_sample(5), eol="\r\n")
+    assert b"\r\n" in path.read_bytes()
+    crlf = load(path).skeleton
+    full = load(AMC / "02_01.amc").skeleton
+    assert crlf.n_frames == 5
+    np.testing.assert_array_equal(crlf.positions, full.positions[:5])
+
+
+def test_asf_unknown_keyword(tmp_path: Path) -> None:
+    lines = (AMC / "02.asf").read_text().split("\n")
+    k = next(i for i, ln in enumerate(lines) if ln.strip().startswith("length 7.59371"))
+    lines[k] = "     lenght 7.59371"
+    (tmp_path / "02.asf").write_text("\n".join(lines))
+    path = write(tmp_path / "02_01.amc", amc_sample(2))
+    with pytest.raises(DataFileError, match="unknown keyword 'lenght'") as err:
+        load(path)
+    assert err.value.path == tmp_path / "02.asf" and err.value.line == k + 1
+
+
+def test_missing_asf_is_a_clear_error(tmp_path: Path) -> None:
+    path = write(tmp_path / "02_01.amc", amc_sample(2))
+    with pytest.raises(ConfigError, match=re.escape("02.asf")):
+        load(path)
+    ok = load(path, asf=AMC / "02.asf")
+    assert ok.skeleton.n_frames == 2
+
+
+def test_config_validation(tmp_path: Path) -> None:
+    from pydantic import ValidationError
+
+    other = write(tmp_path / "x.txt", ["hello"])
+    with pytest.raises(ValidationError, match=r"\.bvh or \.amc"):
+        CmuConfig(file=other)
+    with pytest.raises(ValidationError, match="file not found"):
+        CmuConfig.model_validate({"file": "nope.bvh"}, context={"base_dir": tmp_path})
+    cfg = CmuConfig.model_validate({"file": "bvh/80_10.bvh"}, context={"base_dir": DATA})
+    assert cfg.file == DATA / "bvh" / "80_10.bvh"
+    for name, field in CmuConfig.model_fields.items():
+        assert field.description, name
+
+
+def test_registered_in_plugin_registry() -> None:
+    from mdframework.plugins import default_registry
+
+    assert default_registry().get("motion", "cmu") is CmuSource
