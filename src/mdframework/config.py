@@ -134,6 +134,8 @@ class ProcessingConfig(_Strict):
 class RunConfigBase(_Strict):
     """Fields every run config has besides the plugin sections."""
 
+    seed: int = Field(0, ge=0, description="Seed of every random draw in the run.")
+
     scene: SceneConfig = Field(default_factory=SceneConfig)
     processing: ProcessingConfig = Field(default_factory=ProcessingConfig)
 
@@ -156,9 +158,17 @@ def run_config_model(registry: Registry | None = None) -> type[RunConfigBase]:
             return Field(default={"kind": name}, validate_default=True)
         return ...
 
+    effect_list: Any = list[_union(reg, "effect")]  # type: ignore[misc]
     model = create_model(
         "RunConfig",
         __base__=RunConfigBase,
+        effects=(
+            effect_list,
+            Field(
+                default_factory=list,
+                description="Scene effects to simulate, in order; nothing else is computed.",
+            ),
+        ),
         motion=(_union(reg, "motion"), ...),
         scatterers=(_union(reg, "scatterers"), default("scatterers", "ellipsoid")),
         radar=(_union(reg, "radar"), default("radar", "lfm")),

@@ -16,6 +16,7 @@ Data passed between stages (shapes, dtypes, units):
 
 from __future__ import annotations
 
+import dataclasses
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -97,6 +98,11 @@ class Scatterers:
     positions: FloatArray
     rcs: FloatArray
     names: tuple[str, ...]
+    #: Optional body-part shapes, for effects such as shadowing: ``semi_axes`` (n_scatterers, 3)
+    #: [m] as (a, b, c) and ``axes`` (n_pulses, n_scatterers, 3), the direction of each part's
+    #: c-axis (not necessarily unit length). ``None`` for point scatterers.
+    semi_axes: FloatArray | None = None
+    axes: FloatArray | None = None
 
     def __post_init__(self) -> None:
         if self.positions.ndim != 3 or self.positions.shape[2] != 3:
@@ -107,6 +113,10 @@ class Scatterers:
             raise ValueError(f"rcs must be {self.positions.shape[:2]}, got {self.rcs.shape}")
         if len(self.names) != self.positions.shape[1]:
             raise ValueError("one name per scatterer is required")
+
+    def replace(self, **changes: Any) -> Scatterers:
+        """A copy with some fields replaced (e.g. ``rcs``)."""
+        return dataclasses.replace(self, **changes)
 
     def ranges(self, radar_position: FloatArray) -> FloatArray:
         """Distance of every scatterer to the radar, (n_pulses, n_scatterers) float64 [m]."""
@@ -191,21 +201,33 @@ class Classifier(Plugin):
 
 @dataclass(frozen=True)
 class SceneContext:
-    """What an effect may need to know about the scene: radar position (3,) [m], PRF [Hz],
-    carrier frequency [Hz], pulse times (n_pulses,) [s] and a seeded random generator."""
+    """What an effect may need to know about the scene.
+
+    ``radar_position`` (3,) [m]; ``prf`` and ``carrier_frequency`` [Hz]; ``pulse_times``
+    (n_pulses,) [s]; ``gate_range`` (n_pulses,) [m]; ``skeleton``: the body at the pulse times in
+    the scene frame (canonical joints when the scatterer model uses them); ``waveform``: the radar
+    plugin (for its bandwidth, pulse width, range equation); ``rng``: the run's seeded generator
+    (each effect gets its own stream, derived from the run's seed and the effect's position).
+    """
 
     radar_position: FloatArray
     prf: float
     carrier_frequency: float
     pulse_times: FloatArray
+    gate_range: FloatArray
+    skeleton: Skeleton
+    waveform: RadarWaveform
     rng: np.random.Generator
 
 
 class Effect(Plugin):
-    """A scene effect (noise, clutter, multipath, antenna pattern, ...).
+    """A scene effect (noise, clutter, multipath, antenna pattern, shadowing, ...).
 
-    ``stage`` says where it acts: on the scatterers before the radar (``"scatterers"``) or on the
-    received data (``"received"``). The pipeline runs only the effects a scene names.
+    ``stage`` says where it acts: on the scatterers before the radar (``"scatterers"``: it gets
+    and returns :class:`Scatterers`, e.g. attenuating RCS or adding image scatterers) or on the
+    received data (``"received"``: it gets and returns :class:`Received`, e.g. adding noise).
+    The pipeline instantiates and runs only the effects a scene's ``effects`` list names, in
+    that order within each stage; an effect not named is never constructed.
     """
 
     stage: ClassVar[Literal["scatterers", "received"]]
@@ -213,3 +235,7 @@ class Effect(Plugin):
     @abstractmethod
     def apply(self, data: Any, context: SceneContext) -> Any:
         """Return the modified ``Scatterers`` or ``Received``."""
+
+    def describe(self) -> dict[str, Any]:
+        """What this effect did, for the run's metadata (default: its config)."""
+        return dict(self.config.model_dump())

@@ -16,7 +16,16 @@ from numpy.typing import NDArray
 
 from .config import PersonConfig, RunConfigBase
 from .errors import SceneError
-from .interfaces import Motion, MotionSource, RadarWaveform, Received, ScattererModel, Scatterers
+from .interfaces import (
+    Effect,
+    Motion,
+    MotionSource,
+    RadarWaveform,
+    Received,
+    ScattererModel,
+    Scatterers,
+    SceneContext,
+)
 from .physics import interpolation, radar, scene
 from .physics.spectrogram import RecordTooShortError, Spectrogram, power_to_db, spectrogram
 from .plugins import Registry, default_registry
@@ -47,11 +56,12 @@ class RunResult:
 
 @dataclass(frozen=True)
 class Stages:
-    """The plugin instances of one run."""
+    """The plugin instances of one run; ``effects`` holds only those the scene names."""
 
     source: MotionSource
     model: ScattererModel
     radar: RadarWaveform
+    effects: tuple[Effect, ...] = ()
 
 
 def build_stages(config: RunConfigBase, registry: Registry | None = None) -> Stages:
@@ -60,11 +70,27 @@ def build_stages(config: RunConfigBase, registry: Registry | None = None) -> Sta
     cfg: Any = config
 
     def make(interface: str, section: Any) -> Any:
-        return reg.get(interface, section.kind)(section)
+        try:
+            return reg.get(interface, section.kind)(section)
+        except KeyError as exc:
+            raise SceneError(str(exc.args[0])) from None
 
     return Stages(
-        make("motion", cfg.motion), make("scatterers", cfg.scatterers), make("radar", cfg.radar)
+        make("motion", cfg.motion),
+        make("scatterers", cfg.scatterers),
+        make("radar", cfg.radar),
+        tuple(make("effect", e) for e in cfg.effects),
     )
+
+
+def _apply_effects(
+    stages: Stages, stage: str, data: Any, context: SceneContext, ran: list[dict[str, Any]]
+) -> Any:
+    for effect in stages.effects:
+        if effect.stage == stage:
+            data = effect.apply(data, context)
+            ran.append({"kind": effect.name, "stage": stage, **effect.describe()})
+    return data
 
 
 def place_body(body: Skeleton, person: PersonConfig, radar_position: FloatArray) -> Skeleton:
@@ -148,6 +174,20 @@ def simulate_motion(
 
     clock = time.perf_counter()
     scat = stages.model.scatterers(motion, at_pulses, radar_pos, lam)
+    gate = _gate(sc.gate, at_pulses, radar_pos)
+    effects_ran: list[dict[str, Any]] = []
+    seeds = np.random.SeedSequence(config.seed).spawn(len(stages.effects) + 1)
+    context = SceneContext(
+        radar_pos,
+        wf.prf,
+        wf.carrier_frequency,
+        t,
+        gate,
+        at_pulses,
+        wf,
+        np.random.default_rng(seeds[0]),
+    )
+    scat = _apply_effects(stages, "scatterers", scat, context, effects_ran)
     ranges = scat.ranges(radar_pos)
     _check_ranges(ranges, scat, t, sc.min_range)
     v_max = radar.max_unambiguous_velocity(wf.carrier_frequency, wf.prf)
@@ -160,15 +200,11 @@ def simulate_motion(
         if proc.aliasing == "error":
             raise SceneError(msg)
         warnings.warn(msg, AliasingWarning, stacklevel=2)
-    if sc.gate == "track":
-        ref = at_pulses.index("base") if "base" in at_pulses.joint_names else 0
-        gate = np.linalg.norm(joints[:, ref, :] - radar_pos, axis=1)
-    else:
-        gate = np.full(t.shape, float(sc.gate))
     timings["scatterers"] = time.perf_counter() - clock
 
     clock = time.perf_counter()
     received = wf.receive(ranges, scat.rcs, gate)
+    received = _apply_effects(stages, "received", received, context, effects_ran)
     timings["receive"] = time.perf_counter() - clock
 
     clock = time.perf_counter()
@@ -199,10 +235,20 @@ def simulate_motion(
         "max_radial_speed_mps": speed,
         "radar_position_m": list(sc.radar_position),
         "record_start_s": float(body.time[0]),
-        "effects": [],
+        "effects": effects_ran,
+        "seed": config.seed,
         "timings_s": timings,
     }
     return RunResult(t - t[0], gate, scat, received, spec, spec_db, velocity, metadata)
+
+
+def _gate(gate: str | float, at_pulses: Skeleton, radar_pos: FloatArray) -> FloatArray:
+    """Range gate per pulse [m]: tracking the hip centre (or the first joint), or fixed."""
+    if gate == "track":
+        ref = at_pulses.index("base") if "base" in at_pulses.joint_names else 0
+        d = at_pulses.positions[:, ref, :] - radar_pos
+        return np.asarray(np.sqrt(np.sum(d * d, axis=1)), dtype=np.float64)
+    return np.full(at_pulses.time.shape, float(gate))
 
 
 def _window(body: Skeleton, start: float, duration: float | None) -> Skeleton:

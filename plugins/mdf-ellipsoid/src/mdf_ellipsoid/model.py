@@ -89,4 +89,5 @@ class EllipsoidBody(ScattererModel):
             else:
                 value = rcs.sphere_rcs_optical(a[spheres])
             sigma[:, spheres] = value
-        return Scatterers(pos, sigma, tuple(p.name for p in parts))
+        semi_axes = np.stack([a, a, semi_c], axis=1)
+        return Scatterers(pos, sigma, tuple(p.name for p in parts), semi_axes, axes)
