@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import ConfigError, DataFileError, MdfError
-from .plugins import INTERFACES, PluginError, default_registry
+from .plugins import INTERFACES, PluginError, default_registry, make_plugin_manager
 
 EXIT_USAGE = 2
 
@@ -82,6 +82,8 @@ def build_parser() -> argparse.ArgumentParser:
     config_sub = config.add_subparsers(dest="config_command", required=True)
     schema = config_sub.add_parser("schema", help="print the JSON schema of run configs")
     schema.set_defaults(func=_cmd_schema)
+
+    make_plugin_manager().hook.mdframework_add_cli_commands(subparsers=sub)
     return parser
 
 
@@ -91,7 +93,14 @@ def _one_line(message: str) -> str:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point; returns the exit code."""
-    parser = build_parser()
+    debug = "--debug" in (sys.argv[1:] if argv is None else argv)
+    try:
+        parser = build_parser()
+    except PluginError as exc:
+        if debug:
+            raise
+        print(f"mdf: error: {_one_line(str(exc))}", file=sys.stderr)
+        return EXIT_USAGE
     args = parser.parse_args(argv)
 
     def show_warning(message: Any, category: Any, *rest: Any, **kw: Any) -> None:

@@ -20,6 +20,9 @@ and in ``my_package/plugin.py``::
 
 from __future__ import annotations
 
+import argparse
+from typing import Any
+
 import pluggy
 
 from .interfaces import Classifier, Effect, MotionSource, RadarWaveform, ScattererModel
@@ -52,3 +55,17 @@ def mdframework_register_classifiers() -> list[type[Classifier]]:  # type: ignor
 @hookspec
 def mdframework_register_effects() -> list[type[Effect]]:  # type: ignore[empty-body]
     """Return the :class:`~mdframework.interfaces.Effect` classes this plugin provides."""
+
+
+# --------------------------------------------------------------------------- command line
+
+
+@hookspec
+def mdframework_add_cli_commands(subparsers: argparse._SubParsersAction[Any]) -> None:
+    """Add ``mdf`` sub-commands (e.g. ``mdf capture``).
+
+    Call ``subparsers.add_parser(name, help=...)`` and ``set_defaults(func=handler)``; the handler
+    takes the parsed ``argparse.Namespace`` and returns an exit code. Raise
+    :class:`~mdframework.errors.MdfError` for bad input: the CLI prints it as one line and exits
+    with code 2.
+    """
