@@ -25,8 +25,8 @@ demo: $(STAMP)
 	@echo "spectrograms written to out/demo/*/spectrogram.png"
 
 lint: $(STAMP)
-	$(BIN)/ruff check src plugins tests benchmarks
-	$(BIN)/ruff format --check src plugins tests benchmarks
+	$(BIN)/ruff check src plugins tests benchmarks docs examples/plugin-example
+	$(BIN)/ruff format --check src plugins tests benchmarks docs examples/plugin-example
 
 typecheck: $(STAMP)
 	$(BIN)/mypy src

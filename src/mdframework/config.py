@@ -97,7 +97,9 @@ class SceneConfig(_Strict):
     radar_position: tuple[float, float, float] = Field(
         (10.0, 0.0, 2.0), description="Radar antenna position (x, y, z) [m]."
     )
-    person: PersonConfig = Field(default_factory=PersonConfig)
+    person: PersonConfig = Field(
+        default_factory=PersonConfig, description="Where the person is and how they move."
+    )
     gate: Literal["track"] | float = Field(
         "track",
         description="'track': the gate follows the hip centre (or the first point target); "
@@ -136,8 +138,10 @@ class RunConfigBase(_Strict):
 
     seed: int = Field(0, ge=0, description="Seed of every random draw in the run.")
 
-    scene: SceneConfig = Field(default_factory=SceneConfig)
-    processing: ProcessingConfig = Field(default_factory=ProcessingConfig)
+    scene: SceneConfig = Field(default_factory=SceneConfig, description="The scene.")
+    processing: ProcessingConfig = Field(
+        default_factory=ProcessingConfig, description="Resampling and spectrogram."
+    )
 
 
 def _union(registry: Registry, interface: str) -> Any:

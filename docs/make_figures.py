@@ -1,0 +1,32 @@
+"""Regenerate the figures of the core docs (concepts page) from the shipped examples.
+
+.venv/bin/python docs/make_figures.py
+"""
+
+from __future__ import annotations
+
+import shutil
+import tempfile
+from pathlib import Path
+
+from mdframework.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+FIGURES = ROOT / "docs" / "figures"
+
+
+def run_example(name: str, figure: str, target: str) -> None:
+    """Run ``examples/<name>.toml`` and copy one of its figures into docs/figures."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / name
+        code = main(["run", str(ROOT / "examples" / f"{name}.toml"), "--out", str(out)])
+        if code != 0:
+            raise SystemExit(code)
+        shutil.copyfile(out / figure, FIGURES / target)
+
+
+if __name__ == "__main__":
+    FIGURES.mkdir(parents=True, exist_ok=True)
+    run_example("cmu_walk", "spectrogram.png", "cmu_walk_spectrogram.png")
+    run_example("cmu_walk_raw", "range_time.png", "cmu_walk_range_time.png")
+    run_example("point_target", "spectrogram.png", "point_target_spectrogram.png")
