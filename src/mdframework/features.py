@@ -1,0 +1,152 @@
+"""The seven spectrogram features of Erol & Gurbuz (2015), Table 2 (``physics.md`` section 4).
+
+All features are radial velocities in m/s (positive = approaching):
+
+1. ``torso_mean``: time-mean of the torso velocity ``v_torso(m)``;
+2. ``torso_bandwidth``: peak-to-peak of ``v_torso(m)``;
+3. ``upper_max``: maximum of the upper envelope ``U(m)``;
+4. ``lower_min``: minimum of the lower envelope ``L(m)``;
+5. ``total_bandwidth``: ``upper_max - lower_min``;
+6. ``upper_mean``: mean of ``U(m)``;
+7. ``lower_mean``: mean of ``L(m)``.
+
+The paper only says the envelopes are "curves connecting the maxima and minima of the
+spectrogram", so the method is an option ([L] in the reference):
+
+- ``threshold`` (default): per time column, the highest and lowest velocity bins whose power is
+  within ``threshold_db`` (default -20 dB) of that column's peak, ignoring bins more than
+  ``floor_db`` (default -40 dB) below the whole spectrogram's peak. The torso is the column's
+  strongest bin.
+- ``percentile`` (van Dorp & Groen 2008): per column, the velocities where the cumulative power
+  (above the floor) reaches ``percentiles`` (default 3 % and 97 %); the torso is the 50 % point.
+
+Columns with no bin above the floor (silence) are left out of every statistic.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+
+#: Feature names, in the paper's order.
+FEATURE_NAMES: tuple[str, ...] = (
+    "torso_mean",
+    "torso_bandwidth",
+    "upper_max",
+    "lower_min",
+    "total_bandwidth",
+    "upper_mean",
+    "lower_mean",
+)
+
+EnvelopeMethod = Literal["threshold", "percentile"]
+
+
+@dataclass(frozen=True)
+class Envelopes:
+    """Per-frame tracks [m/s], each (n_frames,), NaN in silent frames."""
+
+    upper: FloatArray
+    lower: FloatArray
+    torso: FloatArray
+
+
+def envelopes(
+    power: FloatArray,
+    velocity: FloatArray,
+    *,
+    method: EnvelopeMethod = "threshold",
+    threshold_db: float = -20.0,
+    floor_db: float = -40.0,
+    percentiles: tuple[float, float] = (3.0, 97.0),
+) -> Envelopes:
+    """Upper and lower envelopes and the torso track of a spectrogram.
+
+    ``power`` (n_doppler, n_frames), linear (not dB), >= 0; ``velocity`` (n_doppler,) [m/s],
+    ascending. See the module docstring for the methods.
+    """
+    p = np.asarray(power, dtype=np.float64)
+    v = np.asarray(velocity, dtype=np.float64)
+    if p.ndim != 2 or p.shape[0] != v.shape[0]:
+        raise ValueError(f"power must be (n_doppler={v.shape[0]}, n_frames), got {p.shape}")
+    if np.any(np.diff(v) <= 0):
+        raise ValueError("velocity must be strictly ascending")
+    n_frames = p.shape[1]
+    p_max = float(p.max()) if p.size else 0.0
+    upper = np.full(n_frames, np.nan)
+    lower = np.full(n_frames, np.nan)
+    torso = np.full(n_frames, np.nan)
+    if p_max <= 0.0:
+        return Envelopes(upper, lower, torso)
+    above_floor = p >= p_max * 10.0 ** (floor_db / 10.0)
+    live = np.any(above_floor, axis=0)
+    if method == "threshold":
+        col_peak = p.max(axis=0)
+        mask = above_floor & (p >= col_peak * 10.0 ** (threshold_db / 10.0))
+        idx = np.arange(v.size)[:, None]
+        hi = np.max(np.where(mask, idx, -1), axis=0)
+        lo = np.min(np.where(mask, idx, v.size), axis=0)
+        upper[live] = v[hi[live]]
+        lower[live] = v[lo[live]]
+        torso[live] = v[np.argmax(p, axis=0)[live]]
+    elif method == "percentile":
+        q = np.where(above_floor, p, 0.0)
+        cum = np.cumsum(q, axis=0)
+        total = cum[-1]
+        for frame in np.flatnonzero(live):
+            c = cum[:, frame] / total[frame]
+            lower[frame] = v[np.searchsorted(c, percentiles[0] / 100.0)]
+            upper[frame] = v[min(int(np.searchsorted(c, percentiles[1] / 100.0)), v.size - 1)]
+            torso[frame] = v[np.searchsorted(c, 0.5)]
+    else:
+        raise ValueError(f"unknown envelope method {method!r}")
+    return Envelopes(upper, lower, torso)
+
+
+def features_from_envelopes(env: Envelopes) -> FloatArray:
+    """The seven features (7,) [m/s] from envelope tracks (NaN frames ignored)."""
+    live = np.isfinite(env.torso)
+    if not np.any(live):
+        raise ValueError("the spectrogram is silent: no frame rises above the floor")
+    t, u, lo = env.torso[live], env.upper[live], env.lower[live]
+    upper_max, lower_min = float(u.max()), float(lo.min())
+    return np.array(
+        [
+            t.mean(),
+            t.max() - t.min(),
+            upper_max,
+            lower_min,
+            upper_max - lower_min,
+            u.mean(),
+            lo.mean(),
+        ]
+    )
+
+
+def spectrogram_features(
+    power: FloatArray,
+    velocity: FloatArray,
+    *,
+    method: EnvelopeMethod = "threshold",
+    threshold_db: float = -20.0,
+    floor_db: float = -40.0,
+    percentiles: tuple[float, float] = (3.0, 97.0),
+) -> FloatArray:
+    """The seven features (7,) [m/s] of a spectrogram, in :data:`FEATURE_NAMES` order.
+
+    ``power`` (n_doppler, n_frames) linear; ``velocity`` (n_doppler,) [m/s] ascending.
+    """
+    env = envelopes(
+        power,
+        velocity,
+        method=method,
+        threshold_db=threshold_db,
+        floor_db=floor_db,
+        percentiles=percentiles,
+    )
+    return features_from_envelopes(env)

@@ -1,0 +1,146 @@
+"""kNN degeneracies (physics.md 6.7), wrapper selection hygiene, any scikit-learn estimator."""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import numpy as np
+import pytest
+from mdf_knn import Knn
+from mdf_sklearn import SklearnClassifier
+
+from mdframework.classify import (
+    Standardizer,
+    balanced_accuracy,
+    confusion_matrix,
+    optimistic_select,
+    wrapper_select,
+)
+from mdframework.interfaces import Classifier
+from mdframework.plugins import default_registry
+
+
+def knn(k: int = 5, tie_rule: str = "nearest") -> Knn:
+    return Knn(Knn.Config(k=k, tie_rule=tie_rule))  # type: ignore[arg-type]
+
+
+def test_zero_variance_feature_is_guarded() -> None:
+    x = np.array([[1.0, 0.3], [2.0, 0.3], [3.0, 0.3], [10.0, 0.3]])
+    s = Standardizer.fit(x)
+    z = s.transform(x)
+    assert np.all(np.isfinite(z)) and np.allclose(z[:, 1], 0.0)
+    y = np.array(["a", "a", "b", "b"])
+    pred = knn(k=1).fit(x, y).predict(np.array([[9.0, 0.3], [1.2, 0.31]]))
+    assert list(pred) == ["b", "a"]
+
+
+def test_standardisation_uses_training_statistics_only() -> None:
+    train = np.array([[0.0], [2.0]])
+    s = Standardizer.fit(train)
+    assert s.transform(np.array([[1000.0]]))[0, 0] == pytest.approx(999.0)
+
+
+def test_vote_tie_goes_to_the_nearest_member() -> None:
+    # k = 4 with a 2-2 split: class "z" has the single nearest neighbour
+    x = np.array([[0.0], [1.0], [-1.5], [2.0], [5.0]])
+    y = np.array(["z", "a", "a", "z", "a"])
+    q = np.array([[0.1]])
+    assert knn(k=4).fit(x, y).predict(q)[0] == "z"
+    assert knn(k=4, tie_rule="lowest").fit(x, y).predict(q)[0] == "a"
+    # symmetric swap of labels: the rule follows the nearest member, not the label name
+    assert knn(k=4).fit(x, np.array(["a", "z", "z", "a", "z"])).predict(q)[0] == "a"
+
+
+def test_five_classes_two_two_one_split() -> None:
+    x = np.array([[1.0], [-1.2], [2.0], [-2.2], [3.0]])
+    y = np.array(["walk", "run", "walk", "run", "box"])
+    assert knn(k=5).fit(x, y).predict(np.array([[0.0]]))[0] == "walk"
+
+
+def test_distance_ties_follow_training_order() -> None:
+    """Four training points at the same distance, k = 1: the earliest one wins, and the
+    decision is the same on every call (no dependence on the search algorithm's order)."""
+    x = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
+    q = np.zeros((1, 2))
+    for labels in (["a", "b", "c", "d"], ["d", "c", "b", "a"]):
+        model = knn(k=1).fit(x, np.array(labels))
+        assert model.predict(q)[0] == labels[0]
+        _, idx = model.neighbours(q)
+        assert list(idx[0]) == [0]
+    # k = 3 of 4 equidistant: the first three in training order vote
+    model = knn(k=3).fit(x, np.array(["a", "b", "b", "a"]))
+    assert model.predict(q)[0] == "b"
+
+
+def test_unequal_class_sizes_reported_per_class() -> None:
+    y_true = np.array(["walk"] * 93 + ["run"] * 32 + ["leap"] * 140)
+    y_pred = y_true.copy()
+    y_pred[:19] = "run"  # 74/93 walk correct
+    y_pred[93:95] = "walk"  # 30/32 run correct
+    cm = confusion_matrix(y_true, y_pred, ["walk", "run", "leap"])
+    assert np.allclose(cm.sum(axis=1), 1.0)
+    assert cm[0, 0] == pytest.approx(74 / 93) and cm[1, 1] == pytest.approx(30 / 32)
+    assert balanced_accuracy(y_true, y_pred) == pytest.approx((74 / 93 + 30 / 32 + 1) / 3)
+
+
+class Spy(Classifier):
+    """A 1-NN classifier that records every row it is shown."""
+
+    name = "spy"
+    Config = Knn.Config
+    seen: ClassVar[list[np.ndarray]] = []
+
+    def __init__(self) -> None:
+        self.inner = knn(k=1)
+
+    def fit(self, features: Any, labels: Any) -> Spy:
+        Spy.seen.append(np.asarray(features))
+        self.inner.fit(features, labels)
+        return self
+
+    def predict(self, features: Any) -> Any:
+        Spy.seen.append(np.asarray(features))
+        return self.inner.predict(features)
+
+
+def test_wrapper_selection_never_sees_the_test_split(rng: np.random.Generator) -> None:
+    n = 60
+    y = np.repeat(["a", "b", "c"], n // 3)
+    x = rng.normal(size=(n, 7))
+    x[:, 2] += np.repeat([0.0, 3.0, 6.0], n // 3)  # feature 2 separates the classes
+    test = rng.permutation(n)[:24]
+    train = np.setdiff1d(np.arange(n), test)
+    x_test = x[test] + 1000.0  # mark the test rows: any of them seen would be found
+    Spy.seen = []
+    sel = wrapper_select(x[train], y[train], Spy, sizes=(1, 2), folds=4)
+    seen = np.concatenate([a.ravel() for a in Spy.seen])
+    assert np.all(np.abs(seen) < 500.0), "wrapper selection saw test data"
+    assert 2 in sel.subset and sel.score > 0.9
+    assert len(sel.scores) == 7 + 21
+    # the optimistic variant does look at the test data (and says so in its name)
+    Spy.seen = []
+    optimistic_select(x[train], y[train], x_test, y[test], Spy, sizes=(1,))
+    assert np.any(np.abs(np.concatenate([a.ravel() for a in Spy.seen])) > 500.0)
+
+
+def test_any_sklearn_estimator_through_the_plugin(rng: np.random.Generator) -> None:
+    reg = default_registry()
+    assert reg.get("classifier", "sklearn") is SklearnClassifier
+    x = np.concatenate([rng.normal(0, 1, (30, 3)), rng.normal(4, 1, (30, 3))])
+    y = np.repeat(["a", "b"], 30)
+    for path, params in (
+        ("sklearn.svm.SVC", {"C": 10.0}),
+        ("sklearn.ensemble.RandomForestClassifier", {"n_estimators": 20, "random_state": 0}),
+    ):
+        cfg = SklearnClassifier.Config(estimator=path, params=params)  # type: ignore[call-arg]
+        model = SklearnClassifier(cfg).fit(x, y)
+        assert np.mean(model.predict(x) == y) > 0.95
+
+
+def test_bad_estimator_path_is_a_validation_error() -> None:
+    from pydantic import ValidationError
+
+    with pytest.raises(ValidationError, match=r"cannot import 'sklearn\.svm\.NoSuchThing'"):
+        SklearnClassifier.Config(estimator="sklearn.svm.NoSuchThing")  # type: ignore[call-arg]
+    with pytest.raises(ValidationError, match="not a classifier"):
+        SklearnClassifier.Config(estimator="numpy.linalg.norm")  # type: ignore[call-arg]

@@ -1,0 +1,96 @@
+"""The seven features on spectrograms with known answers (physics.md section 4)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mdframework.features import FEATURE_NAMES, envelopes, spectrogram_features
+from mdframework.physics import radar
+from mdframework.physics.spectrogram import spectrogram
+
+FC, PRF = 15e9, 2400.0
+LAMBDA = radar.wavelength(FC)
+
+
+def tone_signal(velocity_of_t: list[tuple[np.ndarray, float]], t: np.ndarray) -> np.ndarray:
+    """Complex slow-time signal whose components follow given radial velocities [m/s]."""
+    y = np.zeros(t.size, complex)
+    for v, amp in velocity_of_t:
+        phase = 2 * np.pi * np.cumsum(2 * v / LAMBDA) / PRF
+        y += amp * np.exp(1j * phase)
+    return y
+
+
+def synthetic_walk(window: int) -> tuple[np.ndarray, np.ndarray, float]:
+    """physics.md 4.2: torso 1.1 + 0.15 sin(2 pi 1.8 t), limb 1.1 + 2.6 sin(2 pi 0.9 t) at 0.3."""
+    t = np.arange(int(6 * PRF)) / PRF
+    torso = 1.1 + 0.15 * np.sin(2 * np.pi * 1.8 * t)
+    limb = 1.1 + 2.6 * np.sin(2 * np.pi * 0.9 * t)
+    y = tone_signal([(torso, 1.0), (limb, 0.3)], t)
+    s = spectrogram(y, PRF, window_length=window, hop=32, nfft=4096)
+    vel = radar.doppler_to_velocity(s.doppler, FC)
+    resolution = LAMBDA / 2 / (window / PRF)  # velocity resolution of the window [m/s]
+    return s.power, vel, resolution
+
+
+@pytest.mark.parametrize("window", [128, 256, 512])
+def test_features_of_a_synthetic_walk(window: int) -> None:
+    power, vel, res = synthetic_walk(window)
+    f = dict(zip(FEATURE_NAMES, spectrogram_features(power, vel), strict=True))
+    assert f["torso_mean"] == pytest.approx(1.1, abs=res / 2)
+    assert f["torso_bandwidth"] == pytest.approx(0.30, abs=res)
+    assert f["upper_max"] == pytest.approx(3.7, abs=2 * res)
+    assert f["lower_min"] == pytest.approx(-1.5, abs=2 * res)
+    assert f["total_bandwidth"] == pytest.approx(f["upper_max"] - f["lower_min"], abs=1e-12)
+    assert f["lower_min"] <= f["lower_mean"] <= f["torso_mean"] <= f["upper_mean"]
+    assert f["upper_mean"] <= f["upper_max"]
+
+
+def test_percentile_method_on_the_synthetic_walk() -> None:
+    power, vel, res = synthetic_walk(256)
+    f = dict(
+        zip(
+            FEATURE_NAMES,
+            spectrogram_features(power, vel, method="percentile", floor_db=-60.0),
+            strict=True,
+        )
+    )
+    assert f["torso_mean"] == pytest.approx(1.1, abs=res)
+    assert f["total_bandwidth"] == pytest.approx(f["upper_max"] - f["lower_min"], abs=1e-12)
+    assert f["upper_max"] == pytest.approx(3.7, abs=3 * res)
+    assert f["lower_min"] == pytest.approx(-1.5, abs=3 * res)
+
+
+def test_exact_envelopes_of_a_drawn_spectrogram() -> None:
+    """A spectrogram drawn directly: torso at bin k0, limbs exactly at known bins."""
+    vel = np.linspace(-5, 5, 201)  # 0.05 m/s bins
+    n_frames = 40
+    power = np.full((201, n_frames), 1e-9)
+    torso_v = 1.0 + 0.2 * np.sin(np.linspace(0, 2 * np.pi, n_frames, endpoint=False))
+    limb_hi = 2.0 + 1.5 * np.sin(np.linspace(0, 2 * np.pi, n_frames, endpoint=False)) ** 2
+    for m in range(n_frames):
+        power[np.argmin(np.abs(vel - torso_v[m])), m] = 1.0
+        power[np.argmin(np.abs(vel - limb_hi[m])), m] = 0.05  # -13 dB: inside -20 dB
+        power[np.argmin(np.abs(vel + 0.5)), m] = 0.02  # lower limb at -0.5 m/s, -17 dB
+        power[np.argmin(np.abs(vel + 2.0)), m] = 0.001  # -30 dB: outside the threshold
+    env = envelopes(power, vel)
+    snap = vel[np.argmin(np.abs(vel[:, None] - limb_hi[None, :]), axis=0)]
+    assert np.allclose(env.upper, snap)
+    assert np.allclose(env.lower, -0.5)
+    f = spectrogram_features(power, vel)
+    assert f[2] == pytest.approx(3.5) and f[3] == pytest.approx(-0.5)
+    assert f[0] == pytest.approx(1.0, abs=0.05)
+    assert f[1] == pytest.approx(0.4, abs=0.1)
+    # with a -35 dB threshold the -30 dB line at -2 m/s becomes the lower envelope
+    assert spectrogram_features(power, vel, threshold_db=-35.0)[3] == pytest.approx(-2.0)
+
+
+def test_silent_frames_are_ignored_and_all_silent_is_an_error() -> None:
+    vel = np.linspace(-1, 1, 11)
+    power = np.zeros((11, 6))
+    power[8, :3] = 1.0  # frames 3..5 silent
+    env = envelopes(power, vel)
+    assert np.all(np.isnan(env.torso[3:])) and np.allclose(env.torso[:3], vel[8])
+    with pytest.raises(ValueError, match="silent"):
+        spectrogram_features(np.zeros((11, 6)), vel)
