@@ -14,7 +14,7 @@ from conftest import EXAMPLES
 from mdframework import cli
 from mdframework.config import load_run_config
 
-EXAMPLE_CONFIGS = sorted(EXAMPLES.glob("*.toml"))
+EXAMPLE_CONFIGS = sorted(p for p in EXAMPLES.glob("*.toml") if not p.stem.startswith("experiment_"))
 
 
 def run_cli(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:

@@ -62,6 +62,31 @@ def _cmd_schema(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_dataset_build(args: argparse.Namespace) -> int:
+    from .dataset import build_dataset, load_dataset_config
+
+    config, base = load_dataset_config(args.config)
+    rows = build_dataset(
+        config,
+        base,
+        Path(args.out),
+        workers=args.workers,
+        scheduler=args.scheduler,
+        progress=not args.no_progress,
+    )
+    print(f"{len(rows)} records in {args.out}")
+    return 0
+
+
+def _cmd_experiment(args: argparse.Namespace) -> int:
+    from .experiment import load_experiment_config, run_experiment
+
+    config = load_experiment_config(args.config)
+    run_experiment(config, Path(args.out), source=args.config, progress=not args.no_progress)
+    print(Path(args.out) / "report.md")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``mdf``."""
     parser = argparse.ArgumentParser(
@@ -74,6 +99,26 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("config", help="run config file (.toml, .yaml or .json)")
     run.add_argument("--out", required=True, help="output folder")
     run.set_defaults(func=_cmd_run)
+
+    dataset = sub.add_parser("dataset", help="labelled datasets of simulated records")
+    dataset_sub = dataset.add_subparsers(dest="dataset_command", required=True)
+    build = dataset_sub.add_parser("build", help="build (or resume building) a dataset")
+    build.add_argument("config", help="dataset config file")
+    build.add_argument("--out", required=True, help="dataset folder")
+    build.add_argument("--workers", type=int, default=None, help="local processes")
+    build.add_argument(
+        "--scheduler",
+        default=None,
+        help="Dask scheduler address, or 'local' for a local Dask cluster",
+    )
+    build.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    build.set_defaults(func=_cmd_dataset_build)
+
+    experiment = sub.add_parser("experiment", help="run a classification experiment")
+    experiment.add_argument("config", help="experiment config file")
+    experiment.add_argument("--out", required=True, help="report folder")
+    experiment.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    experiment.set_defaults(func=_cmd_experiment)
 
     plugins = sub.add_parser("plugins", help="list installed plugins by interface")
     plugins.set_defaults(func=_cmd_plugins)

@@ -89,3 +89,74 @@ def plot_range_time(
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
+
+
+def plot_confusion(
+    path: Path,
+    classes: list[str],
+    mean: NDArray[np.float64],
+    std: NDArray[np.float64] | None,
+    *,
+    title: str = "",
+) -> None:
+    """Save a row-normalised confusion matrix (true class down, predicted across)."""
+    plt = _pyplot()
+    n = len(classes)
+    fig, ax = plt.subplots(figsize=(1.3 * n + 2.5, 1.1 * n + 1.8), dpi=110)
+    im = ax.imshow(mean, cmap="Blues", vmin=0.0, vmax=1.0)
+    for i in range(n):
+        for j in range(n):
+            text = f"{mean[i, j]:.2f}" + (f"\n±{std[i, j]:.2f}" if std is not None else "")
+            ax.text(
+                j,
+                i,
+                text,
+                ha="center",
+                va="center",
+                color="white" if mean[i, j] > 0.6 else "black",
+                fontsize=9,
+            )
+    ax.set_xticks(range(n), classes, rotation=30, ha="right")
+    ax.set_yticks(range(n), classes)
+    ax.set_xlabel("predicted")
+    ax.set_ylabel("true")
+    fig.colorbar(im, ax=ax, label="rate")
+    if title:
+        ax.set_title(title)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def plot_feature_scatter(
+    path: Path,
+    x: NDArray[np.float64],
+    y: NDArray[np.float64],
+    labels: NDArray[Any],
+    groups: NDArray[Any],
+    x_name: str,
+    y_name: str,
+) -> None:
+    """Scatter plot of two features [m/s], colour = activity, marker = source group."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(6, 4.5), dpi=110)
+    markers = "o^sDvP*X"
+    for gi, group in enumerate(sorted(set(groups.tolist()))):
+        for li, label in enumerate(sorted(set(labels.tolist()))):
+            sel = (groups == group) & (labels == label)
+            if np.any(sel):
+                ax.scatter(
+                    x[sel],
+                    y[sel],
+                    s=14,
+                    marker=markers[gi % len(markers)],
+                    color=f"C{li}",
+                    alpha=0.7,
+                    label=f"{label} ({group})",
+                )
+    ax.set_xlabel(f"{x_name} [m/s]")
+    ax.set_ylabel(f"{y_name} [m/s]")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)

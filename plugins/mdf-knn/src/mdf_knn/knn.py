@@ -2,9 +2,9 @@
 
 - **Standardisation**: z-scores with the training data's mean and standard deviation only; a
   zero-variance feature is only centred (``mdframework.classify.Standardizer``).
-- **Neighbours**: scikit-learn's ``NearestNeighbors`` (brute force, Euclidean by default). All
-  training points are ranked by distance with a stable sort, so **distance ties** are broken by
-  training order (the earlier sample wins), documented and repeatable.
+- **Neighbours**: scikit-learn's ``NearestNeighbors`` (tree or brute search, Euclidean by
+  default). Candidates are ranked by distance with a stable sort, so **distance ties** are
+  broken by training order (the earlier sample wins), documented and repeatable.
 - **Vote ties**: among the classes with the most votes, the one whose closest member among the
   k neighbours is nearest wins (``tie_rule = "nearest"``, the default); ``"lowest"`` picks the
   alphabetically first class, as ``argmax`` over sorted labels would.
@@ -49,7 +49,7 @@ class Knn(Classifier):
             raise ValueError("features must be (n_samples, n_features) with one label each")
         self.scaler_ = Standardizer.fit(x)
         self.labels_ = np.asarray(labels)
-        self.nn_ = NearestNeighbors(algorithm="brute", metric=self.config.metric)
+        self.nn_ = NearestNeighbors(algorithm="auto", metric=self.config.metric)
         self.nn_.fit(self.scaler_.transform(x))
         return self
 
@@ -57,10 +57,20 @@ class Knn(Classifier):
         """Distances and training indices of the k nearest neighbours, (n_queries, k) each,
         ordered by distance, ties by training order."""
         n_train = self.labels_.shape[0]
-        dist, idx = self.nn_.kneighbors(
-            self.scaler_.transform(features), n_neighbors=n_train, return_distance=True
-        )
-        order = np.lexsort((idx, dist), axis=1)[:, : min(self.config.k, n_train)]
+        k = min(self.config.k, n_train)
+        z = self.scaler_.transform(features)
+        # a few spare neighbours reveal distance ties at the k-th place; rows whose ties reach
+        # past the spares are searched again over the whole training set
+        n_ask = min(n_train, k + 8)
+        dist, idx = self.nn_.kneighbors(z, n_neighbors=n_ask, return_distance=True)
+        if n_ask < n_train:
+            redo = np.flatnonzero(dist[:, k - 1] >= dist[:, -1])
+            if redo.size:
+                d_all, i_all = self.nn_.kneighbors(z[redo], n_neighbors=n_train)
+                order = np.lexsort((i_all, d_all), axis=1)[:, :n_ask]
+                dist[redo] = np.take_along_axis(d_all, order, 1)
+                idx[redo] = np.take_along_axis(i_all, order, 1)
+        order = np.lexsort((idx, dist), axis=1)[:, :k]
         return np.take_along_axis(dist, order, 1), np.take_along_axis(idx, order, 1)
 
     def predict(self, features: NDArray[np.float64]) -> NDArray[Any]:

@@ -1,0 +1,447 @@
+"""The paper's experiments as config-file runs (``mdf experiment CONFIG --out DIR``).
+
+- **Within-source**: for every source group, repeated stratified train/test splits (60/40 by
+  default); optional wrapper feature selection by cross-validation on the training split only;
+  the confusion matrix's mean and spread over repeats and the per-class rates. The paper's
+  optimistic variant (feature subset chosen on the test split) is reported separately and
+  labelled as such.
+- **Cross-source**: train on one group (e.g. Kinect-derived records), test on another (e.g.
+  CMU-derived) over the classes they share, after an optional label map (``jog -> run``).
+- **Feature statistics**: mean and variance of every feature per group and label (like Table 2),
+  and scatter plots of feature pairs (like Figure 12).
+
+Outputs in DIR: ``report.md``; ``within_<group>_confusion.csv/png`` (mean and std);
+``within_<group>_per_class.csv``; ``cross_confusion.csv/png``; ``feature_stats.csv/md``;
+``scatter_<f1>_<f2>.png``; ``summary.json``; and ``dataset/`` when the experiment built it.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from sklearn.model_selection import StratifiedShuffleSplit
+
+from .classify import (
+    Selection,
+    balanced_accuracy,
+    confusion_matrix,
+    optimistic_select,
+    wrapper_select,
+)
+from .config import format_validation_error, read_config_file
+from .dataset import Dataset, build_dataset, load_dataset, load_dataset_config
+from .errors import ConfigError, MdfError
+from .features import FEATURE_NAMES
+from .interfaces import Classifier
+from .plugins import Registry, default_registry
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class DatasetRef(_Strict):
+    """Which data: a dataset config to build (into DIR/dataset), or a built dataset."""
+
+    config: Path | None = Field(None, description="Dataset config file to build.")
+    path: Path | None = Field(None, description="Folder of an already built dataset.")
+
+    @model_validator(mode="after")
+    def _one(self) -> DatasetRef:
+        if (self.config is None) == (self.path is None):
+            raise ValueError("give exactly one of dataset.config and dataset.path")
+        return self
+
+
+class SelectionConfig(_Strict):
+    """Feature selection."""
+
+    method: Literal["wrapper", "none"] = Field(
+        "wrapper", description="wrapper: subsets scored by CV on the training split; none: all."
+    )
+    sizes: list[int] = Field([4], description="Subset sizes to try (the paper: 4 of 7).")
+    folds: int = Field(5, ge=2, description="Cross-validation folds.")
+    optimistic: bool = Field(
+        True, description="Also report the paper's optimistic selection on the test split."
+    )
+
+
+class EvaluationConfig(_Strict):
+    """Repeated stratified splits."""
+
+    repeats: int = Field(10, ge=1, description="Number of random splits.")
+    test_fraction: float = Field(0.4, gt=0, lt=1, description="Test share (the paper: 40 %).")
+
+
+class CrossSourceConfig(_Strict):
+    """Train on one source group, test on another."""
+
+    train: str = Field(description="Group used for training (e.g. 'kinect').")
+    test: str = Field(description="Group used for testing (e.g. 'cmu').")
+    label_map: dict[str, str] = Field(
+        default_factory=dict, description="Rename labels before matching (e.g. jog = 'run')."
+    )
+
+
+class ReportConfig(_Strict):
+    """Plots."""
+
+    scatter_pairs: list[tuple[str, str]] = Field(
+        [("torso_mean", "upper_max"), ("lower_min", "total_bandwidth")],
+        description="Feature pairs to scatter-plot.",
+    )
+
+
+class ExperimentConfig(_Strict):
+    """An experiment."""
+
+    seed: int = Field(0, ge=0)
+    dataset: DatasetRef
+    classifier: dict[str, Any] = Field(
+        default_factory=lambda: {"kind": "knn"}, description="A [classifier] section."
+    )
+    selection: SelectionConfig = Field(default_factory=SelectionConfig)
+    evaluation: EvaluationConfig = Field(default_factory=EvaluationConfig)
+    cross_source: CrossSourceConfig | None = None
+    report: ReportConfig = Field(default_factory=ReportConfig)
+    workers: int | None = Field(None, ge=1, description="Processes for building the dataset.")
+
+
+def load_experiment_config(path: str | Path) -> ExperimentConfig:
+    """Read and validate an experiment config; relative paths become relative to its folder."""
+    p = Path(path)
+    data = read_config_file(p)
+    ds = data.get("dataset")
+    if isinstance(ds, dict):
+        data["dataset"] = {
+            k: (str(p.parent / v) if k in ("config", "path") and isinstance(v, str) else v)
+            for k, v in ds.items()
+        }
+    try:
+        cfg = ExperimentConfig.model_validate(data)
+    except ValidationError as exc:
+        raise ConfigError(format_validation_error(exc, str(p), data)) from None
+    for pair in cfg.report.scatter_pairs:
+        for name in pair:
+            if name not in FEATURE_NAMES:
+                raise ConfigError(f"{p}: report.scatter_pairs: unknown feature {name!r}")
+    return cfg
+
+
+def classifier_factory(
+    section: dict[str, Any], source: str, registry: Registry | None = None
+) -> Callable[[], Classifier]:
+    """A factory of fresh classifiers from a [classifier] section (validated once)."""
+    reg = registry or default_registry()
+    kind = section.get("kind")
+    try:
+        cls = reg.get("classifier", str(kind))
+    except KeyError as exc:
+        raise ConfigError(f"{source}: classifier.kind: {exc.args[0]}") from None
+    try:
+        cfg = cls.Config.model_validate(section)
+    except ValidationError as exc:
+        raise ConfigError(
+            format_validation_error(exc, source, section).replace(
+                f"{source}: ", f"{source}: classifier.", 1
+            )
+        ) from None
+    return lambda: cls(cfg)  # type: ignore[return-value]
+
+
+def _fit_predict(
+    factory: Callable[[], Classifier],
+    x_train: NDArray[np.float64],
+    y_train: NDArray[Any],
+    x_test: NDArray[np.float64],
+    cols: tuple[int, ...],
+) -> NDArray[Any]:
+    return factory().fit(x_train[:, list(cols)], y_train).predict(x_test[:, list(cols)])
+
+
+def _select(
+    cfg: ExperimentConfig,
+    factory: Callable[[], Classifier],
+    x: NDArray[np.float64],
+    y: NDArray[Any],
+    seed: int,
+) -> Selection:
+    if cfg.selection.method == "none":
+        return Selection(tuple(range(x.shape[1])), float("nan"))
+    return wrapper_select(
+        x, y, factory, sizes=cfg.selection.sizes, folds=cfg.selection.folds, seed=seed
+    )
+
+
+def within_source(
+    cfg: ExperimentConfig,
+    factory: Callable[[], Classifier],
+    x: NDArray[np.float64],
+    y: NDArray[Any],
+) -> dict[str, Any]:
+    """Repeated stratified splits of one group's records; returns matrices and scores."""
+    classes = sorted(set(y.tolist()))
+    splitter = StratifiedShuffleSplit(
+        n_splits=cfg.evaluation.repeats,
+        test_size=cfg.evaluation.test_fraction,
+        random_state=cfg.seed,
+    )
+    mats, accs, optimistic, subsets = [], [], [], []
+    for rep, (train, test) in enumerate(splitter.split(x, y)):
+        sel = _select(cfg, factory, x[train], y[train], cfg.seed + rep)
+        pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
+        mats.append(confusion_matrix(y[test], pred, classes))
+        accs.append(balanced_accuracy(y[test], pred))
+        subsets.append([FEATURE_NAMES[i] for i in sel.subset])
+        if cfg.selection.optimistic and cfg.selection.method == "wrapper":
+            opt = optimistic_select(
+                x[train], y[train], x[test], y[test], factory, sizes=cfg.selection.sizes
+            )
+            optimistic.append(opt.score)
+    stack = np.stack(mats)
+    return {
+        "classes": classes,
+        "confusion_mean": np.nanmean(stack, axis=0),
+        "confusion_std": np.nanstd(stack, axis=0),
+        "balanced_accuracy_mean": float(np.mean(accs)),
+        "balanced_accuracy_std": float(np.std(accs)),
+        "optimistic_accuracy_mean": float(np.mean(optimistic)) if optimistic else None,
+        "subsets": subsets,
+        "n_records": len(y),
+        "class_counts": {c: int(np.sum(y == c)) for c in classes},
+    }
+
+
+def cross_source(
+    cfg: ExperimentConfig, factory: Callable[[], Classifier], data: Dataset
+) -> dict[str, Any]:
+    """Train on one group, test on another, over the shared (mapped) classes."""
+    cs = cfg.cross_source
+    assert cs is not None
+    labels = np.array([cs.label_map.get(lab, lab) for lab in data.labels])
+    train = data.groups == cs.train
+    test = data.groups == cs.test
+    for name, mask in (("train", train), ("test", test)):
+        if not np.any(mask):
+            groups = ", ".join(sorted(set(data.groups.tolist())))
+            raise MdfError(f"cross_source.{name}: no records of group {name!r} (have {groups})")
+    shared = sorted(set(labels[train].tolist()) & set(labels[test].tolist()))
+    if len(shared) < 2:
+        raise MdfError(f"cross_source: the groups share fewer than two classes ({shared})")
+    train &= np.isin(labels, shared)
+    test &= np.isin(labels, shared)
+    x, y = data.features, labels
+    sel = _select(cfg, factory, x[train], y[train], cfg.seed)
+    pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
+    return {
+        "classes": shared,
+        "confusion": confusion_matrix(y[test], pred, shared),
+        "balanced_accuracy": balanced_accuracy(y[test], pred),
+        "subset": [FEATURE_NAMES[i] for i in sel.subset],
+        "train_counts": {c: int(np.sum(y[train] == c)) for c in shared},
+        "test_counts": {c: int(np.sum(y[test] == c)) for c in shared},
+    }
+
+
+def feature_statistics(data: Dataset) -> list[dict[str, Any]]:
+    """Mean and variance of each feature per (group, label), like the paper's Table 2."""
+    rows = []
+    for group in sorted(set(data.groups.tolist())):
+        for label in sorted(set(data.labels[data.groups == group].tolist())):
+            sel = (data.groups == group) & (data.labels == label)
+            f = data.features[sel]
+            row: dict[str, Any] = {"group": group, "label": label, "n": int(sel.sum())}
+            for i, name in enumerate(FEATURE_NAMES):
+                row[f"{name}_mean"] = float(f[:, i].mean())
+                row[f"{name}_var"] = float(f[:, i].var(ddof=1)) if len(f) > 1 else float("nan")
+            rows.append(row)
+    return rows
+
+
+def _csv(rows: list[dict[str, Any]]) -> str:
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    return buf.getvalue()
+
+
+def _matrix_rows(classes: list[str], matrix: NDArray[np.float64]) -> list[dict[str, Any]]:
+    return [
+        {"true": c, **{p: round(float(v), 6) for p, v in zip(classes, row, strict=True)}}
+        for c, row in zip(classes, matrix, strict=True)
+    ]
+
+
+def _stats_markdown(rows: list[dict[str, Any]]) -> str:
+    cols = [f"{r['label']} ({r['group']}, n={r['n']})" for r in rows]
+    lines = [
+        "| feature [m/s] | " + " | ".join(cols) + " |",
+        "|---|" + "---|" * len(cols),
+    ]
+    for name in FEATURE_NAMES:
+        cells = [f"{r[f'{name}_mean']:.4g} ({r[f'{name}_var']:.3g})" for r in rows]
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    return "mean (variance)\n\n" + "\n".join(lines) + "\n"
+
+
+def run_experiment(
+    cfg: ExperimentConfig,
+    out_dir: Path,
+    *,
+    source: str = "<experiment>",
+    progress: bool = True,
+    registry: Registry | None = None,
+) -> dict[str, Any]:
+    """Build or load the dataset, run the experiments, write the report."""
+    from .figures import plot_confusion, plot_feature_scatter
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    factory = classifier_factory(cfg.classifier, source, registry)
+    if cfg.dataset.config is not None:
+        dcfg, base = load_dataset_config(cfg.dataset.config)
+        build_dataset(dcfg, base, out / "dataset", workers=cfg.workers, progress=progress)
+        data_dir = out / "dataset"
+    else:
+        assert cfg.dataset.path is not None
+        data_dir = cfg.dataset.path
+    data = load_dataset(data_dir, spectrograms=False)
+
+    summary: dict[str, Any] = {
+        "dataset": str(data_dir),
+        "n_records": len(data.labels),
+        "within": {},
+        "cross": None,
+    }
+    report = [
+        "# Experiment report",
+        "",
+        f"Dataset: `{data_dir}` ({len(data.labels)} records).",
+        f"Classifier: `{json.dumps(cfg.classifier)}`; selection: "
+        f"{cfg.selection.method} (sizes {cfg.selection.sizes}); "
+        f"{cfg.evaluation.repeats} stratified splits, "
+        f"{round(100 * (1 - cfg.evaluation.test_fraction))}/"
+        f"{round(100 * cfg.evaluation.test_fraction)}.",
+        "",
+    ]
+    for group in sorted(set(data.groups.tolist())):
+        mask = data.groups == group
+        if len(set(data.labels[mask].tolist())) < 2:
+            continue
+        res = within_source(cfg, factory, data.features[mask], data.labels[mask])
+        classes = res["classes"]
+        stem = f"within_{group}"
+        (out / f"{stem}_confusion.csv").write_text(
+            _csv(_matrix_rows(classes, res["confusion_mean"]))
+        )
+        (out / f"{stem}_confusion_std.csv").write_text(
+            _csv(_matrix_rows(classes, res["confusion_std"]))
+        )
+        (out / f"{stem}_per_class.csv").write_text(
+            _csv(
+                [
+                    {
+                        "class": c,
+                        "n": res["class_counts"][c],
+                        "rate_mean": float(res["confusion_mean"][i, i]),
+                        "rate_std": float(res["confusion_std"][i, i]),
+                    }
+                    for i, c in enumerate(classes)
+                ]
+            )
+        )
+        plot_confusion(
+            out / f"{stem}_confusion.png",
+            classes,
+            res["confusion_mean"],
+            res["confusion_std"],
+            title=f"{group}: within-source",
+        )
+        summary["within"][group] = {
+            k: v for k, v in res.items() if k not in ("confusion_mean", "confusion_std")
+        }
+        summary["within"][group]["confusion_mean"] = res["confusion_mean"].tolist()
+        opt = res["optimistic_accuracy_mean"]
+        report += [
+            f"## Within-source: {group}",
+            "",
+            f"Balanced accuracy {res['balanced_accuracy_mean']:.3f} "
+            f"(std {res['balanced_accuracy_std']:.3f}) over {cfg.evaluation.repeats} splits; "
+            f"classes and records: {res['class_counts']}.",
+            "",
+            _markdown_matrix(classes, res["confusion_mean"], res["confusion_std"]),
+            "",
+        ]
+        if opt is not None:
+            report += [
+                f"Optimistic (paper's method, subset chosen on the test split, an upper "
+                f"bound, not a fair estimate): {opt:.3f}.",
+                "",
+            ]
+        report += [f"![confusion]({stem}_confusion.png)", ""]
+    if cfg.cross_source is not None:
+        res = cross_source(cfg, factory, data)
+        (out / "cross_confusion.csv").write_text(
+            _csv(_matrix_rows(res["classes"], res["confusion"]))
+        )
+        plot_confusion(
+            out / "cross_confusion.png",
+            res["classes"],
+            res["confusion"],
+            None,
+            title=f"train {cfg.cross_source.train} -> test {cfg.cross_source.test}",
+        )
+        summary["cross"] = {**res, "confusion": res["confusion"].tolist()}
+        report += [
+            f"## Cross-source: train {cfg.cross_source.train}, test {cfg.cross_source.test}",
+            "",
+            f"Balanced accuracy {res['balanced_accuracy']:.3f}; features {res['subset']}; "
+            f"training {res['train_counts']}, test {res['test_counts']}.",
+            "",
+            _markdown_matrix(res["classes"], res["confusion"], None),
+            "",
+            "![cross](cross_confusion.png)",
+            "",
+        ]
+    stats = feature_statistics(data)
+    (out / "feature_stats.csv").write_text(_csv(stats))
+    md = _stats_markdown(stats)
+    (out / "feature_stats.md").write_text(md)
+    report += ["## Feature statistics", "", md, ""]
+    for f1, f2 in cfg.report.scatter_pairs:
+        name = f"scatter_{f1}_{f2}.png"
+        plot_feature_scatter(
+            out / name,
+            data.features[:, FEATURE_NAMES.index(f1)],
+            data.features[:, FEATURE_NAMES.index(f2)],
+            data.labels,
+            data.groups,
+            f1,
+            f2,
+        )
+        report += [f"![{f1} vs {f2}]({name})", ""]
+    (out / "report.md").write_text("\n".join(report))
+    (out / "summary.json").write_text(json.dumps(summary, indent=2, default=str) + "\n")
+    return summary
+
+
+def _markdown_matrix(
+    classes: list[str], mean: NDArray[np.float64], std: NDArray[np.float64] | None
+) -> str:
+    lines = ["| true \\ predicted | " + " | ".join(classes) + " |", "|---|" + "---|" * len(classes)]
+    for i, c in enumerate(classes):
+        cells = [
+            f"{mean[i, j]:.2f}" + (f" ± {std[i, j]:.2f}" if std is not None else "")
+            for j in range(len(classes))
+        ]
+        lines.append(f"| {c} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
