@@ -1,0 +1,137 @@
+"""The Boulic walker as a motion source (kind ``boulic``).
+
+The walker lives in its own frame (x forward from the origin, y left, z up); the scene's
+``person`` section places it (``position``, ``heading_deg`` / ``aspect_deg``, ``motion``), so the
+walker has no start point or heading of its own. Joint positions come from the MuJoCo model
+(:class:`~mdf_mujoco.body_model.WalkerBody`) evaluated at the walker's own rate, ``nt`` samples
+per gait cycle (``nt / Dc`` Hz, 380 Hz for the default ``nt = 512`` at ``rv = 1``); the
+pipeline's spline resamples them to the pulse times. The ``mujoco_body`` scatterer model
+re-evaluates the MuJoCo model at the pulse times themselves (see
+:mod:`mdf_mujoco.scatterers`).
+
+See :mod:`mdf_mujoco.gait` for the model and every difference between the corrected default and
+``chen_compatible`` mode.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from pydantic import Field, model_validator
+
+from mdframework import CANONICAL_JOINTS, Motion, MotionConfig, MotionSource, Skeleton
+from mdframework.physics.body import LEG_FRACTION
+
+from .body_model import WalkerBody
+from .gait import Gait
+
+
+class BoulicConfig(MotionConfig):
+    """Boulic's global walking model (as coded by V.C. Chen), built in MuJoCo."""
+
+    kind: Literal["boulic"] = "boulic"
+    height: float = Field(1.8, gt=0.5, lt=2.5, description="Body height H [m].")
+    rv: float | None = Field(
+        None,
+        gt=0,
+        le=3,
+        description="Relative velocity v / H_t [1/s], 0 < rv <= 3 (H_t = 0.491 H). "
+        "Give rv or speed, not both; default rv = 1.",
+    )
+    speed: float | None = Field(
+        None,
+        gt=0,
+        description="Walking speed [m/s]; sets rv = speed / H_t (chen_compatible: rv = speed, "
+        "since Chen's base moves at rv m/s).",
+    )
+    n_cycles: int | None = Field(
+        None,
+        ge=1,
+        description="Gait cycles to generate; default: enough for start + duration, else 3.",
+    )
+    nt: int = Field(512, ge=4, description="Samples per gait cycle (even).")
+    chen_compatible: bool = Field(
+        False,
+        description="Reproduce the quirks of Chen's MATLAB code (speed scale, gait-a sign flip, "
+        "elbow typo, frozen elbow height, linspace progression, origin at the hips, "
+        "lower-leg ellipsoid) for side-by-side comparison.",
+    )
+    activity: str = Field("walk", description="Activity label recorded with the run.")
+
+    @model_validator(mode="after")
+    def _check(self) -> BoulicConfig:
+        if self.nt % 2:
+            raise ValueError(f"nt must be even (the left side is the right rolled by nt/2), "
+                             f"got {self.nt}")  # fmt: skip
+        if self.rv is not None and self.speed is not None:
+            raise ValueError("give rv or speed, not both")
+        rv = self.relative_velocity
+        if not 0 < rv <= 3:
+            raise ValueError(
+                f"speed {self.speed} m/s gives rv = {rv:.4g}, outside Boulic's 0 < rv <= 3 "
+                f"(H_t = {LEG_FRACTION * self.height:.4g} m)"
+            )
+        return self
+
+    @property
+    def relative_velocity(self) -> float:
+        """The rv the config asks for [1/s]."""
+        if self.speed is not None:
+            return self.speed if self.chen_compatible else self.speed / (LEG_FRACTION * self.height)
+        return 1.0 if self.rv is None else self.rv
+
+
+@dataclass(frozen=True)
+class BoulicMotion(Motion):
+    """A :class:`~mdframework.Motion` that also carries the walker's :class:`Gait`, so that the
+    ``mujoco_body`` scatterer model can evaluate the MuJoCo model at the pulse times."""
+
+    gait: Gait | None = None
+
+
+class BoulicWalker(MotionSource):
+    """Boulic walker (kind ``boulic``)."""
+
+    name = "boulic"
+    Config = BoulicConfig
+    config: BoulicConfig
+
+    def gait(self) -> Gait:
+        """The walker described by the config."""
+        c = self.config
+        return Gait(c.height, c.relative_velocity, c.nt, c.chen_compatible)
+
+    def n_cycles(self, gait: Gait) -> int:
+        """Number of cycles to generate."""
+        c = self.config
+        if c.n_cycles is not None:
+            return c.n_cycles
+        if c.duration is None:
+            return 3
+        return max(1, math.ceil((c.start + c.duration) / gait.cycle_duration - 1e-9))
+
+    def load(self) -> Motion:
+        """Canonical joints at ``k Dc / nt`` s, ``k = 0 .. n_cycles nt`` (both ends)."""
+        g = self.gait()
+        n = self.n_cycles(g) * g.nt
+        t = np.arange(n + 1, dtype=np.float64) * (g.cycle_duration / g.nt)
+        frames = WalkerBody(g).frames(t)
+        meta = {
+            "source": "boulic",
+            "activity": self.config.activity,
+            "height_m": g.height,
+            "rv": g.rv,
+            "gait_class": g.gait,
+            "speed_mps": g.speed,
+            "cycle_duration_s": g.cycle_duration,
+            "support_fraction": g.support_fraction,
+            "n_cycles": self.n_cycles(g),
+            "nt": g.nt,
+            "frame_rate_hz": g.nt / g.cycle_duration,
+            "chen_compatible": g.chen_compatible,
+        }
+        skel = Skeleton(t, frames.joints, CANONICAL_JOINTS)
+        return BoulicMotion(skel, meta, {j: j for j in CANONICAL_JOINTS}, None, g)

@@ -1,0 +1,166 @@
+"""Body self-shadowing (effect kind ``shadowing``)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import mdf_ellipsoid.plugin
+import mdf_lfm.plugin
+import mdf_mujoco.plugin
+import mujoco
+import numpy as np
+import pytest
+import synthetic
+from mdf_mujoco.shadowing import Shadowing, ShadowingConfig
+
+from mdframework import CANONICAL_JOINTS, Scatterers, SceneContext, SceneError, Skeleton
+from mdframework.config import validate_run_config
+from mdframework.pipeline import RunResult, simulate
+from mdframework.plugins import Registry, build_registry
+
+J = {n: i for i, n in enumerate(CANONICAL_JOINTS)}
+
+
+@pytest.fixture(scope="module")
+def registry() -> Registry:
+    return build_registry([mdf_mujoco.plugin, mdf_lfm.plugin, mdf_ellipsoid.plugin], autoload=False)
+
+
+def context(radar: list[float], skeleton: Skeleton, n: int) -> SceneContext:
+    t = np.arange(n) / 2400.0
+    return SceneContext(
+        np.array(radar, dtype=float), 2400.0, 15e9, t, np.zeros(n), skeleton, None,  # type: ignore[arg-type]
+        np.random.default_rng(0),
+    )  # fmt: skip
+
+
+def torso_and_two_balls(n: int = 3) -> Scatterers:
+    """An upright torso ellipsoid at the origin, a small ball 0.5 m behind it (-x) and one
+    0.5 m in front (+x), both a little above the torso's centre (off its line of sight)."""
+    pos = np.array([[0.0, 0.0, 0.0], [-0.5, 0.0, 0.1], [0.5, 0.0, 0.2]])
+    semi = np.array([[0.15, 0.15, 0.26], [0.02, 0.02, 0.02], [0.02, 0.02, 0.02]])
+    axes = np.array([[0.0, 0.0, 0.26], [0.0, 0.0, 0.02], [0.0, 0.0, 0.02]])
+    return Scatterers(
+        np.repeat(pos[None], n, 0),
+        np.ones((n, 3)),
+        ("torso", "behind", "front"),
+        semi,
+        np.repeat(axes[None], n, 0),
+    )
+
+
+def standing_skeleton(n: int = 3) -> Skeleton:
+    joints = np.repeat(synthetic.standing()[None], n, 0)
+    return Skeleton(np.arange(n) / 2400.0, joints, CANONICAL_JOINTS)
+
+
+def test_scatterer_behind_the_torso_is_blocked() -> None:
+    scat = torso_and_two_balls()
+    skel = standing_skeleton()
+    effect = Shadowing(ShadowingConfig(attenuation_db=20.0))
+    blocked = effect.visibility(scat, context([10.0, 0.0, 0.0], skel, 3))
+    assert blocked.tolist() == [[False, True, False]] * 3
+    out = effect.apply(scat, context([10.0, 0.0, 0.0], skel, 3))
+    assert np.allclose(out.rcs, [[1.0, 0.01, 1.0]] * 3)
+    # from the other side the roles swap
+    blocked = effect.visibility(scat, context([-10.0, 0.0, 0.0], skel, 3))
+    assert blocked.tolist() == [[False, False, True]] * 3
+    assert effect.describe()["blocked_fraction"] == {"torso": 0.0, "behind": 0.0, "front": 1.0}
+
+
+def test_ray_just_missing_the_torso_is_not_blocked() -> None:
+    scat = torso_and_two_balls()
+    pos = scat.positions.copy()
+    pos[:, 1] = [-0.5, 0.17, 0.1]  # behind, but beside the 0.15 m torso
+    blocked = Shadowing(ShadowingConfig()).visibility(
+        scat.replace(positions=pos), context([100.0, 0.17, 0.1], standing_skeleton(), 3)
+    )
+    assert not blocked[:, 1].any()
+
+
+def test_capsules_around_a_skeleton() -> None:
+    """Point scatterers at the joints of a standing body seen from its left: the right elbow
+    and hip are hidden behind the torso and pelvis, the left ones are not."""
+    skel = standing_skeleton()
+    scat = Scatterers(skel.positions.copy(), np.ones((3, 17)), CANONICAL_JOINTS)
+    effect = Shadowing(ShadowingConfig())
+    blocked = effect.visibility(scat, context([0.0, 10.0, 1.2], skel, 3))
+    assert effect.describe()["occluders"] == "capsules"
+    assert blocked[:, J["r_elbow"]].all() and blocked[:, J["r_shoulder"]].all()
+    assert not blocked[:, J["l_elbow"]].any() and not blocked[:, J["l_shoulder"]].any()
+    assert not blocked[:, J["head"]].any()
+
+
+def test_capsules_need_a_canonical_body() -> None:
+    skel = Skeleton(np.arange(3.0), np.zeros((3, 1, 3)), ("target0",))
+    scat = Scatterers(np.zeros((3, 1, 3)), np.ones((3, 1)), ("target0",))
+    with pytest.raises(SceneError, match="canonical"):
+        Shadowing(ShadowingConfig()).apply(scat, context([10.0, 0.0, 0.0], skel, 3))
+
+
+def run(registry: Registry, effects: list[dict[str, Any]], **scatterers: Any) -> RunResult:
+    cfg = {
+        "motion": {"kind": "boulic", "rv": 1.0, "duration": 2.0},
+        "scatterers": {"kind": "mujoco_body", **scatterers},
+        "radar": {"kind": "lfm"},
+        "scene": {
+            "radar_position": [10.0, 0.0, 2.0],
+            "person": {"position": [0.0, -1.0], "aspect_deg": 90.0},
+        },
+        "effects": effects,
+    }
+    return simulate(validate_run_config(cfg, registry=registry), registry)
+
+
+def test_no_ray_is_cast_when_shadowing_is_off(
+    registry: Registry, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def fail(*args: Any, **kwargs: Any) -> None:
+        raise AssertionError("a ray was cast")
+
+    monkeypatch.setattr(mujoco, "mj_multiRay", fail)
+    monkeypatch.setattr(mujoco, "mj_ray", fail)
+    res = run(registry, [])
+    assert res.metadata["effects"] == []
+    with pytest.raises(AssertionError, match="a ray was cast"):  # the patch does catch casts
+        run(registry, [{"kind": "shadowing"}])
+
+
+def test_walker_seen_from_the_side(registry: Registry) -> None:
+    """Crossing the beam with the radar on the walker's right: the left (far) limbs are hidden
+    far more often than the right (near) ones, whose returns are untouched."""
+    plain = run(registry, [])
+    shadow = run(registry, [{"kind": "shadowing", "attenuation_db": 30.0}])
+    frac = shadow.metadata["effects"][0]["blocked_fraction"]
+    far = np.mean([frac[f"l_{p}"] for p in ("upper_arm", "lower_arm", "upper_leg", "hip")])
+    near = np.mean([frac[f"r_{p}"] for p in ("upper_arm", "lower_arm", "upper_leg")])
+    assert far > 0.3 and near < 0.05
+    names = plain.scatterers.names
+    ratio = shadow.scatterers.rcs / plain.scatterers.rcs
+    assert np.all(np.isclose(ratio, 1.0) | np.isclose(ratio, 1e-3))
+    assert np.allclose(ratio[:, names.index("r_upper_arm")], 1.0)
+
+
+def test_decimation_holds_the_result(registry: Registry) -> None:
+    plain = run(registry, []).scatterers.rcs
+    every = run(registry, [{"kind": "shadowing"}])
+    fourth = run(registry, [{"kind": "shadowing", "decimation": 4}])
+    assert np.any(every.scatterers.rcs < 0.5 * plain)
+    agree = np.mean(np.isclose(every.scatterers.rcs, fourth.scatterers.rcs, rtol=1e-12, atol=0))
+    assert agree > 0.99
+    assert fourth.metadata["effects"][0]["rays_cast"] * 4 == pytest.approx(
+        every.metadata["effects"][0]["rays_cast"], rel=1e-3
+    )
+
+
+def test_works_with_the_ellipsoid_model(registry: Registry) -> None:
+    cfg = {
+        "motion": {"kind": "boulic", "rv": 1.0, "duration": 1.0},
+        "scatterers": {"kind": "ellipsoid", "placement": "joints17"},
+        "scene": {"radar_position": [10.0, 0.0, 2.0], "person": {"aspect_deg": 90.0}},
+        "effects": [{"kind": "shadowing"}],
+    }
+    res = simulate(validate_run_config(cfg, registry=registry), registry)
+    eff = res.metadata["effects"][0]
+    assert eff["occluders"] == "ellipsoids"
+    assert max(eff["blocked_fraction"].values()) > 0.0
