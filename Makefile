@@ -19,10 +19,12 @@ demo: $(STAMP)
 	@mkdir -p out/demo
 	@for cfg in examples/*.toml; do \
 		name=$$(basename $$cfg .toml); \
+		case $$name in experiment_*) continue;; esac; \
 		echo "mdf run $$cfg --out out/demo/$$name"; \
 		$(BIN)/mdf run $$cfg --out out/demo/$$name || exit 1; \
 	done
-	@echo "spectrograms written to out/demo/*/spectrogram.png"
+	$(BIN)/mdf experiment examples/experiment_cmu.toml --out out/demo/experiment_cmu
+	@echo "spectrograms: out/demo/*/spectrogram.png; experiment report: out/demo/experiment_cmu/report.md"
 
 lint: $(STAMP)
 	$(BIN)/ruff check src plugins tests benchmarks docs examples/plugin-example
