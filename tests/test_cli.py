@@ -157,3 +157,20 @@ def test_debug_shows_the_traceback(tmp_path: Path) -> None:
         [a for a in args if a != "--debug"], capture_output=True, text=True, check=False
     )
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
+
+
+def test_yaml_and_json_configs_run(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    import tomllib
+
+    import yaml
+
+    data = tomllib.loads((EXAMPLES / "point_target.toml").read_text())
+    (tmp_path / "pt.yaml").write_text(yaml.safe_dump(data))
+    (tmp_path / "pt.json").write_text(json.dumps(data))
+    results = []
+    for name in ("pt.yaml", "pt.json"):
+        out = tmp_path / name.replace(".", "_")
+        assert run_cli(["run", str(tmp_path / name), "--out", str(out)], capsys)[0] == 0
+        with np.load(out / "result.npz") as d:
+            results.append(d["signal"])
+    assert np.array_equal(results[0], results[1])
