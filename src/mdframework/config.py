@@ -133,6 +133,64 @@ class ProcessingConfig(_Strict):
         return self
 
 
+class ConditioningConfig(_Strict):
+    """Skeleton conditioning (:mod:`mdframework.conditioning`), applied to the windowed body
+    before placement. Off by default; each step can be switched on its own."""
+
+    enabled: bool = Field(False, description="Condition the body at all (default: off).")
+    zeros_untracked: bool = Field(
+        True, description="Treat an exact (0, 0, 0) joint as untracked (Kinect's lost joints)."
+    )
+    max_gap_s: float = Field(
+        0.2,
+        gt=0,
+        description="Untracked gaps longer than this [s] are flagged (all gaps are bridged by "
+        "the spline); about a fifth of a gait cycle.",
+    )
+    long_gaps: Literal["flag", "error"] = Field(
+        "flag", description="A gap longer than max_gap_s: flag it in the metadata, or stop."
+    )
+    foot_outliers: bool = Field(
+        True,
+        description="Detect foot segments (ankle to toe) deviating from their mean beyond the "
+        "histogram-derived threshold and predict them from past frames (Erol & Gurbuz).",
+    )
+    outlier_bin_m: float = Field(
+        0.01, gt=0, description="Histogram bin width of the outlier deviations [m]."
+    )
+    outlier_min_threshold_m: float = Field(
+        0.05, gt=0, description="Smallest outlier threshold [m], whatever the histogram says."
+    )
+    foot_length_m: float | None = Field(
+        None,
+        gt=0,
+        description="The subject's measured foot length (ankle to toe) [m]; when given, the toe "
+        "is moved along the foot to this length in every frame.",
+    )
+    angle_check: bool = Field(
+        True,
+        description="Report the knee-ankle-foot angle of eq. (7) and its period (a check for "
+        "walking and running).",
+    )
+    speed_limit: bool = Field(
+        True, description="Replace frames where a joint moves faster than max_speed_mps."
+    )
+    max_speed_mps: float = Field(
+        6.0,
+        gt=0,
+        description="Physical joint speed limit [m/s]: walking feet peak near 4-5 m/s; raise to "
+        "about 10 for running (feet reach ~9 m/s).",
+    )
+    smoothing: Literal["none", "violating", "all"] = Field(
+        "violating",
+        description="Gaussian smoothing after the speed limit: of no joint, of the joints that "
+        "exceeded the limit, or of all joints.",
+    )
+    smoothing_sigma_s: float = Field(
+        0.03, ge=0, description="Standard deviation of the smoothing kernel [s]."
+    )
+
+
 class RunConfigBase(_Strict):
     """Fields every run config has besides the plugin sections."""
 
@@ -141,6 +199,10 @@ class RunConfigBase(_Strict):
     scene: SceneConfig = Field(default_factory=SceneConfig, description="The scene.")
     processing: ProcessingConfig = Field(
         default_factory=ProcessingConfig, description="Resampling and spectrogram."
+    )
+    conditioning: ConditioningConfig = Field(
+        default_factory=ConditioningConfig,
+        description="Skeleton conditioning of the body (off by default).",
     )
 
 

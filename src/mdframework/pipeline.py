@@ -14,7 +14,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .config import PersonConfig, RunConfigBase
+from . import conditioning
+from .config import ConditioningConfig, PersonConfig, RunConfigBase
 from .errors import SceneError
 from .interfaces import (
     Effect,
@@ -154,6 +155,7 @@ def simulate_motion(
         )
     body = motion.canonical() if stages.model.needs_canonical else motion.skeleton
     body = _window(body, cfg.motion.start, cfg.motion.duration)
+    body, conditioning_report = _condition(body, config.conditioning)
     if stages.model.needs_canonical:
         body = place_body(body, sc.person, radar_pos)
         placement = sc.person.model_dump()
@@ -226,6 +228,7 @@ def simulate_motion(
     metadata = {
         "motion": dict(motion.metadata),
         "placement": placement,
+        "conditioning": conditioning_report,
         "scatterers": list(scat.names),
         "n_pulses": int(t.shape[0]),
         "prf_hz": wf.prf,
@@ -264,6 +267,16 @@ def _window(body: Skeleton, start: float, duration: float | None) -> Skeleton:
         return body.window(start, duration)
     except ValueError as exc:
         raise SceneError(f"motion.start: {exc}") from None
+
+
+def _condition(body: Skeleton, cfg: ConditioningConfig) -> tuple[Skeleton, dict[str, Any]]:
+    """Skeleton conditioning when enabled (:func:`conditioning.condition`)."""
+    if not cfg.enabled:
+        return body, {"enabled": False}
+    try:
+        return conditioning.condition(body, cfg)
+    except ValueError as exc:
+        raise SceneError(f"conditioning: {exc}") from None
 
 
 def _check_ranges(ranges: FloatArray, scat: Scatterers, t: FloatArray, min_range: float) -> None:

@@ -1,0 +1,295 @@
+"""OpenNI2 devices and ``.oni`` recordings, and NiTE2 skeleton tracking, through the ``openni``
+binding and the system libraries.
+
+- OpenNI2 (Debian ``libopenni2-0``): the library folder comes from ``OPENNI2_REDIST`` or the
+  Debian location ``/usr/lib/x86_64-linux-gnu``; the binding wants byte-string paths.
+- NiTE2 (proprietary, not in any package registry): its ``Redist`` folder (holding
+  ``libNiTE2.so`` and ``NiTE2/``) comes from the ``nite2_redist`` argument or the ``NITE2_REDIST``
+  environment variable. Without it, skeleton tracking stops with :class:`NiteMissingError`; there
+  is no fallback.
+
+``.oni`` files are checked in Python first (:func:`scan_oni`: the 24-byte ``NI10`` header, then
+records with a 28-byte header, ``NIR\\0`` magic, type, node id, fields size (header included),
+payload size, 64-bit undo position), so that a bad file gets an error naming the record rather
+than the library's bare ``ONI_STATUS_ERROR``; frames are then read through OpenNI2, in order
+(seeking is unreliable in that library).
+"""
+
+from __future__ import annotations
+
+import os
+import struct
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from mdframework import DataFileError, MdfError
+
+#: Where Debian installs libOpenNI2.so.
+DEBIAN_OPENNI2 = "/usr/lib/x86_64-linux-gnu"
+
+#: Record types of the .oni format (OpenNI2 OniDataRecords / OpenNI 1 DataRecords).
+RECORD_TYPES: dict[int, str] = {
+    2: "node added (1.0.0.4)",
+    3: "int property",
+    4: "real property",
+    5: "string property",
+    6: "general property",
+    7: "node removed",
+    8: "node data begin",
+    9: "node state ready",
+    10: "new data",
+    11: "end",
+    12: "node added (1.0.0.5)",
+    13: "node added",
+    14: "seek table",
+}
+NEW_DATA = 10
+FILE_HEADER = struct.Struct(
+    "<4sBBHIQI"
+)  # magic, version (major, minor, maint, build), max ts, max node
+RECORD_HEADER = struct.Struct("<4sIIIIQ")
+
+
+class DeviceError(MdfError):
+    """OpenNI2 cannot be loaded or no device can be opened."""
+
+
+class NiteMissingError(MdfError):
+    """Skeleton tracking was asked for but NiTE2 is not installed or not found."""
+
+
+NITE_HELP = (
+    "skeleton tracking needs NiTE2 (PrimeSense's proprietary user tracker; it is not in any "
+    "package registry): install NiTE 2.2 from your vendor's download and point to its Redist "
+    "folder (the one holding libNiTE2.so) with the environment variable NITE2_REDIST or "
+    "the --nite2 option of mdf capture"
+)
+
+
+@dataclass(frozen=True)
+class OniScan:
+    """What :func:`scan_oni` found: record counts by type, frames per node id, node names."""
+
+    n_records: int
+    by_type: dict[str, int]
+    frames_per_node: dict[int, int]
+    nodes: dict[int, str]
+
+
+def scan_oni(path: Path) -> OniScan:
+    """Check an ``.oni`` file's structure (header and record chain) without the library.
+
+    Raises :class:`~mdframework.DataFileError` naming the file and record (number and byte
+    offset) for a wrong magic, a truncated record, or a file without any frame.
+    """
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise DataFileError(path, f"cannot read: {exc.strerror or exc}") from None
+    if len(data) < FILE_HEADER.size:
+        raise DataFileError(path, f"{len(data)} bytes: too short for the 24-byte .oni header")
+    magic = data[:4]
+    if magic != b"NI10":
+        raise DataFileError(path, f"not an OpenNI recording: header magic {magic!r}, not b'NI10'")
+    pos = FILE_HEADER.size
+    n = 0
+    by_type: dict[str, int] = {}
+    frames: dict[int, int] = {}
+    nodes: dict[int, str] = {}
+    while pos < len(data):
+        n += 1
+        if pos + RECORD_HEADER.size > len(data):
+            raise DataFileError(path, f"record {n} at byte {pos}: truncated record header")
+        rmagic, rtype, node, fsize, psize, _undo = RECORD_HEADER.unpack_from(data, pos)
+        if rmagic != b"NIR\0":
+            raise DataFileError(
+                path, f"record {n} at byte {pos}: record magic {rmagic!r}, not b'NIR\\x00'"
+            )
+        if fsize < RECORD_HEADER.size or pos + fsize + psize > len(data):
+            raise DataFileError(
+                path, f"record {n} at byte {pos}: truncated (sizes run past the end)"
+            )
+        name = RECORD_TYPES.get(rtype, f"type {rtype}")
+        by_type[name] = by_type.get(name, 0) + 1
+        if rtype in (2, 12, 13):
+            (ln,) = struct.unpack_from("<I", data, pos + 28)
+            nodes[node] = data[pos + 32 : pos + 32 + ln].rstrip(b"\0").decode("latin-1")
+        if rtype == NEW_DATA:
+            frames[node] = frames.get(node, 0) + 1
+        if rtype == 11:
+            break
+        pos += fsize + psize
+    if not frames:
+        raise DataFileError(
+            path,
+            f"the recording holds no frame: {n} records ({', '.join(sorted(by_type))}) with the "
+            "header and stream properties only",
+        )
+    return OniScan(n, by_type, frames, nodes)
+
+
+def initialize_openni(redist: str | None = None) -> Any:
+    """Load OpenNI2 (``redist``, else ``OPENNI2_REDIST``, else the Debian folder); the module."""
+    try:
+        from openni import openni2
+    except ImportError as exc:  # pragma: no cover - a dependency of this distribution
+        raise DeviceError(f"the Python package 'openni' is missing: {exc}") from None
+    folder = redist or os.environ.get("OPENNI2_REDIST") or DEBIAN_OPENNI2
+    try:
+        openni2.initialize(folder)
+    except Exception as exc:
+        raise DeviceError(
+            f"OpenNI2 could not be loaded from {folder} ({' '.join(str(exc).split())}); install "
+            "it (Debian: apt-get install libopenni2-0 libopenni2-dev) or set OPENNI2_REDIST"
+        ) from None
+    return openni2
+
+
+def initialize_nite(redist: str | None = None) -> Any:
+    """Load NiTE2 from ``redist`` or ``NITE2_REDIST``; :class:`NiteMissingError` otherwise."""
+    folder = redist or os.environ.get("NITE2_REDIST")
+    if not folder:
+        raise NiteMissingError(NITE_HELP + " (neither is set)")
+    lib = Path(folder) / "libNiTE2.so"
+    if not lib.is_file():
+        raise NiteMissingError(f"{NITE_HELP} ({lib} does not exist)")
+    initialize_openni()
+    from openni import nite2
+
+    try:
+        nite2.initialize(folder)
+    except Exception as exc:
+        raise NiteMissingError(f"{NITE_HELP} (loading {lib} failed: {exc})") from None
+    return nite2
+
+
+def open_device(openni2: Any, uri: str | None = None) -> Any:
+    """Open ``uri`` (a device URI or an ``.oni`` path) or the first device."""
+    try:
+        if uri is None:
+            uris = [u for u in openni2.Device.enumerate_uris() if not Path(u.decode()).is_file()]
+            if not uris:
+                raise DeviceError(
+                    "cannot open the first OpenNI2 device: no device is connected (is a Kinect "
+                    "plugged in, powered and readable by this user?)"
+                )
+            return openni2.Device(uris[0])
+        return openni2.Device.open_file(uri.encode())
+    except DeviceError:
+        raise
+    except Exception as exc:
+        what = uri or "the first OpenNI2 device"
+        raise DeviceError(
+            f"cannot open {what}: {' '.join(str(exc).split()) or type(exc).__name__} "
+            "(is a Kinect connected, powered and readable by this user?)"
+        ) from None
+
+
+@dataclass(frozen=True)
+class DepthFrame:
+    """One depth frame: ``depth`` (height, width) uint16 [mm]; ``timestamp_us``; ``index``."""
+
+    index: int
+    timestamp_us: int
+    depth: NDArray[np.uint16]
+
+
+def _sensor(openni2: Any, kind: str) -> Any:
+    return {"depth": openni2.SENSOR_DEPTH, "color": openni2.SENSOR_COLOR, "ir": openni2.SENSOR_IR}[
+        kind
+    ]
+
+
+def iter_oni_frames(path: Path, stream: str = "depth", timeout_s: float = 2.0) -> Iterator[Any]:
+    """Frames of one stream of an ``.oni`` file through OpenNI2, in order, as the binding's
+    ``VideoFrame`` objects (valid until the next one is read)."""
+    scan = scan_oni(path)
+    del scan
+    openni2 = initialize_openni()
+    dev = open_device(openni2, str(path))
+    try:
+        sensor = _sensor(openni2, stream)
+        if not dev.has_sensor(sensor):
+            raise DataFileError(path, f"no {stream} stream in this recording")
+        dev.playback.set_repeat_enabled(False)
+        dev.playback.set_speed(-1.0)  # as fast as frames are read
+        s = dev.create_stream(sensor)
+        n = s.get_number_of_frames()
+        s.start()
+        try:
+            for k in range(n):
+                if openni2.wait_for_any_stream([s], timeout_s) is None:
+                    raise DataFileError(
+                        path, f"{stream} frame {k + 1} of {n}: OpenNI2 delivered no frame"
+                    )
+                frame = s.read_frame()
+                try:
+                    yield frame
+                finally:
+                    frame.close()
+        finally:
+            s.stop()
+            s.close()
+    finally:
+        dev.close()
+
+
+def read_oni_depth(path: Path) -> list[DepthFrame]:
+    """Every depth frame of an ``.oni`` file, (height, width) uint16 [mm] with time stamps."""
+    out: list[DepthFrame] = []
+    for f in iter_oni_frames(path, "depth"):
+        buf = np.frombuffer(bytes(f.get_buffer_as_uint8()), dtype="<u2")
+        depth = buf.reshape(f.height, f.stride // 2)[:, : f.width].copy()
+        out.append(DepthFrame(int(f.frameIndex), int(f.timestamp), depth))
+    return out
+
+
+def oni_info(path: Path) -> dict[str, Any]:
+    """Streams of an ``.oni`` file: resolution, pixel format, frame count, first and last time
+    stamps [us] and measured frame rate [Hz], read through OpenNI2."""
+    scan = scan_oni(path)
+    openni2 = initialize_openni()
+    dev = open_device(openni2, str(path))
+    try:
+        info = dev.get_device_info()
+        device = {
+            "name": info.name.decode(errors="replace"),
+            "vendor": info.vendor.decode(errors="replace"),
+        }
+        has = {k: dev.has_sensor(_sensor(openni2, k)) for k in ("depth", "color", "ir")}
+    finally:
+        dev.close()
+    streams: dict[str, Any] = {}
+    for kind, present in has.items():
+        if not present:
+            continue
+        stamps: list[int] = []
+        mode: dict[str, Any] = {}
+        for f in iter_oni_frames(path, kind):
+            stamps.append(int(f.timestamp))
+            if not mode:
+                vm = f.videoMode
+                mode = {
+                    "width": int(f.width),
+                    "height": int(f.height),
+                    "pixel_format": str(vm.pixelFormat)
+                    .split(".")[-1]
+                    .replace("ONI_PIXEL_FORMAT_", ""),
+                    "nominal_fps": int(vm.fps),
+                    "bytes_per_frame": int(f.dataSize),
+                }
+        rate = (len(stamps) - 1) / ((stamps[-1] - stamps[0]) * 1e-6) if len(stamps) > 1 else None
+        streams[kind] = {
+            **mode,
+            "frames": len(stamps),
+            "first_timestamp_us": stamps[0] if stamps else None,
+            "last_timestamp_us": stamps[-1] if stamps else None,
+            "measured_fps": rate,
+            "timestamps_increasing": bool(np.all(np.diff(stamps) > 0)),
+        }
+    return {"file": str(path), "device": device, "records": scan.n_records, "streams": streams}

@@ -1,0 +1,159 @@
+"""Skeleton conditioning (``mdframework.conditioning``): time stamps, gaps, foot outliers, eq. (7),
+foot length, speed limit. Synthetic bodies with known truth, plus real Kinect walking data."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mdframework import CANONICAL_JOINTS, Skeleton
+from mdframework import conditioning as cond
+from mdframework.config import ConditioningConfig
+
+DATA = Path(__file__).parents[1] / "examples" / "data" / "kinect"
+
+
+def walking_body(n: int = 90, rate: float = 30.0) -> Skeleton:
+    """A smooth canonical body: legs swinging at 1 Hz, feet 0.2 m long, walking at 1 m/s."""
+    t = np.arange(n) / rate
+    pos = np.zeros((n, 17, 3))
+    for j, name in enumerate(CANONICAL_JOINTS):
+        side = 0.1 if name.startswith("l_") else -0.1 if name.startswith("r_") else 0.0
+        height = {"head": 1.7, "neck": 1.45, "base": 0.95}.get(name[2:] if side else name, 1.0)
+        pos[:, j] = [0.0, side, height]
+    phase = 2 * np.pi * t
+    for side, sign in (("l", 1.0), ("r", -1.0)):
+        swing = 0.3 * sign * np.sin(phase)
+        idx = {k: CANONICAL_JOINTS.index(f"{side}_{k}") for k in ("hip", "knee", "ankle", "toe")}
+        pos[:, idx["hip"], 2] = 0.95
+        pos[:, idx["knee"]] = np.stack(
+            [0.45 * np.sin(swing), pos[:, idx["knee"], 1], 0.95 - 0.45 * np.cos(swing)], 1
+        )
+        pos[:, idx["ankle"]] = pos[:, idx["knee"]] + np.stack(
+            [0.45 * np.sin(swing), 0 * t, -0.45 * np.cos(swing)], 1
+        )
+        pos[:, idx["toe"]] = pos[:, idx["ankle"]] + np.stack(
+            [0.2 * np.cos(swing), 0 * t, 0.2 * np.sin(swing) - 0.05], 1
+        )
+    pos[:, :, 0] += t[:, None] * 1.0
+    return Skeleton(t, pos, CANONICAL_JOINTS)
+
+
+def test_sort_timestamps_non_monotonic_and_duplicates() -> None:
+    t = np.array([0.0, 0.1, 0.05, 0.1, 0.2, 0.15])
+    pos = np.arange(6 * 2 * 3, dtype=float).reshape(6, 2, 3)
+    ts, ps, ok, rep = cond.sort_timestamps(t, pos)
+    assert np.all(np.diff(ts) > 0)
+    assert list(ts) == [0.0, 0.05, 0.1, 0.15, 0.2]
+    # the first of the duplicated 0.1 s frames (index 1) is kept, with its own positions
+    assert np.array_equal(ps[2], pos[1]) and np.array_equal(ps[1], pos[2])
+    assert rep["duplicates_dropped"] == 1 and rep["out_of_order"] > 0 and ok.all()
+
+
+def test_nan_and_zero_gaps_bridged_and_long_gaps_flagged() -> None:
+    body = walking_body()
+    pos = body.positions.copy()
+    k = CANONICAL_JOINTS.index("l_toe")
+    pos[30:33, k] = np.nan  # 0.1 s: short
+    pos[50:60, k] = 0.0  # exact zeros = untracked; 0.37 s: long
+    valid = cond.untracked_mask(pos)
+    assert not valid[31, k] and not valid[55, k] and valid[40, k]
+    gaps = cond.find_gaps(body.time, valid)
+    assert [(g[1], g[2]) for g in gaps] == [(30, 32), (50, 59)]
+    sk = Skeleton(body.time, np.where(valid[..., None], pos, np.nan), CANONICAL_JOINTS, valid)
+    out, rep = cond.condition(sk, ConditioningConfig(enabled=True, max_gap_s=0.2))
+    assert np.all(np.isfinite(out.positions)) and out.valid.all()
+    assert [g["first_frame"] for g in rep["gaps"]["long_gaps"]] == [50]
+    assert np.max(np.abs(out.positions[30:33, k] - body.positions[30:33, k])) < 0.01
+    with pytest.raises(ValueError, match="untracked for"):
+        cond.condition(sk, ConditioningConfig(enabled=True, long_gaps="error"))
+
+
+def test_planted_foot_outlier_found_and_corrected() -> None:
+    body = walking_body()
+    pos = body.positions.copy()
+    k = CANONICAL_JOINTS.index("r_toe")
+    truth = pos[40, k].copy()
+    pos[40, k] += [0.35, 0.1, 0.2]  # a Kinect foot jump
+    sk = body.with_positions(pos)
+    out, rep = cond.condition(sk, ConditioningConfig(enabled=True, speed_limit=False))
+    fixed = rep["foot_outliers"]["r_ankle->r_toe"]
+    assert [c["frame"] for c in fixed["corrected"]] == [40]
+    assert fixed["corrected"][0]["direction"] in ("forward", "backward")
+    # predicted from the past: close to the truth (the foot turns a little in one frame)
+    assert np.linalg.norm(out.positions[40, k] - truth) < 0.05
+    # everything else untouched, bit for bit
+    mask = np.ones(pos.shape[:2], bool)
+    mask[40, k] = False
+    assert np.array_equal(out.positions[mask], pos[mask])
+    assert rep["foot_outliers"]["l_ankle->l_toe"]["n_outliers"] == 0
+
+
+def test_clean_data_untouched() -> None:
+    body = walking_body()
+    out, rep = cond.condition(body, ConditioningConfig(enabled=True))
+    assert np.array_equal(out.positions, body.positions)
+    assert rep["speed_limit"]["joints"] == {}
+    assert rep["gaps"]["samples_bridged"] == 0
+    period = rep["knee_ankle_foot_angle"]["l"]["period_s"]
+    assert period == pytest.approx(1.0, abs=0.05)
+
+
+def test_histogram_threshold_separates_jumps() -> None:
+    rng = np.random.default_rng(3)
+    dev = np.abs(rng.normal(0, 0.01, 200))
+    assert cond.histogram_threshold(dev, 0.01, 0.05) == float("inf") or np.all(
+        dev <= cond.histogram_threshold(dev, 0.01, 0.05)
+    )
+    thr = cond.histogram_threshold(np.append(dev, [0.4, 0.5]), 0.01, 0.05)
+    assert dev.max() <= thr < 0.4
+
+
+@pytest.mark.parametrize("angle", [0.0, 1e-8, 1e-4, np.pi / 3, np.pi - 1e-8, np.pi])
+def test_eq7_angle_parallel_and_near_parallel(angle: float) -> None:
+    ankle = np.array([0.3, -0.2, 0.1])
+    knee = ankle + 0.4 * np.array([0.0, 0.0, 1.0])
+    foot = ankle + 0.2 * np.array([np.sin(angle), 0.0, np.cos(angle)])
+    theta = cond.knee_ankle_foot_angle(knee, ankle, foot)
+    assert theta == pytest.approx(angle, rel=1e-6, abs=1e-15)
+    if angle == 0.0:  # arccos would give ~1.5e-8 here; atan2 gives exactly 0
+        assert theta == 0.0
+
+
+def test_foot_length_correction() -> None:
+    body = walking_body()
+    a, t = body.joint("l_ankle"), body.joint("l_toe")
+    new = cond.correct_foot_length(a, t, 0.26)
+    assert np.allclose(np.linalg.norm(new - a, axis=1), 0.26)
+    unit_old = (t - a) / np.linalg.norm(t - a, axis=1, keepdims=True)
+    assert np.allclose((new - a) / 0.26, unit_old)
+
+
+def test_speed_limit_removes_spike_only() -> None:
+    t = np.cumsum(np.r_[0, np.full(59, 1 / 30)])
+    track = np.stack([np.sin(2 * np.pi * t) * 0.2, 0 * t, 0 * t], 1)
+    spiked = track.copy()
+    spiked[20] += [0.3, 0.0, 0.0]  # 9 m/s in and out
+    assert cond.speeds(t, spiked).max() > 8.5
+    out, replaced = cond.limit_speed(t, spiked, 6.0)
+    assert list(np.flatnonzero(replaced)) == [20]
+    assert cond.speeds(t, out).max() < 6.0
+    assert np.array_equal(out[~replaced], spiked[~replaced])
+
+
+def test_real_kinect_walk_feet_slower_after_conditioning() -> None:
+    from mdf_kinect import KinectConfig, KinectSource
+
+    motion = KinectSource(
+        KinectConfig(
+            format="utkinect", file=DATA / "utkinect" / "joints_s01_e01.txt", segment="walk"
+        )
+    ).load()
+    body = motion.canonical()
+    out, _ = cond.condition(body, ConditioningConfig(enabled=True, max_speed_mps=4.0))
+    for toe in ("l_toe", "r_toe"):
+        before = cond.speeds(body.time, body.joint(toe)).max()
+        after = cond.speeds(out.time, out.joint(toe)).max()
+        assert after <= min(before, 4.0) + 1e-9
