@@ -79,6 +79,11 @@ class PersonConfig(_Strict):
         "180 = away. Default 0 when neither this nor heading_deg is given.",
     )
     speed: float | None = Field(None, ge=0, description="Speed for motion = 'straight' [m/s].")
+    facing: Literal["auto", "hips", "travel"] = Field(
+        "auto",
+        description="How the recording's own facing direction is found: from the hip line, "
+        "from the direction of travel, or auto (travel if the hip centre moves > 0.5 m).",
+    )
 
     @model_validator(mode="after")
     def _check(self) -> PersonConfig:

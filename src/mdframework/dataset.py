@@ -76,6 +76,11 @@ class SourceEntry(_Strict):
     )
     hop: float | None = Field(None, gt=0, description="Step between records [s]; default: length.")
     max_records: int | None = Field(None, ge=1, description="At most this many windows.")
+    run: dict[str, Any] = Field(
+        default_factory=dict,
+        description="Run-config sections for this source only, merged over `base` (e.g. "
+        "conditioning for Kinect recordings, or its own scene).",
+    )
 
 
 class Variations(_Strict):
@@ -165,6 +170,17 @@ def _scene_for(base_scene: dict[str, Any], variation: dict[str, Any]) -> dict[st
     return scene
 
 
+def _merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
+    """Deep merge of config dicts: tables merge key by key, other values are replaced."""
+    out = json.loads(json.dumps(base))
+    for key, value in over.items():
+        if isinstance(value, dict) and isinstance(out.get(key), dict):
+            out[key] = _merge(out[key], value)
+        else:
+            out[key] = json.loads(json.dumps(value))
+    return out
+
+
 def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
     """Expand sources x windows x variations into record specs, in a fixed order."""
     v = config.variations
@@ -200,9 +216,9 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
                 section = {**motion, "start": round(float(start), 9), "duration": length}
                 if height is not None:
                     section["height"] = height
-                run = {**json.loads(json.dumps(config.base)), "motion": section}
+                run = {**_merge(config.base, entry.run), "motion": section}
                 run["scene"] = _scene_for(
-                    config.base.get("scene", {}),
+                    run.get("scene", {}),
                     {"aspect_deg": aspect, "radar_range": rng_, "radar_height": rheight},
                 )
                 index = len(specs)

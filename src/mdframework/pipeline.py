@@ -1,7 +1,8 @@
 """The run pipeline: wires the stages, computes nothing itself.
 
-motion source -> window -> canonical body -> scene placement -> resampling to pulse times ->
-scatterers and RCS -> ranges (checked) -> radar receive + pulse compression -> spectrogram.
+motion source -> canonical body -> conditioning -> scene placement -> window -> resampling to
+pulse times -> scatterers and RCS -> effects (scatterers) -> ranges (checked) -> radar receive
+and pulse compression -> effects (received) -> spectrogram.
 """
 
 from __future__ import annotations
@@ -97,7 +98,12 @@ def _apply_effects(
 def place_body(body: Skeleton, person: PersonConfig, radar_position: FloatArray) -> Skeleton:
     """Put a canonical body into the scene as ``person`` says (see :func:`physics.scene.place`)."""
     base = body.joint("base")
-    heading_now = scene.facing_heading(body.joint("l_hip"), body.joint("r_hip"))
+    try:
+        heading_now = scene.body_heading(
+            base, body.joint("l_hip"), body.joint("r_hip"), rule=person.facing
+        )
+    except ValueError as exc:
+        raise SceneError(f"scene.person.facing: {exc}") from None
     if person.heading_deg is not None:
         heading = np.deg2rad(person.heading_deg)
     else:
@@ -153,8 +159,9 @@ def simulate_motion(
             f"scatterers.kind: the {stages.model.name!r} model needs a human body, but this "
             f"motion ({motion.metadata.get('source', 'unknown')}) has no canonical joints"
         )
+    # conditioning and placement see the whole recording (facing, drift, outlier statistics);
+    # the record is then a window of the placed recording
     body = motion.canonical() if stages.model.needs_canonical else motion.skeleton
-    body = _window(body, cfg.motion.start, cfg.motion.duration)
     body, conditioning_report = _condition(body, config.conditioning)
     if stages.model.needs_canonical:
         body = place_body(body, sc.person, radar_pos)
@@ -166,6 +173,7 @@ def simulate_motion(
         )
     else:
         placement = {"motion": "as given"}
+    body = _window(body, cfg.motion.start, cfg.motion.duration)
 
     t = interpolation.pulse_times(body.time[0], body.time[-1], wf.prf)
     joints = interpolation.resample_tracks(

@@ -28,6 +28,38 @@ def facing_heading(left_hip: FloatArray, right_hip: FloatArray) -> float:
     return float(np.arctan2(-left[0], left[1]))
 
 
+def travel_heading(base: FloatArray) -> tuple[float, float]:
+    """Heading [rad] of the straight line from the first to the last hip-centre position
+    (n_frames, 3) [m], and the horizontal distance [m] travelled along it."""
+    d = base[-1, :2] - base[0, :2]
+    return float(np.arctan2(d[1], d[0])), float(np.hypot(d[0], d[1]))
+
+
+def body_heading(
+    base: FloatArray,
+    left_hip: FloatArray,
+    right_hip: FloatArray,
+    *,
+    rule: str = "auto",
+    min_travel: float = 0.5,
+) -> float:
+    """The direction [rad] a recording's body is taken to face.
+
+    ``hips``: perpendicular to the hip line (:func:`facing_heading`); ``travel``: the direction
+    of travel of the hip centre (:func:`travel_heading`); ``auto``: travel when the hip centre
+    moves more than ``min_travel`` [m] over the recording (walking, running: the hip line of a
+    Kinect seen from the side is unreliable), else the hips (boxing, jumping in place).
+    """
+    if rule not in ("auto", "hips", "travel"):
+        raise ValueError(f"unknown facing rule {rule!r}")
+    heading, distance = travel_heading(base)
+    if rule == "travel" or (rule == "auto" and distance > min_travel):
+        if distance < 1e-6:
+            raise ValueError("cannot find the direction of travel: the hip centre does not move")
+        return heading
+    return facing_heading(left_hip, right_hip)
+
+
 def linear_drift(time: FloatArray, track: FloatArray) -> FloatArray:
     """Least-squares straight-line fit of a horizontal track: (n_frames, 2) [m], evaluated at
     ``time`` and zero at the first frame (the translation a treadmill removes)."""
