@@ -172,7 +172,7 @@ def _scene_for(base_scene: dict[str, Any], variation: dict[str, Any]) -> dict[st
 
 def _merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
     """Deep merge of config dicts: tables merge key by key, other values are replaced."""
-    out = json.loads(json.dumps(base))
+    out: dict[str, Any] = json.loads(json.dumps(base))
     for key, value in over.items():
         if isinstance(value, dict) and isinstance(out.get(key), dict):
             out[key] = _merge(out[key], value)
