@@ -5,6 +5,18 @@ between its segment and the line of sight to the radar. A segment whose joints c
 length, e.g. untracked Kinect joints; here: shorter than 10 % of its nominal length 2c) keeps
 the last valid orientation (the first valid one before it); a part that is never valid is
 treated as a sphere of its radius.
+
+``surface_points = N > 0`` (for the accuracy ladder, ``benchmarks/bench_accuracy.py``) replaces
+each part's single scatterer by N points on its surface: a Fibonacci (near equal-area) set
+``s_j`` on the unit sphere mapped to the spheroid, ``x_j = centre + Rot diag(a, a, c) s_j``, with
+``Rot`` taking the local z axis onto the segment. Each point carries the part's RCS ``sigma``
+(the single-point model's GO value for that pulse) times the share of the part's projected area
+it represents toward the radar: for the line of sight ``u`` (local frame, unit), the projected area
+element of the mapped sphere point is proportional to ``max(0, s_j . (u_x/a, u_y/a, u_z/c))``, so
+points on the shadowed side carry nothing and the weights sum to one: the *incoherent* power sum
+equals the single-point RCS, while the coherent sum now spreads each limb's return over the
+Doppler of its surface (points far from a joint move faster). The points are independent point
+scatterers (no surface-integral phase), so ``semi_axes``/``axes`` are not given in this mode.
 """
 
 from __future__ import annotations
@@ -37,6 +49,13 @@ class EllipsoidConfig(PluginConfig):
     sphere_rcs: Literal["optical", "mie"] = Field(
         "optical", description="Sphere RCS: optical pi r^2, or the exact Mie series."
     )
+    surface_points: int = Field(
+        0,
+        ge=0,
+        le=1024,
+        description="0: one scatterer per part; N > 0: N points on each part's surface, "
+        "weighted by their projected area toward the radar.",
+    )
     height: float | None = Field(
         None,
         gt=0.5,
@@ -56,6 +75,55 @@ def hold_last_valid(axes: np.ndarray, ok: np.ndarray) -> tuple[np.ndarray, np.nd
     idx = np.where(idx < 0, first[None, :], idx)
     filled = np.take_along_axis(axes, idx[:, :, None], axis=0)
     return filled, ~np.any(ok, axis=0)
+
+
+def fibonacci_sphere(n: int) -> np.ndarray:
+    """``n`` near equal-area unit vectors (n, 3) (Fibonacci lattice)."""
+    k = np.arange(n, dtype=np.float64) + 0.5
+    z = 1.0 - 2.0 * k / n
+    r = np.sqrt(np.clip(1.0 - z * z, 0.0, None))
+    phi = np.pi * (3.0 - np.sqrt(5.0)) * k
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
+
+
+def segment_frames(axes: np.ndarray) -> np.ndarray:
+    """Rotations (n_pulses, n_parts, 3, 3) whose third column is the unit ``axes`` (n_pulses,
+    n_parts, 3). The roll about the axis is fixed by one helper direction per part over the
+    whole record (the world axis least aligned with the segment at any pulse), so the frame
+    turns smoothly with the segment and surface points do not jump between pulses."""
+    n = np.linalg.norm(axes, axis=-1, keepdims=True)
+    z = np.where(n > 0, axes / np.where(n > 0, n, 1.0), np.array([0.0, 0.0, 1.0]))
+    worst = np.max(np.abs(z), axis=0)
+    helper = np.eye(3)[np.argmin(worst, axis=-1)][None, :, :]
+    x = helper - np.sum(helper * z, -1, keepdims=True) * z
+    x /= np.linalg.norm(x, axis=-1, keepdims=True)
+    return np.stack([x, np.cross(z, x), z], axis=-1)
+
+
+def surface_scatterers(
+    pos: np.ndarray,
+    axes: np.ndarray,
+    a: np.ndarray,
+    semi_c: np.ndarray,
+    sigma: np.ndarray,
+    radar_position: np.ndarray,
+    n_points: int,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Surface points (n_pulses, n_parts * n_points, 3) [m] and their RCS (n_pulses,
+    n_parts * n_points) [m^2] (see the module docstring), part-major order."""
+    s = fibonacci_sphere(n_points)
+    rot = segment_frames(axes)
+    scale = np.stack([a, a, semi_c], axis=1)
+    local = s[None, :, :] * scale[:, None, :]
+    pts = pos[:, :, None, :] + np.einsum("psij,sqj->psqi", rot, local)
+    los = np.asarray(radar_position, dtype=np.float64) - pos
+    u = np.einsum("psji,psj->psi", rot, los)
+    u /= np.linalg.norm(u, axis=-1, keepdims=True)
+    w = np.einsum("qj,psj->psq", s, u / scale[None, :, :])
+    w = np.clip(w, 0.0, None)
+    w /= np.sum(w, axis=-1, keepdims=True)
+    n_p, n_s = sigma.shape
+    return pts.reshape(n_p, n_s * n_points, 3), (sigma[:, :, None] * w).reshape(n_p, -1)
 
 
 class EllipsoidBody(ScattererModel):
@@ -89,5 +157,10 @@ class EllipsoidBody(ScattererModel):
             else:
                 value = rcs.sphere_rcs_optical(a[spheres])
             sigma[:, spheres] = value
+        names = tuple(p.name for p in parts)
+        if c.surface_points > 0:
+            n = c.surface_points
+            pts, sig = surface_scatterers(pos, axes, a, semi_c, sigma, radar_position, n)
+            return Scatterers(pts, sig, tuple(f"{m}#{j}" for m in names for j in range(n)))
         semi_axes = np.stack([a, a, semi_c], axis=1)
         return Scatterers(pos, sigma, tuple(p.name for p in parts), semi_axes, axes)

@@ -9,6 +9,12 @@ Two receive paths:
 
 Both are normalised by the pulse width, so a lone scatterer at the gate gives its range-equation
 amplitude.
+
+``precision = "float32"`` (analytic path only; for the accuracy ladder, ``benchmarks/
+bench_accuracy.py``): the carrier phase is still reduced to a fraction of a cycle in float64 from
+float64 ranges (``physics.md`` section 6.1), then the phasor, the gate weights, the amplitudes and
+the sum over scatterers are float32 / complex64; the result is returned as complex128. The
+default ``float64`` is the reference.
 """
 
 from __future__ import annotations
@@ -46,6 +52,11 @@ class LfmConfig(PluginConfig):
         description="Analytic path: range weighting of scatterers in the gate (exact LFM "
         "response, its sinc limit, or none).",
     )
+    precision: Literal["float64", "float32"] = Field(
+        "float64",
+        description="Analytic path: arithmetic after the float64 phase reduction (float32: "
+        "complex64 phasors and sums).",
+    )
     sample_rate: float | None = Field(
         None, gt=0, description="Raw path: fast-time sample rate [Hz]; default 2 x bandwidth."
     )
@@ -57,6 +68,8 @@ class LfmConfig(PluginConfig):
     def _check(self) -> LfmConfig:
         if self.bandwidth * self.pulse_width < 1.0:
             raise ValueError("bandwidth x pulse_width must be >= 1 for a pulse-compression radar")
+        if self.precision == "float32" and self.path == "raw":
+            raise ValueError("precision 'float32' is implemented for the analytic path only")
         if self.sample_rate is not None and self.sample_rate < self.bandwidth:
             raise ValueError("sample_rate must be >= bandwidth (complex sampling)")
         return self
@@ -96,6 +109,8 @@ class LfmPulseDoppler(RadarWaveform):
         """Compressed slow-time return at the gate (and a range-time map on the raw path)."""
         amp = self.amplitudes(ranges, rcs)
         c = self.config
+        if c.path == "analytic" and c.precision == "float32":
+            return Received(self._receive_float32(ranges, amp, gate_range))
         if c.path == "analytic":
             signal = radar.compressed_return_at_gate(
                 ranges,
@@ -108,6 +123,26 @@ class LfmPulseDoppler(RadarWaveform):
             )
             return Received(signal)
         return self._receive_raw(ranges, amp, gate_range)
+
+    def _receive_float32(
+        self, ranges: np.ndarray, amp: np.ndarray, gate_range: np.ndarray
+    ) -> np.ndarray:
+        """The analytic return with complex64 arithmetic after a float64 phase reduction."""
+        c = self.config
+        w = radar.gate_weights(
+            ranges,
+            gate_range,
+            pulse_width=c.pulse_width,
+            bandwidth=c.bandwidth,
+            response=c.gate_response,
+        ).astype(np.float32)
+        frac = radar.carrier_cycles_fraction(ranges, c.carrier_frequency)
+        phase = ((-2.0 * np.pi) * frac).astype(np.float32)
+        phasor = np.empty(phase.shape, dtype=np.complex64)
+        phasor.real = np.cos(phase)
+        phasor.imag = np.sin(phase)
+        total = np.sum((amp.astype(np.float32) * w) * phasor, axis=1, dtype=np.complex64)
+        return np.asarray(total, dtype=np.complex128)
 
     def fast_time_grid(self, ranges: np.ndarray) -> np.ndarray:
         """Fast-time samples [s] covering every echo of the record plus the range margin."""

@@ -1,0 +1,181 @@
+"""Antenna gain pattern (effect kind ``antenna``, stage ``scatterers``).
+
+The waveform's ``gain_dbi`` is the boresight gain ``G_0`` in the range equation; this effect
+applies the pattern *relative to boresight*, ``g(direction) = G(direction)/G_0 <= 1`` (one-way,
+power). The radar is monostatic with one antenna for transmit and receive, so the received power
+of a scatterer scales by ``g^2`` (two-way) and its RCS is multiplied by ``g^2``; a scatterer at
+the one-way -3 dB edge of the beam (``theta = beamwidth/2`` off boresight) is 6 dB down.
+
+Geometry: the boresight unit vector ``b`` points along azimuth ``az`` (from +x toward +y) and
+elevation ``el`` (up from horizontal); ``e_az = (-sin az, cos az, 0)`` and
+``e_el = b x ... = (-cos az sin el, -sin az sin el, cos el)`` complete the antenna frame. A unit
+direction ``d`` from the radar to a scatterer has components ``(d.b, d.e_az, d.e_el)``.
+
+Patterns (``beamwidth_*_deg`` are full one-way half-power widths):
+
+- ``gaussian``: ``g = exp(-4 ln2 (theta_az^2/BW_az^2 + theta_el^2/BW_el^2))`` with the angles
+  ``theta_az = atan2(d.e_az, d.b)`` and ``theta_el = atan2(d.e_el, d.b)``; ``g = 1/2`` exactly at
+  ``theta = BW/2`` in either plane. A smooth main-beam model without sidelobes.
+- ``uniform``: a uniformly illuminated rectangular aperture,
+  ``g = sinc^2(D_az u / lambda) sinc^2(D_el v / lambda)`` in sine space ``u = d.e_az``,
+  ``v = d.e_el``, with the aperture widths ``D/lambda = x_h / sin(BW/2)`` chosen so that
+  ``sinc^2(x_h) = 1/2`` (x_h = 0.4429): -3 dB at the beam edge, first sidelobes -13.3 dB, nulls.
+
+Directions behind the aperture plane (``d.b <= 0``) get ``g = 0`` (no back lobe).
+
+Pointing: ``pointing = "target"`` aims the boresight at the mean position of the gate's
+reference point (the hip centre ``base``, or the first joint of a non-human motion) over the
+record; ``steering = "track"`` re-aims it at that point on every pulse (a tracking antenna);
+``pointing = "angles"`` uses ``azimuth_deg`` and ``elevation_deg``.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import Field, model_validator
+from scipy.optimize import brentq
+
+from mdframework import Effect, PluginConfig, Scatterers, SceneContext
+
+FloatArray = NDArray[np.float64]
+
+#: ``x_h`` with ``sinc(x_h)^2 = 1/2`` (normalised sinc): the half-power point of a uniform aperture.
+SINC2_HALF_POWER: float = float(brentq(lambda x: np.sinc(x) ** 2 - 0.5, 0.1, 0.9, xtol=1e-15))
+
+
+class AntennaConfig(PluginConfig):
+    """Antenna gain pattern relative to boresight, applied two-way to every scatterer."""
+
+    kind: Literal["antenna"] = "antenna"
+    pattern: Literal["gaussian", "uniform"] = Field(
+        "gaussian",
+        description="gaussian: Gaussian main beam; uniform: sinc^2 of a uniform rectangular "
+        "aperture (with sidelobes and nulls).",
+    )
+    beamwidth_az_deg: float = Field(
+        20.0, gt=0, lt=180, description="Full one-way -3 dB beamwidth in azimuth [deg]."
+    )
+    beamwidth_el_deg: float | None = Field(
+        None,
+        gt=0,
+        lt=180,
+        description="Full one-way -3 dB beamwidth in elevation [deg]; "
+        "default: the azimuth beamwidth.",
+    )
+    pointing: Literal["target", "angles"] = Field(
+        "target",
+        description="target: aim at the gate's reference point (hip centre); angles: use "
+        "azimuth_deg and elevation_deg.",
+    )
+    steering: Literal["fixed", "track"] = Field(
+        "fixed",
+        description="pointing 'target': fixed at the record's mean position, or re-aimed on "
+        "every pulse.",
+    )
+    azimuth_deg: float = Field(
+        180.0, description="pointing 'angles': boresight azimuth, from +x toward +y [deg]."
+    )
+    elevation_deg: float = Field(
+        0.0, ge=-90, le=90, description="pointing 'angles': boresight elevation [deg]."
+    )
+
+    @model_validator(mode="after")
+    def _check(self) -> AntennaConfig:
+        if self.pointing == "angles" and self.steering == "track":
+            raise ValueError("steering 'track' needs pointing 'target'")
+        return self
+
+
+def antenna_frame(boresight: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Unit vectors ``(b, e_az, e_el)``, each (..., 3), of boresight directions (..., 3)."""
+    b = boresight / np.linalg.norm(boresight, axis=-1, keepdims=True)
+    az = np.arctan2(b[..., 1], b[..., 0])
+    el = np.arcsin(np.clip(b[..., 2], -1.0, 1.0))
+    e_az = np.stack([-np.sin(az), np.cos(az), np.zeros_like(az)], axis=-1)
+    e_el = np.stack([-np.cos(az) * np.sin(el), -np.sin(az) * np.sin(el), np.cos(el)], axis=-1)
+    return b, e_az, e_el
+
+
+def one_way_gain(
+    directions: FloatArray,
+    boresight: FloatArray,
+    *,
+    pattern: str,
+    beamwidth_az: float,
+    beamwidth_el: float,
+) -> FloatArray:
+    """One-way power gain relative to boresight (<= 1) of directions (..., 3) (any length, not
+    zero) for boresights broadcastable to them; beamwidths are full -3 dB widths [rad]."""
+    d = np.asarray(directions, dtype=np.float64)
+    norm = np.linalg.norm(d, axis=-1, keepdims=True)
+    d = d / np.where(norm > 0, norm, 1.0)
+    b, e_az, e_el = antenna_frame(np.asarray(boresight, dtype=np.float64))
+    xb = np.sum(d * b, axis=-1)
+    xa = np.sum(d * e_az, axis=-1)
+    xe = np.sum(d * e_el, axis=-1)
+    if pattern == "gaussian":
+        ta = np.arctan2(xa, xb)
+        te = np.arctan2(xe, xb)
+        g = np.exp(-4.0 * np.log(2.0) * ((ta / beamwidth_az) ** 2 + (te / beamwidth_el) ** 2))
+    elif pattern == "uniform":
+        da = SINC2_HALF_POWER / np.sin(beamwidth_az / 2.0)
+        de = SINC2_HALF_POWER / np.sin(beamwidth_el / 2.0)
+        g = np.sinc(da * xa) ** 2 * np.sinc(de * xe) ** 2
+    else:
+        raise ValueError(f"unknown pattern {pattern!r}")
+    return np.asarray(np.where(xb > 0, g, 0.0), dtype=np.float64)
+
+
+def reference_track(context: SceneContext) -> FloatArray:
+    """The gate's reference point over the pulses, (n_pulses, 3) [m]: ``base`` or joint 0."""
+    skel = context.skeleton
+    ref = skel.index("base") if "base" in skel.joint_names else 0
+    return np.asarray(skel.positions[:, ref, :], dtype=np.float64)
+
+
+class AntennaPattern(Effect):
+    """Multiplies each scatterer's RCS by the two-way pattern gain ``g^2`` of its direction."""
+
+    name = "antenna"
+    Config = AntennaConfig
+    config: AntennaConfig
+    stage = "scatterers"
+
+    def __init__(self, config: PluginConfig) -> None:
+        super().__init__(config)
+        self._stats: dict[str, Any] = {}
+
+    def boresight(self, context: SceneContext) -> FloatArray:
+        """Boresight vector(s): (3,) or (n_pulses, 1, 3) when tracking."""
+        c = self.config
+        radar = np.asarray(context.radar_position, dtype=np.float64)
+        if c.pointing == "angles":
+            az, el = np.deg2rad(c.azimuth_deg), np.deg2rad(c.elevation_deg)
+            return np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
+        track = reference_track(context) - radar
+        if c.steering == "track":
+            return track[:, None, :]
+        return np.asarray(np.mean(track, axis=0), dtype=np.float64)
+
+    def apply(self, data: Scatterers, context: SceneContext) -> Scatterers:
+        """Scatterers with RCS times the two-way gain."""
+        c = self.config
+        bw_az = np.deg2rad(c.beamwidth_az_deg)
+        bw_el = bw_az if c.beamwidth_el_deg is None else np.deg2rad(c.beamwidth_el_deg)
+        boresight = self.boresight(context)
+        d = data.positions - np.asarray(context.radar_position, dtype=np.float64)
+        g = one_way_gain(d, boresight, pattern=c.pattern, beamwidth_az=bw_az, beamwidth_el=bw_el)
+        b = np.asarray(boresight).reshape(-1, 3)[0]
+        self._stats = {
+            "boresight_azimuth_deg": float(np.degrees(np.arctan2(b[1], b[0]))),
+            "boresight_elevation_deg": float(np.degrees(np.arcsin(b[2] / np.linalg.norm(b)))),
+            "min_two_way_gain_db": float(10 * np.log10(max(float(np.min(g)) ** 2, 1e-300))),
+        }
+        return data.replace(rcs=data.rcs * g * g)
+
+    def describe(self) -> dict[str, Any]:
+        """The config plus the boresight (first pulse when tracking) and the smallest gain."""
+        return {**self.config.model_dump(), **self._stats}

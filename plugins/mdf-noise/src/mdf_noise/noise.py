@@ -1,0 +1,168 @@
+"""Receiver noise (effect kind ``noise``, stage ``received``).
+
+Circular complex white Gaussian noise ``n(k)`` is added to the pulse-compressed slow-time return
+at the range gate (``Received.signal``), one independent sample per pulse, drawn from the run's
+seeded generator. ``sigma^2 = E|n(k)|^2`` [W] (the units of ``|signal|^2``: the waveform
+normalises its compressed output so that a lone scatterer at the gate gives its range-equation
+amplitude, i.e. the matched-filter output divided by the pulse width ``tau``). ``sigma^2`` is
+set in one of two ways:
+
+``mode = "snr"``
+    ``snr_db`` is the **per-pulse SNR after pulse compression at the range gate**:
+    ``SNR = mean_k |y(k)|^2 / sigma^2``, where ``y`` is the noise-free compressed return (the
+    mean over the whole record, so it includes the body's own fluctuations). It is a property of
+    the slow-time samples, not of the spectrogram: an STFT frame with window ``w`` (length L)
+    integrates a tone coherently, so a single tone of power ``P`` peaks at ``P (sum w)^2`` while
+    the noise floor per bin is ``sigma^2 sum w^2``; the spectrogram's tone-to-floor ratio is
+    ``SNR (sum w)^2 / sum w^2`` (``0.667 L`` for a Hann window, 22.3 dB for L = 256).
+
+``mode = "thermal"``
+    The radar equation's receiver: noise power at the receiver input
+    ``N = k_B T F B_n`` (Boltzmann's constant, system temperature ``T`` [K], noise figure ``F``
+    (linear), noise bandwidth ``B_n`` [Hz], default the waveform's chirp bandwidth ``B``). The
+    matched filter raises the SNR by the time-bandwidth product ``tau B``, so in the normalised
+    output ``sigma^2 = k_B T F B_n / (tau B)``, which is ``k_B T F / tau`` when ``B_n = B``.
+    Paired with the waveform's range-equation amplitudes this gives the physical SNR of a target
+    at any range. ``tau`` and ``B`` are read from the waveform's config (``pulse_width``,
+    ``bandwidth``) or given here.
+
+When the waveform also returns a range-time map (``Received.range_time``, the raw path), noise of
+the same variance is added to every range cell, independently per cell: after pulse compression
+neighbouring cells' noise is in fact correlated over ``1/B``, which this does not model.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import Field, model_validator
+
+from mdframework import Effect, PluginConfig, Received, SceneContext, SceneError
+from mdframework.constants import BOLTZMANN
+
+ComplexArray = NDArray[np.complex128]
+
+
+class NoiseConfig(PluginConfig):
+    """Receiver noise, from an SNR or from the receiver's noise figure and temperature."""
+
+    kind: Literal["noise"] = "noise"
+    mode: Literal["snr", "thermal"] = Field(
+        "snr",
+        description="snr: noise set by snr_db relative to the signal; thermal: k T F B from "
+        "the receiver (physical SNR through the range equation).",
+    )
+    snr_db: float = Field(
+        20.0,
+        description="mode snr: mean power of the noise-free compressed return at the gate over "
+        "the noise power per pulse [dB] (per pulse, after pulse compression).",
+    )
+    noise_figure_db: float = Field(
+        3.0, ge=0, description="mode thermal: receiver noise figure F [dB]."
+    )
+    temperature: float = Field(
+        290.0, gt=0, description="mode thermal: system noise temperature T [K]."
+    )
+    noise_bandwidth: float | None = Field(
+        None, gt=0, description="mode thermal: noise bandwidth B_n [Hz]; default: chirp bandwidth."
+    )
+    pulse_width: float | None = Field(
+        None, gt=0, description="mode thermal: pulse width tau [s]; default: the waveform's."
+    )
+    bandwidth: float | None = Field(
+        None, gt=0, description="mode thermal: chirp bandwidth B [Hz]; default: the waveform's."
+    )
+
+    @model_validator(mode="after")
+    def _check(self) -> NoiseConfig:
+        if self.mode == "snr" and not np.isfinite(self.snr_db):
+            raise ValueError("snr_db must be finite")
+        return self
+
+
+def noise_power(
+    mode: str,
+    *,
+    signal: ComplexArray | None = None,
+    snr_db: float = 20.0,
+    noise_figure_db: float = 3.0,
+    temperature: float = 290.0,
+    noise_bandwidth: float | None = None,
+    pulse_width: float = 1e-6,
+    bandwidth: float = 150e6,
+) -> float:
+    """Noise power per compressed slow-time sample ``sigma^2`` [W] (see the module docstring).
+
+    ``signal`` (n_pulses,) complex: the noise-free compressed return (mode ``snr``).
+    """
+    if mode == "snr":
+        if signal is None:
+            raise ValueError("mode 'snr' needs the signal")
+        p_signal = float(np.mean(np.abs(signal) ** 2)) if signal.size else 0.0
+        return p_signal * 10.0 ** (-snr_db / 10.0)
+    if mode == "thermal":
+        b_n = bandwidth if noise_bandwidth is None else noise_bandwidth
+        f = 10.0 ** (noise_figure_db / 10.0)
+        return BOLTZMANN * temperature * f * b_n / (pulse_width * bandwidth)
+    raise ValueError(f"unknown noise mode {mode!r}")
+
+
+def complex_noise(rng: np.random.Generator, shape: tuple[int, ...], power: float) -> ComplexArray:
+    """Circular complex Gaussian samples with ``E|n|^2 = power`` [W], complex128."""
+    scale = np.sqrt(power / 2.0)
+    out = np.empty(shape, dtype=np.complex128)
+    out.real = rng.standard_normal(shape) * scale
+    out.imag = rng.standard_normal(shape) * scale
+    return out
+
+
+class ReceiverNoise(Effect):
+    """Adds seeded complex white Gaussian receiver noise to the compressed return."""
+
+    name = "noise"
+    Config = NoiseConfig
+    config: NoiseConfig
+    stage = "received"
+
+    def __init__(self, config: PluginConfig) -> None:
+        super().__init__(config)
+        self._power: float | None = None
+
+    def _waveform_param(self, context: SceneContext, field: str) -> float:
+        given = getattr(self.config, field)
+        if given is not None:
+            return float(given)
+        value = getattr(getattr(context.waveform, "config", None), field, None)
+        if value is None:
+            raise SceneError(
+                f"effects.noise: mode 'thermal' needs {field}; the {context.waveform.name!r} "
+                "waveform does not give it, so set it in the effect"
+            )
+        return float(value)
+
+    def apply(self, data: Received, context: SceneContext) -> Received:
+        """The received data plus noise of power :func:`noise_power`."""
+        c = self.config
+        if c.mode == "snr":
+            power = noise_power("snr", signal=data.signal, snr_db=c.snr_db)
+        else:
+            power = noise_power(
+                "thermal",
+                noise_figure_db=c.noise_figure_db,
+                temperature=c.temperature,
+                noise_bandwidth=c.noise_bandwidth,
+                pulse_width=self._waveform_param(context, "pulse_width"),
+                bandwidth=self._waveform_param(context, "bandwidth"),
+            )
+        self._power = power
+        signal = data.signal + complex_noise(context.rng, data.signal.shape, power)
+        range_time = data.range_time
+        if range_time is not None:
+            range_time = range_time + complex_noise(context.rng, range_time.shape, power)
+        return Received(signal, range_time, data.range_axis)
+
+    def describe(self) -> dict[str, Any]:
+        """The config plus the noise power per compressed sample [W]."""
+        return {**self.config.model_dump(), "noise_power_w": self._power}

@@ -1,0 +1,449 @@
+"""Physics of the built-in scene effects (noise, clutter, multipath, antenna, attenuation) and
+the rule that an effect the scene does not call for does no work."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+from mdf_antenna import AntennaPattern, one_way_gain
+from mdf_antenna.antenna import SINC2_HALF_POWER
+from mdf_attenuation import Attenuation
+from mdf_clutter import GroundClutter
+from mdf_lfm import LfmPulseDoppler
+from mdf_mujoco import Shadowing
+from mdf_multipath import GroundMultipath
+from mdf_noise import ReceiverNoise
+
+from mdframework import Received, SceneContext, Skeleton
+from mdframework.config import validate_run_config
+from mdframework.constants import BOLTZMANN, SPEED_OF_LIGHT
+from mdframework.physics import radar
+from mdframework.physics.spectrogram import spectrogram
+from mdframework.pipeline import RunResult, simulate
+
+LAM = SPEED_OF_LIGHT / 15e9
+ALL_EFFECTS = (
+    ReceiverNoise,
+    GroundClutter,
+    GroundMultipath,
+    AntennaPattern,
+    Attenuation,
+    Shadowing,
+)
+
+
+def run(
+    targets: list[dict[str, Any]],
+    effects: list[dict[str, Any]],
+    *,
+    radar_position: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    duration: float = 2.0,
+    radar_cfg: dict[str, Any] | None = None,
+    gate: str | float = "track",
+    seed: int = 0,
+    processing: dict[str, Any] | None = None,
+) -> RunResult:
+    cfg = {
+        "motion": {"kind": "point_targets", "duration": duration, "targets": targets},
+        "scatterers": {"kind": "points"},
+        "radar": {"kind": "lfm", **(radar_cfg or {})},
+        "scene": {"radar_position": list(radar_position), "gate": gate},
+        "processing": processing or {},
+        "effects": effects,
+        "seed": seed,
+    }
+    return simulate(validate_run_config(cfg))
+
+
+APPROACHING = [{"position": [20.0, 0.0, 0.0], "velocity": [-1.0, 0.0, 0.0], "rcs": 1.0}]
+
+
+# --------------------------------------------------------------------------- noise
+
+
+@pytest.mark.parametrize("snr_db", [-10.0, 0.0, 20.0])
+def test_noise_power_matches_requested_snr(snr_db: float) -> None:
+    clean = run(APPROACHING, [])
+    noisy = run(APPROACHING, [{"kind": "noise", "snr_db": snr_db}])
+    noise = noisy.received.signal - clean.received.signal
+    p_sig = np.mean(np.abs(clean.received.signal) ** 2)
+    measured = 10 * np.log10(p_sig / np.mean(np.abs(noise) ** 2))
+    # 4800 complex samples: the power estimate has a relative std of 1/sqrt(4800) = 1.4 %
+    assert measured == pytest.approx(snr_db, abs=0.25)
+    # white and circular: real and imaginary parts carry equal power, neighbours uncorrelated
+    assert np.var(noise.real) / np.var(noise.imag) == pytest.approx(1.0, abs=0.1)
+    rho = np.abs(np.mean(noise[1:] * np.conj(noise[:-1]))) / np.mean(np.abs(noise) ** 2)
+    assert rho < 0.06
+    assert noisy.metadata["effects"][0]["noise_power_w"] == pytest.approx(
+        p_sig * 10 ** (-snr_db / 10), rel=1e-12
+    )
+
+
+def test_thermal_noise_is_kTF_over_tau_after_compression() -> None:
+    tau, bw, nf_db, temp = 2e-6, 150e6, 4.0, 500.0
+    eff = {"kind": "noise", "mode": "thermal", "noise_figure_db": nf_db, "temperature": temp}
+    rcfg = {"pulse_width": tau, "bandwidth": bw}
+    clean = run(APPROACHING, [], radar_cfg=rcfg)
+    noisy = run(APPROACHING, [eff], radar_cfg=rcfg)
+    expected = BOLTZMANN * temp * 10 ** (nf_db / 10) / tau  # k T F B / (tau B)
+    noise = noisy.received.signal - clean.received.signal
+    assert np.mean(np.abs(noise) ** 2) == pytest.approx(expected, rel=0.06)
+    # thermal noise does not depend on the signal (unlike mode 'snr')
+    strong = [{**APPROACHING[0], "rcs": 100.0}]
+    noisy_strong = run(strong, [eff], radar_cfg=rcfg)
+    assert noisy_strong.metadata["effects"][0]["noise_power_w"] == pytest.approx(expected)
+
+
+def test_noise_floor_in_spectrogram_is_sigma2_sum_w2() -> None:
+    """The SNR is per pulse; in the spectrogram the floor per bin is sigma^2 sum(w^2)."""
+    noisy = run(APPROACHING, [{"kind": "noise", "snr_db": 0.0}])
+    clean = run(APPROACHING, [])
+    sigma2 = noisy.metadata["effects"][0]["noise_power_w"]
+    spec = spectrogram(noisy.received.signal - clean.received.signal, 2400.0, nfft=256)
+    w = np.hanning(257)[:-1]  # scipy's periodic hann of length 256
+    assert np.mean(spec.power) == pytest.approx(sigma2 * np.sum(w**2), rel=0.05)
+
+
+def test_noise_is_seeded() -> None:
+    a = run(APPROACHING, [{"kind": "noise"}], seed=3)
+    b = run(APPROACHING, [{"kind": "noise"}], seed=3)
+    c = run(APPROACHING, [{"kind": "noise"}], seed=4)
+    assert np.array_equal(a.received.signal, b.received.signal)
+    assert not np.allclose(a.received.signal, c.received.signal)
+
+
+def test_noise_on_raw_path_reaches_range_time_map() -> None:
+    clean = run(APPROACHING, [], radar_cfg={"path": "raw"}, duration=0.2)
+    noisy = run(
+        APPROACHING, [{"kind": "noise", "snr_db": 10.0}], radar_cfg={"path": "raw"}, duration=0.2
+    )
+    assert clean.received.range_time is not None and noisy.received.range_time is not None
+    diff = noisy.received.range_time - clean.received.range_time
+    sigma2 = noisy.metadata["effects"][0]["noise_power_w"]
+    assert np.mean(np.abs(diff) ** 2) == pytest.approx(sigma2, rel=0.05)
+
+
+# --------------------------------------------------------------------------- clutter
+
+
+def clutter_context(gate: float, n: int, seed: int = 0) -> SceneContext:
+    t = np.arange(n) / 2400.0
+    skel = Skeleton(t, np.zeros((n, 1, 3)), ("target0",))
+    wf = LfmPulseDoppler(LfmPulseDoppler.Config())
+    return SceneContext(
+        np.zeros(3), 2400.0, 15e9, t, np.full(n, gate), skel, wf, np.random.default_rng(seed)
+    )
+
+
+@pytest.mark.parametrize(("spread", "fraction"), [(0.1, 0.3), (0.3, 0.6)])
+def test_clutter_sits_at_zero_doppler_with_requested_spread(spread: float, fraction: float) -> None:
+    n = 4 * 2400
+    ctx = clutter_context(15.0, n)
+    eff = GroundClutter(
+        GroundClutter.Config(power="rcs", rcs_m2=1.0, wind_fraction=fraction, spread_mps=spread)
+    )
+    out = eff.apply(Received(np.zeros(n, complex)), ctx).signal
+    p_total = np.mean(np.abs(out) ** 2)
+    dc = np.mean(out)
+    # the stationary part is constant under a fixed gate: all of it at 0 Hz
+    assert abs(dc) ** 2 / p_total == pytest.approx(1 - fraction, abs=0.05)
+    resid = out - dc
+    f = np.fft.fftfreq(n, 1 / 2400.0)
+    psd = np.abs(np.fft.fft(resid)) ** 2
+    mean_f = np.sum(f * psd) / np.sum(psd)
+    std_v = np.sqrt(np.sum((f - mean_f) ** 2 * psd) / np.sum(psd)) * LAM / 2
+    assert abs(mean_f) * LAM / 2 < 0.1 * spread  # centred on zero Doppler
+    assert std_v == pytest.approx(spread, rel=0.1)
+
+
+def test_clutter_rcs_mode_follows_the_range_equation() -> None:
+    n = 2400
+    ctx = clutter_context(15.0, n)
+    eff = GroundClutter(GroundClutter.Config(power="rcs", rcs_m2=2.0))
+    out = eff.apply(Received(np.zeros(n, complex)), ctx).signal
+    a2 = radar.range_equation_amplitude(2.0, 15.0, wavelength=LAM) ** 2
+    # one resolution cell of clutter RCS sigma at the gate gives about a(R, sigma)^2
+    assert np.mean(np.abs(out) ** 2) == pytest.approx(a2, rel=0.15)
+
+
+def test_clutter_csr_in_pipeline_and_zero_velocity_bin() -> None:
+    clean = run(APPROACHING, [])
+    res = run(APPROACHING, [{"kind": "clutter", "csr_db": 10.0, "wind_fraction": 0.0}])
+    added = res.received.signal - clean.received.signal
+    ratio = np.mean(np.abs(added) ** 2) / np.mean(np.abs(clean.received.signal) ** 2)
+    assert 10 * np.log10(ratio) == pytest.approx(10.0, abs=1e-9)
+    spec = res.spectrogram
+    k0 = int(np.argmin(np.abs(spec.doppler)))
+    k_target = int(np.argmin(np.abs(spec.doppler - 2.0 / LAM)))  # 1 m/s approaching
+    mean_power = spec.power.mean(axis=1)
+    assert int(np.argmax(mean_power)) in (k0 - 1, k0, k0 + 1)
+    assert mean_power[k_target] > 100 * np.median(mean_power)  # the target is still there
+
+
+# --------------------------------------------------------------------------- multipath
+
+MP_RADAR = (10.0, 0.0, 5.0)
+MP_TARGET = [{"position": [0.0, 0.0, 1.0], "velocity": [0.0, 0.0, 2.0], "rcs": 1.0}]
+
+
+def mp_geometry(t: float) -> tuple[float, float, float, float]:
+    """Direct and image ranges [m] and range rates [m/s] of MP_TARGET at time t."""
+    z = 1.0 + 2.0 * t
+    rd = np.hypot(10.0, 5.0 - z)
+    rb = np.hypot(10.0, 5.0 + z)
+    return rd, rb, -2.0 * (5.0 - z) / rd, 2.0 * (5.0 + z) / rb
+
+
+def test_multipath_image_at_right_delay() -> None:
+    """Raw fast-time path at 1.5 GHz bandwidth (0.1 m resolution): the range profile of one
+    pulse peaks at R_d, (R_d + R_b)/2 and R_b."""
+    res = run(
+        MP_TARGET,
+        [{"kind": "multipath", "reflection_magnitude": 0.8}],
+        radar_position=MP_RADAR,
+        duration=0.15,
+        radar_cfg={"path": "raw", "bandwidth": 1.5e9},
+        processing={"window_length": 128},
+    )
+    rt, axis = res.received.range_time, res.received.range_axis
+    assert rt is not None and axis is not None
+    k = 100
+    rd, rb, _, _ = mp_geometry(res.pulse_times[k])
+    prof = np.abs(rt[k])
+    peaks = [i for i in range(1, len(prof) - 1) if prof[i] >= prof[i - 1] and prof[i] > prof[i + 1]]
+    top = sorted(peaks, key=lambda i: -prof[i])[:3]
+    found = np.sort(axis[top])
+    expected = np.array([rd, 0.5 * (rd + rb), rb])
+    assert np.allclose(found, expected, atol=0.06)  # fast-time grid spacing 0.05 m
+    # amplitudes: |Gamma|^2 (R_d/R_b)^2 for the image, 2|Gamma| R_d/R_b-ish for the bounce
+    amp = {round(float(axis[i]), 1): prof[i] for i in top}
+    direct = amp[round(float(found[0]), 1)]
+    image = amp[round(float(found[2]), 1)]
+    assert image / direct == pytest.approx(0.8**2 * (rd / rb) ** 2, rel=0.1)
+
+
+def test_multipath_image_at_right_doppler() -> None:
+    """Vertical motion under a raised radar: the direct echo approaches (positive Doppler), the
+    image recedes (negative), the bounce path sits at their mean."""
+    res = run(
+        MP_TARGET,
+        [{"kind": "multipath"}],
+        radar_position=MP_RADAR,
+        duration=0.5,
+        processing={"nfft": 4096, "hop": 32},
+    )
+    spec = res.spectrogram
+    m = len(spec.time) // 2
+    t_mid = spec.time[m]
+    _, _, rd_dot, rb_dot = mp_geometry(t_mid)
+    expected = {
+        "direct": -2 * rd_dot / LAM,
+        "bounce": -(rd_dot + rb_dot) / LAM,
+        "image": -2 * rb_dot / LAM,
+    }
+    assert expected["direct"] > 40 and expected["image"] < -80
+    col = spec.power[:, m]
+    for name, f0 in expected.items():
+        window = np.abs(spec.doppler - f0) < 15.0
+        f_peak = spec.doppler[window][np.argmax(col[window])]
+        assert f_peak == pytest.approx(f0, abs=3.0), name
+        # a true local maximum of the column, not a sidelobe slope
+        assert col[window].max() > 10 * np.median(col)
+
+
+def test_multipath_reflection_phase_is_exact() -> None:
+    """The virtual scatterers carry Gamma's phase as a sub-wavelength range offset."""
+    base = run(
+        MP_TARGET,
+        [
+            {
+                "kind": "multipath",
+                "paths": "image",
+                "reflection_magnitude": 1.0,
+                "reflection_phase_deg": 0.0,
+            }
+        ],
+        radar_position=MP_RADAR,
+        duration=0.2,
+        processing={"window_length": 128},
+    )
+    flip = run(
+        MP_TARGET,
+        [
+            {
+                "kind": "multipath",
+                "paths": "image",
+                "reflection_magnitude": 1.0,
+                "reflection_phase_deg": 90.0,
+            }
+        ],
+        radar_position=MP_RADAR,
+        duration=0.2,
+        processing={"window_length": 128},
+    )
+    names = base.scatterers.names
+    assert names == ("target0", "target0~image")
+    lam = LAM
+    r0 = base.scatterers.ranges(np.array(MP_RADAR))[:, 1]
+    r1 = flip.scatterers.ranges(np.array(MP_RADAR))[:, 1]
+    # Gamma^2 = exp(j pi): phase pi -> offset lambda/4 either way
+    ph = radar.carrier_phasor(r1, 15e9) / radar.carrier_phasor(r0, 15e9)
+    assert np.allclose(ph, -1.0, atol=1e-9)
+    assert np.max(np.abs(r1 - r0)) <= lam / 4 + 1e-12
+
+
+# --------------------------------------------------------------------------- antenna
+
+
+@pytest.mark.parametrize("pattern", ["gaussian", "uniform"])
+@pytest.mark.parametrize("bw_deg", [5.0, 20.0, 60.0])
+def test_antenna_gain_is_minus_3db_at_beamwidth_edge(pattern: str, bw_deg: float) -> None:
+    bw = np.deg2rad(bw_deg)
+    bore = np.array([1.0, 0.0, 0.0])
+    edge = bw / 2
+    az_edge = np.array([np.cos(edge), np.sin(edge), 0.0])
+    el_edge = np.array([np.cos(edge), 0.0, np.sin(edge)])
+    for d in (az_edge, el_edge):
+        g = one_way_gain(d, bore, pattern=pattern, beamwidth_az=bw, beamwidth_el=bw)
+        assert 10 * np.log10(g) == pytest.approx(10 * np.log10(0.5), abs=1e-9)
+    inside = one_way_gain(
+        np.array([1.0, 0.01, 0.0]), bore, pattern=pattern, beamwidth_az=bw, beamwidth_el=bw
+    )
+    assert 0.5 < inside < 1.0
+    assert one_way_gain(bore, bore, pattern=pattern, beamwidth_az=bw, beamwidth_el=bw) == 1.0
+    assert one_way_gain(-bore, bore, pattern=pattern, beamwidth_az=bw, beamwidth_el=bw) == 0.0
+
+
+def test_uniform_aperture_first_sidelobe_and_null() -> None:
+    bw = np.deg2rad(10.0)
+    d_over_lam = SINC2_HALF_POWER / np.sin(bw / 2)
+    null = np.arcsin(1.0 / d_over_lam)
+    g = one_way_gain(
+        np.array([np.cos(null), np.sin(null), 0.0]),
+        np.array([1.0, 0, 0]),
+        pattern="uniform",
+        beamwidth_az=bw,
+        beamwidth_el=bw,
+    )
+    assert g < 1e-20
+    th = np.linspace(null, 2 * null, 2001)
+    d = np.stack([np.cos(th), np.sin(th), 0 * th], axis=1)
+    side = one_way_gain(
+        d, np.array([1.0, 0, 0]), pattern="uniform", beamwidth_az=bw, beamwidth_el=bw
+    ).max()
+    assert 10 * np.log10(side) == pytest.approx(-13.26, abs=0.05)
+
+
+@pytest.mark.parametrize("pattern", ["gaussian", "uniform"])
+def test_antenna_two_way_gain_end_to_end(pattern: str) -> None:
+    """A target at the beam edge returns 6 dB less power (one way -3 dB, twice)."""
+    bw = 16.0
+    edge = np.deg2rad(bw / 2)
+    r = 30.0
+    target = [{"position": [r * np.cos(edge), r * np.sin(edge), 0.0], "rcs": 1.0}]
+    ant = {
+        "kind": "antenna",
+        "pattern": pattern,
+        "beamwidth_az_deg": bw,
+        "pointing": "angles",
+        "azimuth_deg": 0.0,
+        "elevation_deg": 0.0,
+    }
+    plain = run(target, [], duration=0.2, processing={"window_length": 128})
+    weighted = run(target, [ant], duration=0.2, processing={"window_length": 128})
+    ratio = np.abs(weighted.received.signal) ** 2 / np.abs(plain.received.signal) ** 2
+    assert np.allclose(10 * np.log10(ratio), 20 * np.log10(0.5), atol=1e-9)
+
+
+def test_antenna_pointing_at_target_tracks_it() -> None:
+    """Pointing at the target: boresight gain (no change); steering 'track' keeps a crossing
+    target on boresight, a fixed beam does not."""
+    crossing = [{"position": [30.0, -8.0, 0.0], "velocity": [0.0, 8.0, 0.0], "rcs": 1.0}]
+    plain = run(crossing, [], duration=2.0)
+    ant = {"kind": "antenna", "beamwidth_az_deg": 10.0}
+    tracked = run(crossing, [{**ant, "steering": "track"}], duration=2.0)
+    fixed = run(crossing, [ant], duration=2.0)
+    assert np.allclose(np.abs(tracked.received.signal), np.abs(plain.received.signal), rtol=1e-9)
+    edge = np.abs(fixed.received.signal[[0, -1]]) / np.abs(plain.received.signal[[0, -1]])
+    assert np.all(edge < 0.5)  # ~15 degrees off a 10-degree beam at both ends
+
+
+# --------------------------------------------------------------------------- attenuation
+
+
+def test_attenuation_grows_with_range_as_specified() -> None:
+    target = [{"position": [500.0, 0.0, 0.0], "velocity": [4.0, 0.0, 0.0], "rcs": 1.0}]
+    k, alpha, rain = 0.04, 1.1, 25.0
+    eff = {
+        "kind": "attenuation",
+        "gas_db_per_km": 0.05,
+        "rain_rate_mm_per_h": rain,
+        "rain_k": k,
+        "rain_alpha": alpha,
+    }
+    plain = run(target, [], duration=2.0)
+    att = run(target, [eff], duration=2.0)
+    gamma = 0.05 + k * rain**alpha  # one way, dB/km
+    rng = plain.gate_range
+    loss_db = 10 * np.log10(np.abs(att.received.signal) ** 2 / np.abs(plain.received.signal) ** 2)
+    assert np.allclose(loss_db, -2 * gamma * rng / 1000, atol=1e-9)
+    # linear in range: the slope is the two-way specific attenuation
+    slope = np.polyfit(rng, loss_db, 1)[0] * 1000
+    assert slope == pytest.approx(-2 * gamma, rel=1e-9)
+    assert att.metadata["effects"][0]["specific_attenuation_db_per_km"] == pytest.approx(gamma)
+
+
+def test_attenuation_rain_needs_coefficients() -> None:
+    with pytest.raises(Exception, match="rain_k"):
+        run(APPROACHING, [{"kind": "attenuation", "rain_rate_mm_per_h": 5.0}])
+
+
+# --------------------------------------------------------------------------- on demand
+
+
+def _explode(*args: Any, **kwargs: Any) -> None:
+    raise AssertionError("an effect the scene does not call for did work")
+
+
+def test_effects_not_called_for_are_never_constructed_or_run(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    for cls in ALL_EFFECTS:
+        monkeypatch.setattr(cls, "__init__", _explode)
+        monkeypatch.setattr(cls, "apply", _explode)
+    res = run(APPROACHING, [])
+    assert res.metadata["effects"] == []
+    cfg = {"motion": {"kind": "boulic", "duration": 1.0}, "scatterers": {"kind": "ellipsoid"}}
+    assert simulate(validate_run_config(cfg)).metadata["effects"] == []
+
+
+def test_only_the_named_effect_runs(monkeypatch: pytest.MonkeyPatch) -> None:
+    for cls in ALL_EFFECTS:
+        if cls is not ReceiverNoise:
+            monkeypatch.setattr(cls, "__init__", _explode)
+            monkeypatch.setattr(cls, "apply", _explode)
+    res = run(APPROACHING, [{"kind": "noise"}])
+    assert [e["kind"] for e in res.metadata["effects"]] == ["noise"]
+
+
+def test_metadata_records_effects_in_stage_order() -> None:
+    effects = [
+        {"kind": "noise", "snr_db": 30.0},
+        {"kind": "antenna", "beamwidth_az_deg": 30.0},
+        {"kind": "clutter"},
+        {"kind": "attenuation", "gas_db_per_km": 0.1},
+        {"kind": "multipath", "ground_height": -1.0},
+    ]
+    res = run(APPROACHING, effects)
+    ran = [(e["kind"], e["stage"]) for e in res.metadata["effects"]]
+    assert ran == [
+        ("antenna", "scatterers"),
+        ("attenuation", "scatterers"),
+        ("multipath", "scatterers"),
+        ("noise", "received"),
+        ("clutter", "received"),
+    ]
+    assert res.scatterers.names == ("target0", "target0~image", "target0~bounce")
+    assert np.all(np.isfinite(res.spectrogram_db))
