@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import synthetic
 
 from mdframework.physics import body, rcs
 from mdframework.skeleton import CANONICAL_JOINTS
@@ -116,25 +117,7 @@ def test_placements_count_and_rcs_table(placement: str) -> None:
 
 
 def _standing_body(height: float = 1.8) -> np.ndarray:
-    f = body.SEGMENT_FRACTIONS
-    z_hip = (f["upper_leg"] + f["lower_leg"]) * height
-    p = {
-        "base": (0, 0, z_hip),
-        "neck": (0, 0, z_hip + f["torso"] * height),
-        "head": (0, 0, z_hip + (f["torso"] + f["head"]) * height),
-    }
-    for s, y in (("l", 1.0), ("r", -1.0)):
-        sh = y * f["shoulder"] * height
-        hp = y * f["hip"] * height
-        top = z_hip + f["torso"] * height
-        p[f"{s}_shoulder"] = (0, sh, top)
-        p[f"{s}_elbow"] = (0, sh, top - f["upper_arm"] * height)
-        p[f"{s}_hand"] = (0, sh, top - (f["upper_arm"] + f["lower_arm"]) * height)
-        p[f"{s}_hip"] = (0, hp, z_hip)
-        p[f"{s}_knee"] = (0, hp, z_hip - f["upper_leg"] * height)
-        p[f"{s}_ankle"] = (0, hp, 0.0)
-        p[f"{s}_toe"] = (f["foot"] * height, hp, 0.0)
-    return np.array([p[j] for j in CANONICAL_JOINTS], dtype=float)[None]
+    return synthetic.standing(height)[None]
 
 
 def test_height_estimate_of_a_standing_body() -> None:

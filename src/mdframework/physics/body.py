@@ -193,12 +193,16 @@ def part_geometry(parts: tuple[BodyPart, ...], joints: FloatArray) -> tuple[Floa
     for i, p in enumerate(parts):
         for k, (joint, w) in enumerate(p.position):
             index[k, i], weight[k, i] = _J[joint], w
-    positions = weight[0][None, :, None] * joints[:, index[0]]
+    positions = np.take(joints, index[0], axis=1)
+    if not np.all(weight[0] == 1.0):
+        positions *= weight[0][None, :, None]
     for k in range(1, n_terms):
-        positions += weight[k][None, :, None] * joints[:, index[k]]
+        positions += weight[k][None, :, None] * np.take(joints, index[k], axis=1)
     tail = [_J[p.axis[0]] for p in parts]
     tip = [_J[p.axis[1]] for p in parts]
-    return positions, joints[:, tip] - joints[:, tail]
+    axes = np.take(joints, tip, axis=1)
+    axes -= np.take(joints, tail, axis=1)
+    return positions, axes
 
 
 def estimate_height(joints: FloatArray) -> float:
