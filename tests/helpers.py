@@ -20,7 +20,7 @@ def point_run(
 ) -> RunResult:
     """Simulate point targets with a radar at the origin."""
     cfg = {
-        "motion": {"kind": "point_targets", "duration": duration, "targets": targets},
+        "motion": {"kind": "point_targets", "length": duration, "targets": targets},
         "scatterers": {"kind": "points"},
         "radar": {"kind": "lfm", **(radar or {})},
         "scene": {"radar_position": [0.0, 0.0, 0.0], **(scene or {})},

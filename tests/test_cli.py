@@ -81,12 +81,12 @@ def test_config_schema_is_json_schema(capsys: pytest.CaptureFixture[str]) -> Non
 BAD_CONFIGS = {
     "syntax.toml": ("[motion\nkind = 1\n", "invalid TOML"),
     "field.toml": (
-        '[motion]\nkind = "point_targets"\nduration = 1.0\n'
+        '[motion]\nkind = "point_targets"\nlength = 1.0\n'
         "targets = [{ position = [10, 0, 0] }]\n[radar]\nkind = 'lfm'\nprf = -5\n",
         "radar.prf: Input should be greater than 0",
     ),
     "extra.toml": (
-        '[motion]\nkind = "point_targets"\nduration = 1.0\nspeed = 3\n'
+        '[motion]\nkind = "point_targets"\nlength = 1.0\nspeed = 3\n'
         "targets = [{ position = [10, 0, 0] }]\n",
         "motion.speed: Extra inputs are not permitted",
     ),
@@ -94,18 +94,18 @@ BAD_CONFIGS = {
     "nofile.toml": ('[motion]\nkind = "cmu"\nfile = "missing.bvh"\n', "motion.file:"),
     "yaml.yaml": ("motion: [1, 2\n", "invalid YAML: line"),
     "short.toml": (
-        '[motion]\nkind = "point_targets"\nduration = 0.05\n'
+        '[motion]\nkind = "point_targets"\nlength = 0.05\n'
         "targets = [{ position = [10, 0, 0] }]\n[scatterers]\nkind = 'points'\n",
         "processing.window_length",
     ),
     "atradar.toml": (
-        '[motion]\nkind = "point_targets"\nduration = 1.0\n'
+        '[motion]\nkind = "point_targets"\nlength = 1.0\n'
         "targets = [{ position = [10, 0, 0] }]\n[scatterers]\nkind = 'points'\n"
         "[scene]\nradar_position = [10, 0, 0]\n",
         "comes within 0 m of the radar",
     ),
     "nobody.toml": (
-        '[motion]\nkind = "point_targets"\nduration = 1.0\ntargets = [{ position = [10, 0, 0] }]\n',
+        '[motion]\nkind = "point_targets"\nlength = 1.0\ntargets = [{ position = [10, 0, 0] }]\n',
         "scatterers.kind: the 'ellipsoid' model needs a human body",
     ),
 }

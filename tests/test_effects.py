@@ -46,7 +46,7 @@ def run(
     processing: dict[str, Any] | None = None,
 ) -> RunResult:
     cfg = {
-        "motion": {"kind": "point_targets", "duration": duration, "targets": targets},
+        "motion": {"kind": "point_targets", "length": duration, "targets": targets},
         "scatterers": {"kind": "points"},
         "radar": {"kind": "lfm", **(radar_cfg or {})},
         "scene": {"radar_position": list(radar_position), "gate": gate},

@@ -433,7 +433,7 @@ def test_property_random_point_scenes_have_no_nan_or_inf(
     targets: list[dict[str, Any]], effects: list[dict[str, Any]], radar_z: float, gate: Any
 ) -> None:
     cfg = {
-        "motion": {"kind": "point_targets", "duration": 0.3, "targets": targets},
+        "motion": {"kind": "point_targets", "length": 0.3, "targets": targets},
         "scatterers": {"kind": "points"},
         "scene": {"radar_position": [0.0, 0.0, radar_z], "gate": gate},
         "processing": {"window_length": 128, "hop": 32, "nfft": 256},

@@ -136,7 +136,10 @@ def simulate(config: RunConfigBase, registry: Registry | None = None) -> RunResu
     stages = build_stages(config, registry)
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
-    motion = stages.source.load()
+    try:
+        motion = stages.source.load()
+    except ValueError as exc:  # a plugin's own check of its input
+        raise SceneError(f"motion: {exc}") from None
     timings["load"] = time.perf_counter() - t0
     return simulate_motion(config, stages, motion, timings)
 
@@ -173,9 +176,10 @@ def simulate_motion(
         )
     else:
         placement = {"motion": "as given"}
-    body = _window(body, cfg.motion.start, cfg.motion.duration)
+    t_start, t_end = _window(body, cfg.motion.start, cfg.motion.duration)
 
-    t = interpolation.pulse_times(body.time[0], body.time[-1], wf.prf)
+    # the spline sees the whole recording, so a record has no end effects of its own
+    t = interpolation.pulse_times(t_start, t_end, wf.prf)
     joints = interpolation.resample_tracks(
         body.time, body.positions, body.valid, t, proc.interpolation
     )
@@ -245,7 +249,7 @@ def simulate_motion(
         "max_unambiguous_velocity_mps": v_max,
         "max_radial_speed_mps": speed,
         "radar_position_m": list(sc.radar_position),
-        "record_start_s": float(body.time[0]),
+        "record_start_s": t_start,
         "effects": effects_ran,
         "seed": config.seed,
         "timings_s": timings,
@@ -262,19 +266,20 @@ def _gate(gate: str | float, at_pulses: Skeleton, radar_pos: FloatArray) -> Floa
     return np.full(at_pulses.time.shape, float(gate))
 
 
-def _window(body: Skeleton, start: float, duration: float | None) -> Skeleton:
-    if start == 0.0 and duration is None:
-        return body
+def _window(body: Skeleton, start: float, duration: float | None) -> tuple[float, float]:
+    """First and last time [s] of the record (``start``/``duration`` from the first frame)."""
     end = start + duration if duration is not None else body.duration
+    if start >= body.duration:
+        raise SceneError(
+            f"motion.start: {start:g} s is not before the end of the recording "
+            f"({body.duration:.3f} s)"
+        )
     if end > body.duration + 1e-9:
         raise SceneError(
             f"motion.duration: the window {start:g}..{end:g} s ends after the recording "
             f"({body.duration:.3f} s)"
         )
-    try:
-        return body.window(start, duration)
-    except ValueError as exc:
-        raise SceneError(f"motion.start: {exc}") from None
+    return float(body.time[0] + start), float(body.time[0] + min(end, body.duration))
 
 
 def _condition(body: Skeleton, cfg: ConditioningConfig) -> tuple[Skeleton, dict[str, Any]]:

@@ -1,6 +1,6 @@
 """Point scatterers at constant velocity, for calibration and tests.
 
-The source places each target at ``position + velocity * t`` [m] for ``0 <= t <= duration``,
+The source places each target at ``position + velocity * t`` [m] for ``0 <= t <= length``,
 sampled at ``frame_rate`` (the motion is linear, so any interpolation of it is exact). The
 ``points`` scatterer model turns each joint into an isotropic scatterer whose RCS is the target's.
 """
@@ -39,7 +39,7 @@ class PointTargetsConfig(MotionConfig):
 
     kind: Literal["point_targets"] = "point_targets"
     targets: list[Target] = Field(min_length=1, description="The scatterers.")
-    duration: float | None = Field(None, gt=0, description="Record length [s] (required).")
+    length: float = Field(gt=0, description="Length of the generated recording [s].")
     frame_rate: float = Field(100.0, gt=0, description="Sampling of the tracks [Hz].")
     label: str = Field("point_targets", description="Activity label recorded with the run.")
 
@@ -54,12 +54,10 @@ class PointTargets(MotionSource):
     def load(self) -> Motion:
         """Tracks of all targets; joints are named ``target0``, ``target1``, ..."""
         c = self.config
-        if c.duration is None:
-            raise ValueError("point_targets needs a duration")
-        n = int(np.floor(c.duration * c.frame_rate + 1e-9)) + 1
+        n = int(np.floor(c.length * c.frame_rate + 1e-9)) + 1
         t = np.arange(n) / c.frame_rate
-        if t[-1] < c.duration - 1e-12:
-            t = np.append(t, c.duration)
+        if t[-1] < c.length - 1e-12:
+            t = np.append(t, c.length)
         p0 = np.array([tg.position for tg in c.targets], dtype=np.float64)
         v = np.array([tg.velocity for tg in c.targets], dtype=np.float64)
         pos = p0[None, :, :] + t[:, None, None] * v[None, :, :]
