@@ -174,3 +174,22 @@ def test_yaml_and_json_configs_run(tmp_path: Path, capsys: pytest.CaptureFixture
         with np.load(out / "result.npz") as d:
             results.append(d["signal"])
     assert np.array_equal(results[0], results[1])
+
+
+@pytest.mark.parametrize(
+    ("extra", "expected"),
+    [
+        ("gate = -5.0\n", "scene.gate"),
+        (
+            '[processing]\nwindow = "nosuchwindow"\n',
+            "processing.window: Value error, unknown window",
+        ),
+    ],
+)
+def test_more_config_field_errors(
+    extra: str, expected: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    cfg = tmp_path / "c.toml"
+    cfg.write_text((EXAMPLES / "point_target.toml").read_text() + extra)  # ends in [scene]
+    code, _, err = run_cli(["run", str(cfg), "--out", str(tmp_path / "o")], capsys)
+    assert code == 2 and expected in err and len(err.strip().splitlines()) == 1

@@ -171,3 +171,51 @@ def test_bad_dataset_configs(tmp_path: Path) -> None:
     cfg, base = load_dataset_config(long)
     with pytest.raises(ConfigError, match=r"sources\[0\]: record length 3 s exceeds"):
         plan_records(cfg, base)
+
+
+def test_base_scene_is_kept_unless_varied(tmp_path: Path) -> None:
+    p = tmp_path / "d.toml"
+    p.write_text(f"""
+[[sources]]
+label = "walk"
+record_length = 1.0
+motion = {{ kind = "cmu", file = "{CMU / "asf-amc" / "02_01.amc"}", start = 0.5, duration = 1.5 }}
+[variations]
+radar_range = [7.0]
+[base.scene]
+radar_position = [5.0, 3.0, 2.5]
+person = {{ aspect_deg = 90.0, position = [1.0, 2.0] }}
+""")
+    cfg, base = load_dataset_config(p)
+    specs = plan_records(cfg, base)
+    # the source's own start/duration bound the span: 0.5..2.0 s gives one 1 s window
+    assert [s.run_config["motion"]["start"] for s in specs] == [0.5]
+    scene = specs[0].run_config["scene"]
+    assert scene["person"]["aspect_deg"] == 90.0  # not replaced: no aspect variation
+    assert scene["radar_position"] == [8.0, 2.0, 2.5]  # range varied from the start, height kept
+
+
+def test_point_target_dataset(tmp_path: Path) -> None:
+    p = tmp_path / "d.toml"
+    p.write_text("""
+[[sources]]
+label = "receding"
+record_length = 0.5
+[sources.motion]
+kind = "point_targets"
+length = 1.0
+targets = [{ position = [50.0, 0, 0], velocity = [1.0, 0, 0] }]
+[base.scatterers]
+kind = "points"
+[base.scene]
+radar_position = [0.0, 0.0, 0.0]
+[base.processing]
+window_length = 128
+""")
+    cfg, base = load_dataset_config(p)
+    rows = build_dataset(cfg, base, tmp_path / "ds", workers=1, progress=False)
+    assert len(rows) == 2
+    for row in rows:
+        assert row["torso_mean"] == pytest.approx(-1.0, abs=0.1)
+    data = load_dataset(tmp_path / "ds")
+    assert data.labels.dtype.kind == "U" and list(data.labels) == ["receding"] * 2

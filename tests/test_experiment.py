@@ -37,6 +37,9 @@ def test_bad_experiment_config(tmp_path: Path) -> None:
     cfg = exp.load_experiment_config(p)
     with pytest.raises(ConfigError, match=r"e\.toml: classifier\.k: Input should be greater"):
         exp.classifier_factory(cfg.classifier, str(p))
+    p.write_text('[dataset]\npath = "x"\n[selection]\nsizes = [9]\n')
+    with pytest.raises(ConfigError, match=r"selection\.sizes\.0: Input should be less than"):
+        exp.load_experiment_config(p)
     p.write_text('[dataset]\npath = "x"\nconfig = "y"\n')
     with pytest.raises(ConfigError, match=r"exactly one of dataset\.config and dataset\.path"):
         exp.load_experiment_config(p)

@@ -94,3 +94,24 @@ def test_silent_frames_are_ignored_and_all_silent_is_an_error() -> None:
     assert np.all(np.isnan(env.torso[3:])) and np.allclose(env.torso[:3], vel[8])
     with pytest.raises(ValueError, match="silent"):
         spectrogram_features(np.zeros((11, 6)), vel)
+
+
+def test_torso_median_ignores_a_limb_that_briefly_outshines_the_torso() -> None:
+    """A body whose energy sits around 1 m/s (torso plus arms) and a leg that is the single
+    strongest bin in a few frames: the peak track jumps to the leg, the median does not."""
+    vel = np.linspace(-5, 5, 401)  # 0.025 m/s bins
+    n_frames = 30
+    power = np.full((401, n_frames), 1e-12)
+    k_torso = np.argmin(np.abs(vel - 1.0))
+    power[k_torso, :] = 1.0
+    power[k_torso - 8 : k_torso + 9, :] += 0.2  # arms and hips around the torso
+    jump = [10, 11, 12]
+    power[np.argmin(np.abs(vel - 3.5)), jump] = 1.5  # a leg, briefly the strongest bin
+    peak = envelopes(power, vel, torso_method="peak").torso
+    median = envelopes(power, vel, torso_method="median").torso
+    assert np.allclose(peak[jump], 3.5, atol=0.03)
+    assert np.allclose(median, 1.0, atol=0.03)
+    f_peak = spectrogram_features(power, vel, torso_method="peak")
+    f_median = spectrogram_features(power, vel)
+    assert f_peak[1] == pytest.approx(2.5, abs=0.05)  # torso bandwidth inflated by the leg
+    assert f_median[1] == pytest.approx(0.0, abs=0.03)

@@ -21,6 +21,7 @@ from mdf_knn import Knn
 
 from mdframework import Skeleton
 from mdframework.classify import Standardizer, confusion_matrix
+from mdframework.conditioning import sort_timestamps
 from mdframework.config import validate_run_config
 from mdframework.constants import SPEED_OF_LIGHT
 from mdframework.errors import ConfigError, SceneError
@@ -240,8 +241,8 @@ def test_6_4_interpolation_non_increasing_time_stamps() -> None:
     pos = np.arange(18, dtype=float).reshape(6, 1, 3)
     with pytest.raises(SkeletonError, match="strictly increasing"):
         Skeleton(t, pos, ("j",))
-    ts, ps, idx = interpolation.sort_and_deduplicate(t, pos)
-    assert np.all(np.diff(ts) > 0) and list(idx) == [0, 1, 4, 3, 5]
+    ts, ps, _, _ = sort_timestamps(t, pos)
+    assert np.all(np.diff(ts) > 0) and np.array_equal(ps, pos[[0, 1, 4, 3, 5]])
     # and no extrapolation beyond the last frame
     with pytest.raises(ValueError, match="never extrapolates"):
         interpolation.resample_tracks(ts, ps, np.ones((5, 1), bool), np.array([0.0, 0.3]))

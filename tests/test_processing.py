@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from mdframework.conditioning import sort_timestamps
 from mdframework.physics import interpolation, spectrogram
 from mdframework.skeleton import Skeleton, SkeletonError
 
@@ -57,9 +58,10 @@ def test_non_increasing_time_stamps_refused_and_sortable() -> None:
     pos = np.arange(15, dtype=float).reshape(5, 1, 3)
     with pytest.raises(SkeletonError, match="strictly increasing"):
         Skeleton(t, pos, ("a",))
-    ts, ps, idx = interpolation.sort_and_deduplicate(t, pos)
+    ts, ps, _, report = sort_timestamps(t, pos)
     assert np.all(np.diff(ts) > 0)
-    assert list(idx) == [0, 3, 1, 4]
+    assert np.array_equal(ps, pos[[0, 3, 1, 4]])
+    assert report == {"out_of_order": 3, "duplicates_dropped": 1}
     Skeleton(ts, ps, ("a",))
 
 

@@ -387,11 +387,20 @@ def gaussian_smooth(time: FloatArray, track: FloatArray, sigma_s: float) -> Floa
     """
     if sigma_s <= 0:
         return np.array(track, dtype=np.float64, copy=True)
-    dt = time[:, None] - time[None, :]
-    w = np.exp(-0.5 * (dt / sigma_s) ** 2)
-    w[np.abs(dt) > 3 * sigma_s] = 0.0
-    w /= w.sum(axis=1, keepdims=True)
-    return np.asarray(w @ track, dtype=np.float64)
+    n = time.shape[0]
+    lo = np.searchsorted(time, time - 3 * sigma_s, side="left")
+    hi = np.searchsorted(time, time + 3 * sigma_s, side="right")
+    reach = int(max(np.max(np.arange(n) - lo), np.max(hi - 1 - np.arange(n))))
+    total = np.zeros_like(np.asarray(track, dtype=np.float64))
+    weight = np.zeros(n)
+    for k in range(-reach, reach + 1):  # O(n x frames within 3 sigma), not O(n^2)
+        j = np.arange(n) + k
+        inside = (j >= lo) & (j < hi)
+        jj = np.clip(j, 0, n - 1)
+        w = np.where(inside, np.exp(-0.5 * ((time[jj] - time) / sigma_s) ** 2), 0.0)
+        total += w[:, None] * track[jj]
+        weight += w
+    return np.asarray(total / weight[:, None], dtype=np.float64)
 
 
 # --------------------------------------------------------------------------- entry point

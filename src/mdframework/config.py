@@ -20,9 +20,11 @@ from pydantic import (
     BaseModel,
     ConfigDict,
     Field,
+    PositiveFloat,
     ValidationError,
     ValidationInfo,
     create_model,
+    field_validator,
     model_validator,
 )
 
@@ -55,11 +57,13 @@ class MotionConfig(PluginConfig):
     )
 
 
-class _Strict(BaseModel):
+class StrictModel(BaseModel):
+    """Base of every config model that is not a plugin's: unknown fields are errors."""
+
     model_config = ConfigDict(extra="forbid", frozen=True)
 
 
-class PersonConfig(_Strict):
+class PersonConfig(StrictModel):
     """Where the person is and how they move."""
 
     motion: Literal["recorded", "treadmill", "straight"] = Field(
@@ -96,7 +100,7 @@ class PersonConfig(_Strict):
         return self
 
 
-class SceneConfig(_Strict):
+class SceneConfig(StrictModel):
     """The radar's position, the person's placement and the range gate."""
 
     radar_position: tuple[float, float, float] = Field(
@@ -105,7 +109,7 @@ class SceneConfig(_Strict):
     person: PersonConfig = Field(
         default_factory=PersonConfig, description="Where the person is and how they move."
     )
-    gate: Literal["track"] | float = Field(
+    gate: Literal["track"] | PositiveFloat = Field(
         "track",
         description="'track': the gate follows the hip centre (or the first point target); "
         "a number: a fixed gate range [m].",
@@ -115,13 +119,25 @@ class SceneConfig(_Strict):
     )
 
 
-class ProcessingConfig(_Strict):
+class ProcessingConfig(StrictModel):
     """Resampling and spectrogram settings."""
 
     interpolation: Method = Field(
         "cubic", description="Joint resampling: cubic (C2 spline), pchip, akima, linear."
     )
     window: str = Field("hann", description="STFT window (any scipy.signal window name).")
+
+    @field_validator("window")
+    @classmethod
+    def _known_window(cls, value: str) -> str:
+        from scipy.signal import get_window
+
+        try:
+            get_window(value, 8)
+        except (ValueError, TypeError) as exc:
+            raise ValueError(f"unknown window {value!r}: {exc}") from None
+        return value
+
     window_length: int = Field(256, ge=2, description="STFT window length [pulses].")
     hop: int = Field(32, ge=1, description="STFT hop [pulses].")
     nfft: int = Field(1024, ge=2, description="FFT size (>= window_length).")
@@ -138,9 +154,12 @@ class ProcessingConfig(_Strict):
         return self
 
 
-class ConditioningConfig(_Strict):
-    """Skeleton conditioning (:mod:`mdframework.conditioning`), applied to the windowed body
-    before placement. Off by default; each step can be switched on its own."""
+class ConditioningConfig(StrictModel):
+    """Skeleton conditioning (:mod:`mdframework.conditioning`), applied to the whole canonical
+    recording before placement and windowing. Off by default; each step can be switched on its
+    own. (Sorting time stamps and dropping duplicates happens in the motion sources, since a
+    Skeleton's time stamps are strictly increasing by construction; they report it in their
+    metadata.)"""
 
     enabled: bool = Field(False, description="Condition the body at all (default: off).")
     zeros_untracked: bool = Field(
@@ -196,7 +215,7 @@ class ConditioningConfig(_Strict):
     )
 
 
-class RunConfigBase(_Strict):
+class RunConfigBase(StrictModel):
     """Fields every run config has besides the plugin sections."""
 
     seed: int = Field(0, ge=0, description="Seed of every random draw in the run.")

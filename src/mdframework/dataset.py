@@ -37,33 +37,34 @@ from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import Field, ValidationError
 
-from .config import format_validation_error, read_config_file, validate_run_config
+from .config import StrictModel, format_validation_error, read_config_file, validate_run_config
 from .errors import ConfigError, MdfError
 from .features import FEATURE_NAMES, spectrogram_features
 from .interfaces import Motion
 from .pipeline import build_stages, simulate_motion
 
 RECORDS = "records"
+#: index.csv columns that hold text (all others are numbers)
+TEXT_COLUMNS = ("id", "label", "group", "source", "file")
 INDEX = "index.csv"
 MANIFEST = "dataset.json"
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
-
-class FeatureConfig(_Strict):
+class FeatureConfig(StrictModel):
     """How the seven features are extracted (see :mod:`mdframework.features`)."""
 
     method: Literal["threshold", "percentile"] = Field("threshold", description="Envelopes.")
     threshold_db: float = Field(-20.0, lt=0, description="Threshold below each column's peak.")
     floor_db: float = Field(-40.0, lt=0, description="Ignore bins this far below the peak.")
     percentiles: tuple[float, float] = Field((3.0, 97.0), description="Percentile method.")
+    torso: Literal["median", "peak"] = Field(
+        "median", description="Torso track: the column's power median, or its peak bin."
+    )
 
 
-class SourceEntry(_Strict):
+class SourceEntry(StrictModel):
     """One recording (or generator) and its label."""
 
     label: str = Field(description="Activity label, e.g. 'walk'.")
@@ -83,10 +84,13 @@ class SourceEntry(_Strict):
     )
 
 
-class Variations(_Strict):
+class Variations(StrictModel):
     """Scene variations; every combination multiplies every record."""
 
-    aspect_deg: list[float] = Field([0.0], description="Facing relative to the radar [deg].")
+    aspect_deg: list[float] | None = Field(
+        None,
+        description="Facing relative to the radar [deg]; default: as the (base) scene says.",
+    )
     radar_range: list[float] | None = Field(
         None, description="Horizontal distance radar - person's start [m]; default: base scene."
     )
@@ -96,7 +100,7 @@ class Variations(_Strict):
     )
 
 
-class DatasetConfig(_Strict):
+class DatasetConfig(StrictModel):
     """A dataset: sources, record lengths, variations, shared run settings, build options."""
 
     seed: int = Field(0, ge=0, description="Seed of the whole dataset.")
@@ -147,7 +151,10 @@ def _load_motion(motion_json: str, base_dir: str) -> Motion:
     config = validate_run_config(
         {"motion": section}, source="dataset motion", base_dir=Path(base_dir)
     )
-    return build_stages(config).source.load()
+    try:
+        return build_stages(config).source.load()
+    except ValueError as exc:  # a plugin's own check of its input
+        raise MdfError(f"motion {section.get('kind')!r}: {exc}") from None
 
 
 def _record_seed(seed: int, index: int) -> int:
@@ -155,18 +162,21 @@ def _record_seed(seed: int, index: int) -> int:
 
 
 def _scene_for(base_scene: dict[str, Any], variation: dict[str, Any]) -> dict[str, Any]:
+    """The scene of one record: the (base) scene with only the varied fields replaced."""
     scene: dict[str, Any] = json.loads(json.dumps(base_scene))
-    person = dict(scene.get("person", {}))
-    person.pop("heading_deg", None)
-    person["aspect_deg"] = variation["aspect_deg"]
-    start = person.get("position", (0.0, 0.0))
-    radar = list(scene.get("radar_position", (10.0, 0.0, 2.0)))
-    if variation.get("radar_range") is not None:
-        radar[0], radar[1] = start[0] + variation["radar_range"], start[1]
-    if variation.get("radar_height") is not None:
-        radar[2] = variation["radar_height"]
-    scene["radar_position"] = radar
-    scene["person"] = person
+    if variation["aspect_deg"] is not None:
+        person = dict(scene.get("person", {}))
+        person.pop("heading_deg", None)  # the aspect replaces any fixed heading
+        person["aspect_deg"] = variation["aspect_deg"]
+        scene["person"] = person
+    if variation["radar_range"] is not None or variation["radar_height"] is not None:
+        start = scene.get("person", {}).get("position", (0.0, 0.0))
+        radar = list(scene.get("radar_position", (10.0, 0.0, 2.0)))
+        if variation["radar_range"] is not None:
+            radar[0], radar[1] = start[0] + variation["radar_range"], start[1]
+        if variation["radar_height"] is not None:
+            radar[2] = variation["radar_height"]
+        scene["radar_position"] = radar
     return scene
 
 
@@ -187,7 +197,7 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
     none: list[float | None] = [None]
     grid = list(
         itertools.product(
-            v.aspect_deg,
+            v.aspect_deg or none,
             v.radar_range or none,
             v.radar_height or none,
             v.height or none,
@@ -198,9 +208,14 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
         motion = dict(entry.motion)
         if "kind" not in motion:
             raise ConfigError(f"sources[{entry_no}].motion: a kind is required")
+        # a source's own start/duration limit the span that records are cut from
         whole = {k: v for k, v in motion.items() if k not in ("start", "duration")}
         loaded = _load_motion(json.dumps(whole, sort_keys=True), str(base_dir))
-        duration = loaded.skeleton.duration - float(motion.get("start", 0.0))
+        span_start = float(motion.get("start", 0.0))
+        span_end = loaded.skeleton.duration
+        if motion.get("duration") is not None:
+            span_end = min(span_end, span_start + float(motion["duration"]))
+        duration = span_end - span_start
         length = entry.record_length or config.record_lengths.get(entry.label) or duration
         if length > duration + 1e-9:
             raise ConfigError(
@@ -262,6 +277,7 @@ def build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         threshold_db=fcfg["threshold_db"],
         floor_db=fcfg["floor_db"],
         percentiles=tuple(fcfg["percentiles"]),
+        torso_method=fcfg["torso"],
     )
     cfg: Any = config
     meta = {
@@ -489,10 +505,10 @@ def load_dataset(path: str | Path, *, spectrograms: bool = True) -> Dataset:
     table: dict[str, NDArray[Any]] = {}
     for key in rows[0]:
         col = [r[key] for r in rows]
-        try:
+        if key in TEXT_COLUMNS:
+            table[key] = np.array(col, dtype=str)
+        else:
             table[key] = np.array([float(c) if c != "" else np.nan for c in col])
-        except ValueError:
-            table[key] = np.array(col)
     feats = np.stack([table[n].astype(np.float64) for n in FEATURE_NAMES], axis=1)
     specs: NDArray[np.float32] | list[NDArray[np.float32]] | None = None
     velocity = None

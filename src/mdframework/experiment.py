@@ -22,11 +22,11 @@ import io
 import json
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import Field, ValidationError, model_validator
 from sklearn.model_selection import StratifiedShuffleSplit
 
 from .classify import (
@@ -36,7 +36,7 @@ from .classify import (
     optimistic_select,
     wrapper_select,
 )
-from .config import format_validation_error, read_config_file
+from .config import StrictModel, format_validation_error, read_config_file
 from .dataset import Dataset, build_dataset, load_dataset, load_dataset_config
 from .errors import ConfigError, MdfError
 from .features import FEATURE_NAMES
@@ -44,11 +44,7 @@ from .interfaces import Classifier
 from .plugins import Registry, default_registry
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
-
-class DatasetRef(_Strict):
+class DatasetRef(StrictModel):
     """Which data: a dataset config to build (into DIR/dataset), or a built dataset."""
 
     config: Path | None = Field(None, description="Dataset config file to build.")
@@ -61,27 +57,29 @@ class DatasetRef(_Strict):
         return self
 
 
-class SelectionConfig(_Strict):
+class SelectionConfig(StrictModel):
     """Feature selection."""
 
     method: Literal["wrapper", "none"] = Field(
         "wrapper", description="wrapper: subsets scored by CV on the training split; none: all."
     )
-    sizes: list[int] = Field([4], description="Subset sizes to try (the paper: 4 of 7).")
+    sizes: list[Annotated[int, Field(ge=1, le=len(FEATURE_NAMES))]] = Field(
+        [4], min_length=1, description="Subset sizes to try (the paper: 4 of 7)."
+    )
     folds: int = Field(5, ge=2, description="Cross-validation folds.")
     optimistic: bool = Field(
         True, description="Also report the paper's optimistic selection on the test split."
     )
 
 
-class EvaluationConfig(_Strict):
+class EvaluationConfig(StrictModel):
     """Repeated stratified splits."""
 
     repeats: int = Field(10, ge=1, description="Number of random splits.")
     test_fraction: float = Field(0.4, gt=0, lt=1, description="Test share (the paper: 40 %).")
 
 
-class CrossSourceConfig(_Strict):
+class CrossSourceConfig(StrictModel):
     """Train on one source group, test on another."""
 
     train: str = Field(description="Group used for training (e.g. 'kinect').")
@@ -91,7 +89,7 @@ class CrossSourceConfig(_Strict):
     )
 
 
-class ReportConfig(_Strict):
+class ReportConfig(StrictModel):
     """Plots."""
 
     scatter_pairs: list[tuple[str, str]] = Field(
@@ -100,7 +98,7 @@ class ReportConfig(_Strict):
     )
 
 
-class ExperimentConfig(_Strict):
+class ExperimentConfig(StrictModel):
     """An experiment."""
 
     seed: int = Field(0, ge=0)

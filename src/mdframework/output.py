@@ -33,6 +33,14 @@ from .physics.spectrogram import power_to_db
 from .pipeline import RunResult
 
 MAX_RANGE_TIME_ROWS = 2000
+#: every file a run may write
+OUTPUTS = (
+    "result.npz",
+    "spectrogram.png",
+    "range_time.png",
+    "config.resolved.json",
+    "metadata.json",
+)
 
 
 def result_arrays(result: RunResult) -> dict[str, np.ndarray]:
@@ -90,6 +98,9 @@ def write_run(result: RunResult, resolved_config: dict[str, Any], out_dir: Path)
             json.dumps(result.metadata, indent=2, default=_jsonable) + "\n"
         )
         out_dir.mkdir(parents=True, exist_ok=True)
+        for name in OUTPUTS:  # an earlier run's file this run does not make (range_time.png)
+            if not (stage / name).exists():
+                (out_dir / name).unlink(missing_ok=True)
         written = []
         for f in sorted(stage.iterdir()):
             os.replace(f, out_dir / f.name)

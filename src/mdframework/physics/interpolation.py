@@ -27,20 +27,6 @@ def pulse_times(t_first: float, t_last: float, prf: float) -> FloatArray:
     return t_first + np.arange(n, dtype=np.float64) / prf
 
 
-def sort_and_deduplicate(
-    time: FloatArray, positions: FloatArray
-) -> tuple[FloatArray, FloatArray, NDArray[np.intp]]:
-    """Stable-sort frames by time and keep the first of frames with equal times.
-
-    Returns the sorted time (n_kept,), positions (n_kept, ...) and the kept frame indices."""
-    order = np.argsort(time, kind="stable")
-    t = time[order]
-    keep = np.ones(t.shape, dtype=bool)
-    keep[1:] = np.diff(t) > 0
-    idx = order[keep]
-    return time[idx], positions[idx], idx
-
-
 def resample_tracks(
     time: FloatArray,
     positions: FloatArray,
