@@ -1,10 +1,8 @@
 """Make the figures and the feature table of ``docs/validation.md``.
 
 Boulic walker (corrected and Chen-compatible) and CMU trial 02_01 walking toward the same radar
-(15 GHz, at (10, 0, 2) m, aspect 0), same processing. Features, until the paper's Table 2
-features exist: torso velocity (mean of the strongest Doppler bin per frame) and the upper and
-lower Doppler envelopes (the fastest / slowest bin within 40 dB of the record's peak in each
-frame), summarised by their 95th / 5th percentiles and extremes.
+(15 GHz, at (10, 0, 2) m, aspect 0), same processing, and the seven features of the paper's
+Table 2 (``mdframework.features`` with its defaults) printed as a Markdown table.
 
     .venv/bin/python docs/make_validation_figures.py
 """
