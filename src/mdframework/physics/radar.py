@@ -158,11 +158,15 @@ def compressed_return_at_gate(
     ``ranges``, ``amplitudes``: (n_pulses, n_scatterers) [m], [sqrt(W)]; ``gate_range``
     (n_pulses,) [m]. Returns (n_pulses,) complex128 [sqrt(W)].
     """
-    w = gate_weights(
+    weighted = amplitudes * gate_weights(
         ranges, gate_range, pulse_width=pulse_width, bandwidth=bandwidth, response=response
     )
-    phasor = carrier_phasor(ranges, carrier_frequency)
-    return np.asarray(np.sum(amplitudes * w * phasor, axis=1), dtype=np.complex128)
+    # sum the real and imaginary parts separately: no complex temporaries
+    phase = (-2.0 * np.pi) * carrier_cycles_fraction(ranges, carrier_frequency)
+    out = np.empty(ranges.shape[0], dtype=np.complex128)
+    out.real = np.einsum("ps,ps->p", weighted, np.cos(phase))
+    out.imag = np.einsum("ps,ps->p", weighted, np.sin(phase))
+    return out
 
 
 def raw_pulse_returns(
