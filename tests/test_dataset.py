@@ -219,3 +219,35 @@ window_length = 128
         assert row["torso_mean"] == pytest.approx(-1.0, abs=0.1)
     data = load_dataset(tmp_path / "ds")
     assert data.labels.dtype.kind == "U" and list(data.labels) == ["receding"] * 2
+
+
+def test_radar_position_and_walker_height_variations(tmp_path: Path) -> None:
+    p = tmp_path / "d.toml"
+    p.write_text("""
+[[sources]]
+label = "walk"
+record_length = 1.0
+motion = { kind = "boulic", n_cycles = 1 }
+[variations]
+radar_position = [[10.0, 0.0, 2.0], [0.0, 10.0, 1.0]]
+height = [1.6, 1.9]
+""")
+    cfg, base = load_dataset_config(p)
+    specs = plan_records(cfg, base)
+    combos = {
+        (tuple(s.run_config["scene"]["radar_position"]), s.run_config["motion"]["height"])
+        for s in specs
+    }
+    assert combos == {
+        ((10.0, 0.0, 2.0), 1.6),
+        ((10.0, 0.0, 2.0), 1.9),
+        ((0.0, 10.0, 1.0), 1.6),
+        ((0.0, 10.0, 1.0), 1.9),
+    }
+    rows = build_dataset(cfg, base, tmp_path / "ds", workers=1, progress=False)
+    torso = {(r["radar_x_m"], r["height_m"]): r["torso_mean"] for r in rows}
+    # a taller walker at the same relative velocity walks faster (v = rv * 0.491 H)
+    assert torso[(10.0, 1.9)] > torso[(10.0, 1.6)]
+    p.write_text(p.read_text() + "radar_range = [5.0]\n")
+    with pytest.raises(ConfigError, match="radar_position, or radar_range"):
+        load_dataset_config(p)

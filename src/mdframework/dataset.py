@@ -37,7 +37,7 @@ from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import Field, ValidationError
+from pydantic import Field, ValidationError, model_validator
 
 from .config import StrictModel, format_validation_error, read_config_file, validate_run_config
 from .errors import ConfigError, MdfError
@@ -95,9 +95,21 @@ class Variations(StrictModel):
         None, description="Horizontal distance radar - person's start [m]; default: base scene."
     )
     radar_height: list[float] | None = Field(None, description="Radar height [m].")
+    radar_position: list[tuple[float, float, float]] | None = Field(
+        None,
+        description="Radar positions (x, y, z) [m]; exclusive with radar_range/radar_height.",
+    )
     height: list[float] | None = Field(
         None, description="Person's height [m], for sources whose config has a `height`."
     )
+
+    @model_validator(mode="after")
+    def _radar_one_way(self) -> Variations:
+        if self.radar_position is not None and (
+            self.radar_range is not None or self.radar_height is not None
+        ):
+            raise ValueError("give radar_position, or radar_range/radar_height, not both")
+        return self
 
 
 class DatasetConfig(StrictModel):
@@ -169,6 +181,8 @@ def _scene_for(base_scene: dict[str, Any], variation: dict[str, Any]) -> dict[st
         person.pop("heading_deg", None)  # the aspect replaces any fixed heading
         person["aspect_deg"] = variation["aspect_deg"]
         scene["person"] = person
+    if variation["radar_position"] is not None:
+        scene["radar_position"] = list(variation["radar_position"])
     if variation["radar_range"] is not None or variation["radar_height"] is not None:
         start = scene.get("person", {}).get("position", (0.0, 0.0))
         radar = list(scene.get("radar_position", (10.0, 0.0, 2.0)))
@@ -194,12 +208,13 @@ def _merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
 def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
     """Expand sources x windows x variations into record specs, in a fixed order."""
     v = config.variations
-    none: list[float | None] = [None]
+    none: list[Any] = [None]
     grid = list(
         itertools.product(
             v.aspect_deg or none,
             v.radar_range or none,
             v.radar_height or none,
+            v.radar_position or none,
             v.height or none,
         )
     )
@@ -227,14 +242,19 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
         if entry.max_records is not None:
             starts = starts[: entry.max_records]
         for start in starts:
-            for aspect, rng_, rheight, height in grid:
+            for aspect, rng_, rheight, rpos, height in grid:
                 section = {**motion, "start": round(float(start), 9), "duration": length}
                 if height is not None:
                     section["height"] = height
                 run = {**_merge(config.base, entry.run), "motion": section}
                 run["scene"] = _scene_for(
                     run.get("scene", {}),
-                    {"aspect_deg": aspect, "radar_range": rng_, "radar_height": rheight},
+                    {
+                        "aspect_deg": aspect,
+                        "radar_range": rng_,
+                        "radar_height": rheight,
+                        "radar_position": rpos,
+                    },
                 )
                 index = len(specs)
                 run["seed"] = _record_seed(config.seed, index)
