@@ -10,6 +10,10 @@ Arrays and units:
   that frame (its position must then not be used).
 - ``joint_names``: tuple of ``n_joints`` strings.
 
+The arrays are made read-only on construction: stages share skeletons (and datasets cache them
+across records), so a stage that wants different positions builds a new skeleton
+(:meth:`Skeleton.with_positions`) instead of changing one in place.
+
 The canonical body is Chen's 17-point set used with the Boulic walking model (``physics.md``
 section 2.3): base (hip centre), neck, head, left/right shoulder, elbow, hand, hip, knee, ankle,
 toe.
@@ -117,6 +121,8 @@ class Skeleton:
                 raise SkeletonError(f"valid must have shape {pos.shape[:2]}, got {valid.shape}")
             if not np.all(finite | ~valid[:, :, None]):
                 raise SkeletonError("positions marked valid must be finite")
+        for array in (time, pos, valid):  # shared between stages (and cached): never mutated
+            array.flags.writeable = False
         object.__setattr__(self, "time", time)
         object.__setattr__(self, "positions", pos)
         object.__setattr__(self, "joint_names", names)
