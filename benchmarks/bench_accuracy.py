@@ -9,7 +9,8 @@ each row's error is the error of that knob alone:
 - ``interpolation``: linear, pchip, akima, cubic (ref: cubic, C2 spline; physics.md 6.4);
 - ``prf``: 800, 1200, 2400 (default), 4800 Hz (ref 4800), the STFT window, hop and FFT size
   scaled with the PRF so that they keep their durations and Hz resolution;
-- ``scatterers``: ``ellipsoid`` joints17 (default) and chen16,
+- ``scatterers``: isotropic points at the 17 joints (0.05 m^2 each), ``ellipsoid`` joints17
+  (default) and chen16,
   ``mujoco_body`` (Boulic only), chen16 parts sampled with 8 and 32 surface points (ref: 32);
 - ``receive``: analytic exact (default), sinc, phase_only, raw fast-time path (ref: raw);
 - ``precision``: float64 (default, ref) vs float32 (complex64 after a float64 phase reduction);
@@ -103,6 +104,7 @@ def ladders(scene: str, quick: bool) -> list[Setting]:
             )
         )
     models: list[tuple[str, dict[str, Any]]] = [
+        ("points", {"kind": "points", "body": True, "rcs": 0.05}),
         ("joints17", {"kind": "ellipsoid", "placement": "joints17"}),
         ("chen16", {"kind": "ellipsoid", "placement": "chen16"}),
     ]

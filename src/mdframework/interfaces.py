@@ -127,8 +127,8 @@ class Scatterers:
 class ScattererModel(Plugin):
     """Turns a body (or a set of points) into scatterers with an RCS for each pulse."""
 
-    #: Whether this model needs the canonical 17-joint body.
-    needs_canonical: ClassVar[bool] = True
+    #: Whether this model needs the canonical 17-joint body (a model may decide per config).
+    needs_canonical: bool = True
 
     @abstractmethod
     def scatterers(

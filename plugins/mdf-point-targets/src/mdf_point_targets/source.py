@@ -74,6 +74,11 @@ class IsotropicPointsConfig(PluginConfig):
     rcs: float | None = Field(
         None, ge=0, description="RCS of every point [m^2]; default: the source's, else 1 m^2."
     )
+    body: bool = Field(
+        False,
+        description="Use a human body's 17 canonical joints, placed in the scene like any body "
+        "(the crudest body model: one isotropic point per joint).",
+    )
 
 
 class IsotropicPoints(ScattererModel):
@@ -82,7 +87,10 @@ class IsotropicPoints(ScattererModel):
     name = "points"
     Config = IsotropicPointsConfig
     config: IsotropicPointsConfig
-    needs_canonical = False
+
+    def __init__(self, config: IsotropicPointsConfig) -> None:
+        super().__init__(config)
+        self.needs_canonical = config.body
 
     def scatterers(
         self, motion: Motion, skeleton: Skeleton, radar_position: np.ndarray, wavelength: float
