@@ -107,3 +107,28 @@ def test_experiment_on_shipped_cmu_data(tmp_path: Path) -> None:
     for name in ("report.md", "within_cmu_confusion.png", "scatter_torso_mean_upper_max.png"):
         assert (out / name).stat().st_size > 100
     assert json.loads((out / "summary.json").read_text())["n_records"] == 280
+
+
+def test_recording_split_holds_out_whole_recordings(rng: np.random.Generator) -> None:
+    labels = np.repeat(["a", "b"], 30)
+    recordings = np.array([f"{lab}{i // 10}" for lab, i in zip(labels, range(60), strict=True)])
+    splits = exp.recording_splits(labels, recordings, repeats=5, test_fraction=0.4, seed=3)
+    for train, test in splits:
+        assert not set(recordings[train]) & set(recordings[test])
+        assert set(labels[test]) == {"a", "b"} and set(labels[train]) == {"a", "b"}
+        assert len(np.concatenate([train, test])) == 60
+    x = rng.normal(size=(60, 7))
+    x[:, 0] += np.repeat([0.0, 6.0], 30)
+    cfg = exp.ExperimentConfig.model_validate(
+        {
+            "dataset": {"path": "unused"},
+            "evaluation": {"repeats": 3, "split": "recording"},
+            "selection": {"method": "none", "optimistic": False},
+        }
+    )
+    res = exp.within_source(
+        cfg, exp.classifier_factory({"kind": "knn"}, "t"), x, labels, recordings
+    )
+    assert np.allclose(res["confusion_mean"].sum(axis=1), 1.0)
+    with pytest.raises(exp.MdfError, match="class 'a' has only one recording"):
+        exp.recording_splits(labels, np.where(labels == "a", "one", recordings), 1, 0.4, 0)

@@ -77,6 +77,12 @@ class EvaluationConfig(StrictModel):
 
     repeats: int = Field(10, ge=1, description="Number of random splits.")
     test_fraction: float = Field(0.4, gt=0, lt=1, description="Test share (the paper: 40 %).")
+    split: Literal["record", "recording"] = Field(
+        "record",
+        description="record: records are split at random (windows of one recording can land "
+        "on both sides, which flatters the score); recording: whole recordings (source files) "
+        "are held out, per class.",
+    )
 
 
 class CrossSourceConfig(StrictModel):
@@ -179,21 +185,50 @@ def _select(
     )
 
 
+def recording_splits(
+    labels: NDArray[Any], recordings: NDArray[Any], repeats: int, test_fraction: float, seed: int
+) -> list[tuple[NDArray[np.intp], NDArray[np.intp]]]:
+    """Train/test index splits that hold out whole recordings: for every class, a random
+    ``test_fraction`` of its recordings (at least one, and never all) goes to the test side."""
+    rng = np.random.default_rng(seed)
+    splits = []
+    for _ in range(repeats):
+        test_mask = np.zeros(labels.shape[0], dtype=bool)
+        for label in sorted(set(labels.tolist())):
+            files = sorted(set(recordings[labels == label].tolist()))
+            if len(files) < 2:
+                raise MdfError(
+                    f"evaluation.split = 'recording': class {label!r} has only one recording"
+                )
+            n_test = min(len(files) - 1, max(1, round(test_fraction * len(files))))
+            held = set(rng.permutation(files)[:n_test].tolist())
+            test_mask |= (labels == label) & np.isin(recordings, list(held))
+        splits.append((np.flatnonzero(~test_mask), np.flatnonzero(test_mask)))
+    return splits
+
+
 def within_source(
     cfg: ExperimentConfig,
     factory: Callable[[], Classifier],
     x: NDArray[np.float64],
     y: NDArray[Any],
+    recordings: NDArray[Any] | None = None,
 ) -> dict[str, Any]:
-    """Repeated stratified splits of one group's records; returns matrices and scores."""
+    """Repeated stratified splits of one group's records; returns matrices and scores.
+    ``recordings`` (n_records,) names each record's source file (for ``split = 'recording'``)."""
     classes = sorted(set(y.tolist()))
-    splitter = StratifiedShuffleSplit(
-        n_splits=cfg.evaluation.repeats,
-        test_size=cfg.evaluation.test_fraction,
-        random_state=cfg.seed,
-    )
+    ev = cfg.evaluation
+    if ev.split == "recording":
+        if recordings is None:
+            raise MdfError("evaluation.split = 'recording' needs each record's recording")
+        splits = recording_splits(y, recordings, ev.repeats, ev.test_fraction, cfg.seed)
+    else:
+        splitter = StratifiedShuffleSplit(
+            n_splits=ev.repeats, test_size=ev.test_fraction, random_state=cfg.seed
+        )
+        splits = list(splitter.split(x, y))
     mats, accs, optimistic, subsets = [], [], [], []
-    for rep, (train, test) in enumerate(splitter.split(x, y)):
+    for rep, (train, test) in enumerate(splits):
         sel = _select(cfg, factory, x[train], y[train], cfg.seed + rep)
         pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
         mats.append(confusion_matrix(y[test], pred, classes))
@@ -326,7 +361,7 @@ def run_experiment(
         f"Dataset: `{data_dir}` ({len(data.labels)} records).",
         f"Classifier: `{json.dumps(cfg.classifier)}`; selection: "
         f"{cfg.selection.method} (sizes {cfg.selection.sizes}); "
-        f"{cfg.evaluation.repeats} stratified splits, "
+        f"{cfg.evaluation.repeats} stratified splits by {cfg.evaluation.split}, "
         f"{round(100 * (1 - cfg.evaluation.test_fraction))}/"
         f"{round(100 * cfg.evaluation.test_fraction)}.",
         "",
@@ -335,7 +370,14 @@ def run_experiment(
         mask = data.groups == group
         if len(set(data.labels[mask].tolist())) < 2:
             continue
-        res = within_source(cfg, factory, data.features[mask], data.labels[mask])
+        try:
+            res = within_source(
+                cfg, factory, data.features[mask], data.labels[mask], data.table["file"][mask]
+            )
+        except MdfError as exc:  # e.g. a class with a single recording cannot be held out
+            report += [f"## Within-source: {group}", "", f"Not evaluated: {exc}.", ""]
+            summary["within"][group] = {"skipped": str(exc)}
+            continue
         classes = res["classes"]
         stem = f"within_{group}"
         (out / f"{stem}_confusion.csv").write_text(
