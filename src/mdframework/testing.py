@@ -1,0 +1,107 @@
+"""Contract checks every plugin of an interface must pass, for plugin authors' own tests.
+
+Each ``check_*`` function raises ``AssertionError`` naming the broken contract::
+
+    from mdframework.testing import check_plugin_class, check_motion_source
+
+    def test_my_source():
+        check_plugin_class(MySource, "motion")
+        check_motion_source(MySource(MySource.Config(...)))
+
+The project runs them over every installed plugin (``tests/test_contracts.py``).
+"""
+
+from __future__ import annotations
+
+import json
+import typing
+
+import numpy as np
+
+from .interfaces import (
+    Effect,
+    Motion,
+    MotionSource,
+    Plugin,
+    RadarWaveform,
+    ScattererModel,
+    Scatterers,
+)
+from .physics import radar
+from .plugins import INTERFACES
+from .skeleton import CANONICAL_JOINTS, Skeleton
+
+
+def check_plugin_class(cls: type[Plugin], interface: str) -> None:
+    """A plugin class has a name, a docstring, and a strict Config whose ``kind`` is its name."""
+    base = INTERFACES[interface][1]
+    assert issubclass(cls, base), f"{cls.__name__} is not a {base.__name__}"
+    assert isinstance(cls.name, str) and cls.name, f"{cls.__name__} has no name"
+    assert (cls.__doc__ or "").strip(), f"{cls.__name__} has no docstring"
+    field = cls.Config.model_fields.get("kind")
+    assert field is not None, f"{cls.__name__}.Config has no kind field"
+    assert typing.get_args(field.annotation) == (cls.name,), (
+        f"{cls.__name__}.Config.kind must be Literal[{cls.name!r}]"
+    )
+    assert cls.Config.model_config.get("extra") == "forbid", (
+        f"{cls.__name__}.Config must forbid unknown fields"
+    )
+
+
+def check_motion_source(source: MotionSource) -> Motion:
+    """``load()`` gives a consistent Motion: JSON metadata, a complete canonical map whose
+    canonical body is finite where valid, and RCS per joint when given."""
+    motion = source.load()
+    assert isinstance(motion, Motion), "load() must return a Motion"
+    assert isinstance(motion.skeleton, Skeleton)
+    assert motion.skeleton.n_frames >= 2, "a recording needs at least two frames"
+    json.dumps(dict(motion.metadata))  # JSON-serialisable
+    if motion.canonical_map is not None:
+        body = motion.canonical()
+        assert body.joint_names == CANONICAL_JOINTS
+        assert np.all(np.isfinite(body.positions[body.valid])), "valid joints must be finite"
+    if motion.point_rcs is not None:
+        assert motion.point_rcs.shape == (motion.skeleton.n_joints,)
+        assert np.all(motion.point_rcs >= 0), "RCS must be >= 0"
+    return motion
+
+
+def check_scatterer_model(
+    model: ScattererModel, skeleton: Skeleton, motion: Motion, wavelength: float = 0.02
+) -> Scatterers:
+    """Scatterers for a body at 10 m: shapes, finite positions, finite non-negative RCS."""
+    radar_position = np.array([10.0, 0.0, 1.0])
+    scat = model.scatterers(motion, skeleton, radar_position, wavelength)
+    n = skeleton.n_frames
+    assert scat.positions.shape[0] == n and scat.rcs.shape[0] == n, "one row per pulse"
+    assert np.all(np.isfinite(scat.positions)), "positions must be finite"
+    assert np.all(np.isfinite(scat.rcs)) and np.all(scat.rcs >= 0), "RCS finite and >= 0"
+    return scat
+
+
+def check_waveform(waveform: RadarWaveform) -> None:
+    """Positive carrier and PRF; ``receive`` returns one complex sample per pulse; an
+    approaching scatterer has positive Doppler (the project's sign convention)."""
+    fc, prf = waveform.carrier_frequency, waveform.prf
+    assert fc > 0 and prf > 0
+    n = 512
+    t = np.arange(n) / prf
+    v = 0.25 * radar.max_unambiguous_velocity(fc, prf)  # approaching, well inside the limit
+    ranges = (50.0 - v * t)[:, None]
+    received = waveform.receive(ranges, np.ones_like(ranges), ranges[:, 0])
+    y = received.signal
+    assert y.shape == (n,) and np.iscomplexobj(y), "signal must be (n_pulses,) complex"
+    assert np.all(np.isfinite(y))
+    doppler = np.angle(np.sum(y[1:] * np.conj(y[:-1]))) * prf / (2 * np.pi)
+    expected = float(radar.velocity_to_doppler(v, fc))
+    assert abs(doppler - expected) < 1e-3 * expected, (
+        f"an approaching target must show +{expected:.3f} Hz, got {doppler:.3f} Hz"
+    )
+
+
+def check_effect_class(cls: type[Effect]) -> None:
+    """An effect declares the stage it acts on."""
+    check_plugin_class(cls, "effect")
+    assert getattr(cls, "stage", None) in ("scatterers", "received"), (
+        f"{cls.__name__}.stage must be 'scatterers' or 'received'"
+    )
