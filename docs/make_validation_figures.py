@@ -44,6 +44,15 @@ def cmu() -> RunResult:
     return simulate(load_run_config(EXAMPLES / "cmu_walk.toml"))
 
 
+def kinect() -> RunResult:
+    """The UTKinect walk (conditioned) seen from the same radar and aspect as the others."""
+    import tomllib
+
+    cfg = tomllib.loads((EXAMPLES / "kinect_utkinect_walk.toml").read_text())
+    cfg["scene"] = {"radar_position": [10.0, 0.0, 2.0], "person": {"aspect_deg": 0.0}}
+    return simulate(validate_run_config(cfg, base_dir=EXAMPLES))
+
+
 def features(res: RunResult) -> dict[str, float]:
     """The seven Table 2 features [m/s] of a run."""
     values = spectrogram_features(res.spectrogram.power, res.velocity)
@@ -56,8 +65,9 @@ def main() -> None:
         "Boulic (corrected)": boulic(False),
         "Boulic (chen_compatible)": boulic(True),
         "CMU 02_01 walk": cmu(),
+        "Kinect UTKinect walk": kinect(),
     }
-    fig, axes = plt.subplots(1, len(runs), figsize=(15, 4.2), sharey=True, constrained_layout=True)
+    fig, axes = plt.subplots(1, len(runs), figsize=(19, 4.2), sharey=True, constrained_layout=True)
     image = None
     for ax, (name, res) in zip(axes, runs.items(), strict=True):
         t = res.spectrogram.time
