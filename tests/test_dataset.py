@@ -251,3 +251,20 @@ height = [1.6, 1.9]
     p.write_text(p.read_text() + "radar_range = [5.0]\n")
     with pytest.raises(ConfigError, match="radar_position, or radar_range"):
         load_dataset_config(p)
+
+
+def test_cli_dataset_error_names_the_config_and_leaves_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from mdframework import cli
+
+    p = tmp_path / "d.toml"
+    p.write_text(
+        f'[[sources]]\nlabel = "run"\nrecord_length = 3.0\n'
+        f'motion = {{ kind = "cmu", file = "{CMU / "asf-amc" / "09_06.amc"}" }}\n'
+    )
+    out = tmp_path / "ds"
+    assert cli.main(["dataset", "build", str(p), "--out", str(out), "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"mdf: error: {p}: sources[0]: record length")
+    assert not out.exists()

@@ -11,14 +11,27 @@ import json
 import sys
 import traceback
 import warnings
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from .errors import ConfigError, DataFileError, MdfError
+from .errors import DataFileError, MdfError
 from .plugins import INTERFACES, PluginError, default_registry, make_plugin_manager
 
 EXIT_USAGE = 2
+
+
+@contextmanager
+def _naming(config_file: str) -> Iterator[None]:
+    """Prefix the config file to errors that name only a field (data-file errors name their own
+    file)."""
+    try:
+        yield
+    except MdfError as exc:
+        if isinstance(exc, DataFileError) or str(exc).startswith(config_file):
+            raise
+        raise type(exc)(f"{config_file}: {exc}") from exc
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
@@ -27,12 +40,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from .pipeline import simulate
 
     config = load_run_config(args.config)
-    try:
+    with _naming(args.config):
         result = simulate(config)
-    except MdfError as exc:
-        if isinstance(exc, ConfigError | DataFileError):
-            raise
-        raise type(exc)(f"{args.config}: {exc}") from exc
     resolved = json.loads(config.model_dump_json())
     written = write_run(result, resolved, Path(args.out))
     for path in written:
@@ -66,14 +75,15 @@ def _cmd_dataset_build(args: argparse.Namespace) -> int:
     from .dataset import build_dataset, load_dataset_config
 
     config, base = load_dataset_config(args.config)
-    rows = build_dataset(
-        config,
-        base,
-        Path(args.out),
-        workers=args.workers,
-        scheduler=args.scheduler,
-        progress=not args.no_progress,
-    )
+    with _naming(args.config):
+        rows = build_dataset(
+            config,
+            base,
+            Path(args.out),
+            workers=args.workers,
+            scheduler=args.scheduler,
+            progress=not args.no_progress,
+        )
     print(f"{len(rows)} records in {args.out}")
     return 0
 
@@ -82,7 +92,8 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
     from .experiment import load_experiment_config, run_experiment
 
     config = load_experiment_config(args.config)
-    run_experiment(config, Path(args.out), source=args.config, progress=not args.no_progress)
+    with _naming(args.config):
+        run_experiment(config, Path(args.out), source=args.config, progress=not args.no_progress)
     print(Path(args.out) / "report.md")
     return 0
 

@@ -451,11 +451,11 @@ def build_dataset(
     """Build (or finish building) a dataset; returns the index rows in record order."""
     from tqdm import tqdm
 
+    specs = plan_records(config, base_dir)  # errors in the config stop before any file
     out = Path(out_dir)
     (out / RECORDS).mkdir(parents=True, exist_ok=True)
     for stale in (out / RECORDS).glob(".tmp-*"):
         stale.unlink()
-    specs = plan_records(config, base_dir)
     rows: dict[str, dict[str, Any]] = {}
     todo = []
     for spec in specs:
