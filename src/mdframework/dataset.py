@@ -43,7 +43,7 @@ from .config import StrictModel, format_validation_error, read_config_file, vali
 from .errors import ConfigError, MdfError
 from .features import FEATURE_NAMES, spectrogram_features
 from .interfaces import Motion
-from .pipeline import build_stages, simulate_motion
+from .pipeline import build_stages, load_motion, simulate_motion
 
 RECORDS = "records"
 #: index.csv columns that hold text (all others are numbers)
@@ -163,10 +163,7 @@ def _load_motion(motion_json: str, base_dir: str) -> Motion:
     config = validate_run_config(
         {"motion": section}, source="dataset motion", base_dir=Path(base_dir)
     )
-    try:
-        return build_stages(config).source.load()
-    except ValueError as exc:  # a plugin's own check of its input
-        raise MdfError(f"motion {section.get('kind')!r}: {exc}") from None
+    return load_motion(build_stages(config).source)
 
 
 def _record_seed(seed: int, index: int) -> int:

@@ -134,14 +134,19 @@ def _is_default_placement(person: PersonConfig) -> bool:
 def simulate(config: RunConfigBase, registry: Registry | None = None) -> RunResult:
     """Run one config end to end."""
     stages = build_stages(config, registry)
-    timings: dict[str, float] = {}
     t0 = time.perf_counter()
-    try:
-        motion = stages.source.load()
-    except ValueError as exc:  # a plugin's own check of its input
-        raise SceneError(f"motion: {exc}") from None
-    timings["load"] = time.perf_counter() - t0
+    motion = load_motion(stages.source)
+    timings = {"load": time.perf_counter() - t0}
     return simulate_motion(config, stages, motion, timings)
+
+
+def load_motion(source: MotionSource) -> Motion:
+    """``source.load()``, with a plugin's own check of its input (``ValueError``) reported as
+    a one-line user error naming the source."""
+    try:
+        return source.load()
+    except ValueError as exc:
+        raise SceneError(f"motion {source.name!r}: {exc}") from None
 
 
 def simulate_motion(
