@@ -10,7 +10,7 @@ import pytest
 
 from mdframework import CANONICAL_JOINTS, Skeleton
 from mdframework import conditioning as cond
-from mdframework.config import ConditioningConfig
+from mdframework.settings import ConditioningConfig
 
 DATA = Path(__file__).parents[1] / "examples" / "data" / "kinect"
 

@@ -9,7 +9,6 @@ See ``docs/plugins.md`` for writing a plugin distribution.
 
 from __future__ import annotations
 
-from .config import DataPath, MotionConfig
 from .errors import ConfigError, DataFileError, MdfError, SceneError
 from .hookspecs import hookimpl
 from .interfaces import (
@@ -24,6 +23,7 @@ from .interfaces import (
     Scatterers,
     SceneContext,
 )
+from .settings import DataPath, MotionConfig
 from .skeleton import CANONICAL_JOINTS, CANONICAL_SEGMENTS, Skeleton, to_canonical
 
 __version__ = "0.1.0"

@@ -5,7 +5,7 @@ Pure functions on arrays plus one entry point, :func:`condition`. Arrays and uni
 ``valid`` (n_frames, n_joints) bool. Nothing here changes data that need no change: every step
 touches only the frames and joints it flags, and reports what it did.
 
-Steps (each configurable through :class:`mdframework.config.ConditioningConfig`):
+Steps (each configurable through :class:`mdframework.settings.ConditioningConfig`):
 
 1. time stamps (:func:`sort_timestamps`): stable sort, duplicates dropped (first kept). Sources
    call it before building a :class:`~mdframework.skeleton.Skeleton` (which must be strictly
@@ -38,7 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
-from .config import ConditioningConfig
+from .settings import ConditioningConfig
 from .skeleton import Skeleton
 
 FloatArray = NDArray[np.float64]

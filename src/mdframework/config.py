@@ -1,8 +1,10 @@
-"""Run configs: pydantic models, read from TOML, YAML or JSON files.
+"""Run configs read from TOML, YAML or JSON files, validated against the installed plugins.
 
 Every section that chooses a plugin has a ``kind`` field; the plugin's own ``Config`` model
 validates the rest. The full run model is assembled from the registered plugins
-(:func:`run_config_model`), so ``mdf config schema`` shows exactly what is installed.
+(:func:`run_config_model`) on top of :class:`~mdframework.settings.RunConfigBase`, so
+``mdf config schema`` shows exactly what is installed. This module sits above the pipeline: the
+pipeline and the physics see only the shared models of :mod:`mdframework.settings`.
 
 Relative paths inside a config are relative to the config file's folder.
 """
@@ -12,222 +14,15 @@ from __future__ import annotations
 import json
 import tomllib
 from pathlib import Path
-from typing import Annotated, Any, Literal, Union
+from typing import Annotated, Any, Union
 
 import yaml
-from pydantic import (
-    AfterValidator,
-    BaseModel,
-    ConfigDict,
-    Field,
-    PositiveFloat,
-    ValidationError,
-    ValidationInfo,
-    create_model,
-    field_validator,
-    model_validator,
-)
+from pydantic import Field, ValidationError, create_model
 
 from .errors import ConfigError
 from .interfaces import PluginConfig
-from .physics.interpolation import Method
 from .plugins import Registry, default_registry
-
-
-def _resolve_path(value: Path, info: ValidationInfo) -> Path:
-    base = (info.context or {}).get("base_dir")
-    path = Path(value).expanduser()
-    if not path.is_absolute() and base is not None:
-        path = Path(base) / path
-    if not path.exists():
-        raise ValueError(f"file not found: {path}")
-    return path
-
-
-#: A path to an existing file, relative to the config file's folder.
-DataPath = Annotated[Path, AfterValidator(_resolve_path)]
-
-
-class MotionConfig(PluginConfig):
-    """Base of motion-source configs: every source can be cut to a time window."""
-
-    start: float = Field(0.0, ge=0, description="Start of the window, s from the first frame.")
-    duration: float | None = Field(
-        None, gt=0, description="Length of the window [s]; default: to the end."
-    )
-
-
-class StrictModel(BaseModel):
-    """Base of every config model that is not a plugin's: unknown fields are errors."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
-
-class PersonConfig(StrictModel):
-    """Where the person is and how they move."""
-
-    motion: Literal["recorded", "treadmill", "straight"] = Field(
-        "recorded",
-        description="recorded: keep the recording's translation; treadmill: remove it; "
-        "straight: replace it by a straight path at `speed`.",
-    )
-    position: tuple[float, float] = Field(
-        (0.0, 0.0), description="Horizontal position (x, y) of the hip centre at the start [m]."
-    )
-    heading_deg: float | None = Field(
-        None, description="Direction the person faces, degrees from +x toward +y."
-    )
-    aspect_deg: float | None = Field(
-        None,
-        description="Facing direction relative to the radar: 0 = toward it, 90 = crossing, "
-        "180 = away. Default 0 when neither this nor heading_deg is given.",
-    )
-    speed: float | None = Field(None, ge=0, description="Speed for motion = 'straight' [m/s].")
-    facing: Literal["auto", "hips", "travel"] = Field(
-        "auto",
-        description="How the recording's own facing direction is found: from the hip line, "
-        "from the direction of travel, or auto (travel if the hip centre moves > 0.5 m).",
-    )
-
-    @model_validator(mode="after")
-    def _check(self) -> PersonConfig:
-        if self.heading_deg is not None and self.aspect_deg is not None:
-            raise ValueError("give heading_deg or aspect_deg, not both")
-        if self.motion == "straight" and self.speed is None:
-            raise ValueError("motion = 'straight' needs a speed")
-        if self.motion != "straight" and self.speed is not None:
-            raise ValueError("speed is used only with motion = 'straight'")
-        return self
-
-
-class SceneConfig(StrictModel):
-    """The radar's position, the person's placement and the range gate."""
-
-    radar_position: tuple[float, float, float] = Field(
-        (10.0, 0.0, 2.0), description="Radar antenna position (x, y, z) [m]."
-    )
-    person: PersonConfig = Field(
-        default_factory=PersonConfig, description="Where the person is and how they move."
-    )
-    gate: Literal["track"] | PositiveFloat = Field(
-        "track",
-        description="'track': the gate follows the hip centre (or the first point target); "
-        "a number: a fixed gate range [m].",
-    )
-    min_range: float = Field(
-        0.5, gt=0, description="Smallest allowed scatterer range [m]; closer is an error."
-    )
-
-
-class ProcessingConfig(StrictModel):
-    """Resampling and spectrogram settings."""
-
-    interpolation: Method = Field(
-        "cubic", description="Joint resampling: cubic (C2 spline), pchip, akima, linear."
-    )
-    window: str = Field("hann", description="STFT window (any scipy.signal window name).")
-
-    @field_validator("window")
-    @classmethod
-    def _known_window(cls, value: str) -> str:
-        from scipy.signal import get_window
-
-        try:
-            get_window(value, 8)
-        except (ValueError, TypeError) as exc:
-            raise ValueError(f"unknown window {value!r}: {exc}") from None
-        return value
-
-    window_length: int = Field(256, ge=2, description="STFT window length [pulses].")
-    hop: int = Field(32, ge=1, description="STFT hop [pulses].")
-    nfft: int = Field(1024, ge=2, description="FFT size (>= window_length).")
-    floor_db: float = Field(-60.0, lt=0, description="Spectrogram floor, dB below its peak.")
-    aliasing: Literal["warn", "error"] = Field(
-        "warn",
-        description="When a scatterer's radial speed exceeds lambda*PRF/4: warn, or stop.",
-    )
-
-    @model_validator(mode="after")
-    def _check(self) -> ProcessingConfig:
-        if self.nfft < self.window_length:
-            raise ValueError(f"nfft ({self.nfft}) must be >= window_length ({self.window_length})")
-        return self
-
-
-class ConditioningConfig(StrictModel):
-    """Skeleton conditioning (:mod:`mdframework.conditioning`), applied to the whole canonical
-    recording before placement and windowing. Off by default; each step can be switched on its
-    own. (Sorting time stamps and dropping duplicates happens in the motion sources, since a
-    Skeleton's time stamps are strictly increasing by construction; they report it in their
-    metadata.)"""
-
-    enabled: bool = Field(False, description="Condition the body at all (default: off).")
-    zeros_untracked: bool = Field(
-        True, description="Treat an exact (0, 0, 0) joint as untracked (Kinect's lost joints)."
-    )
-    max_gap_s: float = Field(
-        0.2,
-        gt=0,
-        description="Untracked gaps longer than this [s] are flagged (all gaps are bridged by "
-        "the spline); about a fifth of a gait cycle.",
-    )
-    long_gaps: Literal["flag", "error"] = Field(
-        "flag", description="A gap longer than max_gap_s: flag it in the metadata, or stop."
-    )
-    foot_outliers: bool = Field(
-        True,
-        description="Detect foot segments (ankle to toe) deviating from their mean beyond the "
-        "histogram-derived threshold and predict them from past frames (Erol & Gurbuz).",
-    )
-    outlier_bin_m: float = Field(
-        0.01, gt=0, description="Histogram bin width of the outlier deviations [m]."
-    )
-    outlier_min_threshold_m: float = Field(
-        0.05, gt=0, description="Smallest outlier threshold [m], whatever the histogram says."
-    )
-    foot_length_m: float | None = Field(
-        None,
-        gt=0,
-        description="The subject's measured foot length (ankle to toe) [m]; when given, the toe "
-        "is moved along the foot to this length in every frame.",
-    )
-    angle_check: bool = Field(
-        True,
-        description="Report the knee-ankle-foot angle of eq. (7) and its period (a check for "
-        "walking and running).",
-    )
-    speed_limit: bool = Field(
-        True, description="Replace frames where a joint moves faster than max_speed_mps."
-    )
-    max_speed_mps: float = Field(
-        6.0,
-        gt=0,
-        description="Physical joint speed limit [m/s]: walking feet peak near 4-5 m/s; raise to "
-        "about 10 for running (feet reach ~9 m/s).",
-    )
-    smoothing: Literal["none", "violating", "all"] = Field(
-        "violating",
-        description="Gaussian smoothing after the speed limit: of no joint, of the joints that "
-        "exceeded the limit, or of all joints.",
-    )
-    smoothing_sigma_s: float = Field(
-        0.03, ge=0, description="Standard deviation of the smoothing kernel [s]."
-    )
-
-
-class RunConfigBase(StrictModel):
-    """Fields every run config has besides the plugin sections."""
-
-    seed: int = Field(0, ge=0, description="Seed of every random draw in the run.")
-
-    scene: SceneConfig = Field(default_factory=SceneConfig, description="The scene.")
-    processing: ProcessingConfig = Field(
-        default_factory=ProcessingConfig, description="Resampling and spectrogram."
-    )
-    conditioning: ConditioningConfig = Field(
-        default_factory=ConditioningConfig,
-        description="Skeleton conditioning of the body (off by default).",
-    )
+from .settings import RunConfigBase
 
 
 def _union(registry: Registry, interface: str) -> Any:

@@ -39,11 +39,12 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field, ValidationError, model_validator
 
-from .config import StrictModel, format_validation_error, read_config_file, validate_run_config
+from .config import format_validation_error, read_config_file, validate_run_config
 from .errors import ConfigError, MdfError
 from .features import FEATURE_NAMES, spectrogram_features
 from .interfaces import Motion
 from .pipeline import build_stages, load_motion, simulate_motion
+from .settings import StrictModel
 
 RECORDS = "records"
 #: index.csv columns that hold text (all others are numbers)

@@ -14,8 +14,8 @@ from pydantic import BaseModel
 from pydantic.fields import FieldInfo
 from pydantic_core import PydanticUndefined
 
-from .config import PersonConfig, ProcessingConfig, SceneConfig
 from .plugins import INTERFACES, Registry, default_registry
+from .settings import PersonConfig, ProcessingConfig, SceneConfig
 
 SECTIONS = {
     "motion": "`[motion]`: the motion source",

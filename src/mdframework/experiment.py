@@ -36,12 +36,13 @@ from .classify import (
     optimistic_select,
     wrapper_select,
 )
-from .config import StrictModel, format_validation_error, read_config_file
+from .config import format_validation_error, read_config_file
 from .dataset import Dataset, build_dataset, load_dataset, load_dataset_config
 from .errors import ConfigError, MdfError
 from .features import FEATURE_NAMES
 from .interfaces import Classifier
 from .plugins import Registry, default_registry
+from .settings import StrictModel
 
 
 class DatasetRef(StrictModel):

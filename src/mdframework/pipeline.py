@@ -16,7 +16,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import conditioning
-from .config import ConditioningConfig, PersonConfig, RunConfigBase
 from .errors import SceneError
 from .interfaces import (
     Effect,
@@ -31,6 +30,7 @@ from .interfaces import (
 from .physics import interpolation, radar, scene
 from .physics.spectrogram import RecordTooShortError, Spectrogram, power_to_db, spectrogram
 from .plugins import Registry, default_registry
+from .settings import ConditioningConfig, PersonConfig, RunConfigBase
 from .skeleton import Skeleton
 
 FloatArray = NDArray[np.float64]

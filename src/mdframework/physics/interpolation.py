@@ -11,7 +11,6 @@ from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.interpolate import Akima1DInterpolator, CubicSpline, PchipInterpolator
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
@@ -66,6 +65,8 @@ def _interp(t: FloatArray, y: FloatArray, t_out: FloatArray, method: Method) -> 
             f"{t[0]:.4f}..{t[-1]:.4f} s; interpolation never extrapolates"
         )
     tq = np.clip(t_out, t[0], t[-1])
+    from scipy.interpolate import Akima1DInterpolator, CubicSpline, PchipInterpolator
+
     if method == "linear":
         flat = y.reshape(y.shape[0], -1)
         res = np.stack([np.interp(tq, t, flat[:, k]) for k in range(flat.shape[1])], axis=1)
