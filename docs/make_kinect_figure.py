@@ -8,18 +8,19 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
 
 from mdframework.conditioning import speeds
 from mdframework.config import load_run_config
+from mdframework.figures import draw_spectrogram, save, style
 from mdframework.pipeline import build_stages, simulate_motion
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = ROOT / "examples" / "kinect_utkinect_walk.toml"
+CAPTION = (
+    "kinect joints_s01_e01.txt (UTKinect, walk): lfm 15 GHz, PRF 2400 Hz; radar at (0, 0, 1) m; "
+    "aspect 0°, from 2.3 m; scatterers ellipsoid joints17; effects: none"
+)
 TARGET = ROOT / "docs" / "figures" / "kinect_walk_conditioning.png"
 
 
@@ -43,29 +44,25 @@ def run(enabled: bool) -> tuple[object, dict[str, float]]:
 
 def main() -> None:
     TARGET.parent.mkdir(parents=True, exist_ok=True)
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), dpi=110, sharey=True)
-    for ax, enabled in zip(axes, (False, True), strict=True):
-        res, peak = run(enabled)
-        t = res.spectrogram.time  # type: ignore[attr-defined]
-        v = res.velocity  # type: ignore[attr-defined]
-        im = ax.imshow(
-            res.spectrogram_db,  # type: ignore[attr-defined]
-            origin="lower",
-            aspect="auto",
-            extent=(t[0], t[-1], v[0], v[-1]),
-            cmap="jet",
-            vmin=-50,
-            vmax=0,
-        )
-        ax.set_ylim(-6, 6)
-        ax.set_xlabel("time [s]")
-        state = "with conditioning" if enabled else "raw Kinect joints"
-        feet = ", ".join(f"{k} {s:.1f} m/s" for k, s in peak.items())
-        ax.set_title(f"UTKinect walk, {state}\npeak foot speed: {feet}", fontsize=9)
-        print(state, peak)
-    axes[0].set_ylabel("radial velocity [m/s] (+ approaching)")
-    fig.colorbar(im, ax=axes, label="power [dB re peak]")
-    fig.savefig(TARGET)
+    with style() as plt:
+        fig, axes = plt.subplots(1, 2, figsize=(11, 4.4), sharey=True, layout="constrained")
+        for ax, enabled in zip(axes, (False, True), strict=True):
+            res, peak = run(enabled)
+            im = draw_spectrogram(
+                ax,
+                res.spectrogram_db,  # type: ignore[attr-defined]
+                res.spectrogram.time,  # type: ignore[attr-defined]
+                res.velocity,  # type: ignore[attr-defined]
+            )
+            ax.set_ylim(-6, 6)
+            state = "with conditioning" if enabled else "raw Kinect joints"
+            feet = ", ".join(f"{k} {s:.1f} m/s" for k, s in peak.items())
+            ax.set_title(f"UTKinect walk, {state}\npeak foot speed: {feet}", fontsize=9)
+            if enabled:
+                ax.set_ylabel("")
+            print(state, peak)
+        fig.colorbar(im, ax=axes, label="power [dB re peak]")
+        save(fig, TARGET, CAPTION)
     print(TARGET)
 
 

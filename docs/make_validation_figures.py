@@ -12,19 +12,19 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
-
 from mdframework.config import load_run_config, validate_run_config
 from mdframework.features import FEATURE_NAMES, spectrogram_features
+from mdframework.figures import draw_spectrogram, save, style
 from mdframework.pipeline import RunResult, simulate
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
 FIGURES = ROOT / "docs" / "figures"
 DURATION = 4.0
+CAPTION = (
+    "lfm 15 GHz, PRF 2400 Hz; radar at (10, 0, 2) m; aspect 0° (walking toward the radar); "
+    "scatterers: Boulic mujoco_body chen16, CMU and Kinect ellipsoid joints17; effects: none"
+)
 
 
 def boulic(chen: bool) -> RunResult:
@@ -67,21 +67,20 @@ def main() -> None:
         "CMU 02_01 walk": cmu(),
         "Kinect UTKinect walk": kinect(),
     }
-    fig, axes = plt.subplots(1, len(runs), figsize=(19, 4.2), sharey=True, constrained_layout=True)
-    image = None
-    for ax, (name, res) in zip(axes, runs.items(), strict=True):
-        t = res.spectrogram.time
-        image = ax.pcolormesh(
-            t, res.velocity, res.spectrogram_db, shading="nearest", cmap="jet", vmin=-50, vmax=0
-        )
-        ax.set_title(name)
-        ax.set_xlabel("time [s]")
-        ax.set_xlim(0, min(DURATION, float(t[-1])))
-        ax.set_ylim(-3, 6)
-    axes[0].set_ylabel("radial velocity [m/s] (+ approaching)")
-    fig.colorbar(image, ax=axes, label="power [dB re peak]")
     out = FIGURES / "validation_walk_spectrograms.png"
-    fig.savefig(out, dpi=110)
+    with style() as plt:
+        fig, axes = plt.subplots(1, len(runs), figsize=(19, 4.2), sharey=True, layout="constrained")
+        image = None
+        for ax, (name, res) in zip(axes, runs.items(), strict=True):
+            t = res.spectrogram.time
+            image = draw_spectrogram(ax, res.spectrogram_db, t, res.velocity, velocity_span="full")
+            ax.set_title(name)
+            ax.set_xlim(0, min(DURATION, float(t[-1])))
+            ax.set_ylim(-3, 6)
+            if ax is not axes[0]:
+                ax.set_ylabel("")
+        fig.colorbar(image, ax=axes, label="power [dB re peak]")
+        save(fig, out, CAPTION)
     print(f"wrote {out.relative_to(ROOT)}")
     print()
     print("| source | " + " | ".join(FEATURE_NAMES) + " |")

@@ -367,6 +367,10 @@ def run_experiment(
         f"{round(100 * cfg.evaluation.test_fraction)}.",
         "",
     ]
+    caption = (
+        f"dataset {Path(data_dir).name} ({len(data.labels)} records); classifier "
+        f"{json.dumps(cfg.classifier)}; selection {cfg.selection.method}"
+    )
     for group in sorted(set(data.groups.tolist())):
         mask = data.groups == group
         if len(set(data.labels[mask].tolist())) < 2:
@@ -406,6 +410,8 @@ def run_experiment(
             res["confusion_mean"],
             res["confusion_std"],
             title=f"{group}: within-source",
+            caption=f"{caption}; mean ± std over {cfg.evaluation.repeats} splits by "
+            f"{cfg.evaluation.split}",
         )
         summary["within"][group] = {
             k: v for k, v in res.items() if k not in ("confusion_mean", "confusion_std")
@@ -440,6 +446,7 @@ def run_experiment(
             res["confusion"],
             None,
             title=f"train {cfg.cross_source.train} -> test {cfg.cross_source.test}",
+            caption=f"{caption}; features {res['subset']}",
         )
         summary["cross"] = {**res, "confusion": res["confusion"].tolist()}
         report += [
@@ -468,6 +475,8 @@ def run_experiment(
             data.groups,
             f1,
             f2,
+            title=f"{f1} vs {f2}",
+            caption=caption,
         )
         report += [f"![{f1} vs {f2}]({name})", ""]
     (out / "report.md").write_text("\n".join(report))

@@ -1,12 +1,49 @@
-"""Figures of a run: the spectrogram (velocity and Doppler axes) and the range-time map."""
+"""Figures the project writes, in one style: the spectrogram (velocity and Doppler axes), the
+range-time map, experiment confusion matrices and feature scatter plots.
+
+Every figure goes through :func:`style` (one set of matplotlib rc parameters: fonts, sizes,
+a colour-blind-safe line cycle) and :func:`save` (a caption below the axes, one resolution).
+Power maps use perceptually uniform colour maps (``viridis`` by default, see
+:class:`~mdframework.settings.FiguresConfig`). :func:`draw_spectrogram` draws a spectrogram into
+given axes, so multi-panel figures (the docs figures, the motion preview) look like a run's own
+``spectrogram.png``. :func:`run_caption` builds the title and caption of a run's figures from its
+metadata and resolved config.
+
+matplotlib is imported inside the functions that draw, never at import time.
+"""
 
 from __future__ import annotations
 
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+#: Default dynamic range of spectrogram and range-time images [dB below the peak].
+DYNAMIC_RANGE_DB = 40.0
+#: Default colour map of power images (perceptually uniform).
+COLORMAP = "viridis"
+#: Resolution of every saved figure [dots per inch].
+DPI = 110
+
+_RC: dict[str, Any] = {
+    "font.size": 9.0,
+    "axes.titlesize": 10.0,
+    "axes.labelsize": 9.0,
+    "xtick.labelsize": 8.0,
+    "ytick.labelsize": 8.0,
+    "legend.fontsize": 8.0,
+    "figure.dpi": DPI,
+    "savefig.dpi": DPI,
+    "image.cmap": COLORMAP,
+    "image.interpolation": "nearest",
+    "axes.grid": False,
+    "figure.facecolor": "white",
+}
+_CAPTION_SIZE = 7.5
 
 
 def _pyplot() -> Any:
@@ -18,6 +55,106 @@ def _pyplot() -> Any:
     return plt
 
 
+@contextmanager
+def style() -> Iterator[Any]:
+    """The project's figure style as a matplotlib rc context; yields ``matplotlib.pyplot``.
+
+    Use it around any figure the project writes (docs scripts included)::
+
+        with style() as plt:
+            fig, ax = plt.subplots(layout="constrained")
+    """
+    plt = _pyplot()
+    rc = dict(_RC)
+    rc["axes.prop_cycle"] = plt.cycler(
+        color=plt.style.library["tableau-colorblind10"]["axes.prop_cycle"].by_key()["color"]
+    )
+    with plt.rc_context(rc):
+        yield plt
+
+
+def save(fig: Any, path: Path, caption: str = "", *, title: str = "") -> None:
+    """Save ``fig`` (made with constrained layout under :func:`style`) with ``title`` over its
+    first axes and ``caption`` set in small type below the axes, then close it."""
+    plt = _pyplot()
+    if title:
+        fig.axes[0].set_title(title)
+    if caption:
+        lines = caption.count("\n") + 1
+        height = fig.get_figheight()
+        bottom = min(0.4, (lines * _CAPTION_SIZE * 1.45 + 6) / 72 / height)
+        engine = fig.get_layout_engine()
+        if engine is not None and hasattr(engine, "set"):
+            engine.set(rect=(0.0, bottom, 1.0, 1.0 - bottom))
+        fig.text(0.01, 0.01, caption, ha="left", va="bottom", fontsize=_CAPTION_SIZE, color="0.25")
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def velocity_limits(
+    spectrogram_db: NDArray[np.floating[Any]],
+    velocity: NDArray[np.float64],
+    span: str | float = "auto",
+    dynamic_range_db: float = DYNAMIC_RANGE_DB,
+) -> tuple[float, float]:
+    """Velocity-axis limits [m/s] of a spectrogram display.
+
+    ``span``: ``"full"``: the whole unambiguous axis; a number ``v``: ``(-v, v)``, clipped to the
+    axis; ``"auto"``: the velocities where the power is. Auto takes the velocity bins in which
+    any frame comes within ``dynamic_range_db`` of the peak (the bins the image shows in
+    colour), widens their extent (zero always included) by a tenth of itself plus two bins on
+    each side, and clips it to the axis. ``spectrogram_db`` (n_doppler, n_frames) [dB re peak];
+    ``velocity`` (n_doppler,) ascending [m/s].
+    """
+    dv = float(velocity[1] - velocity[0]) if velocity.size > 1 else 1.0
+    lo_axis, hi_axis = float(velocity[0]) - dv / 2, float(velocity[-1]) + dv / 2
+    if span == "full":
+        return lo_axis, hi_axis
+    if not isinstance(span, str):
+        return max(lo_axis, -float(span)), min(hi_axis, float(span))
+    if span != "auto":
+        raise ValueError(f"velocity span must be 'auto', 'full' or a number, got {span!r}")
+    peak = np.max(spectrogram_db, axis=1)
+    shown = velocity[peak >= np.max(peak) - dynamic_range_db]
+    lo, hi = min(0.0, float(shown.min())), max(0.0, float(shown.max()))
+    pad = 0.1 * (hi - lo) + 2 * dv
+    return max(lo_axis, lo - pad), min(hi_axis, hi + pad)
+
+
+def draw_spectrogram(
+    ax: Any,
+    spectrogram_db: NDArray[np.floating[Any]],
+    time: NDArray[np.float64],
+    velocity: NDArray[np.float64],
+    *,
+    dynamic_range_db: float = DYNAMIC_RANGE_DB,
+    velocity_span: str | float = "auto",
+    colormap: str = COLORMAP,
+) -> Any:
+    """Draw a spectrogram into ``ax``: time [s] across, radial velocity [m/s] up (positive =
+    approaching), the top ``dynamic_range_db`` in colour. Returns the image (for a colour bar).
+    ``spectrogram_db`` (n_doppler, n_frames) [dB re peak]; ``time`` (n_frames,) [s];
+    ``velocity`` (n_doppler,) ascending [m/s]."""
+    dt = float(time[1] - time[0]) if time.size > 1 else 1.0
+    dv = float(velocity[1] - velocity[0]) if velocity.size > 1 else 1.0
+    extent = (time[0] - dt / 2, time[-1] + dt / 2, velocity[0] - dv / 2, velocity[-1] + dv / 2)
+    peak = float(np.max(spectrogram_db))
+    im = ax.imshow(
+        spectrogram_db,
+        origin="lower",
+        aspect="auto",
+        extent=extent,
+        cmap=colormap,
+        vmin=peak - dynamic_range_db,
+        vmax=peak,
+        interpolation="nearest",
+    )
+    ax.set_ylim(*velocity_limits(spectrogram_db, velocity, velocity_span, dynamic_range_db))
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("radial velocity [m/s] (+ approaching)")
+    return im
+
+
 def plot_spectrogram(
     path: Path,
     spectrogram_db: NDArray[np.floating[Any]],
@@ -26,36 +163,29 @@ def plot_spectrogram(
     doppler: NDArray[np.float64],
     *,
     title: str = "",
-    dynamic_range_db: float = 50.0,
+    caption: str = "",
+    dynamic_range_db: float = DYNAMIC_RANGE_DB,
+    velocity_span: str | float = "auto",
+    colormap: str = COLORMAP,
 ) -> None:
     """Save a spectrogram image: time [s] across, radial velocity [m/s] up (positive =
-    approaching) with Doppler [Hz] on the right-hand axis."""
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(8, 4.5), dpi=110)
-    dt = time[1] - time[0] if time.size > 1 else 1.0
-    dv = velocity[1] - velocity[0]
-    extent = (time[0] - dt / 2, time[-1] + dt / 2, velocity[0] - dv / 2, velocity[-1] + dv / 2)
-    im = ax.imshow(
-        spectrogram_db,
-        origin="lower",
-        aspect="auto",
-        extent=extent,
-        cmap="jet",
-        vmin=-dynamic_range_db,
-        vmax=0.0,
-        interpolation="nearest",
-    )
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("radial velocity [m/s] (+ approaching)")
-    ratio = float(doppler[-1] / velocity[-1]) if velocity[-1] != 0 else 1.0
-    sec = ax.secondary_yaxis("right", functions=(lambda v: v * ratio, lambda f: f / ratio))
-    sec.set_ylabel("Doppler [Hz]")
-    fig.colorbar(im, ax=ax, pad=0.12, label="power [dB re peak]")
-    if title:
-        ax.set_title(title)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
+    approaching) with Doppler [Hz] on the right-hand axis; see :func:`draw_spectrogram`."""
+    with style() as plt:
+        fig, ax = plt.subplots(figsize=(8, 4.5), layout="constrained")
+        im = draw_spectrogram(
+            ax,
+            spectrogram_db,
+            time,
+            velocity,
+            dynamic_range_db=dynamic_range_db,
+            velocity_span=velocity_span,
+            colormap=colormap,
+        )
+        ratio = float(doppler[-1] / velocity[-1]) if velocity[-1] != 0 else 1.0
+        sec = ax.secondary_yaxis("right", functions=(lambda v: v * ratio, lambda f: f / ratio))
+        sec.set_ylabel("Doppler [Hz]")
+        fig.colorbar(im, ax=ax, pad=0.02, label="power [dB re peak]")
+        save(fig, path, caption, title=title)
 
 
 def plot_range_time(
@@ -65,30 +195,30 @@ def plot_range_time(
     ranges: NDArray[np.float64],
     *,
     title: str = "",
-    dynamic_range_db: float = 40.0,
+    caption: str = "",
+    dynamic_range_db: float = DYNAMIC_RANGE_DB,
+    colormap: str = COLORMAP,
 ) -> None:
-    """Save a range-time map: time [s] across, range [m] up, |compressed output| in dB."""
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(8, 4), dpi=110)
-    extent = (time[0], time[-1], ranges[0], ranges[-1])
-    im = ax.imshow(
-        range_time_db.T,
-        origin="lower",
-        aspect="auto",
-        extent=extent,
-        cmap="viridis",
-        vmin=-dynamic_range_db,
-        vmax=0.0,
-        interpolation="nearest",
-    )
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("range [m]")
-    fig.colorbar(im, ax=ax, label="compressed power [dB re peak]")
-    if title:
-        ax.set_title(title)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
+    """Save a range-time map: time [s] across, range [m] up, |compressed output|^2 in dB re
+    peak. ``range_time_db`` (n_slow, n_range); ``time`` (n_slow,) [s]; ``ranges`` (n_range,)
+    [m]."""
+    with style() as plt:
+        fig, ax = plt.subplots(figsize=(8, 4), layout="constrained")
+        peak = float(np.max(range_time_db))
+        im = ax.imshow(
+            range_time_db.T,
+            origin="lower",
+            aspect="auto",
+            extent=(time[0], time[-1], ranges[0], ranges[-1]),
+            cmap=colormap,
+            vmin=peak - dynamic_range_db,
+            vmax=peak,
+            interpolation="nearest",
+        )
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel("range [m]")
+        fig.colorbar(im, ax=ax, label="compressed power [dB re peak]")
+        save(fig, path, caption, title=title)
 
 
 def plot_confusion(
@@ -98,34 +228,32 @@ def plot_confusion(
     std: NDArray[np.float64] | None,
     *,
     title: str = "",
+    caption: str = "",
 ) -> None:
-    """Save a row-normalised confusion matrix (true class down, predicted across)."""
-    plt = _pyplot()
+    """Save a row-normalised confusion matrix (true class down, predicted across); ``mean``
+    and ``std`` (n_classes, n_classes) rates in [0, 1]."""
     n = len(classes)
-    fig, ax = plt.subplots(figsize=(1.3 * n + 2.5, 1.1 * n + 1.8), dpi=110)
-    im = ax.imshow(mean, cmap="Blues", vmin=0.0, vmax=1.0)
-    for i in range(n):
-        for j in range(n):
-            text = f"{mean[i, j]:.2f}" + (f"\n±{std[i, j]:.2f}" if std is not None else "")
-            ax.text(
-                j,
-                i,
-                text,
-                ha="center",
-                va="center",
-                color="white" if mean[i, j] > 0.6 else "black",
-                fontsize=9,
-            )
-    ax.set_xticks(range(n), classes, rotation=30, ha="right")
-    ax.set_yticks(range(n), classes)
-    ax.set_xlabel("predicted")
-    ax.set_ylabel("true")
-    fig.colorbar(im, ax=ax, label="rate")
-    if title:
-        ax.set_title(title)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
+    with style() as plt:
+        fig, ax = plt.subplots(figsize=(1.3 * n + 2.5, 1.1 * n + 1.8), layout="constrained")
+        cmap = plt.get_cmap("cividis")
+        im = ax.imshow(mean, cmap=cmap, vmin=0.0, vmax=1.0)
+        for i in range(n):
+            for j in range(n):
+                text = f"{mean[i, j]:.2f}" + (f"\n±{std[i, j]:.2f}" if std is not None else "")
+                ax.text(
+                    j,
+                    i,
+                    text,
+                    ha="center",
+                    va="center",
+                    color="black" if mean[i, j] > 0.6 else "white",
+                )
+        ax.set_xticks(range(n), classes, rotation=30, ha="right")
+        ax.set_yticks(range(n), classes)
+        ax.set_xlabel("predicted")
+        ax.set_ylabel("true")
+        fig.colorbar(im, ax=ax, label="rate")
+        save(fig, path, caption, title=title)
 
 
 def plot_feature_scatter(
@@ -136,27 +264,74 @@ def plot_feature_scatter(
     groups: NDArray[Any],
     x_name: str,
     y_name: str,
+    *,
+    title: str = "",
+    caption: str = "",
 ) -> None:
     """Scatter plot of two features [m/s], colour = activity, marker = source group."""
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(6, 4.5), dpi=110)
     markers = "o^sDvP*X"
-    for gi, group in enumerate(sorted(set(groups.tolist()))):
-        for li, label in enumerate(sorted(set(labels.tolist()))):
-            sel = (groups == group) & (labels == label)
-            if np.any(sel):
-                ax.scatter(
-                    x[sel],
-                    y[sel],
-                    s=14,
-                    marker=markers[gi % len(markers)],
-                    color=f"C{li}",
-                    alpha=0.7,
-                    label=f"{label} ({group})",
-                )
-    ax.set_xlabel(f"{x_name} [m/s]")
-    ax.set_ylabel(f"{y_name} [m/s]")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
+    with style() as plt:
+        fig, ax = plt.subplots(figsize=(6, 4.5), layout="constrained")
+        for gi, group in enumerate(sorted(set(groups.tolist()))):
+            for li, label in enumerate(sorted(set(labels.tolist()))):
+                sel = (groups == group) & (labels == label)
+                if np.any(sel):
+                    ax.scatter(
+                        x[sel],
+                        y[sel],
+                        s=14,
+                        marker=markers[gi % len(markers)],
+                        color=f"C{li}",
+                        alpha=0.7,
+                        label=f"{label} ({group})",
+                    )
+        ax.set_xlabel(f"{x_name} [m/s]")
+        ax.set_ylabel(f"{y_name} [m/s]")
+        ax.legend()
+        save(fig, path, caption, title=title)
+
+
+def run_caption(
+    metadata: Mapping[str, Any],
+    config: Mapping[str, Any],
+    gate_range: tuple[float, float] | None = None,
+) -> tuple[str, str]:
+    """Title and caption of a run's figures, from its ``metadata.json`` and resolved config.
+
+    The title names the activity and the source (file, subject); the caption gives the radar
+    (kind, carrier, PRF), the geometry (aspect or heading, and ``gate_range``: the range gate
+    [m] at the first and last pulse), the scatterer model and the effects that ran."""
+    motion = dict(metadata.get("motion", {}))
+    source = str(motion.get("source", config.get("motion", {}).get("kind", "?")))
+    what = [str(motion["activity"])] if motion.get("activity") else []
+    origin = [source]
+    if motion.get("file"):
+        origin.append(str(motion["file"]))
+    if motion.get("subject") is not None:
+        origin.append(f"subject {motion['subject']}")
+    title = " — ".join([*what, " ".join(origin)])
+
+    radar = dict(config.get("radar", {}))
+    f_c = float(metadata.get("carrier_frequency_hz", 0.0))
+    prf = float(metadata.get("prf_hz", 0.0))
+    radar_part = f"{radar.get('kind', 'radar')} {f_c / 1e9:g} GHz, PRF {prf:g} Hz"
+    placement = dict(metadata.get("placement", {}))
+    if placement.get("heading_deg") is not None:
+        geometry = f"heading {placement['heading_deg']:g}°"
+    elif "aspect_deg" in placement:
+        geometry = f"aspect {placement.get('aspect_deg') or 0.0:g}°"
+    else:
+        geometry = "placed as given"
+    if placement.get("motion") in ("treadmill", "straight"):
+        geometry += f", {placement['motion']}"
+    if gate_range is not None:
+        geometry += f", range {gate_range[0]:.1f} → {gate_range[1]:.1f} m"
+    effects = [str(e.get("kind")) for e in metadata.get("effects", [])]
+    model = dict(config.get("scatterers", {})).get("kind", "?")
+    parts = [
+        radar_part,
+        geometry,
+        f"scatterers {model}",
+        f"effects: {', '.join(effects) if effects else 'none'}",
+    ]
+    return title, "; ".join(parts)

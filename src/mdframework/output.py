@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from .figures import plot_range_time, plot_spectrogram
+from .figures import plot_range_time, plot_spectrogram, run_caption
 from .physics.spectrogram import power_to_db
 from .pipeline import RunResult
 
@@ -76,7 +76,9 @@ def write_run(result: RunResult, resolved_config: dict[str, Any], out_dir: Path)
     try:
         arrays = result_arrays(result)
         np.savez_compressed(stage / "result.npz", **arrays)  # type: ignore[arg-type]
-        title = str(result.metadata.get("motion", {}).get("activity", ""))
+        gate = (float(result.gate_range[0]), float(result.gate_range[-1]))
+        title, caption = run_caption(result.metadata, resolved_config, gate)
+        look = resolved_config.get("figures", {})
         plot_spectrogram(
             stage / "spectrogram.png",
             arrays["spectrogram_db"],
@@ -84,6 +86,8 @@ def write_run(result: RunResult, resolved_config: dict[str, Any], out_dir: Path)
             arrays["velocity_mps"],
             arrays["doppler_hz"],
             title=title,
+            caption=caption,
+            **look,
         )
         if "range_time_db" in arrays:
             plot_range_time(
@@ -92,6 +96,9 @@ def write_run(result: RunResult, resolved_config: dict[str, Any], out_dir: Path)
                 arrays["range_time_time_s"],
                 arrays["range_m"],
                 title=title,
+                caption=caption,
+                dynamic_range_db=look.get("dynamic_range_db", 40.0),
+                colormap=look.get("colormap", "viridis"),
             )
         (stage / "config.resolved.json").write_text(json.dumps(resolved_config, indent=2) + "\n")
         (stage / "metadata.json").write_text(

@@ -210,6 +210,38 @@ class ConditioningConfig(StrictModel):
     )
 
 
+class FiguresConfig(StrictModel):
+    """How a run's figures show the data (``spectrogram.png``, ``range_time.png`` and the
+    motion preview of ``mdf show``). The arrays in ``result.npz`` are not affected."""
+
+    dynamic_range_db: float = Field(
+        40.0,
+        gt=0,
+        description="Power range shown in colour, dB below the peak; weaker is drawn at the "
+        "bottom of the colour map. 40 dB shows a walker's limbs above the window sidelobes.",
+    )
+    velocity_span: Literal["auto", "full"] | PositiveFloat = Field(
+        "auto",
+        description="Velocity axis of spectrograms: 'auto' covers the velocities where the "
+        "shown power is (with a margin, zero included); 'full' the whole unambiguous span "
+        "+-lambda*PRF/4; a number v: -v..v [m/s].",
+    )
+    colormap: str = Field(
+        "viridis",
+        description="matplotlib colour map of power images; perceptually uniform ones "
+        "(viridis, magma, inferno, plasma, cividis) keep equal dB steps equally visible.",
+    )
+
+    @field_validator("colormap")
+    @classmethod
+    def _known_colormap(cls, value: str) -> str:
+        from matplotlib import colormaps
+
+        if value not in colormaps:
+            raise ValueError(f"unknown colour map {value!r}; try viridis, magma or cividis")
+        return value
+
+
 class RunConfigBase(StrictModel):
     """Fields every run config has besides the plugin sections."""
 
@@ -222,4 +254,7 @@ class RunConfigBase(StrictModel):
     conditioning: ConditioningConfig = Field(
         default_factory=ConditioningConfig,
         description="Skeleton conditioning of the body (off by default).",
+    )
+    figures: FiguresConfig = Field(
+        default_factory=FiguresConfig, description="How the run's figures show the data."
     )

@@ -1,0 +1,320 @@
+"""Motion previews: the body in the scene beside its spectrogram (``mdf show``).
+
+Two figures of one run, both drawn in the project style (:mod:`mdframework.figures`):
+
+- :func:`animate` saves an animation (GIF through Pillow, or MP4 through the ffmpeg binary that
+  ``imageio-ffmpeg`` ships) of three panels: the scene from above (radar, line of sight to the
+  hip centre, the hip centre's path, the body's outline), the body in 3-D following the person
+  (segments, the line of sight toward the radar), and the spectrogram with a time cursor.
+- :func:`plot_stills` saves the body at chosen instants above the spectrogram, with the instants
+  marked on it.
+
+The body is a :class:`~mdframework.skeleton.Skeleton` in the scene frame, times [s] from the
+record's first pulse (the spectrogram's time base); at an instant the preview shows the body's
+nearest frame (never an interpolated pose). Joints marked not valid are left out. A body with
+the canonical joints is drawn with the canonical segments, any other as points.
+
+matplotlib is imported inside the functions that draw.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .errors import MdfError
+from .figures import COLORMAP, DYNAMIC_RANGE_DB, draw_spectrogram, save, style
+from .skeleton import CANONICAL_JOINTS, CANONICAL_SEGMENTS, Skeleton
+
+FloatArray = NDArray[np.float64]
+
+#: Animation formats and the matplotlib writer each uses.
+FORMATS = ("gif", "mp4")
+#: Resolution of animations [dots per inch] (14 x 4.8 in: 1120 x 384 pixels).
+ANIMATION_DPI = 80
+#: Side of the 3-D body view [m].
+BODY_BOX_M = 2.2
+
+
+class PreviewError(MdfError):
+    """A preview cannot be made as asked (an instant outside the record, no video encoder)."""
+
+
+@dataclass(frozen=True)
+class SpectrogramView:
+    """A spectrogram and how to show it: ``power_db`` (n_doppler, n_frames) [dB re peak],
+    ``time`` (n_frames,) [s from the first pulse], ``velocity`` (n_doppler,) ascending [m/s]."""
+
+    power_db: NDArray[np.floating[Any]]
+    time: FloatArray
+    velocity: FloatArray
+    dynamic_range_db: float = DYNAMIC_RANGE_DB
+    velocity_span: str | float = "auto"
+    colormap: str = COLORMAP
+
+
+def frame_at(time: FloatArray, instants: FloatArray) -> NDArray[np.intp]:
+    """Index of the frame nearest to each instant (ties to the earlier frame); ``time``
+    (n_frames,) strictly increasing [s], ``instants`` (n,) [s]."""
+    t = np.asarray(time, dtype=np.float64)
+    x = np.asarray(instants, dtype=np.float64)
+    right = np.clip(np.searchsorted(t, x, side="left"), 1, max(1, t.size - 1))
+    left = right - 1
+    if t.size == 1:
+        return np.zeros(x.shape, dtype=np.intp)
+    nearer_left = np.abs(x - t[left]) <= np.abs(t[right] - x)
+    return np.where(nearer_left, left, right).astype(np.intp)
+
+
+def animation_times(body: Skeleton, fps: int) -> FloatArray:
+    """Times [s] of the animation frames: every ``1/fps`` s from the body's first frame to its
+    last, in real time."""
+    if fps <= 0:
+        raise PreviewError(f"--fps: must be positive, got {fps}")
+    n = int(np.floor(body.duration * fps + 1e-9)) + 1
+    return np.asarray(body.time[0] + np.arange(n) / fps, dtype=np.float64)
+
+
+def check_instants(body: Skeleton, instants: Sequence[float]) -> FloatArray:
+    """The instants as an array, each within the body's time span (else :class:`PreviewError`
+    naming ``--at`` and the span)."""
+    x: FloatArray = np.asarray(list(instants), dtype=np.float64)
+    lo, hi = float(body.time[0]), float(body.time[-1])
+    bad = x[(x < lo - 1e-9) | (x > hi + 1e-9) | ~np.isfinite(x)]
+    if x.size == 0 or bad.size:
+        which = f"{bad[0]:g} s is" if bad.size else "no instant is"
+        raise PreviewError(f"--at: {which} outside the record ({lo:.3f} to {hi:.3f} s)")
+    return x
+
+
+def default_instants(body: Skeleton, n: int = 5) -> FloatArray:
+    """``n`` instants evenly spread over the record: the centres of ``n`` equal parts."""
+    lo, hi = float(body.time[0]), float(body.time[-1])
+    step = (hi - lo) / n
+    return np.asarray(lo + step * (np.arange(n) + 0.5), dtype=np.float64)
+
+
+class _Scene:
+    """The artists of the preview panels and how they follow time."""
+
+    def __init__(self, body: Skeleton, radar_position: FloatArray) -> None:
+        self.body = body
+        self.radar = np.asarray(radar_position, dtype=np.float64)
+        if body.joint_names == CANONICAL_JOINTS:
+            self.segments = [(body.index(a), body.index(b)) for a, b in CANONICAL_SEGMENTS]
+            self.centre: int | None = body.index("base")
+        else:
+            self.segments = []
+            self.centre = None
+        self.top_lines: list[Any] = []
+        self.body_lines: list[Any] = []
+        self.top_points: Any = None
+
+    def pose(self, frame: int) -> FloatArray:
+        """Joint positions of one frame, NaN where not valid, (n_joints, 3) [m]."""
+        p = np.array(self.body.positions[frame], dtype=np.float64)
+        p[~self.body.valid[frame]] = np.nan
+        return p
+
+    def centre_of(self, pose: FloatArray) -> FloatArray:
+        """Hip centre, or the mean of the valid joints (3,) [m]."""
+        if self.centre is not None and np.all(np.isfinite(pose[self.centre])):
+            return np.asarray(pose[self.centre], dtype=np.float64)
+        return np.asarray(np.nanmean(pose, axis=0), dtype=np.float64)
+
+    def path(self) -> FloatArray:
+        """The centre's track over the record (n_frames, 3) [m]."""
+        return np.array(
+            [self.centre_of(self.pose(k)) for k in range(self.body.n_frames)], dtype=np.float64
+        )
+
+    def draw_top(self, ax: Any) -> None:
+        """Top view: radar, path, line of sight, body outline (x-y plane)."""
+        path = self.path()
+        ax.plot(path[:, 0], path[:, 1], ls="--", lw=1.0, color="0.5", label="path")
+        ax.plot(*self.radar[:2], marker="^", ms=9, color="C1", ls="", label="radar")
+        (self.los_top,) = ax.plot([], [], lw=1.0, color="C1", label="line of sight")
+        self.top_lines = [ax.plot([], [], lw=1.5, color="C0")[0] for _ in self.segments]
+        (self.top_points,) = ax.plot([], [], ls="", marker=".", ms=3, color="C0")
+        xy = np.vstack([path[:, :2], self.radar[None, :2]])
+        xy = xy[np.all(np.isfinite(xy), axis=1)]
+        mid = (xy.min(axis=0) + xy.max(axis=0)) / 2
+        half = float(np.max(xy.max(axis=0) - xy.min(axis=0))) / 2 + 1.0
+        ax.set_xlim(mid[0] - half, mid[0] + half)
+        ax.set_ylim(mid[1] - half, mid[1] + half)
+        ax.set_aspect("equal", adjustable="box")
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.set_title("scene from above")
+        ax.legend(loc="upper left", fontsize=7)
+
+    def draw_body(self, ax: Any) -> None:
+        """3-D body view that follows the person."""
+        self.body_lines = [ax.plot([], [], [], lw=2.0, color="C0")[0] for _ in self.segments]
+        (self.body_points,) = ax.plot([], [], [], ls="", marker="o", ms=2.5, color="C0")
+        (self.los_body,) = ax.plot([], [], [], lw=1.0, color="C1", label="toward the radar")
+        ax.set_box_aspect((1.0, 1.0, 1.0))
+        # the box follows the person: tick labels would change every frame, so none are drawn
+        ax.set_xticklabels([])
+        ax.set_yticklabels([])
+        ax.set_zticklabels([])
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+        ax.set_zlabel("z")
+        ax.set_title(f"body (box {BODY_BOX_M:g} m)")
+        ax.legend(loc="upper left", fontsize=7)
+        self.body_ax = ax
+
+    def update(self, t: float) -> FloatArray:
+        """Show the body's nearest frame to ``t``; returns that frame's pose (n_joints, 3)."""
+        k = int(frame_at(self.body.time, np.array([t]))[0])
+        pose = self.pose(k)
+        centre = self.centre_of(pose)
+        for line, (a, b) in zip(self.top_lines, self.segments, strict=False):
+            line.set_data(pose[[a, b], 0], pose[[a, b], 1])
+        for line3, (a, b) in zip(self.body_lines, self.segments, strict=True):
+            line3.set_data_3d(pose[[a, b], 0], pose[[a, b], 1], pose[[a, b], 2])
+        self.body_points.set_data_3d(pose[:, 0], pose[:, 1], pose[:, 2])
+        if self.top_points is not None:
+            self.top_points.set_data(pose[:, 0], pose[:, 1])
+            self.los_top.set_data([self.radar[0], centre[0]], [self.radar[1], centre[1]])
+        to_radar = self.radar - centre
+        dist = float(np.linalg.norm(to_radar))
+        tip = centre + to_radar * min(1.0, 0.5 * BODY_BOX_M / dist) if dist > 0 else centre
+        self.los_body.set_data_3d([centre[0], tip[0]], [centre[1], tip[1]], [centre[2], tip[2]])
+        half = BODY_BOX_M / 2
+        ax = self.body_ax
+        ax.set_xlim(centre[0] - half, centre[0] + half)
+        ax.set_ylim(centre[1] - half, centre[1] + half)
+        ax.set_zlim(centre[2] - half, centre[2] + half)
+        return pose
+
+
+def _figure(plt: Any, scene: _Scene, spec: SpectrogramView) -> tuple[Any, Any]:
+    fig = plt.figure(figsize=(14, 4.8), layout="constrained")
+    grid = fig.add_gridspec(1, 3, width_ratios=(1.0, 1.0, 1.6))
+    scene.draw_top(fig.add_subplot(grid[0]))
+    scene.draw_body(fig.add_subplot(grid[1], projection="3d"))
+    ax = fig.add_subplot(grid[2])
+    im = _spectrogram(ax, spec)
+    fig.colorbar(im, ax=ax, label="power [dB re peak]")
+    cursor = ax.axvline(float(spec.time[0]), color="white", lw=1.2)
+    return fig, cursor
+
+
+def _spectrogram(ax: Any, spec: SpectrogramView) -> Any:
+    return draw_spectrogram(
+        ax,
+        spec.power_db,
+        spec.time,
+        spec.velocity,
+        dynamic_range_db=spec.dynamic_range_db,
+        velocity_span=spec.velocity_span,
+        colormap=spec.colormap,
+    )
+
+
+def animate(
+    path: Path,
+    body: Skeleton,
+    radar_position: FloatArray,
+    spec: SpectrogramView,
+    *,
+    fps: int = 12,
+    title: str = "",
+    caption: str = "",
+) -> int:
+    """Save the animated preview to ``path`` (``.gif`` or ``.mp4``); one frame every ``1/fps``
+    s of the record, played in real time. Returns the number of frames."""
+    fmt = Path(path).suffix.lower().lstrip(".")
+    times = animation_times(body, fps)
+    with style() as plt:
+        from matplotlib.animation import FFMpegWriter, PillowWriter
+
+        writer: Any
+        if fmt == "gif":
+            writer = PillowWriter(fps=fps)
+        elif fmt == "mp4":
+            writer = FFMpegWriter(fps=fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"])
+            plt.rcParams["animation.ffmpeg_path"] = _ffmpeg()
+        else:
+            raise PreviewError(f"--format: {fmt!r} is not one of {', '.join(FORMATS)}")
+        scene = _Scene(body, radar_position)
+        fig, cursor = _figure(plt, scene, spec)
+        if title:
+            fig.suptitle(title)
+        if caption:
+            fig.text(0.01, 0.01, caption, fontsize=7.5, color="0.25")
+            fig.get_layout_engine().set(rect=(0.0, 0.05, 1.0, 0.95))
+        scene.update(float(times[0]))
+        fig.canvas.draw()  # lay the figure out once; the frames only move artists
+        fig.set_layout_engine("none")
+
+        with writer.saving(fig, str(path), dpi=ANIMATION_DPI):
+            for t in times:
+                scene.update(float(t))
+                cursor.set_xdata([t, t])
+                writer.grab_frame()
+        plt.close(fig)
+    return int(times.size)
+
+
+def plot_stills(
+    path: Path,
+    body: Skeleton,
+    radar_position: FloatArray,
+    spec: SpectrogramView,
+    instants: Sequence[float] | None = None,
+    *,
+    title: str = "",
+    caption: str = "",
+) -> FloatArray:
+    """Save the body at ``instants`` [s from the first pulse] (default: five spread over the
+    record) in 3-D above the spectrogram, with the instants marked on it. Returns the times of
+    the frames shown [s]."""
+    at = default_instants(body) if instants is None else check_instants(body, instants)
+    frames = frame_at(body.time, at)
+    scene = _Scene(body, radar_position)
+    with style() as plt:
+        n = at.size
+        fig = plt.figure(figsize=(max(8.0, 2.6 * n), 7.5), layout="constrained")
+        grid = fig.add_gridspec(2, n, height_ratios=(1.2, 1.0))
+        for i, k in enumerate(frames):
+            ax = fig.add_subplot(grid[0, i], projection="3d")
+            scene.draw_body(ax)
+            if i:
+                ax.get_legend().remove()
+            scene.update(float(body.time[k]))
+            ax.set_title(f"t = {body.time[k]:.2f} s")
+        ax = fig.add_subplot(grid[1, :])
+        im = _spectrogram(ax, spec)
+        for i, k in enumerate(frames):
+            ax.axvline(float(body.time[k]), color="white", lw=1.0)
+            ax.annotate(
+                f"{i + 1}",
+                (float(body.time[k]), 1.0),
+                xycoords=("data", "axes fraction"),
+                ha="center",
+                va="bottom",
+            )
+        fig.colorbar(im, ax=ax, label="power [dB re peak]")
+        if title:
+            fig.suptitle(title)
+        save(fig, path, caption)
+    return np.asarray(body.time[frames], dtype=np.float64)
+
+
+def _ffmpeg() -> str:
+    try:
+        import imageio_ffmpeg
+    except ImportError:
+        raise PreviewError(
+            "--format mp4 needs the ffmpeg binary of imageio-ffmpeg: "
+            "pip install 'mdframework[video]', or use --format gif"
+        ) from None
+    return str(imageio_ffmpeg.get_ffmpeg_exe())

@@ -1,0 +1,92 @@
+"""Figures say what they show: the velocity span follows the power, captions name the run."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import EXAMPLES
+from helpers import point_run
+
+from mdframework.config import load_run_config, validate_run_config
+from mdframework.errors import ConfigError
+from mdframework.figures import draw_spectrogram, run_caption, style, velocity_limits
+from mdframework.output import write_run
+from mdframework.pipeline import simulate
+
+
+def _tone_spectrogram(v0: float, floor_db: float = -60.0) -> tuple[np.ndarray, np.ndarray]:
+    """A spectrogram (at the floor everywhere) with one bin at velocity ``v0`` at 0 dB."""
+    velocity = np.linspace(-6.0, 6.0, 481)  # 0.025 m/s bins
+    spec = np.full((velocity.size, 20), floor_db)
+    spec[np.argmin(np.abs(velocity - v0)), :] = 0.0
+    return spec, velocity
+
+
+def test_auto_span_covers_the_power_and_zero() -> None:
+    spec, velocity = _tone_spectrogram(2.0)
+    lo, hi = velocity_limits(spec, velocity, "auto", 40.0)
+    dv = velocity[1] - velocity[0]
+    # extent 0..2 m/s widened by a tenth (0.2) plus two bins each side
+    assert lo == pytest.approx(-0.2 - 2 * dv)
+    assert hi == pytest.approx(2.0 + 0.2 + 2 * dv)
+
+
+def test_auto_span_counts_only_power_within_the_dynamic_range() -> None:
+    spec, velocity = _tone_spectrogram(-1.0)
+    spec[np.argmin(np.abs(velocity - 4.0)), :] = -45.0  # below a 40 dB display, above 50 dB
+    assert velocity_limits(spec, velocity, "auto", 40.0)[1] < 0.5
+    assert velocity_limits(spec, velocity, "auto", 50.0)[1] > 4.0
+
+
+def test_noise_everywhere_gives_the_full_axis(rng: np.random.Generator) -> None:
+    velocity = np.linspace(-6.0, 6.0, 481)
+    spec = rng.uniform(-10.0, 0.0, (velocity.size, 30))
+    dv = velocity[1] - velocity[0]
+    full = (velocity[0] - dv / 2, velocity[-1] + dv / 2)
+    assert velocity_limits(spec, velocity, "auto", 40.0) == pytest.approx(full)
+    assert velocity_limits(spec, velocity, "full") == pytest.approx(full)
+    assert velocity_limits(spec, velocity, 2.5) == pytest.approx((-2.5, 2.5))
+    assert velocity_limits(spec, velocity, 100.0) == pytest.approx(full)
+
+
+def test_auto_span_of_a_receding_point_target() -> None:
+    """A point receding at 1 m/s (15 GHz, PRF 2400 Hz: +-12 m/s unambiguous) is shown on an axis
+    a tenth of the unambiguous span, not the whole of it."""
+    res = point_run([{"position": [100.0, 0.0, 0.0], "velocity": [1.0, 0.0, 0.0]}])
+    lo, hi = velocity_limits(res.spectrogram_db, res.velocity, "auto", 40.0)
+    assert -1.6 < lo < -1.0 and 0.0 < hi < 0.5
+    with style() as plt:
+        fig, ax = plt.subplots()
+        draw_spectrogram(ax, res.spectrogram_db, res.spectrogram.time, res.velocity)
+        assert ax.get_ylim() == pytest.approx((lo, hi))
+        plt.close(fig)
+
+
+def test_caption_names_source_radar_geometry_and_effects(tmp_path: Path) -> None:
+    config = load_run_config(EXAMPLES / "cmu_walk.toml")
+    data = json.loads(config.model_dump_json())
+    data["effects"] = [{"kind": "noise", "snr_db": 20.0}]
+    data["radar"]["prf"] = 3000.0
+    data["motion"]["duration"] = 1.0
+    data["scene"]["person"]["aspect_deg"] = 30.0
+    data["figures"] = {"velocity_span": "full", "colormap": "magma"}
+    config = validate_run_config(data)
+    result = simulate(config)
+    resolved = json.loads(config.model_dump_json())
+    title, caption = run_caption(result.metadata, resolved, (10.05, 8.1))
+    assert title == "walk — cmu 02_01.amc subject 2"
+    for part in ("lfm 15 GHz", "PRF 3000 Hz", "aspect 30°", "range 10.1 → 8.1 m", "noise"):
+        assert part in caption, (part, caption)
+    written = write_run(result, resolved, tmp_path / "run")
+    assert tmp_path / "run" / "spectrogram.png" in written
+
+
+def test_unknown_colormap_is_a_config_error() -> None:
+    data = {"motion": {"kind": "point_targets", "length": 1.0, "targets": []}}
+    with pytest.raises(ConfigError, match=r"figures\.colormap: .*unknown colour map 'jett'"):
+        validate_run_config({**data, "figures": {"colormap": "jett"}})
+    with pytest.raises(ConfigError, match=r"figures\.dynamic_range_db"):
+        validate_run_config({**data, "figures": {"dynamic_range_db": 0}})

@@ -1,0 +1,134 @@
+"""Motion previews show the body's own frames at the right instants, in the right place."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+from synthetic import standing
+
+from mdframework.figures import style
+from mdframework.preview import (
+    PreviewError,
+    SpectrogramView,
+    _figure,
+    _Scene,
+    animate,
+    animation_times,
+    check_instants,
+    frame_at,
+    plot_stills,
+)
+from mdframework.skeleton import CANONICAL_JOINTS, Skeleton
+
+RADAR = np.array([10.0, 0.0, 2.0])
+
+
+def walker(frame_rate: float = 30.0, duration: float = 1.0, speed: float = 1.2) -> Skeleton:
+    """The standing body moving along +x at ``speed`` [m/s], frames at ``frame_rate``."""
+    t = np.arange(0.0, duration + 1e-9, 1.0 / frame_rate)
+    pos = standing()[None] + np.array([speed, 0.0, 0.0]) * t[:, None, None]
+    return Skeleton(t, pos, CANONICAL_JOINTS)
+
+
+def spec_for(body: Skeleton) -> SpectrogramView:
+    time = np.linspace(body.time[0], body.time[-1], 40)
+    velocity = np.linspace(-5.0, 5.0, 101)
+    power = np.full((velocity.size, time.size), -60.0)
+    power[np.argmin(np.abs(velocity - 1.2))] = 0.0
+    return SpectrogramView(power, time, velocity)
+
+
+def test_frame_at_picks_the_nearest_frame() -> None:
+    t = np.array([0.0, 0.1, 0.3, 0.6])
+    got = frame_at(t, np.array([-1.0, 0.0, 0.04, 0.05, 0.06, 0.21, 0.59, 9.0]))
+    assert got.tolist() == [0, 0, 0, 0, 1, 2, 3, 3]  # tie at 0.05 goes to the earlier frame
+
+
+def test_animation_frames_run_in_real_time() -> None:
+    body = walker(duration=1.0)
+    times = animation_times(body, 12)
+    assert times.size == 13 and times[-1] == pytest.approx(1.0)
+    with pytest.raises(PreviewError, match="--fps"):
+        animation_times(body, 0)
+
+
+def test_the_scene_shows_the_nearest_frame_and_the_line_of_sight() -> None:
+    body = walker(frame_rate=10.0)
+    scene = _Scene(body, RADAR)
+    with style() as plt:
+        fig, _ = _figure(plt, scene, spec_for(body))
+        pose = scene.update(0.34)  # frames at 0.3 and 0.4 s: 0.3 is nearer
+        assert np.array_equal(pose, body.positions[3])
+        neck = CANONICAL_JOINTS.index("neck")
+        base = CANONICAL_JOINTS.index("base")
+        x, y, z = scene.body_lines[0].get_data_3d()  # segment base -> neck
+        assert np.allclose([x, y, z], body.positions[3][[base, neck]].T)
+        los_x, los_y = scene.los_top.get_data()
+        assert np.allclose(los_x, [RADAR[0], body.positions[3, base, 0]])
+        assert np.allclose(los_y, [RADAR[1], body.positions[3, base, 1]])
+        # the 3-D view follows the hip centre
+        lo, hi = scene.body_ax.get_xlim()
+        assert (lo + hi) / 2 == pytest.approx(body.positions[3, base, 0])
+        plt.close(fig)
+
+
+def test_untracked_joints_are_left_out() -> None:
+    body = walker()
+    valid = np.ones(body.valid.shape, dtype=bool)
+    valid[:, CANONICAL_JOINTS.index("head")] = False
+    scene = _Scene(Skeleton(body.time, body.positions, body.joint_names, valid), RADAR)
+    pose = scene.pose(0)
+    assert np.all(np.isnan(pose[CANONICAL_JOINTS.index("head")]))
+    assert np.all(np.isfinite(np.delete(pose, CANONICAL_JOINTS.index("head"), axis=0)))
+
+
+def test_instants_outside_the_record_are_refused() -> None:
+    body = walker(duration=1.0)
+    assert check_instants(body, [0.0, 0.5, 1.0]).tolist() == [0.0, 0.5, 1.0]
+    with pytest.raises(PreviewError, match=r"--at: 1.5 s is outside the record \(0.000 to 1.000"):
+        check_instants(body, [0.2, 1.5])
+
+
+def test_gif_has_one_frame_per_step_at_the_frame_rate(tmp_path: Path) -> None:
+    body = walker(duration=0.5)
+    n = animate(tmp_path / "m.gif", body, RADAR, spec_for(body), fps=10, title="t", caption="c")
+    with Image.open(tmp_path / "m.gif") as gif:
+        assert gif.n_frames == n == 6
+        assert gif.info["duration"] == 100  # ms per frame at 10 fps (GIF stores centiseconds)
+
+
+def test_stills_show_the_frames_nearest_the_instants(tmp_path: Path) -> None:
+    body = walker(frame_rate=10.0)
+    shown = plot_stills(tmp_path / "s.png", body, RADAR, spec_for(body), [0.26, 0.74])
+    assert shown.tolist() == pytest.approx([0.3, 0.7])
+    assert (tmp_path / "s.png").stat().st_size > 10_000
+
+
+def test_unknown_format_is_refused(tmp_path: Path) -> None:
+    body = walker(duration=0.2)
+    with pytest.raises(PreviewError, match="--format"):
+        animate(tmp_path / "m.avi", body, RADAR, spec_for(body))
+    assert not (tmp_path / "m.avi").exists()
+
+
+def test_mp4_through_the_shipped_ffmpeg(tmp_path: Path) -> None:
+    """imageio-ffmpeg (the ``video`` extra, in ``dev``) ships the encoder; the file it writes is
+    read back by the same binary with the frame count and rate asked for."""
+    import subprocess
+
+    import imageio_ffmpeg
+
+    body = walker(duration=0.5)
+    n = animate(tmp_path / "m.mp4", body, RADAR, spec_for(body), fps=10)
+    probe = subprocess.run(
+        [imageio_ffmpeg.get_ffmpeg_exe(), "-i", str(tmp_path / "m.mp4")],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert "h264" in probe.stderr and "10 fps" in probe.stderr
+    frames, _ = imageio_ffmpeg.count_frames_and_secs(str(tmp_path / "m.mp4"))
+    assert frames == n == 6
