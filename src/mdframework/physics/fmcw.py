@@ -517,9 +517,7 @@ class AngleGrid:
     iz: IntArray
 
 
-def angle_grid(
-    positions: FloatArray, wavelength: float, n_x: int = 65, n_z: int = 33
-) -> AngleGrid:
+def angle_grid(positions: FloatArray, wavelength: float, n_x: int = 65, n_z: int = 33) -> AngleGrid:
     """The beam-scan grid for an array: ``u_x`` over [-1, 1] in ``n_x`` steps, ``u_z`` likewise
     when the array has vertical extent (else only 0); directions with ``u_x^2 + u_z^2 > 1`` are
     left out."""
