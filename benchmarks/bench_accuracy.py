@@ -59,6 +59,7 @@ from scipy.interpolate import RegularGridInterpolator  # noqa: E402
 
 from mdframework.config import read_config_file, validate_run_config  # noqa: E402
 from mdframework.features import FEATURE_NAMES, spectrogram_features  # noqa: E402
+from mdframework.figures import save, style  # noqa: E402
 from mdframework.pipeline import RunResult, build_stages, simulate_motion  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -313,15 +314,18 @@ def write_outputs(rows: list[dict[str, Any]], notes: list[str], out: Path, argv:
 
 
 def plot(rows: list[dict[str, Any]], path: Path) -> None:
-    import matplotlib
+    """Error against run time, one panel per scene, in the project's figure style."""
+    with style() as plt:
+        _plot(plt, rows, path)
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
+def _plot(plt: Any, rows: list[dict[str, Any]], path: Path) -> None:
     scenes = sorted({r["scene"] for r in rows})
     ladder_names = sorted({r["ladder"] for r in rows})
-    colours = dict(zip(ladder_names, plt.cm.tab10.colors, strict=False))
-    fig, axes = plt.subplots(1, len(scenes), figsize=(5.2 * len(scenes), 4.4), squeeze=False)
+    colours = {name: f"C{i}" for i, name in enumerate(ladder_names)}
+    fig, axes = plt.subplots(
+        1, len(scenes), figsize=(5.2 * len(scenes), 4.4), squeeze=False, layout="constrained"
+    )
     for ax, scene in zip(axes[0], scenes, strict=True):
         for r in (x for x in rows if x["scene"] == scene):
             err = max(r["spec_err_db"], 1e-3)
@@ -356,9 +360,12 @@ def plot(rows: list[dict[str, Any]], path: Path) -> None:
     )
     handles.append(plt.Line2D([], [], color="grey", marker="s", ls="", label="reference (0 dB)"))
     axes[0][-1].legend(handles=handles, fontsize=7, loc="upper right")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save(
+        fig,
+        path,
+        "spectrogram error over the support against median run time; star: the "
+        "default setting, square: the reference",
+    )
 
 
 def main() -> None:

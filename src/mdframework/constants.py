@@ -1,7 +1,7 @@
 """Physical constants and fixed conventions (SI units throughout).
 
 Every module that needs the speed of light imports it from here, so code and tests agree on the
-exact value (``physics.md`` section 0: using 3e8 moves Doppler values by 0.07 %).
+exact value (using 3e8 would move Doppler values by 0.07 %).
 """
 
 from __future__ import annotations

@@ -353,7 +353,8 @@ def _row(meta: dict[str, Any], feats: NDArray[np.float64]) -> dict[str, Any]:
 
 
 def _atomic_savez(path: Path, **arrays: Any) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".npz", dir=path.parent)
+    # the partial file must not look like a record (*.npz) to a reader or a resumed build
+    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".part", dir=path.parent)
     try:
         with os.fdopen(fd, "wb") as fh:
             np.savez(fh, **arrays)

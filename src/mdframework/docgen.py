@@ -1,11 +1,14 @@
 """Render the config reference (docs/config-reference.md) from the pydantic models.
 
 The reference is generated, never written by hand, so it always matches the code:
-``python -m mdframework.docgen > docs/config-reference.md`` (a test checks it is current).
+``python -m mdframework.docgen > docs/config-reference.md`` (a test checks it is current). Every
+section of every model is rendered: a field whose type is itself a model gets its own
+subsection, so no field is left undocumented.
 """
 
 from __future__ import annotations
 
+import re
 import sys
 import types
 from typing import Annotated, Any, Literal, Union, get_args, get_origin
@@ -14,15 +17,14 @@ from pydantic import BaseModel
 from pydantic.fields import FieldInfo
 from pydantic_core import PydanticUndefined
 
-from .plugins import INTERFACES, Registry, default_registry
-from .settings import PersonConfig, ProcessingConfig, SceneConfig
+from .plugins import Registry, default_registry
+from .settings import RunConfigBase
 
-SECTIONS = {
-    "motion": "`[motion]`: the motion source",
-    "scatterers": "`[scatterers]`: the scatterer (RCS) model",
-    "radar": "`[radar]`: the radar waveform",
-    "effect": "`[[effects]]`: scene effects (only those listed are simulated)",
-    "classifier": "`[classifier]`: classifiers",
+RUN_PLUGIN_SECTIONS = {
+    "motion": ("motion", "`[motion]`: the motion source"),
+    "scatterers": ("scatterers", "`[scatterers]`: the scatterer (RCS) model"),
+    "radar": ("radar", "`[radar]`: the radar waveform"),
+    "effect": ("effects", "`[[effects]]`: scene effects (only those listed are simulated)"),
 }
 
 
@@ -41,75 +43,127 @@ def _type_name(annotation: Any) -> str:
     return annotation.__name__ if isinstance(annotation, type) else str(annotation)
 
 
-def _default(field: FieldInfo) -> str:
+def _submodel(annotation: Any) -> type[BaseModel] | None:
+    """The model a field holds (directly, optionally, or as list items), if any."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    for arg in get_args(annotation):
+        found = _submodel(arg)
+        if found is not None:
+            return found
+    return None
+
+
+def _default(field: FieldInfo, section: str) -> str:
     if field.default is PydanticUndefined:
-        if field.default_factory is not None:
-            return "(see below)" if isinstance(field.default_factory, type) else "[]"
-        return "**required**"
+        factory = field.default_factory
+        if factory is None:
+            return "**required**"
+        if isinstance(factory, type) and issubclass(factory, BaseModel):
+            return f"see `[{section}]`"
+        value = factory()  # type: ignore[call-arg]
+        return f"`{value!r}`".replace("(", "[").replace(")", "]")
     if isinstance(field.default, str):
         return f'`"{field.default}"`'
     return f"`{field.default!r}`".replace("(", "[").replace(")", "]")
 
 
-def model_table(model: type[BaseModel], skip: tuple[str, ...] = ()) -> str:
-    """A Markdown table of a model's fields: name, type, default, description."""
+def model_table(model: type[BaseModel], skip: tuple[str, ...] = (), prefix: str = "") -> str:
+    """A Markdown table of a model's fields: name, type, default, description. ``prefix`` is
+    the model's own section (``scene``), used to name nested sections."""
     rows = ["| field | type | default | description |", "|---|---|---|---|"]
     for name, field in model.model_fields.items():
         if name in skip:
             continue
-        desc = (field.description or "").replace("|", "\\|").replace("\n", " ")
+        sub = _submodel(field.annotation)
+        desc = field.description or (_summary(sub) if sub is not None else "")
+        desc = desc.replace("|", "\\|").replace("\n", " ")
         typ = _type_name(field.annotation).replace("|", "\\|")
-        rows.append(f"| `{name}` | `{typ}` | {_default(field)} | {desc} |")
+        section = f"{prefix}.{name}" if prefix else name
+        rows.append(f"| `{name}` | `{typ}` | {_default(field, section)} | {desc} |")
     return "\n".join(rows)
 
 
+def model_sections(
+    model: type[BaseModel], section: str, level: int, skip: tuple[str, ...] = ()
+) -> list[str]:
+    """The model's table, then one subsection per field that holds a model (recursively)."""
+    out = [model_table(model, skip, section), ""]
+    for name, field in model.model_fields.items():
+        sub = _submodel(field.annotation)
+        if name in skip or sub is None:
+            continue
+        path = f"{section}.{name}" if section else name
+        brackets = f"[[{path}]]" if get_origin(field.annotation) is list else f"[{path}]"
+        out += [f"{'#' * level} `{brackets}`", "", _summary(sub), ""]
+        out += model_sections(sub, path, level + 1)
+    return out
+
+
+def _summary(model: type[BaseModel]) -> str:
+    """The model's docstring on one line, Sphinx roles (:mod:`x`) reduced to code (`x`)."""
+    return re.sub(r":\w+:`~?([^`]+)`", r"`\1`", " ".join((model.__doc__ or "").split()))
+
+
+def _plugin_sections(reg: Registry, interface: str, title: str) -> list[str]:
+    names = reg.names(interface)
+    if not names:
+        return []
+    out = [f"## {title}", ""]
+    for name in names:
+        info = reg.plugins[interface][name]
+        doc = (info.cls.__doc__ or "").strip().splitlines()[0]
+        out += [f"### kind = `{name}` ({info.provider.split()[0]})", "", doc, ""]
+        out += [model_table(info.cls.Config, skip=("kind",)), ""]
+    return out
+
+
 def render(registry: Registry | None = None) -> str:
-    """The whole config reference as Markdown."""
+    """The whole config reference as Markdown: run, dataset and experiment configs."""
+    from .dataset import DatasetConfig
+    from .experiment import ExperimentConfig
+
     reg = registry or default_registry()
+    plugin_fields = ("motion", "scatterers", "radar", "effects")
     out = [
         "# Config reference",
         "",
         "Generated from the code by `python -m mdframework.docgen`; do not edit by hand.",
-        "Run configs are TOML, YAML or JSON. Unknown fields are errors. Relative paths are",
+        "Configs are TOML, YAML or JSON. Unknown fields are errors. Relative paths are",
         "relative to the config file. Units are SI unless a field name says otherwise",
-        "(`_deg`, `_db`, `_dbi`). `mdf config schema` prints the same as a JSON schema.",
+        "(`_deg`, `_db`, `_dbi`). `mdf config schema` prints the run config as a JSON schema.",
         "",
-        "## Top level",
+        "- [Run configs](#run-configs) (`mdf run`, `mdf show`): motion, scatterers, radar,",
+        "  effects, scene, processing, conditioning, figures.",
+        "- [Dataset configs](#dataset-configs) (`mdf dataset build`).",
+        "- [Experiment configs](#experiment-configs) (`mdf experiment`), with the classifiers.",
+        "",
+        "## Run configs",
         "",
         "| field | description |",
         "|---|---|",
-        "| `motion` | the motion source (required), see below |",
+        "| `motion` | the motion source (required), see `[motion]` below |",
         "| `scatterers` | the scatterer model, default `ellipsoid` |",
         "| `radar` | the radar, default `lfm` |",
         "| `effects` | list of scene effects, default none |",
-        "| `scene` | radar position, the person's placement, range gate |",
-        "| `processing` | resampling and spectrogram |",
-        "| `seed` | seed of every random draw, default 0 |",
-        "",
-        "## `[scene]`",
-        "",
-        model_table(SceneConfig),
-        "",
-        "### `[scene.person]`",
-        "",
-        model_table(PersonConfig),
-        "",
-        "## `[processing]`",
-        "",
-        model_table(ProcessingConfig),
-        "",
     ]
-    for interface in INTERFACES:
-        names = reg.names(interface)
-        if not names:
-            continue
-        out += [f"## {SECTIONS[interface]}", ""]
-        for name in names:
-            info = reg.plugins[interface][name]
-            doc = (info.cls.__doc__ or "").strip().splitlines()[0]
-            out += [f"### kind = `{name}` ({info.provider.split()[0]})", "", doc, ""]
-            out += [model_table(info.cls.Config, skip=("kind",)), ""]
-    return "\n".join(out)
+    for name, field in RunConfigBase.model_fields.items():
+        out.append(f"| `{name}` | {field.description} |")
+    out.append("")
+    for name, field in RunConfigBase.model_fields.items():
+        sub = _submodel(field.annotation)
+        if sub is not None:
+            out += [f"### `[{name}]`", "", _summary(sub), ""]
+            out += model_sections(sub, name, 4)
+    for interface, (_, title) in RUN_PLUGIN_SECTIONS.items():
+        out += _plugin_sections(reg, interface, title)
+    out += ["## Dataset configs", "", _summary(DatasetConfig), ""]
+    out += model_sections(DatasetConfig, "", 3)
+    out += ["## Experiment configs", "", _summary(ExperimentConfig), ""]
+    out += model_sections(ExperimentConfig, "", 3)
+    out += _plugin_sections(reg, "classifier", "`[classifier]` of experiment configs: classifiers")
+    assert all(f not in RunConfigBase.model_fields for f in plugin_fields)
+    return "\n".join(out).rstrip("\n") + "\n"
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-"""The seven spectrogram features of Erol & Gurbuz (2015), Table 2 (``physics.md`` section 4).
+"""The seven spectrogram features of Erol & Gurbuz (2015), Table 2.
 
 All features are radial velocities in m/s (positive = approaching):
 

@@ -14,9 +14,9 @@ The arrays are made read-only on construction: stages share skeletons (and datas
 across records), so a stage that wants different positions builds a new skeleton
 (:meth:`Skeleton.with_positions`) instead of changing one in place.
 
-The canonical body is Chen's 17-point set used with the Boulic walking model (``physics.md``
-section 2.3): base (hip centre), neck, head, left/right shoulder, elbow, hand, hip, knee, ankle,
-toe.
+The canonical body is Chen's 17-point set used with the Boulic walking model (V. C. Chen, "The
+Micro-Doppler Effect in Radar", 2011): base (hip centre), neck, head, left/right shoulder, elbow,
+hand, hip, knee, ankle, toe.
 Body axes: ``x`` forward, ``y`` to the subject's left, ``z`` up.
 """
 

@@ -1,4 +1,4 @@
-"""Body dimensions and scatterer placement (``physics.md`` sections 2.3 and 2.4).
+"""Body dimensions and scatterer placement.
 
 Segment lengths are Boulic's proportions of the height ``H`` as coded by Chen; each body part is a
 spheroid (``a = b``) whose long semi-axis ``c`` is half the segment length and whose axis follows

@@ -1,4 +1,4 @@
-"""Resampling joint tracks to pulse times (``physics.md`` section 6.4).
+"""Resampling joint tracks to pulse times.
 
 Positions are interpolated, never the complex return; the default is a C2-smooth cubic spline.
 Output times never extend past the recording (no extrapolation). Untracked frames (``valid`` False)

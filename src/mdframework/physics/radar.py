@@ -1,6 +1,6 @@
 """Radar equations: range equation, carrier phase, LFM pulse compression, Doppler bookkeeping.
 
-Sign convention (``physics.md`` section 0): the slow-time return is proportional to
+Sign convention: the slow-time return is proportional to
 ``exp(-j 4 pi f_c R / c)``, so an approaching target (R falling) has positive Doppler
 ``f_D = 2 v_r / lambda`` with ``v_r > 0`` when approaching.
 
@@ -144,8 +144,9 @@ def lfm_compressed_envelope(
 ) -> FloatArray:
     """Matched-filter output of the symmetric LFM pulse versus delay offset (real-valued) [s].
 
-    ``chi(D) = (tau - |D|) sinc(gamma D (tau - |D|))`` for ``|D| < tau``, else 0 (``physics.md``
-    section 1.4); its peak ``chi(0) = tau``. ``delay_offset`` [s]."""
+    ``chi(D) = (tau - |D|) sinc(gamma D (tau - |D|))`` for ``|D| < tau``, else 0 (the
+    LFM ambiguity function on the zero-Doppler cut); its peak ``chi(0) = tau``.
+    ``delay_offset`` [s]."""
     d = np.abs(np.asarray(delay_offset, dtype=np.float64))
     gamma = bandwidth / pulse_width
     rem = np.clip(pulse_width - d, 0.0, None)

@@ -1,4 +1,4 @@
-"""Radar cross sections of the body-part shapes (``physics.md`` section 2).
+"""Radar cross sections of the body-part shapes.
 
 All RCS values are in m^2, lengths in m. Angles in radians.
 """

@@ -1,4 +1,4 @@
-"""Two-sided spectrogram of the complex slow-time return (``physics.md`` sections 1.7 and 6.3).
+"""Two-sided spectrogram of the complex slow-time return.
 
 ``S(m, k) = |sum_n y(n) w(n - mH) exp(-j 2 pi k n / N_fft)|^2``, bins ``k = -N/2 .. N/2 - 1``,
 ``f_k = k PRF / N_fft``. Positive frequencies are approaching targets.
