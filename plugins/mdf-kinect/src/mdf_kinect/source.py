@@ -82,8 +82,9 @@ class KinectConfig(MotionConfig):
     frame_rate: float | None = Field(
         None,
         gt=0,
-        description="Rate [Hz] for formats without time stamps (UTKinect 30, MSR 15, PRECOG 25, "
-        "NTU 30 by default); NiTE files carry their own time stamps.",
+        description="Rate [Hz] for formats without time stamps (MSR 15, PRECOG 25, NTU 30 by "
+        "default); for UTKinect, frame numbers per second (60 by default: two per 30 Hz "
+        "frame); NiTE files carry their own time stamps.",
     )
     floor: Literal["auto"] | float = Field(
         "auto",
