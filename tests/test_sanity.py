@@ -178,3 +178,16 @@ def test_cadence_needs_a_period() -> None:
     t = np.arange(50) / 30.0
     still = np.zeros((50, 3))
     assert cadence_spm(t, still, still + np.array([0.0, 0.2, 0.0])) is None
+
+
+def test_short_clip_cadence_takes_the_first_period_not_the_highest() -> None:
+    # Mixamo walk cycle, 69 frames at 30 Hz, forward then back: the ankle distance peaks every
+    # ~17 frames (0.53 s per step), while its autocorrelation is highest at 3 steps (1.67 s)
+    motion, msgs = load({"kind": "bvh", "file": "data/bvh/test_freebvh.bvh", "activity": "walk"})
+    spm = motion.metadata["sanity"]["cadence"]["steps_per_min"]
+    body = motion.canonical()
+    dist = np.linalg.norm(body.joint("l_ankle") - body.joint("r_ankle"), axis=1)
+    peaks, _ = find_peaks(dist, prominence=0.05)
+    counted = 60.0 / np.median(np.diff(body.time[peaks]))
+    assert spm == pytest.approx(counted, rel=0.1) and 100 < spm < 125
+    assert msgs == []

@@ -223,25 +223,48 @@ def bone_lengths(skeleton: Skeleton) -> dict[str, dict[str, float]]:
     return out
 
 
+def first_period(time: FloatArray, signal: FloatArray, min_strength: float = 0.3) -> float | None:
+    """The signal's shortest clear period [s]: the lag of the first local maximum of its
+    autocorrelation (after the first zero crossing) that reaches ``min_strength``; None if
+    there is none. The signal is resampled linearly to its mean rate first.
+
+    The first such peak rather than the highest one: in a short clip the autocorrelation at a
+    multiple of the period can be higher than at the period itself.
+    """
+    t = np.asarray(time, dtype=np.float64)
+    n = t.shape[0]
+    if n < 8 or t[-1] <= t[0]:
+        return None
+    dt = (t[-1] - t[0]) / (n - 1)
+    x = np.interp(t[0] + dt * np.arange(n), t, signal)
+    x = x - x.mean()
+    denom = float(x @ x)
+    if denom <= 0:
+        return None
+    ac = np.correlate(x, x, mode="full")[n - 1 :] / denom
+    neg = np.flatnonzero(ac < 0)
+    if neg.size == 0:
+        return None
+    for lag in range(int(neg[0]) + 1, n - 1):
+        if ac[lag] >= min_strength and ac[lag] >= ac[lag - 1] and ac[lag] >= ac[lag + 1]:
+            return float(lag * dt)
+    return None
+
+
 def cadence_spm(time: FloatArray, l_ankle: FloatArray, r_ankle: FloatArray) -> float | None:
     """Steps per minute from the distance between the ankles, or None if it has no clear period.
 
     The distance peaks once per step (feet apart at double support for a walk; one foot raised
     when jogging in place) whichever foot leads, so the cadence is ``60 / period``
-    (:func:`mdframework.conditioning.periodicity`). Needs at least 8 frames and a periodicity
-    strength of 0.3 or more; a recording shorter than about two steps gives None.
+    (:func:`first_period`, strength 0.3 or more). A recording shorter than about two steps
+    gives None.
     """
-    from .conditioning import periodicity
-
     dist = np.linalg.norm(np.asarray(l_ankle, dtype=np.float64) - r_ankle, axis=1)
     ok = np.isfinite(dist)
     if ok.sum() < 8:
         return None
-    per = periodicity(np.asarray(time, dtype=np.float64)[ok], dist[ok])
-    period = per["period_s"]
-    if period is None or (per["strength"] or 0.0) < 0.3:
-        return None
-    return 60.0 / period
+    period = first_period(np.asarray(time, dtype=np.float64)[ok], dist[ok])
+    return None if period is None else 60.0 / period
 
 
 def _activity_kind(activity: str) -> str | None:
