@@ -71,6 +71,15 @@ def test_80_10_one_frame_arm_glitch_is_flagged_and_confirmed_in_the_raw_channels
     x = bvh.values[148:151, col]
     assert abs(x[1] - (x[0] + x[2]) / 2) > 40.0
     assert abs(x[0] - x[2]) < 30.0
+    assert [(it["joint"], it["time_s"]) for it in items] == [
+        ("r_elbow", 2.466667),
+        ("l_hand", 4.033333),
+        ("r_elbow", 8.666667),
+    ]
+    # the left-hand channels jump too (moving only the fingers): LThumb Z at file frame 213
+    thumb = next(j for j in bvh.joints if j.name == "LThumb")
+    z = bvh.values[212:215, thumb.first_channel + thumb.channels.index("Zrotation")]
+    assert abs(z[1] - (z[0] + z[2]) / 2) > 70.0
 
 
 def test_repair_removes_the_glitch_and_leaves_every_other_frame_alone() -> None:
