@@ -191,3 +191,21 @@ def test_histogram_input_needs_histogram_records_and_no_selection(tmp_path: Path
     p.write_text('input = "histogram"\n[dataset]\npath = "x"\n')
     with pytest.raises(ConfigError, match=r"needs selection\.method = 'none'"):
         exp.load_experiment_config(p)
+
+
+def test_a_source_can_have_its_own_draws(tmp_path: Path) -> None:
+    path = write_random(tmp_path / "r.toml")
+    text = path.read_text().replace(
+        "[base.processing]",
+        '[[sources]]\nlabel = "slow walk"\nmotion = { kind = "cmu", file = "'
+        + str(CMU_WALK)
+        + '" }\nrecord_length = 1.0\nmax_records = 1\n'
+        "randomize = { speed = { uniform = [0.5, 0.6] } }\n[base.processing]",
+    )
+    path.write_text(text)
+    cfg, base = load_dataset_config(path)
+    specs = plan_records(cfg, base)
+    assert [s.label for s in specs] == ["walk"] * 3 + ["slow walk"]
+    assert specs[3].draws is not None and set(specs[3].draws) == {"speed"}
+    assert 0.5 <= specs[3].draws["speed"] <= 0.6
+    assert "speed" not in (specs[0].draws or {})

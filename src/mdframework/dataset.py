@@ -132,6 +132,9 @@ class SourceEntry(StrictModel):
         description="Run-config sections for this source only, merged over `base` (e.g. "
         "conditioning for Kinect recordings, or its own scene).",
     )
+    randomize: Randomization | None = Field(
+        None, description="Random draws for this source only, instead of the dataset's."
+    )
 
     @model_validator(mode="after")
     def _one_kind(self) -> SourceEntry:
@@ -379,12 +382,11 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
     """Expand sources x windows x variations x random draws into record specs, in a fixed
     order."""
     v = config.variations
-    rz = config.randomize
-    for name in ("aspect_deg", "radar_range", "radar_height", "height"):
-        if getattr(v, name) is not None and getattr(rz, name) is not None:
-            raise ConfigError(f"{name}: give it as a variation or as a random draw, not both")
-    if rz.radar_range is not None or rz.radar_height is not None:
-        if v.radar_position is not None:
+    for rz in [config.randomize] + [e.randomize for e in config.sources if e.randomize]:
+        for name in ("aspect_deg", "radar_range", "radar_height", "height"):
+            if getattr(v, name) is not None and getattr(rz, name) is not None:
+                raise ConfigError(f"{name}: give it as a variation or as a random draw, not both")
+        if (rz.radar_range is not None or rz.radar_height is not None) and v.radar_position:
             raise ConfigError("randomize.radar_range/height cannot combine with radar_position")
     none: list[Any] = [None]
     grid = list(
@@ -420,6 +422,7 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
                 f"{duration:.3f} s recording ({motion.get('file', motion['kind'])})"
             )
         hop = entry.hop or length
+        rz = entry.randomize or config.randomize
         starts = float(motion.get("start", 0.0)) + np.arange(0.0, duration - length + 1e-9, hop)
         if entry.max_records is not None:
             starts = starts[: entry.max_records]
