@@ -244,6 +244,38 @@ def window_transform(name: WindowName, n: int, nu: FloatArray) -> ComplexArray:
 # --------------------------------------------------------------------------- IF and range
 
 
+def _window_transform_on_bins(
+    name: WindowName, n: int, x: FloatArray, bins: IntArray
+) -> ComplexArray:
+    """:func:`window_transform` at ``nu = k / n - x`` for integer bins ``k`` of an unpadded
+    FFT, (*x.shape, n_bins): the same values with one sine per element. On bins,
+    ``D_n(k/n - x) = -(-1)^k sin(pi n x) exp(j pi (n-1)(k/n - x)) / sin(pi (k/n - x))``, and a
+    cosine-sum window's shifts by ``c / n`` are shifts by ``c`` bins, so ``D`` is evaluated once
+    on the bins ``k - C .. k + C`` and combined."""
+    coeffs = WINDOWS[name]
+    reach = len(coeffs) - 1
+    ext = np.unique((bins[:, None] + np.arange(-reach, reach + 1)[None, :]).ravel() % n)
+    pos = {int(k): i for i, k in enumerate(ext)}
+    xe = np.asarray(x, np.float64)[..., None]
+    den = np.sin(np.pi * (ext / n - xe))
+    near = np.abs(den) < 1e-12
+    num = -np.sin(np.pi * n * xe) * np.where(ext % 2 == 0, 1.0, -1.0)
+    ratio = np.where(near, float(n), num / np.where(near, 1.0, den))
+    # the phase factor exp(j pi (n-1) nu) is 1 where nu is an integer (D = n exactly there)
+    left = np.exp(1j * np.pi * (n - 1) * ext / n)
+    right = np.exp(-1j * np.pi * (n - 1) * np.asarray(x, np.float64))[..., None]
+    d = np.where(near, float(n) + 0j, ratio * (right * left))
+    out = np.zeros((*np.shape(x), bins.size), dtype=np.complex128)
+    for c, a in enumerate(coeffs):
+        if c == 0:
+            out += a * d[..., [pos[int(k)] for k in bins]]
+            continue
+        up = [pos[int(k)] for k in (bins + c) % n]
+        down = [pos[int(k)] for k in (bins - c) % n]
+        out += (-1) ** c * a / 2.0 * (d[..., up] + d[..., down])
+    return out
+
+
 def _if_cycles0(delays: FloatArray, seq: ChirpSequence) -> FloatArray:
     """Fractional cycles of ``f0 tau + S tau t_0 - S tau^2 / 2`` (the IF phase at the first ADC
     sample), reduced in float64."""
@@ -298,11 +330,12 @@ def analytic_range_profile(
     channel with scatterer ``i`` multiplied by its phasor, (n_chirps, n_ch, n_sel).
     """
     c0 = _if_cycles0(delays, seq)
-    nu = (
-        np.asarray(bins, np.float64)[None, None, :] / n_fft
-        - (seq.slope * delays / seq.sample_rate)[:, :, None]
-    )
-    kern = window_transform(name, seq.n_samples, nu)
+    x = seq.slope * delays / seq.sample_rate  # beat frequency in cycles per sample
+    if n_fft == seq.n_samples:
+        kern = _window_transform_on_bins(name, seq.n_samples, x, np.asarray(bins, np.int64))
+    else:
+        nu = np.asarray(bins, np.float64)[None, None, :] / n_fft - x[:, :, None]
+        kern = window_transform(name, seq.n_samples, nu)
     phase = (-2.0 * np.pi) * c0
     coef = np.empty(c0.shape, dtype=np.complex128)
     coef.real = amplitudes * np.cos(phase)
@@ -473,19 +506,18 @@ def steering(
 @dataclass(frozen=True)
 class AngleGrid:
     """A beam-scan grid of direction cosines: ``ux`` (n_x,), ``uz`` (n_z,) (``uz = [0]`` for
-    an array without vertical extent) and the steering vectors of the visible ones,
-    ``vectors`` (n_visible, n_virt), with their grid indices ``ix``, ``iz`` (n_visible,)."""
+    an array without vertical extent) and the conjugated steering vectors of the visible ones,
+    ``weights`` (n_virt, n_visible) (contiguous, for one matrix product per frame), with their
+    grid indices ``ix``, ``iz`` (n_visible,)."""
 
     ux: FloatArray
     uz: FloatArray
-    vectors: ComplexArray
+    weights: ComplexArray
     ix: IntArray
     iz: IntArray
 
 
-def angle_grid(
-    positions: FloatArray, wavelength: float, n_x: int = 129, n_z: int = 65
-) -> AngleGrid:
+def angle_grid(positions: FloatArray, wavelength: float, n_x: int = 65, n_z: int = 33) -> AngleGrid:
     """The beam-scan grid for an array: ``u_x`` over [-1, 1] in ``n_x`` steps, ``u_z`` likewise
     when the array has vertical extent (else only 0); directions with ``u_x^2 + u_z^2 > 1`` are
     left out."""
@@ -495,19 +527,31 @@ def angle_grid(
     gx, gz = np.meshgrid(np.arange(ux.size), np.arange(uz.size), indexing="ij")
     visible = ux[gx] ** 2 + uz[gz] ** 2 <= 1.0 + 1e-12
     ix, iz = gx[visible].astype(np.int64), gz[visible].astype(np.int64)
-    return AngleGrid(ux, uz, steering(positions, ux[ix], uz[iz], wavelength), ix, iz)
+    weights = np.ascontiguousarray(steering(positions, ux[ix], uz[iz], wavelength).conj().T)
+    return AngleGrid(ux, uz, weights, ix, iz)
 
 
-def _refine(values: FloatArray, i: int, axis: FloatArray, cyclic: bool = False) -> float:
-    """Parabolic interpolation of a peak at index ``i`` of ``values`` on the grid ``axis``."""
-    if axis.size < 3 or i == 0 or i == axis.size - 1:
-        return float(axis[i])
-    a, b, c = values[i - 1], values[i], values[i + 1]
-    if not (np.isfinite(a) and np.isfinite(c)):
-        return float(axis[i])
-    den = a - 2 * b + c
-    off = 0.5 * (a - c) / den if den < 0 else 0.0
-    return float(axis[i] + np.clip(off, -0.5, 0.5) * (axis[1] - axis[0]))
+def _refine(
+    maps: FloatArray, d: IntArray, i: IntArray, k: IntArray, axis: FloatArray, along: int
+) -> FloatArray:
+    """Parabolic interpolation of peaks ``maps[d, i, k]`` along grid axis ``along`` (1: u_x,
+    2: u_z) on the grid ``axis``; a peak at the grid's edge or beside a non-visible direction
+    stays on its grid point."""
+    idx = i if along == 1 else k
+    n = maps.shape[along]
+    out = axis[idx].astype(np.float64)
+    if n < 3:
+        return out
+    lo, hi = np.clip(idx - 1, 0, n - 1), np.clip(idx + 1, 0, n - 1)
+    if along == 1:
+        a, b, c = maps[d, lo, k], maps[d, i, k], maps[d, hi, k]
+    else:
+        a, b, c = maps[d, i, lo], maps[d, i, k], maps[d, i, hi]
+    ok = (idx > 0) & (idx < n - 1) & np.isfinite(a) & np.isfinite(c)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        den = np.where(ok, a - 2 * b + c, -1.0)
+        off = np.where(ok & (den < 0), 0.5 * (np.where(ok, a - c, 0.0)) / den, 0.0)
+    return np.asarray(out + np.clip(off, -0.5, 0.5) * (axis[1] - axis[0] if n > 1 else 0.0))
 
 
 def estimate_angles(
@@ -517,40 +561,39 @@ def estimate_angles(
 
     ``snapshots`` (n_det, n_virt). For each detection the direction of the beam map's maximum,
     refined by parabolic interpolation along ``u_x`` and ``u_z``; with ``multi_peak`` (0..1),
-    also every other local maximum of at least that fraction of the maximum (at most one more:
-    TI's multi-object beamforming). Returns the detection index of each direction (n_out,), its
+    also the strongest other local maximum of at least that fraction of the maximum (TI's
+    multi-object beamforming). Returns the detection index of each direction (n_out,), its
     ``u_x``, ``u_z`` (n_out,) and beam power (n_out,) [|snapshot|^2 units x n_virt].
     """
-    if snapshots.shape[0] == 0:
+    n_det = snapshots.shape[0]
+    if n_det == 0:
         e = np.zeros(0)
         return np.zeros(0, np.int64), e, e.copy(), e.copy()
-    beams = np.abs(snapshots @ grid.vectors.conj().T) ** 2 / snapshots.shape[1]
-    maps = np.full((snapshots.shape[0], grid.ux.size, grid.uz.size), -np.inf)
+    product = snapshots @ grid.weights
+    beams = (product.real**2 + product.imag**2) / snapshots.shape[1]
+    maps = np.full((n_det, grid.ux.size, grid.uz.size), -np.inf)
     maps[:, grid.ix, grid.iz] = beams
-    det: list[int] = []
-    uxs: list[float] = []
-    uzs: list[float] = []
-    pw: list[float] = []
-    for d in range(snapshots.shape[0]):
-        m = maps[d]
-        order = [int(np.argmax(m))]
-        if multi_peak is not None:
-            from scipy.ndimage import maximum_filter
+    flat = maps.reshape(n_det, -1)
+    det = np.arange(n_det)
+    best = np.argmax(flat, axis=1)
+    if multi_peak is not None:
+        from scipy.ndimage import maximum_filter
 
-            finite = np.where(np.isfinite(m), m, -1.0)
-            peaks = (finite == maximum_filter(finite, size=3, mode="nearest")) & (
-                finite >= multi_peak * finite.max()
-            )
-            cand = np.flatnonzero(peaks.ravel())
-            cand = cand[np.argsort(-finite.ravel()[cand])]
-            order += [int(c) for c in cand if int(c) != order[0]][:1]
-        for flat in order:
-            i, k = np.unravel_index(flat, m.shape)
-            det.append(d)
-            uxs.append(_refine(m[:, k], int(i), grid.ux))
-            uzs.append(_refine(m[i, :], int(k), grid.uz) if grid.uz.size > 1 else 0.0)
-            pw.append(float(m[i, k]))
-    return np.asarray(det, np.int64), np.asarray(uxs), np.asarray(uzs), np.asarray(pw)
+        finite = np.where(np.isfinite(maps), maps, -1.0)
+        local = finite == maximum_filter(finite, size=(1, 3, 3), mode="nearest")
+        strong = finite >= multi_peak * flat[det, best][:, None, None]
+        cand = np.where(local & strong, finite, -np.inf).reshape(n_det, -1)
+        cand[det, best] = -np.inf
+        second = np.argmax(cand, axis=1)
+        has = np.isfinite(cand[det, second])
+        det = np.concatenate([det, det[has]])
+        best = np.concatenate([best, second[has]])
+        order = np.argsort(det, kind="stable")
+        det, best = det[order], best[order]
+    i, k = np.divmod(best, grid.uz.size)
+    ux = _refine(maps, det, i, k, grid.ux, 1)
+    uz = _refine(maps, det, i, k, grid.uz, 2) if grid.uz.size > 1 else np.zeros(det.size)
+    return det.astype(np.int64), ux, uz, flat[det, best]
 
 
 def tdm_compensation(
