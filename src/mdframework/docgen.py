@@ -18,7 +18,7 @@ from pydantic.fields import FieldInfo
 from pydantic_core import PydanticUndefined
 
 from .plugins import Registry, default_registry
-from .settings import RunConfigBase
+from .settings import RunConfigBase, SanityConfig
 
 RUN_PLUGIN_SECTIONS = {
     "motion": ("motion", "`[motion]`: the motion source"),
@@ -54,13 +54,14 @@ def _submodel(annotation: Any) -> type[BaseModel] | None:
     return None
 
 
-def _default(field: FieldInfo, section: str) -> str:
+def _default(field: FieldInfo, target: str) -> str:
+    """The default as Markdown; a section made by its model's defaults points to ``target``."""
     if field.default is PydanticUndefined:
         factory = field.default_factory
         if factory is None:
             return "**required**"
         if isinstance(factory, type) and issubclass(factory, BaseModel):
-            return f"see `[{section}]`"
+            return f"see `[{target}]`"
         value = factory()  # type: ignore[call-arg]
         return f"`{value!r}`".replace("(", "[").replace(")", "]")
     if isinstance(field.default, str):
@@ -68,9 +69,16 @@ def _default(field: FieldInfo, section: str) -> str:
     return f"`{field.default!r}`".replace("(", "[").replace(")", "]")
 
 
-def model_table(model: type[BaseModel], skip: tuple[str, ...] = (), prefix: str = "") -> str:
+def model_table(
+    model: type[BaseModel],
+    skip: tuple[str, ...] = (),
+    prefix: str = "",
+    seen: dict[type[BaseModel], str] | None = None,
+) -> str:
     """A Markdown table of a model's fields: name, type, default, description. ``prefix`` is
-    the model's own section (``scene``), used to name nested sections."""
+    the model's own section (``scene``), used to name nested sections; ``seen`` maps a model
+    already documented to its section."""
+    seen = seen or {}
     rows = ["| field | type | default | description |", "|---|---|---|---|"]
     for name, field in model.model_fields.items():
         if name in skip:
@@ -79,24 +87,37 @@ def model_table(model: type[BaseModel], skip: tuple[str, ...] = (), prefix: str 
         desc = field.description or (_summary(sub) if sub is not None else "")
         desc = desc.replace("|", "\\|").replace("\n", " ")
         typ = _type_name(field.annotation).replace("|", "\\|")
-        section = f"{prefix}.{name}" if prefix else name
-        rows.append(f"| `{name}` | `{typ}` | {_default(field, section)} | {desc} |")
+        own = f"{prefix}.{name}" if prefix else name
+        target = seen.get(sub, own) if sub is not None else own
+        if target != own:
+            desc += f" Fields: see `[{target}]`."
+        rows.append(f"| `{name}` | `{typ}` | {_default(field, target)} | {desc} |")
     return "\n".join(rows)
 
 
 def model_sections(
-    model: type[BaseModel], section: str, level: int, skip: tuple[str, ...] = ()
+    model: type[BaseModel],
+    section: str,
+    level: int,
+    skip: tuple[str, ...] = (),
+    seen: dict[type[BaseModel], str] | None = None,
 ) -> list[str]:
-    """The model's table, then one subsection per field that holds a model (recursively)."""
-    out = [model_table(model, skip, section), ""]
+    """The model's table, then one subsection per model a field holds (recursively); a model
+    is documented once, where it first appears, and later fields point there."""
+    seen = {} if seen is None else seen
+    subs = []
     for name, field in model.model_fields.items():
         sub = _submodel(field.annotation)
-        if name in skip or sub is None:
+        if name in skip or sub is None or sub in seen:
             continue
         path = f"{section}.{name}" if section else name
-        brackets = f"[[{path}]]" if get_origin(field.annotation) is list else f"[{path}]"
-        out += [f"{'#' * level} `{brackets}`", "", _summary(sub), ""]
-        out += model_sections(sub, path, level + 1)
+        seen[sub] = path
+        subs.append((path, get_origin(field.annotation) is list, sub))
+    out = [model_table(model, skip, section, seen), ""]
+    for path, is_list, sub in subs:
+        out += [f"{'#' * level} `{f'[[{path}]]' if is_list else f'[{path}]'}`", ""]
+        out += [_summary(sub), ""]
+        out += model_sections(sub, path, level + 1, seen=seen)
     return out
 
 
@@ -105,7 +126,7 @@ def _summary(model: type[BaseModel]) -> str:
     return re.sub(r":\w+:`~?([^`]+)`", r"`\1`", " ".join((model.__doc__ or "").split()))
 
 
-def _plugin_sections(reg: Registry, interface: str, title: str) -> list[str]:
+def _plugin_sections(reg: Registry, interface: str, title: str, section: str = "") -> list[str]:
     names = reg.names(interface)
     if not names:
         return []
@@ -114,7 +135,17 @@ def _plugin_sections(reg: Registry, interface: str, title: str) -> list[str]:
         info = reg.plugins[interface][name]
         doc = (info.cls.__doc__ or "").strip().splitlines()[0]
         out += [f"### kind = `{name}` ({info.provider.split()[0]})", "", doc, ""]
-        out += [model_table(info.cls.Config, skip=("kind",)), ""]
+        out += [model_table(info.cls.Config, skip=("kind",), prefix=section), ""]
+    if interface == "motion":
+        out += [
+            "### `[motion.sanity]` (every motion source)",
+            "",
+            "Motion sanity checks, run on every human motion after loading; see "
+            "[motion formats and sanity checks](motion-formats.md).",
+            "",
+            model_table(SanityConfig, prefix="motion.sanity"),
+            "",
+        ]
     return out
 
 
@@ -155,10 +186,13 @@ def render(registry: Registry | None = None) -> str:
         if sub is not None:
             out += [f"### `[{name}]`", "", _summary(sub), ""]
             out += model_sections(sub, name, 4)
-    for interface, (_, title) in RUN_PLUGIN_SECTIONS.items():
-        out += _plugin_sections(reg, interface, title)
+    for interface, (section, title) in RUN_PLUGIN_SECTIONS.items():
+        out += _plugin_sections(reg, interface, title, section)
     out += ["## Dataset configs", "", _summary(DatasetConfig), ""]
     out += model_sections(DatasetConfig, "", 3)
+    out += _plugin_sections(
+        reg, "recording", "`recording` of a dataset source: readers of real radar recordings"
+    )
     out += ["## Experiment configs", "", _summary(ExperimentConfig), ""]
     out += model_sections(ExperimentConfig, "", 3)
     out += _plugin_sections(reg, "classifier", "`[classifier]` of experiment configs: classifiers")
