@@ -17,11 +17,13 @@ from .interfaces import (
     Motion,
     MotionSource,
     PluginConfig,
+    PulseBlock,
     RadarWaveform,
     Received,
     ScattererModel,
     Scatterers,
     SceneContext,
+    receive_points,
 )
 from .settings import DataPath, MotionConfig
 from .skeleton import CANONICAL_JOINTS, CANONICAL_SEGMENTS, Skeleton, to_canonical
@@ -41,6 +43,7 @@ __all__ = [
     "MotionConfig",
     "MotionSource",
     "PluginConfig",
+    "PulseBlock",
     "RadarWaveform",
     "Received",
     "ScattererModel",
@@ -49,5 +52,6 @@ __all__ = [
     "SceneError",
     "Skeleton",
     "hookimpl",
+    "receive_points",
     "to_canonical",
 ]
