@@ -25,15 +25,16 @@ from typing import Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from mdframework import PluginConfig, PulseBlock, RadarWaveform, Received
+from mdframework import PulseBlock, RadarWaveform, Received
 from mdframework.constants import SPEED_OF_LIGHT
 from mdframework.physics import radar
+from mdframework.settings import RadarPowerConfig
 
 #: Pulses per block on the raw path (bounds memory to ~ block x n_fast complex samples).
 RAW_BLOCK = 1024
 
 
-class LfmConfig(PluginConfig):
+class LfmConfig(RadarPowerConfig):
     """LFM pulse-Doppler radar. Defaults: the paper's radar (15 GHz, 150 MHz, PRF 2400 Hz)."""
 
     kind: Literal["lfm"] = "lfm"
@@ -41,10 +42,6 @@ class LfmConfig(PluginConfig):
     bandwidth: float = Field(150e6, gt=0, description="Chirp bandwidth [Hz].")
     prf: float = Field(2400.0, gt=0, description="Pulse repetition frequency [Hz].")
     pulse_width: float = Field(1e-6, gt=0, description="Pulse length tau [s].")
-    transmit_power: float = Field(1.0, gt=0, description="Peak transmit power [W].")
-    gain_dbi: float = Field(0.0, description="Antenna gain (transmit = receive) [dBi].")
-    system_loss_db: float = Field(0.0, ge=0, description="System loss L_s [dB].")
-    atmospheric_loss_db: float = Field(0.0, ge=0, description="Atmospheric loss L_a [dB].")
     path: Literal["analytic", "raw"] = Field(
         "analytic", description="analytic: closed-form compressed return; raw: sampled chirps."
     )
@@ -93,17 +90,9 @@ class LfmPulseDoppler(RadarWaveform):
         return self.config.prf
 
     def amplitudes(self, ranges: np.ndarray, rcs: np.ndarray) -> np.ndarray:
-        """Range-equation amplitudes [sqrt(W)], same shape as ``ranges``."""
-        c = self.config
-        return radar.range_equation_amplitude(
-            rcs,
-            ranges,
-            wavelength=radar.wavelength(c.carrier_frequency),
-            transmit_power=c.transmit_power,
-            gain=10.0 ** (c.gain_dbi / 10.0),
-            system_loss=10.0 ** (c.system_loss_db / 10.0),
-            atmospheric_loss=10.0 ** (c.atmospheric_loss_db / 10.0),
-        )
+        """Scatterer amplitudes [sqrt(W)] (range equation or sqrt(rcs), ``amplitude``), same
+        shape as ``ranges``."""
+        return self.config.amplitudes(rcs, ranges, radar.wavelength(self.config.carrier_frequency))
 
     def start_record(self, times: np.ndarray, range_span: tuple[float, float]) -> None:
         """Fix the raw path's range-time window for the record: the joints' range span plus
@@ -125,7 +114,7 @@ class LfmPulseDoppler(RadarWaveform):
     ) -> np.ndarray:
         """Eq. (4) in one pass: ``y(n) = sum_i a_i w_i exp(-j 4 pi f_c R_i / c)``, with the
         carrier phase reduced to a fraction of a cycle in float64 from float64 ranges and the
-        rest (range-equation amplitude, gate weight, phasor, sum) in ``precision``."""
+        rest (amplitude by the ``amplitude`` model, gate weight, phasor, sum) in ``precision``."""
         c = self.config
         real = np.float32 if c.precision == "float32" else np.float64
         if not np.all(ranges > 0):
@@ -134,15 +123,16 @@ class LfmPulseDoppler(RadarWaveform):
         cycles -= np.floor(cycles)  # the fraction of a cycle, in float64
         phase = cycles.astype(real, copy=False)
         phase *= real(-2.0 * np.pi)
-        lam = radar.wavelength(c.carrier_frequency)
-        gain = 10.0 ** (c.gain_dbi / 10.0)
-        loss = 10.0 ** ((c.system_loss_db + c.atmospheric_loss_db) / 10.0)
-        k = c.transmit_power * gain**2 * lam**2 / ((4.0 * np.pi) ** 3 * loss)
-        r = ranges.astype(real, copy=False)
         amp = rcs.astype(real)  # a copy: amplitudes are built in place
-        amp *= real(k)
+        if c.amplitude == "range_equation":
+            lam = radar.wavelength(c.carrier_frequency)
+            gain = 10.0 ** (c.gain_dbi / 10.0)
+            loss = 10.0 ** ((c.system_loss_db + c.atmospheric_loss_db) / 10.0)
+            amp *= real(c.transmit_power * gain**2 * lam**2 / ((4.0 * np.pi) ** 3 * loss))
         np.sqrt(amp, out=amp)
-        amp /= r * r
+        r = ranges.astype(real, copy=False)
+        if c.amplitude == "range_equation":
+            amp /= r * r
         if c.gate_response != "phase_only":
             amp *= self._gate_weights(r, gate_range.astype(real, copy=False), real)
         out = np.empty(ranges.shape[0], dtype=np.complex128)
