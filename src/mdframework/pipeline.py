@@ -245,6 +245,7 @@ def simulate_motion(
                 window_length=proc.window_length,
                 hop=proc.hop,
                 nfft=proc.nfft,
+                precision=proc.precision,
             )
         except RecordTooShortError as exc:
             raise SceneError(f"processing.window_length: {exc}") from None

@@ -165,6 +165,11 @@ class ProcessingConfig(StrictModel):
     hop: int = Field(32, ge=1, description="STFT hop [pulses].")
     nfft: int = Field(1024, ge=2, description="FFT size (>= window_length).")
     floor_db: float = Field(-60.0, lt=0, description="Spectrogram floor, dB below its peak.")
+    precision: Literal["float32", "float64"] = Field(
+        "float32",
+        description="STFT arithmetic: float32 (complex64 FFTs and float32 power, the default: "
+        "the accuracy ladder measures its cost at under 0.001 dB) or float64.",
+    )
     block_pulses: int = Field(
         4096,
         ge=16,
