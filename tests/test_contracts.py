@@ -18,6 +18,7 @@ from mdframework.testing import (
     check_effect_class,
     check_motion_source,
     check_plugin_class,
+    check_recording_source,
     check_scatterer_model,
     check_waveform,
 )
@@ -28,6 +29,7 @@ ALL = [(i, n) for i in INTERFACES for n in REGISTRY.names(i)]
 #: an example config that uses each motion source (every source must have one)
 SOURCE_EXAMPLES = {
     "boulic": "boulic_walk.toml",
+    "bvh": "bvh_mixamo.toml",
     "cmu": "cmu_walk.toml",
     "kinect": "kinect_utkinect_walk.toml",
     "point_targets": "point_target.toml",
@@ -48,6 +50,19 @@ def test_motion_source_contract(name: str) -> None:
     assert name in SOURCE_EXAMPLES, f"add an example using the {name!r} source"
     config = load_run_config(EXAMPLES / SOURCE_EXAMPLES[name])
     check_motion_source(build_stages(config).source)
+
+
+#: a recording each recording source reads in its contract check
+RECORDING_EXAMPLES = {"radhar": {"file": "data/radhar/radhar_walk_subset.npz"}}
+
+
+@pytest.mark.parametrize("name", REGISTRY.names("recording"))
+def test_recording_source_contract(name: str) -> None:
+    assert name in RECORDING_EXAMPLES, f"add an example recording for the {name!r} source"
+    cls: Any = REGISTRY.get("recording", name)
+    section = {"kind": name, **RECORDING_EXAMPLES[name]}
+    config = cls.Config.model_validate(section, context={"base_dir": EXAMPLES})
+    check_recording_source(cls(config))
 
 
 @pytest.fixture(scope="module")

@@ -7,6 +7,11 @@
   labelled as such.
 - **Cross-source**: train on one group (e.g. Kinect-derived records), test on another (e.g.
   CMU-derived) over the classes they share, after an optional label map (``jog -> run``).
+- **Inputs**: the seven features (``input = "features"``), or, for datasets of per-frame Doppler
+  histograms (real radar recordings, simulated point clouds), the window's histogram vector
+  (``input = "histogram"``, :func:`mdframework.pointcloud.histogram_vector`). Trained on a
+  simulated group and tested on a real one (``cross_source``), the within-source result of the
+  real group on the same input and classifier is the real-to-real reference in the same report.
 - **Feature statistics**: mean and variance of every feature per group and label (like Table 2),
   and scatter plots of feature pairs (like Figure 12).
 
@@ -20,7 +25,7 @@ from __future__ import annotations
 import csv
 import io
 import json
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -42,6 +47,7 @@ from .errors import ConfigError, MdfError
 from .features import FEATURE_NAMES
 from .interfaces import Classifier
 from .plugins import Registry, default_registry
+from .pointcloud import histogram_vector, histogram_vector_names, velocity_bins
 from .settings import StrictModel
 
 
@@ -78,11 +84,21 @@ class EvaluationConfig(StrictModel):
 
     repeats: int = Field(10, ge=1, description="Number of random splits.")
     test_fraction: float = Field(0.4, gt=0, lt=1, description="Test share (the paper: 40 %).")
-    split: Literal["record", "recording"] = Field(
+    split: Literal["record", "recording", "groups"] = Field(
         "record",
         description="record: records are split at random (windows of one recording can land "
         "on both sides, which flatters the score); recording: whole recordings (source files) "
-        "are held out, per class.",
+        "are held out, per class; groups: cross-validation that holds out whole values of the "
+        "column `by` (e.g. leave-subjects-out).",
+    )
+    by: Literal["subject", "recording", "source", "dataset", "group", "file"] = Field(
+        "subject", description="split = 'groups': the record column whose values are held out."
+    )
+    folds: int | None = Field(
+        None,
+        ge=2,
+        description="split = 'groups': number of folds (GroupKFold); default: one fold per "
+        "value (leave-one-out).",
     )
 
 
@@ -91,6 +107,23 @@ class CrossSourceConfig(StrictModel):
 
     train: str = Field(description="Group used for training (e.g. 'kinect').")
     test: str = Field(description="Group used for testing (e.g. 'cmu').")
+    label_map: dict[str, str] = Field(
+        default_factory=dict, description="Rename labels before matching (e.g. jog = 'run')."
+    )
+
+
+Selector = dict[str, str | list[str]]
+
+
+class TrainTestConfig(StrictModel):
+    """Train on one selection of records and test on another, selected by any record column
+    (subject, recording, source, dataset, group, file, label)."""
+
+    train: Selector = Field(
+        description="Column -> value or list of values, e.g. {source = 'kinect'}; a record is "
+        "selected when it matches every column."
+    )
+    test: Selector = Field(description="The same for the test records, e.g. {source = 'cmu'}.")
     label_map: dict[str, str] = Field(
         default_factory=dict, description="Rename labels before matching (e.g. jog = 'run')."
     )
@@ -110,12 +143,20 @@ class ExperimentConfig(StrictModel):
 
     seed: int = Field(0, ge=0)
     dataset: DatasetRef
+    input: Literal["features", "histogram"] = Field(
+        "features",
+        description="Classifier input: the seven features, or the per-frame Doppler histogram "
+        "vector (histogram datasets only; feature selection must then be 'none').",
+    )
     classifier: dict[str, Any] = Field(
         default_factory=lambda: {"kind": "knn"}, description="A [classifier] section."
     )
     selection: SelectionConfig = Field(default_factory=SelectionConfig)
     evaluation: EvaluationConfig = Field(default_factory=EvaluationConfig)
     cross_source: CrossSourceConfig | None = None
+    train_test: TrainTestConfig | None = Field(
+        None, description="Train on one selection of records, test on another."
+    )
     report: ReportConfig = Field(default_factory=ReportConfig)
     workers: int | None = Field(None, ge=1, description="Processes for building the dataset.")
 
@@ -134,6 +175,8 @@ def load_experiment_config(path: str | Path) -> ExperimentConfig:
         cfg = ExperimentConfig.model_validate(data)
     except ValidationError as exc:
         raise ConfigError(format_validation_error(exc, str(p), data)) from None
+    if cfg.input == "histogram" and cfg.selection.method != "none":
+        raise ConfigError(f"{p}: input = 'histogram' needs selection.method = 'none'")
     for pair in cfg.report.scatter_pairs:
         for name in pair:
             if name not in FEATURE_NAMES:
@@ -208,18 +251,102 @@ def recording_splits(
     return splits
 
 
+def group_splits(
+    groups: NDArray[Any], folds: int | None
+) -> list[tuple[NDArray[np.intp], NDArray[np.intp]]]:
+    """Cross-validation splits that hold out whole groups (e.g. subjects): one fold per group
+    (leave-one-group-out) or ``folds`` folds of whole groups (GroupKFold)."""
+    from sklearn.model_selection import GroupKFold, LeaveOneGroupOut
+
+    values = sorted(set(groups.tolist()))
+    if len(values) < 2:
+        raise MdfError(f"split = 'groups' needs two or more groups, have {values}")
+    if folds is not None and folds > len(values):
+        raise MdfError(f"evaluation.folds = {folds} exceeds the {len(values)} groups {values}")
+    splitter = LeaveOneGroupOut() if folds is None else GroupKFold(n_splits=folds)
+    x = np.zeros((groups.shape[0], 1))
+    return [(tr, te) for tr, te in splitter.split(x, groups=groups)]
+
+
+def select(table: dict[str, NDArray[Any]], selector: Selector, name: str) -> NDArray[np.bool_]:
+    """Records matching every column of a selector (value or list of values)."""
+    n = len(next(iter(table.values())))
+    mask = np.ones(n, dtype=bool)
+    for column, wanted in selector.items():
+        if column not in table:
+            raise MdfError(
+                f"{name}: the dataset has no column {column!r} (have {', '.join(table)}); "
+                "rebuild it to get subject, recording and dataset columns"
+            )
+        values = [wanted] if isinstance(wanted, str) else list(wanted)
+        col = np.array([_text(v) for v in table[column]])
+        mask &= np.isin(col, [str(v) for v in values])
+    return mask
+
+
+def _text(value: Any) -> str:
+    """A table cell as text (numbers that are whole print without '.0')."""
+    if isinstance(value, float | np.floating) and float(value).is_integer():
+        return str(int(value))
+    return str(value)
+
+
+def train_test(
+    cfg: ExperimentConfig,
+    factory: Callable[[], Classifier],
+    data: Dataset,
+    x: NDArray[np.float64] | None = None,
+    names: Sequence[str] = FEATURE_NAMES,
+) -> dict[str, Any]:
+    """Train on one selection of records and test on another, over the shared (mapped)
+    classes; records in both selections are an error. ``x``: the classifier input
+    (n_records, n_columns) named by ``names``; default: the seven features."""
+    tt = cfg.train_test
+    assert tt is not None
+    labels = np.array([tt.label_map.get(lab, lab) for lab in data.labels])
+    train = select(data.table, tt.train, "train_test.train")
+    test = select(data.table, tt.test, "train_test.test")
+    for name, mask in (("train", train), ("test", test)):
+        if not np.any(mask):
+            raise MdfError(f"train_test.{name}: no record matches {getattr(tt, name)}")
+    if np.any(train & test):
+        raise MdfError(f"train_test: {int(np.sum(train & test))} records are in both selections")
+    shared = sorted(set(labels[train].tolist()) & set(labels[test].tolist()))
+    if len(shared) < 2:
+        raise MdfError(f"train_test: the selections share fewer than two classes ({shared})")
+    train &= np.isin(labels, shared)
+    test &= np.isin(labels, shared)
+    x, y = (data.features if x is None else x), labels
+    sel = _select(cfg, factory, x[train], y[train], cfg.seed)
+    pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
+    return {
+        "classes": shared,
+        "confusion": confusion_matrix(y[test], pred, shared),
+        "balanced_accuracy": balanced_accuracy(y[test], pred),
+        "subset": [names[i] for i in sel.subset],
+        "train_counts": {c: int(np.sum(y[train] == c)) for c in shared},
+        "test_counts": {c: int(np.sum(y[test] == c)) for c in shared},
+    }
+
+
 def within_source(
     cfg: ExperimentConfig,
     factory: Callable[[], Classifier],
     x: NDArray[np.float64],
     y: NDArray[Any],
     recordings: NDArray[Any] | None = None,
+    names: Sequence[str] = FEATURE_NAMES,
 ) -> dict[str, Any]:
     """Repeated stratified splits of one group's records; returns matrices and scores.
-    ``recordings`` (n_records,) names each record's source file (for ``split = 'recording'``)."""
+    ``recordings`` (n_records,) names each record's source file (for ``split = 'recording'``);
+    ``names`` the columns of ``x``."""
     classes = sorted(set(y.tolist()))
     ev = cfg.evaluation
-    if ev.split == "recording":
+    if ev.split == "groups":
+        if recordings is None:
+            raise MdfError(f"evaluation.split = 'groups' needs each record's {ev.by}")
+        splits = group_splits(recordings, ev.folds)
+    elif ev.split == "recording":
         if recordings is None:
             raise MdfError("evaluation.split = 'recording' needs each record's recording")
         splits = recording_splits(y, recordings, ev.repeats, ev.test_fraction, cfg.seed)
@@ -234,7 +361,7 @@ def within_source(
         pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
         mats.append(confusion_matrix(y[test], pred, classes))
         accs.append(balanced_accuracy(y[test], pred))
-        subsets.append([FEATURE_NAMES[i] for i in sel.subset])
+        subsets.append([names[i] for i in sel.subset])
         if cfg.selection.optimistic and cfg.selection.method == "wrapper":
             opt = optimistic_select(
                 x[train], y[train], x[test], y[test], factory, sizes=cfg.selection.sizes
@@ -255,9 +382,14 @@ def within_source(
 
 
 def cross_source(
-    cfg: ExperimentConfig, factory: Callable[[], Classifier], data: Dataset
+    cfg: ExperimentConfig,
+    factory: Callable[[], Classifier],
+    data: Dataset,
+    x: NDArray[np.float64] | None = None,
+    names: Sequence[str] = FEATURE_NAMES,
 ) -> dict[str, Any]:
-    """Train on one group, test on another, over the shared (mapped) classes."""
+    """Train on one group, test on another, over the shared (mapped) classes. ``x``: the
+    classifier input (n_records, n_columns) named by ``names``; default: the seven features."""
     cs = cfg.cross_source
     assert cs is not None
     labels = np.array([cs.label_map.get(lab, lab) for lab in data.labels])
@@ -272,14 +404,14 @@ def cross_source(
         raise MdfError(f"cross_source: the groups share fewer than two classes ({shared})")
     train &= np.isin(labels, shared)
     test &= np.isin(labels, shared)
-    x, y = data.features, labels
+    x, y = (data.features if x is None else x), labels
     sel = _select(cfg, factory, x[train], y[train], cfg.seed)
     pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
     return {
         "classes": shared,
         "confusion": confusion_matrix(y[test], pred, shared),
         "balanced_accuracy": balanced_accuracy(y[test], pred),
-        "subset": [FEATURE_NAMES[i] for i in sel.subset],
+        "subset": [names[i] for i in sel.subset],
         "train_counts": {c: int(np.sum(y[train] == c)) for c in shared},
         "test_counts": {c: int(np.sum(y[test] == c)) for c in shared},
     }
@@ -327,6 +459,32 @@ def _stats_markdown(rows: list[dict[str, Any]]) -> str:
     return "mean (variance)\n\n" + "\n".join(lines) + "\n"
 
 
+def classifier_inputs(
+    cfg: ExperimentConfig, data_dir: Path
+) -> tuple[Dataset, NDArray[np.float64], list[str]]:
+    """The dataset, the classifier input (n_records, n_columns) and the columns' names."""
+    if cfg.input == "features":
+        data = load_dataset(data_dir, spectrograms=False)
+        return data, data.features, list(FEATURE_NAMES)
+    data = load_dataset(data_dir, spectrograms=False, histograms=True)
+    hists = data.histograms or []
+    missing = [str(data.table["id"][i]) for i, h in enumerate(hists) if h is None]
+    if missing:
+        raise MdfError(
+            f"input = 'histogram': record {missing[0]} has no histograms (build simulated "
+            "records with representation = 'histogram')"
+        )
+    widths = {h.shape[1] for h in hists if h is not None}
+    if len(widths) != 1:
+        raise MdfError(f"input = 'histogram': records have different bin counts {widths}")
+    x = np.stack([histogram_vector(h.astype(np.float64)) for h in hists if h is not None])
+    assert data.velocity is not None
+    n_bins = widths.pop()
+    width = float(data.velocity[1] - data.velocity[0]) if n_bins > 1 else 1.0
+    centres, _ = velocity_bins(width, n_bins)
+    return data, x, list(histogram_vector_names(centres))
+
+
 def run_experiment(
     cfg: ExperimentConfig,
     out_dir: Path,
@@ -348,7 +506,7 @@ def run_experiment(
     else:
         assert cfg.dataset.path is not None
         data_dir = cfg.dataset.path
-    data = load_dataset(data_dir, spectrograms=False)
+    data, x_all, names = classifier_inputs(cfg, data_dir)
 
     summary: dict[str, Any] = {
         "dataset": str(data_dir),
@@ -360,7 +518,7 @@ def run_experiment(
         "# Experiment report",
         "",
         f"Dataset: `{data_dir}` ({len(data.labels)} records).",
-        f"Classifier: `{json.dumps(cfg.classifier)}`; selection: "
+        f"Input: {cfg.input}. Classifier: `{json.dumps(cfg.classifier)}`; selection: "
         f"{cfg.selection.method} (sizes {cfg.selection.sizes}); "
         f"{cfg.evaluation.repeats} stratified splits by {cfg.evaluation.split}, "
         f"{round(100 * (1 - cfg.evaluation.test_fraction))}/"
@@ -371,9 +529,19 @@ def run_experiment(
         mask = data.groups == group
         if len(set(data.labels[mask].tolist())) < 2:
             continue
+        column = cfg.evaluation.by if cfg.evaluation.split == "groups" else "file"
+        if column not in data.table:
+            raise MdfError(
+                f"evaluation.by = {column!r}: the dataset has no such column; rebuild it"
+            )
         try:
             res = within_source(
-                cfg, factory, data.features[mask], data.labels[mask], data.table["file"][mask]
+                cfg,
+                factory,
+                x_all[mask],
+                data.labels[mask],
+                np.array([_text(v) for v in data.table[column][mask]]),
+                names,
             )
         except MdfError as exc:  # e.g. a class with a single recording cannot be held out
             report += [f"## Within-source: {group}", "", f"Not evaluated: {exc}.", ""]
@@ -430,7 +598,7 @@ def run_experiment(
             ]
         report += [f"![confusion]({stem}_confusion.png)", ""]
     if cfg.cross_source is not None:
-        res = cross_source(cfg, factory, data)
+        res = cross_source(cfg, factory, data, x_all, names)
         (out / "cross_confusion.csv").write_text(
             _csv(_matrix_rows(res["classes"], res["confusion"]))
         )
@@ -445,12 +613,40 @@ def run_experiment(
         report += [
             f"## Cross-source: train {cfg.cross_source.train}, test {cfg.cross_source.test}",
             "",
+            f"Balanced accuracy {res['balanced_accuracy']:.3f}; inputs {res['subset']}; "
+            f"training {res['train_counts']}, test {res['test_counts']}.",
+            "",
+            "Per-class rates (test records of each class classified correctly): "
+            + ", ".join(f"{c} {res['confusion'][i, i]:.2f}" for i, c in enumerate(res["classes"]))
+            + ".",
+            "",
+            _markdown_matrix(res["classes"], res["confusion"], None),
+            "",
+            "![cross](cross_confusion.png)",
+            "",
+        ]
+    if cfg.train_test is not None:
+        res = train_test(cfg, factory, data, x_all, names)
+        (out / "train_test_confusion.csv").write_text(
+            _csv(_matrix_rows(res["classes"], res["confusion"]))
+        )
+        plot_confusion(
+            out / "train_test_confusion.png",
+            res["classes"],
+            res["confusion"],
+            None,
+            title=f"train {cfg.train_test.train} -> test {cfg.train_test.test}",
+        )
+        summary["train_test"] = {**res, "confusion": res["confusion"].tolist()}
+        report += [
+            f"## Train on {cfg.train_test.train}, test on {cfg.train_test.test}",
+            "",
             f"Balanced accuracy {res['balanced_accuracy']:.3f}; features {res['subset']}; "
             f"training {res['train_counts']}, test {res['test_counts']}.",
             "",
             _markdown_matrix(res["classes"], res["confusion"], None),
             "",
-            "![cross](cross_confusion.png)",
+            "![train/test](train_test_confusion.png)",
             "",
         ]
     stats = feature_statistics(data)

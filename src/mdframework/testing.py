@@ -24,7 +24,9 @@ from .interfaces import (
     MotionSource,
     Plugin,
     PulseBlock,
+    RadarRecordingSource,
     RadarWaveform,
+    Recording,
     ScattererModel,
     Scatterers,
     SceneContext,
@@ -169,3 +171,21 @@ def check_block_invariance(
     assert np.max(np.abs(sig_one - sig_many)) <= 1e-9 * scale, (
         "received signal differs between one block and many: the waveform is not block-invariant"
     )
+
+
+def check_recording_source(source: RadarRecordingSource) -> list[Recording]:
+    """``load()`` gives named recordings with consistent point clouds: unique names, frame
+    indices within the recording, finite positions and velocities, a positive frame period and
+    JSON metadata."""
+    recordings = source.load()
+    assert recordings, "load() must return at least one recording"
+    names = [r.name for r in recordings]
+    assert len(set(names)) == len(names), "recording names must be unique"
+    for rec in recordings:
+        assert isinstance(rec, Recording), "load() must return Recording objects"
+        cloud = rec.cloud
+        assert cloud.n_frames >= 1 and cloud.frame_period > 0
+        assert np.all(np.isfinite(cloud.positions)) and np.all(np.isfinite(cloud.velocity))
+        assert np.all(np.diff(cloud.frame) >= 0), "points must be in frame order"
+        json.dumps(dict(rec.metadata))
+    return recordings
