@@ -213,17 +213,35 @@ def test_every_hook_is_documented_in_the_plugin_guide() -> None:
         assert name in guide, f"{name} missing from docs/plugins.md"
 
 
+OUTSIDE = ("physics.md", "../shared", "/work/", "reference material")
+
+
 def test_docs_stand_alone() -> None:
     """No reference to material outside the repository, and every relative link resolves."""
     link = re.compile(r"\]\(([^)#\s]+)(?:#[^)]*)?\)")
     for path in DOCS:
         text = path.read_text()
-        for banned in ("physics.md", "../shared", "/work/", "reference material"):
+        for banned in OUTSIDE:
             assert banned not in text, f"{path.relative_to(ROOT)} mentions {banned!r}"
         for target in link.findall(text):
             if "://" in target:
                 continue
             assert (path.parent / target).exists(), f"{path.relative_to(ROOT)}: {target}"
+
+
+def test_code_and_examples_cite_nothing_outside_the_repository() -> None:
+    """The API reference is made from the docstrings, and examples are read as documentation."""
+    files = [
+        *(ROOT / "src").rglob("*.py"),
+        *(ROOT / "plugins").rglob("*.py"),
+        *(ROOT / "examples").rglob("*.toml"),
+        *(ROOT / "examples").rglob("*.md"),
+    ]
+    assert len(files) > 50
+    for path in files:
+        text = path.read_text()
+        for banned in OUTSIDE:
+            assert banned not in text, f"{path.relative_to(ROOT)} mentions {banned!r}"
 
 
 def test_readme_quick_start() -> None:

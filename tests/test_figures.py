@@ -90,3 +90,12 @@ def test_unknown_colormap_is_a_config_error() -> None:
         validate_run_config({**data, "figures": {"colormap": "jett"}})
     with pytest.raises(ConfigError, match=r"figures\.dynamic_range_db"):
         validate_run_config({**data, "figures": {"dynamic_range_db": 0}})
+
+
+def test_auto_span_of_the_cmu_walk() -> None:
+    """docs/figures.md: a walker toward a 15 GHz radar at PRF 2400 Hz uses about -1.5..5 m/s of
+    the unambiguous -12..12 m/s, and the auto axis shows just that."""
+    result = simulate(load_run_config(EXAMPLES / "cmu_walk.toml"))
+    lo, hi = velocity_limits(result.spectrogram_db, result.velocity, "auto", 40.0)
+    assert result.metadata["max_unambiguous_velocity_mps"] == pytest.approx(12.0, abs=0.05)
+    assert -2.0 < lo < -1.0 and 4.5 < hi < 5.5

@@ -132,3 +132,50 @@ def test_mp4_through_the_shipped_ffmpeg(tmp_path: Path) -> None:
     assert "h264" in probe.stderr and "10 fps" in probe.stderr
     frames, _ = imageio_ffmpeg.count_frames_and_secs(str(tmp_path / "m.mp4"))
     assert frames == n == 6
+
+
+def test_mdf_show_writes_the_run_and_its_preview(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`mdf show` on a 1 s CMU walk: the run's files plus an animation whose frames step through
+    the record at --fps, and stills at the asked instants; the joints are in result.npz."""
+    import json
+    import tomllib
+
+    from conftest import EXAMPLES
+
+    from mdframework import cli
+
+    data = tomllib.loads((EXAMPLES / "cmu_walk.toml").read_text())
+    data["motion"]["file"] = str(EXAMPLES / "data" / "cmu" / "asf-amc" / "02_01.amc")
+    data["motion"]["duration"] = 1.0
+    config = tmp_path / "walk.json"
+    config.write_text(json.dumps(data))
+    out = tmp_path / "out"
+    code = cli.main(["show", str(config), "--out", str(out), "--fps", "5", "--at", "0.2", "0.8"])
+    assert code == 0, capsys.readouterr().err
+    names = {p.name for p in out.iterdir()}
+    assert {"motion.gif", "skeleton.png", "spectrogram.png", "result.npz"} <= names
+    with Image.open(out / "motion.gif") as gif:
+        assert gif.n_frames == 6 and gif.info["duration"] == 200  # 0..1 s at 5 fps
+    with np.load(out / "result.npz") as d:
+        t, joints = d["body_time_s"], d["body_positions_m"]
+        assert t[0] >= 0.0 and t[-1] <= 1.0 + 1e-9
+        assert joints.shape == (t.size, len(CANONICAL_JOINTS), 3)
+        # the placed walker starts at the origin (hip centre) and walks toward the radar at +x
+        base = joints[:, CANONICAL_JOINTS.index("base")]
+        assert np.hypot(*base[0, :2]) < 0.05 and base[-1, 0] > base[0, 0] + 0.5
+
+
+def test_mdf_show_refuses_an_instant_outside_the_record(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from conftest import EXAMPLES
+
+    from mdframework import cli
+
+    out = tmp_path / "out"
+    code = cli.main(["show", str(EXAMPLES / "point_target.toml"), "--out", str(out), "--at", "7"])
+    err = capsys.readouterr().err
+    assert code == 2 and "--at: 7 s is outside the record" in err
+    assert not out.exists()

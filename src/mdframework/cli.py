@@ -49,6 +49,27 @@ def _cmd_run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_show(args: argparse.Namespace) -> int:
+    from .config import load_run_config
+    from .output import write_run
+    from .pipeline import simulate
+    from .preview import check_instants, write_preview
+
+    config = load_run_config(args.config)
+    with _naming(args.config):
+        result = simulate(config)
+    if args.at is not None:
+        check_instants(result.body, args.at)  # before anything is written
+    resolved = json.loads(config.model_dump_json())
+    written = write_run(result, resolved, Path(args.out))
+    written += write_preview(
+        result, resolved, Path(args.out), fmt=args.format, fps=args.fps, instants=args.at
+    )
+    for path in written:
+        print(path)
+    return 0
+
+
 def _cmd_plugins(args: argparse.Namespace) -> int:
     registry = default_registry()
     for interface in INTERFACES:
@@ -101,6 +122,13 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
     return 0
 
 
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"must be a positive integer, got {text}")
+    return value
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``mdf``."""
     parser = argparse.ArgumentParser(
@@ -113,6 +141,24 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("config", help="run config file (.toml, .yaml or .json)")
     run.add_argument("--out", required=True, help="output folder")
     run.set_defaults(func=_cmd_run)
+
+    show = sub.add_parser(
+        "show",
+        help="run a config and preview the motion: the body in the scene beside its spectrogram",
+        description="Run a config (writing what `mdf run` writes) and add motion.gif (or .mp4): "
+        "the scene from above, the body in 3-D and the spectrogram with a time cursor; and "
+        "skeleton.png: the body at chosen instants above the spectrogram.",
+        epilog="example: mdf show examples/cmu_walk.toml --out out/walk --at 0.5 1.0 1.5",
+    )
+    show.add_argument("config", help="run config file (.toml, .yaml or .json)")
+    show.add_argument("--out", required=True, help="output folder")
+    show.add_argument("--format", choices=("gif", "mp4"), default="gif", help="animation format")
+    show.add_argument("--fps", type=_positive_int, default=12, help="animation frames per second")
+    show.add_argument(
+        "--at", type=float, nargs="+", default=None, metavar="T",
+        help="instants of skeleton.png [s from the record's start]; default: five spread over it",
+    )  # fmt: skip
+    show.set_defaults(func=_cmd_show)
 
     dataset = sub.add_parser("dataset", help="labelled datasets of simulated records")
     dataset_sub = dataset.add_subparsers(dest="dataset_command", required=True)

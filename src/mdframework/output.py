@@ -181,17 +181,24 @@ def write_run(result: RunResult, resolved_config: dict[str, Any], out_dir: Path)
         (stage / "metadata.json").write_text(
             json.dumps(result.metadata, indent=2, default=_jsonable) + "\n"
         )
-        out_dir.mkdir(parents=True, exist_ok=True)
-        for name in OUTPUTS:  # an earlier run's file this run does not make (range_time.png)
-            if not (stage / name).exists():
-                (out_dir / name).unlink(missing_ok=True)
-        written = []
-        for f in sorted(stage.iterdir()):
-            os.replace(f, out_dir / f.name)
-            written.append(out_dir / f.name)
-        return written
+        return move_in(stage, out_dir, OUTPUTS)
     finally:
         shutil.rmtree(stage, ignore_errors=True)
+
+
+def move_in(stage: Path, out_dir: Path, names: tuple[str, ...]) -> list[Path]:
+    """Move every file of ``stage`` into ``out_dir`` (each an atomic rename on one file
+    system), first removing the files of ``names`` that ``stage`` lacks (an earlier run's file
+    this run does not make, such as ``range_time.png``). Returns the moved paths."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    for name in names:
+        if not (stage / name).exists():
+            (out_dir / name).unlink(missing_ok=True)
+    written = []
+    for f in sorted(stage.iterdir()):
+        os.replace(f, out_dir / f.name)
+        written.append(out_dir / f.name)
+    return written
 
 
 def _jsonable(value: Any) -> Any:

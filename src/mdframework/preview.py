@@ -19,17 +19,23 @@ matplotlib is imported inside the functions that draw.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import shutil
+import tempfile
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from .errors import MdfError
-from .figures import COLORMAP, DYNAMIC_RANGE_DB, draw_spectrogram, save, style
+from .figures import COLORMAP, DYNAMIC_RANGE_DB, draw_spectrogram, run_caption, save, style
+from .output import move_in
 from .skeleton import CANONICAL_JOINTS, CANONICAL_SEGMENTS, Skeleton
+
+if TYPE_CHECKING:
+    from .pipeline import RunResult
 
 FloatArray = NDArray[np.float64]
 
@@ -80,7 +86,7 @@ def animation_times(body: Skeleton, fps: int) -> FloatArray:
     return np.asarray(body.time[0] + np.arange(n) / fps, dtype=np.float64)
 
 
-def check_instants(body: Skeleton, instants: Sequence[float]) -> FloatArray:
+def check_instants(body: Skeleton, instants: Sequence[float] | FloatArray) -> FloatArray:
     """The instants as an array, each within the body's time span (else :class:`PreviewError`
     naming ``--at`` and the span)."""
     x: FloatArray = np.asarray(list(instants), dtype=np.float64)
@@ -269,7 +275,7 @@ def plot_stills(
     body: Skeleton,
     radar_position: FloatArray,
     spec: SpectrogramView,
-    instants: Sequence[float] | None = None,
+    instants: Sequence[float] | FloatArray | None = None,
     *,
     title: str = "",
     caption: str = "",
@@ -318,3 +324,47 @@ def _ffmpeg() -> str:
             "pip install 'mdframework[video]', or use --format gif"
         ) from None
     return str(imageio_ffmpeg.get_ffmpeg_exe())
+
+
+#: The files :func:`write_preview` adds to a run's folder (the animation's suffix is its format).
+PREVIEW_FILES = ("motion.gif", "motion.mp4", "skeleton.png")
+
+
+def write_preview(
+    result: RunResult,
+    resolved_config: Mapping[str, Any],
+    out_dir: Path,
+    *,
+    fmt: str = "gif",
+    fps: int = 12,
+    instants: Sequence[float] | None = None,
+) -> list[Path]:
+    """Write ``motion.<fmt>`` (:func:`animate`) and ``skeleton.png`` (:func:`plot_stills`) of a
+    run into ``out_dir``: both are made in a temporary folder beside it and moved in only when
+    both succeeded. The body is ``result.body`` (times from the first pulse); the figures carry
+    the run's title and caption and its ``[figures]`` options. Returns the written paths."""
+    if fmt not in FORMATS:
+        raise PreviewError(f"--format: {fmt!r} is not one of {', '.join(FORMATS)}")
+    body = result.body
+    at = None if instants is None else check_instants(body, instants)
+    radar = np.asarray(result.metadata["radar_position_m"], dtype=np.float64)
+    look = dict(resolved_config.get("figures", {}))
+    spec = SpectrogramView(
+        result.spectrogram_db,
+        result.spectrogram.time,
+        result.velocity,
+        dynamic_range_db=float(look.get("dynamic_range_db", DYNAMIC_RANGE_DB)),
+        velocity_span=look.get("velocity_span", "auto"),
+        colormap=str(look.get("colormap", COLORMAP)),
+    )
+    gate = (float(result.gate_range[0]), float(result.gate_range[-1]))
+    title, caption = run_caption(result.metadata, resolved_config, gate)
+    out_dir = Path(out_dir)
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.preview.", dir=out_dir.parent))
+    try:
+        animate(stage / f"motion.{fmt}", body, radar, spec, fps=fps, title=title, caption=caption)
+        plot_stills(stage / "skeleton.png", body, radar, spec, at, title=title, caption=caption)
+        return move_in(stage, out_dir, PREVIEW_FILES)  # drops an animation in the other format
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)

@@ -1,4 +1,4 @@
-"""Body parts as a sphere (head) and spheroids along the segments (``physics.md`` section 2).
+"""Body parts as a sphere (head) and spheroids along the segments.
 
 Each part's RCS follows from its semi-axes (the height-scaled segment table) and the aspect angle
 between its segment and the line of sight to the radar. A segment whose joints coincide (zero

@@ -147,7 +147,7 @@ def _limb_map(hip_centre: str, neck: str) -> dict[str, str]:
     return m
 
 
-#: Canonical joint -> Kinect v1 joint (physics.md 2.3; Spine and both wrists are not used).
+#: Canonical joint -> Kinect v1 joint (Spine and both wrists are not used).
 KINECT_V1_CANONICAL: dict[str, str] = _limb_map("HipCenter", "ShoulderCenter")
 #: Canonical joint -> Kinect v2 joint (SpineShoulder is v1's ShoulderCenter).
 KINECT_V2_CANONICAL: dict[str, str] = _limb_map("SpineBase", "SpineShoulder")

@@ -10,7 +10,7 @@ x = y = 0. Heights are then shifted so that the floor is at z = 0: ``floor = "au
 floor at the 1st percentile of the lowest foot joint, a number gives the floor's Kinect Y [m];
 the sensor's height above the floor (if it was level) is recorded as ``sensor_height_m``.
 
-Canonical body (physics.md 2.3): HipCenter -> base, ShoulderCenter (v2: SpineShoulder) -> neck,
+Canonical body: HipCenter -> base, ShoulderCenter (v2: SpineShoulder) -> neck,
 Head, Shoulder/Elbow/Hand, Hip/Knee/Ankle, Foot -> toe; Spine and both wrists (v2 also the hand
 tips, thumbs, SpineMid and Neck) are not used. NiTE: see :mod:`mdf_kinect.nitefile`.
 

@@ -1,4 +1,4 @@
-"""LFM pulse-Doppler radar (``physics.md`` sections 1.1-1.5).
+"""LFM pulse-Doppler radar.
 
 Two receive paths:
 

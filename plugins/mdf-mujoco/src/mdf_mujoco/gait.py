@@ -1,4 +1,5 @@
-"""Boulic (1990) global walking model as coded by V.C. Chen (``physics.md`` section 3).
+"""Boulic (1990) global walking model as coded by V.C. Chen ("The Micro-Doppler
+Effect in Radar", 2011).
 
 Pure numpy: the gait parameters, the joint-angle and translation trajectories as functions of the
 cycle phase, and a plain evaluation of the kinematic chain with Chen's passive Euler matrices
@@ -91,7 +92,7 @@ def _periodic_pchip(xs: list[float], ys: list[float], phase: FloatArray) -> Floa
 
 @dataclass(frozen=True)
 class Dimensions:
-    """Segment lengths [m] of a walker of height ``height`` [m] (``physics.md`` 2.3)."""
+    """Segment lengths [m] of a walker of height ``height`` [m]."""
 
     height: float
 
