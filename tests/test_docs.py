@@ -7,6 +7,8 @@ from __future__ import annotations
 import inspect
 import re
 import shlex
+import subprocess
+import sys
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -15,7 +17,7 @@ from typing import Any
 import pytest
 from conftest import EXAMPLES, ROOT
 
-from mdframework import cli, hookspecs
+from mdframework import hookspecs
 from mdframework.config import validate_run_config
 from mdframework.docgen import _submodel, render
 from mdframework.settings import RunConfigBase
@@ -88,20 +90,17 @@ def workdir(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 @pytest.mark.parametrize(("where", "command"), COMMANDS, ids=[c for _, c in COMMANDS])
-def test_every_documented_command_runs(
-    where: str, command: str, workdir: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
+def test_every_documented_command_runs(where: str, command: str, workdir: Path) -> None:
+    """Each command in its own process, from the repository root, as a reader runs it."""
     if command in NOT_RUNNABLE:
         pytest.skip(f"{where}: {NOT_RUNNABLE[command]}")
     argv = shlex.split(command)[1:]
     for i, arg in enumerate(argv[:-1]):
         if arg == "--out":  # outputs go to the temporary root, inputs stay as documented
             argv[i + 1] = str(workdir / argv[i + 1])
-    with pytest.MonkeyPatch.context() as mp:
-        mp.chdir(ROOT)
-        code = cli.main(argv)
-    err = capsys.readouterr().err
-    assert code == 0, f"{where}: `{command}` exited {code}: {err}"
+    mdf = [sys.executable, "-m", "mdframework.cli"]
+    done = subprocess.run([*mdf, *argv], cwd=ROOT, capture_output=True, text=True, check=False)
+    assert done.returncode == 0, f"{where}: `{command}` exited {done.returncode}: {done.stderr}"
 
 
 def test_commands_that_cannot_run_here_are_still_documented() -> None:
