@@ -12,7 +12,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
-from sklearn.model_selection import StratifiedKFold
 
 from .interfaces import Classifier
 
@@ -106,6 +105,8 @@ def wrapper_select(
     n_folds = min(int(folds), int(np.unique(y, return_counts=True)[1].min()))
     if n_folds < 2:
         raise ValueError("wrapper selection needs at least two training samples per class")
+    from sklearn.model_selection import StratifiedKFold
+
     splits = list(StratifiedKFold(n_folds, shuffle=True, random_state=seed).split(x, y))
     scores: dict[tuple[int, ...], float] = {}
     for subset in _subsets(x.shape[1], sizes):

@@ -27,7 +27,6 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field, ValidationError, model_validator
-from sklearn.model_selection import StratifiedShuffleSplit
 
 from .classify import (
     Selection,
@@ -133,7 +132,7 @@ def load_experiment_config(path: str | Path) -> ExperimentConfig:
     try:
         cfg = ExperimentConfig.model_validate(data)
     except ValidationError as exc:
-        raise ConfigError(format_validation_error(exc, str(p), data)) from None
+        raise ConfigError(format_validation_error(exc, str(p), data, ExperimentConfig)) from None
     for pair in cfg.report.scatter_pairs:
         for name in pair:
             if name not in FEATURE_NAMES:
@@ -155,7 +154,7 @@ def classifier_factory(
         cfg = cls.Config.model_validate(section)
     except ValidationError as exc:
         raise ConfigError(
-            format_validation_error(exc, source, section).replace(
+            format_validation_error(exc, source, section, cls.Config).replace(
                 f"{source}: ", f"{source}: classifier.", 1
             )
         ) from None
@@ -224,6 +223,8 @@ def within_source(
             raise MdfError("evaluation.split = 'recording' needs each record's recording")
         splits = recording_splits(y, recordings, ev.repeats, ev.test_fraction, cfg.seed)
     else:
+        from sklearn.model_selection import StratifiedShuffleSplit
+
         splitter = StratifiedShuffleSplit(
             n_splits=ev.repeats, test_size=ev.test_fraction, random_state=cfg.seed
         )

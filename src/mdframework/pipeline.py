@@ -81,7 +81,7 @@ def build_stages(config: RunConfigBase, registry: Registry | None = None) -> Sta
         make("motion", cfg.motion),
         make("scatterers", cfg.scatterers),
         make("radar", cfg.radar),
-        tuple(make("effect", e) for e in cfg.effects),
+        tuple(make("effects", e) for e in cfg.effects),
     )
 
 
@@ -214,7 +214,9 @@ def simulate_motion(
     if speed > v_max:
         msg = (
             f"the fastest scatterer moves at {speed:.2f} m/s radially, beyond the unambiguous "
-            f"{v_max:.2f} m/s of PRF {wf.prf:g} Hz: its Doppler aliases"
+            f"{v_max:.2f} m/s of PRF {wf.prf:g} Hz: its Doppler aliases; raise radar.prf to at "
+            f"least {np.ceil(radar.min_prf_for_velocity(speed, wf.carrier_frequency)):.0f} Hz "
+            "(processing.aliasing = 'error' stops such runs)"
         )
         if proc.aliasing == "error":
             raise SceneError(msg)

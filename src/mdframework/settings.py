@@ -125,10 +125,10 @@ class ProcessingConfig(StrictModel):
     @field_validator("window")
     @classmethod
     def _known_window(cls, value: str) -> str:
-        from scipy.signal import get_window
+        from .physics.spectrogram import stft_window
 
         try:
-            get_window(value, 8)
+            stft_window(value, 8)
         except (ValueError, TypeError) as exc:
             raise ValueError(f"unknown window {value!r}: {exc}") from None
         return value

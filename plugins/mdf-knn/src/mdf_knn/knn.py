@@ -17,7 +17,6 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field
-from sklearn.neighbors import NearestNeighbors
 
 from mdframework import Classifier, PluginConfig
 from mdframework.classify import Standardizer
@@ -49,6 +48,8 @@ class Knn(Classifier):
             raise ValueError("features must be (n_samples, n_features) with one label each")
         self.scaler_ = Standardizer.fit(x)
         self.labels_ = np.asarray(labels)
+        from sklearn.neighbors import NearestNeighbors
+
         self.nn_ = NearestNeighbors(algorithm="auto", metric=self.config.metric)
         self.nn_.fit(self.scaler_.transform(x))
         return self
