@@ -304,3 +304,53 @@ def test_split_global_options_stops_at_double_dash() -> None:
     assert rest == ["run", "x.toml"] and debug and off == ["mdf_cmu", "mdf_kinect"]
     rest, debug, off = cli.split_global_options(["run", "--", "--debug"])
     assert rest == ["run", "--", "--debug"] and not debug and off == []
+
+
+def test_check_output_in_the_docs_is_current(capsys: pytest.CaptureFixture[str]) -> None:
+    guide = (EXAMPLES.parent / "docs" / "getting-started.md").read_text()
+    code, out, _ = run_cli(["check", "examples/point_target.toml"], capsys)
+    assert code == 0
+    assert f"```text\n{out}```" in guide
+
+
+@pytest.mark.parametrize("name", ["cmu_walk.toml", "point_target.toml", "boulic_walk.toml"])
+def test_check_predicts_what_the_run_does(
+    name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The pulses, frames, axes and aliasing verdict of `mdf check` are those of the run; the
+    fastest joint's radial speed bounds the run's fastest scatterer within the frame-rate
+    differencing (10 %)."""
+    code, out, err = run_cli(["check", str(EXAMPLES / name), "--json"], capsys)
+    assert code == 0, err
+    plan = json.loads(out)
+    assert run_cli(["run", str(EXAMPLES / name), "--out", str(tmp_path / "o")], capsys)[0] == 0
+    meta = json.loads((tmp_path / "o" / "metadata.json").read_text())
+    with np.load(tmp_path / "o" / "result.npz") as d:
+        assert d["signal"].shape == (plan["n_pulses"],)
+        assert d["spectrogram_db"].shape == (plan["nfft"], plan["n_frames"])
+        dv = float(np.diff(d["velocity_mps"][:2])[0])
+    assert plan["velocity_bin_mps"] == pytest.approx(dv, rel=1e-12)
+    assert plan["max_unambiguous_velocity_mps"] == meta["max_unambiguous_velocity_mps"]
+    assert plan["max_joint_radial_speed_mps"] >= 0.9 * meta["max_radial_speed_mps"]
+    assert plan["aliasing"] is False
+
+
+def test_check_warns_of_aliasing_and_names_the_prf(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """3 m/s at 24 GHz needs PRF >= 4 * 3 / 0.012491 = 960.7 Hz; 500 Hz aliases."""
+    cfg = tmp_path / "fast.toml"
+    cfg.write_text(
+        '[motion]\nkind = "point_targets"\nlength = 2.0\n'
+        "targets = [{ position = [100.0, 0.0, 0.0], velocity = [3.0, 0.0, 0.0] }]\n"
+        '[scatterers]\nkind = "points"\n[radar]\ncarrier_frequency = 24e9\nprf = 500.0\n'
+        "[scene]\nradar_position = [0.0, 0.0, 0.0]\n"
+        "[processing]\nwindow_length = 128\nhop = 16\nnfft = 256\n"
+    )
+    code, out, _ = run_cli(["check", str(cfg)], capsys)
+    assert code == 0
+    assert (
+        "aliasing    LIKELY: fastest joint 3 m/s radially; raise radar.prf to at least 961 Hz"
+        in out
+    )
+    assert not (tmp_path / "o").exists()

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 import textwrap
@@ -19,6 +20,7 @@ from mdframework.plugins import (
     PluginError,
     PluginWarning,
     build_registry,
+    default_registry,
     reset_default_registry,
 )
 
@@ -237,10 +239,14 @@ def test_one_plugin_is_disabled_by_entry_point_or_distribution_name(
 
 
 def test_disabled_plugin_is_the_stated_cause_of_a_config_error(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str], fresh_default_registry: object
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    fresh_default_registry: object,
 ) -> None:
     from conftest import EXAMPLES
 
+    monkeypatch.delenv(DISABLE_PLUGINS_ENV, raising=False)
     args = ["run", str(EXAMPLES / "cmu_walk.toml"), "--out", str(tmp_path / "o")]
     code = cli.main([*args, "--disable-plugin", "mdf_cmu"])
     err = capsys.readouterr().err.strip().splitlines()
@@ -248,6 +254,8 @@ def test_disabled_plugin_is_the_stated_cause_of_a_config_error(
     assert "motion.kind: no motion plugin named 'cmu'" in err[0]
     assert "mdf_cmu (mdf-cmu 0.1.0, disabled by MDFRAMEWORK_DISABLE_PLUGINS)" in err[0]
     assert not (tmp_path / "o").exists()
+    assert DISABLE_PLUGINS_ENV not in os.environ  # restored for whatever runs next
+    assert "cmu" in default_registry().names("motion")
 
 
 def test_plugins_off_is_the_stated_cause(

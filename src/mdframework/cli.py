@@ -371,7 +371,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point; returns the exit code."""
     raw = sys.argv[1:] if argv is None else argv
     args_list, debug, disable = split_global_options(raw)
-    if disable:
+    old_env = os.environ.get(DISABLE_PLUGINS_ENV)
+    if disable:  # in the environment, so that worker processes see it too
         off = sorted(disabled_by_user() | set(disable))
         os.environ[DISABLE_PLUGINS_ENV] = ",".join(off)
         reset_default_registry()
@@ -383,6 +384,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _quiet_broken_pipe()
     finally:
         warnings.showwarning = old_showwarning
+        if disable:  # main() may be called again in this process (tests, embedding)
+            if old_env is None:
+                os.environ.pop(DISABLE_PLUGINS_ENV, None)
+            else:
+                os.environ[DISABLE_PLUGINS_ENV] = old_env
+            reset_default_registry()
 
 
 def _main(argv: list[str], debug: bool) -> int:

@@ -167,7 +167,9 @@ class ProcessingConfig(StrictModel):
     floor_db: float = Field(-60.0, lt=0, description="Spectrogram floor, dB below its peak.")
     aliasing: Literal["warn", "error"] = Field(
         "warn",
-        description="When a scatterer's radial speed exceeds lambda*PRF/4: warn, or stop.",
+        description="When a scatterer's radial speed exceeds the unambiguous lambda*PRF/4 its "
+        "Doppler folds over: 'warn' (the warning names the PRF that avoids it; the results are "
+        "still written) or 'error' (stop, write nothing). `mdf check` predicts it.",
     )
 
     @model_validator(mode="after")
