@@ -32,6 +32,8 @@ SOURCE_EXAMPLES = {
     "kinect": "kinect_utkinect_walk.toml",
     "point_targets": "point_target.toml",
 }
+#: a recording each of the project's recording sources reads in its contract check
+RECORDING_EXAMPLES = {"radhar": {"file": "data/radhar/radhar_walk_subset.npz"}}
 #: configs for plugins whose default Config is not the one to check
 CONFIGS: dict[tuple[str, str], dict[str, Any]] = {
     ("scatterers", "points"): {"body": True},
@@ -47,6 +49,10 @@ def _instance(interface: str, name: str) -> Any:
         assert name in SOURCE_EXAMPLES, f"add an example using the {name!r} source"
         return build_stages(load_run_config(EXAMPLES / SOURCE_EXAMPLES[name])).source
     cls: Any = info.cls
+    if interface == "recording" and info.provider.split()[0] in OWN:
+        assert name in RECORDING_EXAMPLES, f"add an example recording for the {name!r} source"
+        section = {"kind": name, **RECORDING_EXAMPLES[name]}
+        return cls(cls.Config.model_validate(section, context={"base_dir": EXAMPLES}))
     return cls(cls.Config(**CONFIGS.get((interface, name), {})))
 
 

@@ -14,7 +14,9 @@ base class, the registration hook and the contract check follow :data:`INTERFACE
 - ``radar``: ``RadarWaveform``, ``mdframework_register_radar_waveforms``,
   ``check_radar_waveform``;
 - ``classifier``: ``Classifier``, ``mdframework_register_classifiers``, ``check_classifier``;
-- ``effects``: ``Effect``, ``mdframework_register_effects``, ``check_effect``.
+- ``effects``: ``Effect``, ``mdframework_register_effects``, ``check_effect``;
+- ``recording`` (dataset configs): ``RadarRecordingSource``, ``mdframework_register_recordings``,
+  ``check_recording_source``.
 
 Old spellings (the registry key ``effect``, the hook ``mdframework_register_waveforms``) keep
 working with a :class:`DeprecationWarning`.
@@ -50,6 +52,7 @@ from .interfaces import (
     Effect,
     MotionSource,
     Plugin,
+    RadarRecordingSource,
     RadarWaveform,
     ScattererModel,
 )
@@ -72,6 +75,7 @@ INTERFACES: dict[str, Interface] = {
     "radar": Interface("mdframework_register_radar_waveforms", RadarWaveform),
     "classifier": Interface("mdframework_register_classifiers", Classifier),
     "effects": Interface("mdframework_register_effects", Effect),
+    "recording": Interface("mdframework_register_recordings", RadarRecordingSource),
 }
 
 #: old interface spelling -> current one

@@ -43,8 +43,10 @@ from .interfaces import (
     MotionSource,
     Plugin,
     PluginConfig,
+    RadarRecordingSource,
     RadarWaveform,
     Received,
+    Recording,
     ScattererModel,
     Scatterers,
     SceneContext,
@@ -420,6 +422,27 @@ def check_effect(effect: Effect, model: ScattererModel | None = None) -> None:
     assert np.array_equal(first, second), f"{who}: the same seed must give the same output"
 
 
+# --------------------------------------------------------------------------- recordings
+
+
+def check_recording_source(source: RadarRecordingSource) -> list[Recording]:
+    """``load()`` gives named recordings with consistent point clouds: unique names, frame
+    indices within the recording, finite positions and velocities, a positive frame period and
+    JSON metadata."""
+    recordings = source.load()
+    assert recordings, "load() must return at least one recording"
+    names = [r.name for r in recordings]
+    assert len(set(names)) == len(names), "recording names must be unique"
+    for rec in recordings:
+        assert isinstance(rec, Recording), "load() must return Recording objects"
+        cloud = rec.cloud
+        assert cloud.n_frames >= 1 and cloud.frame_period > 0
+        assert np.all(np.isfinite(cloud.positions)) and np.all(np.isfinite(cloud.velocity))
+        assert np.all(np.diff(cloud.frame) >= 0), "points must be in frame order"
+        json.dumps(dict(rec.metadata))
+    return recordings
+
+
 # --------------------------------------------------------------------------- the suite
 
 
@@ -430,6 +453,7 @@ INSTANCE_CHECKS: dict[str, tuple[Check, ...]] = {
     "radar": (check_radar_waveform,),
     "classifier": (check_classifier,),
     "effects": (check_effect,),
+    "recording": (check_recording_source,),
 }
 
 
@@ -531,6 +555,7 @@ __all__ = [
     "check_plugin",
     "check_plugin_class",
     "check_radar_waveform",
+    "check_recording_source",
     "check_scatterer_model",
     "parametrize_with_checks",
     "plugin_checks",
