@@ -28,6 +28,7 @@ OWN = project_distributions()
 #: an example config that uses each of the project's motion sources (every one must have one)
 SOURCE_EXAMPLES = {
     "boulic": "boulic_walk.toml",
+    "bvh": "bvh_mixamo.toml",
     "cmu": "cmu_walk.toml",
     "kinect": "kinect_utkinect_walk.toml",
     "point_targets": "point_target.toml",
