@@ -11,8 +11,12 @@ venv: $(STAMP)
 
 $(STAMP): pyproject.toml $(PLUGINS)
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[dev]" $(foreach p,$(PLUGINS),-e $(dir $(p)))
+	@echo "Installing mdframework and $(words $(PLUGINS)) plugins into $(VENV): pip reports every distribution"
+	$(BIN)/python -m pip install --progress-bar on --upgrade pip "setuptools>=70.1"
+	@# one pip call for every editable distribution; they all build with the setuptools just
+	@# installed, instead of one isolated build environment each
+	$(BIN)/python -m pip install --progress-bar on --no-build-isolation \
+		-e ".[dev]" $(foreach p,$(PLUGINS),-e $(dir $(p)))
 	touch $(STAMP)
 
 demo: $(STAMP)
