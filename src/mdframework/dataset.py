@@ -422,8 +422,8 @@ def _executor(
         raise MdfError("a Dask scheduler needs `pip install mdframework[dask]`") from None
     import dask
 
-    # the statistical profiler samples every worker thread (10 ms) and costs more than the
-    # records' own bookkeeping; workers started here inherit the setting
+    # the statistical profiler samples every worker thread every 10 ms and nothing reads its
+    # profiles; the workers started here inherit the setting
     with dask.config.set({"distributed.worker.profile.enabled": False}):
         cluster = (
             LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None)
