@@ -19,8 +19,8 @@ from typing import Any
 import numpy as np
 
 from .errors import SceneError
-from .physics import interpolation, radar
-from .pipeline import _condition, _window, build_stages, load_motion, place_body
+from .physics import radar
+from .pipeline import _place, _window, build_stages, load_motion
 from .plugins import Registry, default_registry
 from .settings import RunConfigBase
 
@@ -80,15 +80,23 @@ def max_joint_radial_speed(
 
 
 def memory_estimate(
-    n_pulses: int, n_scatterers: int, n_doppler: int, n_frames: int
+    n_pulses: int,
+    n_scatterers: int,
+    n_doppler: int,
+    n_frames: int,
+    block_pulses: int,
+    keep_scatterers: bool = False,
+    stft_bytes: int = 4,
 ) -> dict[str, float]:
     """The arrays a run holds at once [MiB]: per pulse the time, gate and complex signal
-    (8 + 8 + 16 bytes), the scatterer positions, ranges and RCS (5 float64 per scatterer), and
-    the spectrogram's power and dB maps (two float64 per Doppler bin and frame)."""
+    (8 + 8 + 16 bytes); the scatterer positions, ranges and RCS (5 float64 per scatterer) of one
+    block of ``block_pulses`` (of every pulse with ``keep_scatterers``); the spectrogram's power
+    (``stft_bytes`` per value) and its float64 dB map."""
+    rows = n_pulses if keep_scatterers else min(n_pulses, block_pulses)
     return {
         "signal": n_pulses * 32 / MIB,
-        "scatterers": n_pulses * n_scatterers * 40 / MIB,
-        "spectrogram": n_doppler * n_frames * 16 / MIB,
+        "scatterers": rows * n_scatterers * 40 / MIB,
+        "spectrogram": n_doppler * n_frames * (stft_bytes + 8) / MIB,
     }
 
 
@@ -104,17 +112,9 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
     proc = config.processing
 
     motion = load_motion(stages.source)
-    if stages.model.needs_canonical and motion.canonical_map is None:
-        raise SceneError(
-            f"scatterers.kind: the {stages.model.name!r} model needs a human body, but this "
-            f"motion ({motion.metadata.get('source', 'unknown')}) has no canonical joints"
-        )
-    body = motion.canonical() if stages.model.needs_canonical else motion.skeleton
-    body, _ = _condition(body, config.conditioning)
-    if stages.model.needs_canonical:
-        body = place_body(body, config.scene.person, radar_pos)
+    body, _, _ = _place(config, stages, motion, radar_pos)
     t_start, t_end = _window(body, cfg.motion.start, cfg.motion.duration)
-    n_pulses = int(interpolation.pulse_times(t_start, t_end, prf).shape[0])
+    n_pulses = int(wf.pulse_times(t_start, t_end).shape[0])
     if n_pulses < proc.window_length:
         raise SceneError(
             f"processing.window_length: the record has {n_pulses} pulses "
@@ -126,10 +126,18 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
     speed = max_joint_radial_speed(
         body.time[inside], body.positions[inside], body.valid[inside], radar_pos
     )
-    v_max = radar.max_unambiguous_velocity(fc, prf)
+    v_max = float(wf.max_unambiguous_velocity)
     n_frames = max(0, 1 + (n_pulses - proc.window_length) // proc.hop)
     n_scatterers = body.n_joints  # the body models have about one scatterer per joint/segment
-    terms = memory_estimate(n_pulses, n_scatterers, proc.nfft, n_frames)
+    terms = memory_estimate(
+        n_pulses,
+        n_scatterers,
+        proc.nfft,
+        n_frames,
+        proc.block_pulses,
+        proc.keep_scatterers,
+        4 if proc.precision == "float32" else 8,
+    )
     return RunPlan(
         plugins={
             "motion": _provider(reg, "motion", cfg.motion.kind),
@@ -155,7 +163,7 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
         max_unambiguous_velocity_mps=v_max,
         max_joint_radial_speed_mps=speed,
         aliasing=speed > v_max,
-        prf_needed_hz=radar.min_prf_for_velocity(speed, fc),
+        prf_needed_hz=prf * speed / v_max,  # v_max grows in proportion to the PRF
         memory_mib=sum(terms.values()),
         memory_terms_mib=terms,
     )

@@ -43,6 +43,7 @@ from .interfaces import (
     MotionSource,
     Plugin,
     PluginConfig,
+    PulseBlock,
     RadarRecordingSource,
     RadarWaveform,
     Received,
@@ -50,6 +51,7 @@ from .interfaces import (
     ScattererModel,
     Scatterers,
     SceneContext,
+    receive_points,
 )
 from .physics import body as body_physics
 from .physics import radar
@@ -153,19 +155,24 @@ class ReferenceRadar(RadarWaveform):
         """PRF [Hz]."""
         return self.config.prf
 
-    def receive(self, ranges: Any, rcs: Any, gate_range: Any) -> Received:
-        """The sum of the scatterers' phasors per pulse."""
+    def receive(self, block: PulseBlock) -> Received:
+        """The sum of the scatterers' phasors per pulse of the block."""
         lam = radar.wavelength(self.carrier_frequency)
-        r = np.asarray(ranges, dtype=np.float64)
+        r = block.ranges
+        rcs = block.scatterers.rcs
         phasor = np.sqrt(np.asarray(rcs, dtype=np.float64)) / r**2 * np.exp(-4j * np.pi * r / lam)
         return Received(np.asarray(phasor.sum(axis=1), dtype=np.complex128))
 
 
 def scene_context(
-    motion: Motion | None = None, waveform: RadarWaveform | None = None, seed: int = 0
+    motion: Motion | None = None,
+    waveform: RadarWaveform | None = None,
+    seed: int = 0,
+    stage: str = "scatterers",
 ) -> SceneContext:
     """The scene the effect checks use: ``motion`` (default :func:`walking_motion`) taken as
-    already at the pulse times, the radar at :data:`RADAR_POSITION`, the gate on the hips."""
+    already at the pulse times, the radar at :data:`RADAR_POSITION`, the gate on the hips; for
+    the ``"received"`` stage the context has no skeleton (as in a run)."""
     motion = motion or walking_motion()
     wf = waveform or ReferenceRadar(ReferenceRadar.Config(prf=1.0 / _step(motion.skeleton.time)))
     body = motion.canonical()
@@ -176,7 +183,7 @@ def scene_context(
         wf.carrier_frequency,
         body.time,
         gate,
-        body,
+        body if stage == "scatterers" else None,
         wf,
         np.random.default_rng(seed),
     )
@@ -277,12 +284,13 @@ def check_scatterer_model(
     wavelength: float = 0.02,
 ) -> Scatterers:
     """Scatterers for a walking body 10 m from the radar: one row per pulse, finite positions,
-    finite non-negative RCS, one name per scatterer; the same body split in two halves gives
-    the same scatterers (the pipeline streams pulses in blocks)."""
+    finite non-negative RCS, one name per scatterer (block invariance:
+    :func:`check_scatterer_model_blocks`)."""
     motion = motion or walking_motion()
     if skeleton is None:
         skeleton = motion.canonical() if model.needs_canonical else motion.skeleton
     who = _label(model)
+    model.start_record(skeleton)
     scat = model.scatterers(motion, skeleton, RADAR_POSITION, wavelength)
     assert isinstance(scat, Scatterers), f"{who}: scatterers() must return Scatterers"
     n = skeleton.n_frames
@@ -291,22 +299,7 @@ def check_scatterer_model(
     assert np.all(np.isfinite(scat.rcs)) and np.all(scat.rcs >= 0), (
         f"{who}: RCS must be finite and >= 0"
     )
-    half = n // 2
-    parts = [
-        model.scatterers(motion, _rows(skeleton, sl), RADAR_POSITION, wavelength)
-        for sl in (slice(0, half), slice(half, n))
-    ]
-    joined = np.concatenate([p.rcs for p in parts])
-    assert np.allclose(joined, scat.rcs, rtol=1e-9, atol=0), (
-        f"{who}: the RCS of a pulse must not depend on the other pulses of the call"
-    )
     return scat
-
-
-def _rows(skeleton: Skeleton, rows: slice) -> Skeleton:
-    return Skeleton(
-        skeleton.time[rows], skeleton.positions[rows], skeleton.joint_names, skeleton.valid[rows]
-    )
 
 
 # --------------------------------------------------------------------------- radar waveforms
@@ -323,7 +316,7 @@ def check_radar_waveform(waveform: RadarWaveform) -> None:
     t = np.arange(n) / prf
     v = 0.25 * radar.max_unambiguous_velocity(fc, prf)  # approaching, well inside the limit
     ranges = (50.0 - v * t)[:, None]
-    received = waveform.receive(ranges, np.ones_like(ranges), ranges[:, 0])
+    received = receive_points(waveform, ranges, np.ones_like(ranges), ranges[:, 0], times=t)
     assert isinstance(received, Received), f"{who}: receive() must return Received"
     y = received.signal
     assert y.shape == (n,) and np.iscomplexobj(y), f"{who}: signal must be (n_pulses,) complex"
@@ -334,8 +327,10 @@ def check_radar_waveform(waveform: RadarWaveform) -> None:
         f"{who}: an approaching target must show +{expected:.3f} Hz, got {doppler:.3f} Hz"
     )
     second = ranges + 0.05  # a second scatterer 5 cm behind the first, same gate
-    both = waveform.receive(np.hstack([ranges, second]), np.ones((n, 2)), ranges[:, 0]).signal
-    alone = waveform.receive(second, np.ones_like(second), ranges[:, 0]).signal
+    both = receive_points(
+        waveform, np.hstack([ranges, second]), np.ones((n, 2)), ranges[:, 0], times=t
+    ).signal
+    alone = receive_points(waveform, second, np.ones_like(second), ranges[:, 0], times=t).signal
     scale = np.max(np.abs(both)) + 1e-300
     assert np.max(np.abs(both - (y + alone))) <= 1e-6 * scale, (
         f"{who}: the return of two scatterers must be the sum of their returns"
@@ -373,35 +368,47 @@ def check_classifier(classifier: Classifier) -> None:
 # --------------------------------------------------------------------------- effects
 
 
-def _effect_input(effect: Effect, context: SceneContext, model: ScattererModel | None) -> Any:
-    motion = walking_motion()
+def _effect_input(
+    effect: Effect, context: SceneContext, model: ScattererModel | None, body: Skeleton
+) -> Any:
+    """The data an effect of the checks gets: the walking body's scatterers, or what the
+    context's radar receives of them."""
     if model is None:
-        body = context.skeleton
         scat = Scatterers(body.positions, np.ones(body.positions.shape[:2]), body.joint_names)
     else:
-        scat = model.scatterers(motion, context.skeleton, context.radar_position, 0.03)
+        model.start_record(body)
+        scat = model.scatterers(walking_motion(), body, context.radar_position, 0.03)
     if effect.stage == "scatterers":
         return scat
     ranges = scat.ranges(context.radar_position)
-    return context.waveform.receive(ranges, scat.rcs, context.gate_range)
+    block = PulseBlock(
+        0, context.pulse_times, scat, ranges, context.gate_range, context.radar_position
+    )
+    return context.waveform.receive(block)
 
 
 def check_effect(effect: Effect, model: ScattererModel | None = None) -> None:
     """An effect declares its stage; ``apply`` returns the same kind of data it was given
     (``Scatterers`` or ``Received``, never None), for the same pulses, finite; ``describe()``
-    is a JSON-serialisable dict; the same seed gives the same output. ``model`` makes the
-    scatterers (default: one unit point per joint of a walking body)."""
+    is a JSON-serialisable dict; the same seed gives the same output; a scatterer-stage effect
+    gives the same scatterers and signal whether the record comes as one block or many.
+    ``model`` makes the scatterers (default: one unit point per joint of a walking body)."""
     who = _label(effect)
     stage = getattr(effect, "stage", None)
     assert stage in ("scatterers", "received"), f"{who}: stage must be 'scatterers' or 'received'"
-    context = scene_context()
-    data = _effect_input(effect, context, model)
-    out = effect.apply(data, context)
+    body = walking_motion().canonical()
+
+    def run() -> Any:
+        context = scene_context(stage=stage)
+        effect.start_record(body, context.radar_position)
+        return effect.apply(_effect_input(effect, context, model, body), context)
+
+    out = run()
     expected = Scatterers if stage == "scatterers" else Received
     assert isinstance(out, expected), (
         f"{who}: apply() on the {stage!r} stage must return {expected.__name__}, got {out!r}"
     )
-    n = context.pulse_times.shape[0]
+    n = body.n_frames
     if isinstance(out, Scatterers):
         assert out.positions.shape[0] == n, f"{who}: apply() must keep one row per pulse"
         assert np.all(np.isfinite(out.positions)), f"{who}: positions must be finite"
@@ -417,12 +424,132 @@ def check_effect(effect: Effect, model: ScattererModel | None = None) -> None:
         json.dumps(described)
     except TypeError as exc:
         raise AssertionError(f"{who}: describe() must be JSON-serialisable: {exc}") from None
-    again = effect.apply(_effect_input(effect, context, model), scene_context())
+    again = run()
     second = again.rcs if isinstance(again, Scatterers) else again.signal
     assert np.array_equal(first, second), f"{who}: the same seed must give the same output"
+    if stage == "scatterers":
+        effect.start_record(body, RADAR_POSITION)
+        _invariant(who, JointPoints(JointPoints.Config()), _reference_radar(body), body, (effect,))
+
+
+class JointPointsConfig(PluginConfig):
+    """Unit isotropic points at the joints."""
+
+    kind: Literal["joint_points"] = "joint_points"
+
+
+class JointPoints(ScattererModel):
+    """A unit isotropic point scatterer at every joint (the checks' scatterer model)."""
+
+    name = "joint_points"
+    Config = JointPointsConfig
+    needs_canonical = False
+
+    def scatterers(
+        self, motion: Motion, skeleton: Skeleton, radar_position: Any, wavelength: float
+    ) -> Scatterers:
+        """One unit-RCS point per joint."""
+        rcs = np.ones(skeleton.positions.shape[:2])
+        return Scatterers(skeleton.positions, rcs, skeleton.joint_names)
+
+
+def _reference_radar(body: Skeleton) -> ReferenceRadar:
+    return ReferenceRadar(ReferenceRadar.Config(prf=1.0 / _step(body.time)))
+
+
+def _invariant(
+    who: str,
+    model: ScattererModel,
+    waveform: RadarWaveform,
+    body: Skeleton,
+    effects: tuple[Effect, ...] = (),
+) -> None:
+    try:
+        check_block_invariance(model, waveform, body, walking_motion(), effects)
+    except AssertionError as exc:
+        raise AssertionError(f"{who}: {exc}") from None
+
+
+def check_scatterer_model_blocks(model: ScattererModel) -> None:
+    """A walking body's scatterers (and the reference radar's signal) are the same whether the
+    record comes as one block or in blocks of 37 pulses."""
+    motion = walking_motion()
+    body = motion.canonical() if model.needs_canonical else motion.skeleton
+    _invariant(_label(model), model, _reference_radar(body), body)
+
+
+def check_radar_waveform_blocks(waveform: RadarWaveform) -> None:
+    """The waveform's signal for a walking body (unit points at its joints, at the waveform's own
+    pulse times) is the same whether the record comes as one block or in blocks of 37 pulses."""
+    t = waveform.pulse_times(0.0, 0.25)
+    pos = walking_positions(t)
+    pos[:, :, 0] -= 2.0  # 12 m from the radar at the start, approaching
+    body = Skeleton(t, pos, CANONICAL_JOINTS)
+    _invariant(_label(waveform), JointPoints(JointPoints.Config()), waveform, body)
 
 
 # --------------------------------------------------------------------------- recordings
+
+
+def check_block_invariance(
+    model: ScattererModel,
+    waveform: RadarWaveform,
+    skeleton: Skeleton,
+    motion: Motion,
+    effects: tuple[Effect, ...] = (),
+    block: int = 37,
+) -> None:
+    """The streaming contract: scatterers, scatterer-stage ``effects`` and ``receive`` give the
+    same result for a record processed as one block and as blocks of ``block`` pulses
+    (``skeleton``: the body at the pulse times, in the scene frame)."""
+    radar_position = np.array([10.0, 0.0, 1.0])
+    lam = float(radar.wavelength(waveform.carrier_frequency))
+    t = skeleton.time
+    span = np.linalg.norm(skeleton.positions - radar_position, axis=-1)
+
+    def run(size: int) -> tuple[np.ndarray, np.ndarray]:
+        model.start_record(skeleton)
+        waveform.start_record(t, (float(span.min()), float(span.max())))
+        rcs_parts, signal_parts = [], []
+        step = max(waveform.block_multiple, size - size % waveform.block_multiple)
+        for lo in range(0, t.shape[0], step):
+            sk = skeleton.select_frames(slice(lo, lo + step))
+            scat = model.scatterers(motion, sk, radar_position, lam)
+            gate = np.linalg.norm(sk.positions[:, 0, :] - radar_position, axis=-1)
+            rng = np.random.default_rng(0)
+            ctx = SceneContext(
+                radar_position,
+                waveform.prf,
+                waveform.carrier_frequency,
+                sk.time,
+                gate,
+                sk,
+                waveform,
+                rng,
+                lo,
+            )
+            for effect in effects:
+                if effect.stage == "scatterers":
+                    scat = effect.apply(scat, ctx)
+                    assert isinstance(scat, Scatterers), (
+                        f"effect {effect.name!r}: apply must return Scatterers"
+                    )
+            ranges = scat.ranges(radar_position)
+            rec = waveform.receive(PulseBlock(lo, sk.time, scat, ranges, gate, radar_position))
+            rcs_parts.append(scat.rcs)
+            signal_parts.append(rec.signal)
+        return np.concatenate(rcs_parts), np.concatenate(signal_parts)
+
+    rcs_one, sig_one = run(t.shape[0])
+    rcs_many, sig_many = run(block)
+    assert np.allclose(rcs_one, rcs_many, rtol=1e-12, atol=0), (
+        "scatterer RCS differs between one block and many: the model or an effect is not "
+        "block-invariant (take record-wide quantities in start_record)"
+    )
+    scale = float(np.max(np.abs(sig_one))) or 1.0
+    assert np.max(np.abs(sig_one - sig_many)) <= 1e-9 * scale, (
+        "received signal differs between one block and many: the waveform is not block-invariant"
+    )
 
 
 def check_recording_source(source: RadarRecordingSource) -> list[Recording]:
@@ -449,8 +576,8 @@ def check_recording_source(source: RadarRecordingSource) -> list[Recording]:
 #: interface -> the checks of its instances (besides the class check and the config round trip)
 INSTANCE_CHECKS: dict[str, tuple[Check, ...]] = {
     "motion": (check_motion_source,),
-    "scatterers": (check_scatterer_model,),
-    "radar": (check_radar_waveform,),
+    "scatterers": (check_scatterer_model, check_scatterer_model_blocks),
+    "radar": (check_radar_waveform, check_radar_waveform_blocks),
     "classifier": (check_classifier,),
     "effects": (check_effect,),
     "recording": (check_recording_source,),
@@ -547,7 +674,9 @@ __all__ = [
     "INSTANCE_CHECKS",
     "RADAR_POSITION",
     "Check",
+    "JointPoints",
     "ReferenceRadar",
+    "check_block_invariance",
     "check_classifier",
     "check_config_round_trip",
     "check_effect",
@@ -555,8 +684,10 @@ __all__ = [
     "check_plugin",
     "check_plugin_class",
     "check_radar_waveform",
+    "check_radar_waveform_blocks",
     "check_recording_source",
     "check_scatterer_model",
+    "check_scatterer_model_blocks",
     "parametrize_with_checks",
     "plugin_checks",
     "scene_context",
