@@ -205,7 +205,9 @@ def test_a_source_can_have_its_own_draws(tmp_path: Path) -> None:
     path.write_text(text)
     cfg, base = load_dataset_config(path)
     specs = plan_records(cfg, base)
-    assert [s.label for s in specs] == ["walk"] * 3 + ["slow walk"]
-    assert specs[3].draws is not None and set(specs[3].draws) == {"speed"}
-    assert 0.5 <= specs[3].draws["speed"] <= 0.6
+    assert [s.label for s in specs] == ["walk"] * 3 + ["slow walk"] * 3
+    # the source's speed range, and the dataset's scene draws (and number of draws)
+    own = [s.draws or {} for s in specs[3:]]
+    assert len(own) == 3 and all(0.5 <= d["speed"] <= 0.6 for d in own)
+    assert all({"radar_height", "aspect_deg"} <= set(d) for d in own)
     assert "speed" not in (specs[0].draws or {})

@@ -133,7 +133,9 @@ class SourceEntry(StrictModel):
         "conditioning for Kinect recordings, or its own scene).",
     )
     randomize: Randomization | None = Field(
-        None, description="Random draws for this source only, instead of the dataset's."
+        None,
+        description="Random draws for this source: the fields given here replace the "
+        "dataset's (e.g. its own speed range); the others stay as the dataset's.",
     )
 
     @model_validator(mode="after")
@@ -378,11 +380,19 @@ def _apply_draws(
                 raise ConfigError(f"{where}: randomize.params: {exc.args[0]}") from None
 
 
+def _randomize(config: DatasetConfig, entry: SourceEntry) -> Randomization:
+    """The draws of one source: the dataset's, with the fields the source gives replaced."""
+    if entry.randomize is None:
+        return config.randomize
+    own = {k: getattr(entry.randomize, k) for k in entry.randomize.model_fields_set}
+    return config.randomize.model_copy(update=own)
+
+
 def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
     """Expand sources x windows x variations x random draws into record specs, in a fixed
     order."""
     v = config.variations
-    for rz in [config.randomize] + [e.randomize for e in config.sources if e.randomize]:
+    for rz in [config.randomize] + [_randomize(config, e) for e in config.sources]:
         for name in ("aspect_deg", "radar_range", "radar_height", "height"):
             if getattr(v, name) is not None and getattr(rz, name) is not None:
                 raise ConfigError(f"{name}: give it as a variation or as a random draw, not both")
@@ -422,7 +432,7 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
                 f"{duration:.3f} s recording ({motion.get('file', motion['kind'])})"
             )
         hop = entry.hop or length
-        rz = entry.randomize or config.randomize
+        rz = _randomize(config, entry)
         starts = float(motion.get("start", 0.0)) + np.arange(0.0, duration - length + 1e-9, hop)
         if entry.max_records is not None:
             starts = starts[: entry.max_records]
