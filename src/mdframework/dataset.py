@@ -586,7 +586,7 @@ def build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     fcfg = spec.features
     extra: dict[str, Any] = {}
     if spec.histogram is not None:
-        cloud = _simulated_cloud(result, spec.record_id)
+        cloud = _simulated_cloud(result, config, spec.record_id)
         arrays = _histogram_arrays(cloud, spec.histogram["histogram"], fcfg, spec.record_id)
         feats = arrays["features"]
         extra = {"histograms": arrays["histograms"]}
@@ -634,21 +634,23 @@ def build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     return _row(meta, feats)
 
 
-def _simulated_cloud(result: Any, record: str) -> PointCloud:
-    """The point cloud a simulated radar produced (``products["points"]``, columns frame, t,
-    x, y, z [m], v [m/s] positive approaching, intensity [dB])."""
+def _simulated_cloud(result: Any, config: Any, record: str) -> PointCloud:
+    """The point cloud a simulated radar produced: ``products["points"]`` (n_points, 7) with
+    columns frame (from 0 in the record), t [s], x, y, z [m, sensor frame], v [m/s, positive
+    approaching], intensity [dB]; the frame period is the radar's ``frame_period`` [s]."""
     products = getattr(result, "products", None) or {}
     points = products.get("points")
-    if points is None:
+    period = getattr(config.radar, "frame_period", None)
+    if points is None or period is None:
         raise SceneError(
             f"record {record}: representation = 'histogram' needs a radar that outputs point "
-            "clouds (e.g. an FMCW sensor with detection); this one outputs none"
+            "clouds frame by frame (e.g. kind = 'fmcw' with points = true); this one does not"
         )
     pts = np.asarray(points, dtype=np.float64)
     frame = pts[:, 0].astype(np.int64)
-    n_frames = int(result.metadata.get("n_frames", int(frame.max()) + 1 if frame.size else 1))
-    period = float(result.metadata["frame_period_s"])
-    return PointCloud(frame, pts[:, 2:5], pts[:, 5], pts[:, 6], period, n_frames)
+    whole = int(np.floor(float(config.motion.duration) / period + 1e-6))
+    n_frames = max(whole, int(frame.max()) + 1 if frame.size else 1)
+    return PointCloud(frame, pts[:, 2:5], pts[:, 5], pts[:, 6], float(period), n_frames)
 
 
 def _blank(value: Any) -> Any:
