@@ -504,14 +504,14 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
                         "radar_position": rpos,
                     },
                 )
-                if config.place == "record":
-                    run["scene"] = _place_record(run, loaded, base_dir)
                 index = len(specs)
                 draws = None
                 if rz.active():
                     rng = np.random.default_rng(np.random.SeedSequence([config.seed, index, 1]))
                     draws = rz.sample(rng)
                     _apply_draws(run, section, draws, f"sources[{entry_no}]")
+                if config.place == "record":  # after the draws: it fixes the drawn aspect
+                    run["scene"] = _place_record(run, loaded, base_dir)
                 run["seed"] = _record_seed(config.seed, index)
                 specs.append(
                     _spec(config, index, entry, motion["kind"], run, base_dir, draws, hist, meta)
