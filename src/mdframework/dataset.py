@@ -767,10 +767,11 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
 
 
 def _simulated_cloud(result: Any, config: Any, record: str) -> PointCloud:
-    """The point cloud a simulated radar produced: ``products["points"]`` (n_points, 7) with
-    columns frame (from 0 in the record), t [s], x, y, z [m, sensor frame], v [m/s, positive
-    approaching], intensity [dB]; the frame period is the radar's ``frame_period`` [s]."""
-    products = getattr(result, "products", None) or {}
+    """The point cloud a simulated radar produced: ``received.products["points"]``
+    (n_points, 7) with columns frame (from 0 in the record), t [s], x, y, z [m, sensor frame],
+    v [m/s, positive approaching], intensity [dB]; the frame period is the radar's
+    ``frame_period`` [s]."""
+    products = getattr(result.received, "products", None) or {}
     points = products.get("points")
     period = getattr(config.radar, "frame_period", None)
     if points is None or period is None:
