@@ -24,6 +24,7 @@ from mdframework.features import FEATURE_NAMES
 
 RADHAR = EXAMPLES / "data" / "radhar"
 CMU_WALK = EXAMPLES / "data" / "cmu" / "asf-amc" / "02_01.amc"
+CMU_BOXING = EXAMPLES / "data" / "cmu" / "asf-amc" / "13_18.amc"
 
 
 def test_real_recordings_become_windows_of_histograms(tmp_path: Path) -> None:
@@ -227,8 +228,7 @@ def test_simulated_point_clouds_become_the_same_histograms(tmp_path: Path) -> No
 representation = "histogram"
 [[sources]]
 label = "boxing"
-motion = {{ kind = "cmu", file = "{EXAMPLES / "data" / "cmu" / "asf-amc" / "13_18.amc"}",
-           start = 5.0 }}
+motion = {{ kind = "cmu", file = "{CMU_BOXING}", start = 5.0 }}
 record_length = 0.5
 max_records = 1
 [base.radar]
