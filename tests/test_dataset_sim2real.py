@@ -238,7 +238,7 @@ save_range_doppler = false
 [base.scene]
 radar_position = [1.6, 0.0, 1.0]
 min_range = 0.25
-""".replace(",\n           start", ", start")
+"""
     )
     cfg, base = load_dataset_config(path)
     [spec] = plan_records(cfg, base)
