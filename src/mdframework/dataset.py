@@ -63,6 +63,7 @@ from .pointcloud import (
     histogram_features,
     velocity_bins,
 )
+from .progress import note
 from .randomize import Randomization, set_path
 from .settings import StrictModel
 
@@ -936,6 +937,7 @@ def build_dataset(
     """Build (or finish building) a dataset; returns the index rows in record order."""
     from tqdm import tqdm
 
+    note("planning the records (reading each recording once)", progress)
     specs = plan_records(config, base_dir)  # errors in the config stop before any file
     out = Path(out_dir)
     (out / RECORDS).mkdir(parents=True, exist_ok=True)
