@@ -415,7 +415,8 @@ class _Stream:
             self._blocks.append(scat)
         if rec.range_time is not None:
             first = (-lo) % self._rt_step
-            self._rt.append(np.asarray(rec.range_time[first :: self._rt_step]))
+            # a copy: a view would keep the whole block's map alive
+            self._rt.append(np.array(rec.range_time[first :: self._rt_step]))
             self._rt_axis = rec.range_axis
         for key, value in rec.products.items():
             self._products.setdefault(key, []).append(np.asarray(value))
