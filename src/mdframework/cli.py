@@ -8,7 +8,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+import signal
 import sys
+import threading
 import traceback
 import warnings
 from collections.abc import Iterator, Sequence
@@ -16,34 +19,36 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from .errors import DataFileError, MdfError
+from .errors import DataFileError, MdfError, OutputError
 from .plugins import INTERFACES, PluginError, default_registry, make_plugin_manager
 
 EXIT_USAGE = 2
+EXIT_INTERRUPTED = 130
 
 
 @contextmanager
 def _naming(config_file: str) -> Iterator[None]:
-    """Prefix the config file to errors that name only a field (data-file errors name their own
-    file)."""
+    """Prefix the config file to errors that name only a field (data-file and output-folder
+    errors name their own file or folder)."""
     try:
         yield
     except MdfError as exc:
-        if isinstance(exc, DataFileError) or str(exc).startswith(config_file):
+        if isinstance(exc, (DataFileError, OutputError)) or str(exc).startswith(config_file):
             raise
         raise type(exc)(f"{config_file}: {exc}") from exc
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
     from .config import load_run_config
-    from .output import write_run
+    from .output import run_folder, write_run
     from .pipeline import simulate
 
     config = load_run_config(args.config)
-    with _naming(args.config):
-        result = simulate(config)
-    resolved = json.loads(config.model_dump_json())
-    written = write_run(result, resolved, Path(args.out))
+    with run_folder(args.out, force=args.force, staging_dir=args.staging_dir) as folder:
+        with _naming(args.config):
+            result = simulate(config)
+        resolved = json.loads(config.model_dump_json())
+        written = write_run(result, resolved, folder)
     for path in written:
         print(path)
     return 0
@@ -83,6 +88,7 @@ def _cmd_dataset_build(args: argparse.Namespace) -> int:
             workers=args.workers,
             scheduler=args.scheduler,
             progress=not args.no_progress,
+            force=args.force,
         )
     print(f"{len(rows)} records in {args.out}")
     return 0
@@ -93,9 +99,26 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
 
     config = load_experiment_config(args.config)
     with _naming(args.config):
-        run_experiment(config, Path(args.out), source=args.config, progress=not args.no_progress)
+        run_experiment(
+            config,
+            Path(args.out),
+            source=args.config,
+            progress=not args.no_progress,
+            force=args.force,
+            staging_dir=args.staging_dir,
+        )
     print(Path(args.out) / "report.md")
     return 0
+
+
+FORCE_HELP = (
+    "write into an existing folder that holds other files (only this command's files are "
+    "replaced; nothing else is deleted), or rebuild a dataset from a different config"
+)
+STAGING_HELP = (
+    "folder for the files being written (default: inside --out); must be on the same file "
+    "system as --out"
+)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -109,6 +132,8 @@ def build_parser() -> argparse.ArgumentParser:
     run = sub.add_parser("run", help="run a config: motion -> radar -> spectrogram")
     run.add_argument("config", help="run config file (.toml, .yaml or .json)")
     run.add_argument("--out", required=True, help="output folder")
+    run.add_argument("--force", action="store_true", help=FORCE_HELP)
+    run.add_argument("--staging-dir", default=None, help=STAGING_HELP)
     run.set_defaults(func=_cmd_run)
 
     dataset = sub.add_parser("dataset", help="labelled datasets of simulated records")
@@ -123,12 +148,15 @@ def build_parser() -> argparse.ArgumentParser:
         help="Dask scheduler address, or 'local' for a local Dask cluster",
     )
     build.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    build.add_argument("--force", action="store_true", help=FORCE_HELP)
     build.set_defaults(func=_cmd_dataset_build)
 
     experiment = sub.add_parser("experiment", help="run a classification experiment")
     experiment.add_argument("config", help="experiment config file")
     experiment.add_argument("--out", required=True, help="report folder")
     experiment.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    experiment.add_argument("--force", action="store_true", help=FORCE_HELP)
+    experiment.add_argument("--staging-dir", default=None, help=STAGING_HELP)
     experiment.set_defaults(func=_cmd_experiment)
 
     plugins = sub.add_parser("plugins", help="list installed plugins by interface")
@@ -148,7 +176,44 @@ def _one_line(message: str) -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point; returns the exit code."""
+    """Entry point; returns the exit code. Ctrl-C at any moment (plugin loading included) prints
+    one line and returns 130."""
+    previous = _catch_interrupts()
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:
+        return _interrupted()
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
+
+
+def _interrupted() -> int:
+    print("mdf: interrupted", file=sys.stderr)
+    return EXIT_INTERRUPTED
+
+
+def _catch_interrupts() -> Any:
+    """The first Ctrl-C raises KeyboardInterrupt (the command cleans up: staging folders, the
+    lock, worker processes) and prints one line; a second one during that clean-up ends the
+    process at once with the same line (the next command on the folder removes what is left).
+    Returns the handler to restore, or None where signals cannot be handled (not the main
+    thread)."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+
+    def again(signum: int, frame: Any) -> None:
+        os.write(2, b"mdf: interrupted\n")
+        os._exit(EXIT_INTERRUPTED)
+
+    def first(signum: int, frame: Any) -> None:
+        signal.signal(signal.SIGINT, again)
+        raise KeyboardInterrupt
+
+    return signal.signal(signal.SIGINT, first)
+
+
+def _main(argv: Sequence[str] | None) -> int:
     debug = "--debug" in (sys.argv[1:] if argv is None else argv)
     try:
         parser = build_parser()
@@ -170,9 +235,6 @@ def main(argv: Sequence[str] | None = None) -> int:
             traceback.print_exc()
         print(f"mdf: error: {_one_line(str(exc))}", file=sys.stderr)
         return EXIT_USAGE
-    except KeyboardInterrupt:
-        print("mdf: interrupted", file=sys.stderr)
-        return 130
     except Exception as exc:
         if args.debug:
             raise

@@ -16,7 +16,10 @@ followed by the seven features. ``build_dataset`` writes::
 Records are independent pure functions of their spec (including a seed derived from the
 dataset seed and the record's index), so the result is identical whatever the number of workers
 or the scheduler. A killed build, run again, keeps every complete record, removes temp files and
-redoes records whose file is missing or unreadable.
+redoes records whose file is missing or unreadable. It resumes only into a folder built from the
+same config (the marker ``.mdf-dataset.json`` holds it; a different config is an error naming
+the difference, or with ``force`` a rebuild that keeps the old dataset whole until the new index
+is written). The folder rules are those of :mod:`mdframework.outdir`.
 """
 
 from __future__ import annotations
@@ -27,9 +30,9 @@ import io
 import itertools
 import json
 import os
-import tempfile
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Generator, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from contextlib import AbstractContextManager, closing
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -37,12 +40,13 @@ from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import Field, ValidationError, model_validator
+from pydantic import Field, ValidationError, field_validator, model_validator
 
 from .config import format_validation_error, read_config_file, validate_run_config
-from .errors import ConfigError, MdfError
+from .errors import ConfigError, MdfError, OutputError
 from .features import FEATURE_NAMES, spectrogram_features
 from .interfaces import Motion
+from .outdir import OutputFolder, atomic_savez, atomic_write_text, output_folder
 from .pipeline import build_stages, load_motion, simulate_motion
 from .settings import StrictModel
 
@@ -51,6 +55,10 @@ RECORDS = "records"
 TEXT_COLUMNS = ("id", "label", "group", "source", "file")
 INDEX = "index.csv"
 MANIFEST = "dataset.json"
+#: every name a dataset build writes in its folder
+DATASET_FILES = (RECORDS, INDEX, MANIFEST)
+#: build options that do not change a dataset (ignored when comparing configs)
+BUILD_OPTIONS = ("workers", "scheduler")
 
 
 class FeatureConfig(StrictModel):
@@ -83,6 +91,15 @@ class SourceEntry(StrictModel):
         description="Run-config sections for this source only, merged over `base` (e.g. "
         "conditioning for Kinect recordings, or its own scene).",
     )
+
+    @field_validator("label", "group")
+    @classmethod
+    def _printable(cls, value: str | None) -> str | None:
+        if value is not None and (not value.strip() or not value.isprintable()):
+            raise ValueError(
+                "must be a non-empty name without control characters (tabs, line breaks)"
+            )
+        return value
 
 
 class Variations(StrictModel):
@@ -320,7 +337,7 @@ def build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         },
         "run_config": json.loads(cfg.model_dump_json()),
     }
-    _atomic_savez(
+    atomic_savez(
         Path(out_dir) / RECORDS / f"{spec.record_id}.npz",
         spectrogram_db=result.spectrogram_db.astype(np.float32),
         velocity_mps=result.velocity,
@@ -352,26 +369,6 @@ def _row(meta: dict[str, Any], feats: NDArray[np.float64]) -> dict[str, Any]:
     return row
 
 
-def _atomic_savez(path: Path, **arrays: Any) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".npz", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            np.savez(fh, **arrays)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def _atomic_write_text(path: Path, text: str) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", dir=path.parent)
-    with os.fdopen(fd, "w") as fh:
-        fh.write(text)
-    os.replace(tmp, path)
-
-
 def read_record(path: Path) -> tuple[dict[str, NDArray[Any]], dict[str, Any]]:
     """Arrays and metadata of one record file; raises if it is incomplete or corrupt."""
     with np.load(path) as data:
@@ -394,16 +391,22 @@ def _complete(path: Path) -> dict[str, Any] | None:
 
 def _executor(
     config: DatasetConfig, workers: int | None, scheduler: str | None
-) -> Iterator[Callable[[list[RecordSpec], str], Iterator[dict[str, Any]]]]:
+) -> Generator[Callable[[list[RecordSpec], str], Iterator[dict[str, Any]]], None, None]:
     """Yield a map function running records locally or on Dask (a generator so that clusters
-    are closed afterwards)."""
+    are closed afterwards). Local worker processes end when this process ends, however it ends
+    (:func:`mdframework.workers.die_with_parent`)."""
+    from .workers import die_with_parent, stop_pool
+
     address = scheduler or config.scheduler
     n = workers or config.workers or os.cpu_count() or 1
     if address is None:
         if n == 1:
             yield lambda specs, out: (build_record(s, out) for s in specs)
             return
-        with ProcessPoolExecutor(max_workers=n) as pool:
+        pool = ProcessPoolExecutor(
+            max_workers=n, initializer=die_with_parent, initargs=(os.getpid(),)
+        )
+        try:
 
             def run_local(specs: list[RecordSpec], out: str) -> Iterator[dict[str, Any]]:
                 futures = [pool.submit(build_record, s, out) for s in specs]
@@ -411,6 +414,10 @@ def _executor(
                     yield fut.result()
 
             yield run_local
+        except BaseException:
+            stop_pool(pool)  # Ctrl-C or an error: do not wait for the queued records
+            raise
+        pool.shutdown()
         return
     try:
         from distributed import Client, LocalCluster
@@ -424,6 +431,10 @@ def _executor(
     )
     client = Client(cluster if cluster is not None else address)
     try:
+        if cluster is not None:
+            from .workers import dask_die_with_parent_plugin
+
+            client.register_plugin(dask_die_with_parent_plugin())
 
         def run_dask(specs: list[RecordSpec], out: str) -> Iterator[dict[str, Any]]:
             futures = client.map(build_record, specs, out_dir=out, pure=False)
@@ -437,6 +448,56 @@ def _executor(
             cluster.close()
 
 
+def dataset_folder(out: str | Path, *, force: bool = False) -> AbstractContextManager[OutputFolder]:
+    """Open ``out`` for a dataset build (see :func:`mdframework.outdir.output_folder`)."""
+    return output_folder(out, "dataset", DATASET_FILES, force=force)
+
+
+def _comparable(config: DatasetConfig) -> dict[str, Any]:
+    """The config as JSON, without the build options that do not change the dataset."""
+    data: dict[str, Any] = json.loads(config.model_dump_json())
+    return {k: v for k, v in data.items() if k not in BUILD_OPTIONS}
+
+
+def _built_from(folder: OutputFolder) -> dict[str, Any] | None:
+    """The config the folder's dataset was (or is being) built from; None for a new folder."""
+    if not folder.previous:
+        return None
+    built = folder.marker.get("config")
+    if built is None and (folder.path / MANIFEST).exists():  # built before markers existed
+        try:
+            built = json.loads((folder.path / MANIFEST).read_text()).get("config")
+        except (OSError, ValueError, AttributeError):
+            built = None
+    if not isinstance(built, dict):
+        return None
+    return {k: v for k, v in built.items() if k not in BUILD_OPTIONS}
+
+
+def config_differences(old: Any, new: Any, where: str = "") -> list[str]:
+    """Dotted names of the fields that differ between two JSON-like configs, with both values
+    (``"variations.aspect_deg: [0.0, 45.0] -> [0.0, 30.0]"``)."""
+    if isinstance(old, dict) and isinstance(new, dict):
+        out = []
+        for key in sorted(set(old) | set(new), key=str):
+            name = f"{where}.{key}" if where else str(key)
+            if key not in old:
+                out.append(f"{name}: new")
+            elif key not in new:
+                out.append(f"{name}: removed")
+            else:
+                out += config_differences(old[key], new[key], name)
+        return out
+    if isinstance(old, list) and isinstance(new, list) and len(old) == len(new):
+        out = []
+        for i, (a, b) in enumerate(zip(old, new, strict=True)):
+            out += config_differences(a, b, f"{where}[{i}]")
+        return out
+    if old == new:
+        return []
+    return [f"{where or 'config'}: {json.dumps(old)} -> {json.dumps(new)}"]
+
+
 def build_dataset(
     config: DatasetConfig,
     base_dir: Path,
@@ -445,33 +506,59 @@ def build_dataset(
     workers: int | None = None,
     scheduler: str | None = None,
     progress: bool = True,
+    force: bool = False,
 ) -> list[dict[str, Any]]:
-    """Build (or finish building) a dataset; returns the index rows in record order."""
+    """Build (or finish building) a dataset; returns the index rows in record order.
+
+    ``out_dir`` must be new, empty, or hold a dataset of the same config (resumed); ``force``
+    also accepts other folders (writing only the dataset's files) and other configs (rebuilt;
+    the old dataset stays whole until the new index is written, then its records are removed).
+    """
     from tqdm import tqdm
 
-    specs = plan_records(config, base_dir)  # errors in the config stop before any file
-    out = Path(out_dir)
-    (out / RECORDS).mkdir(parents=True, exist_ok=True)
-    for stale in (out / RECORDS).glob(".tmp-*"):
-        stale.unlink()
-    rows: dict[str, dict[str, Any]] = {}
-    todo = []
-    for spec in specs:
-        row = _complete(out / RECORDS / f"{spec.record_id}.npz")
-        if row is None:
-            todo.append(spec)
-        else:
-            rows[spec.record_id] = row
-    bar = tqdm(
-        total=len(specs), initial=len(rows), desc="records", unit="rec", disable=not progress
-    )
-    for run in _executor(config, workers, scheduler):
-        for row in run(todo, str(out)):
-            rows[row["id"]] = row
-            bar.update(1)
-    bar.close()
-    ordered = [rows[s.record_id] for s in specs]
-    _write_index(out, ordered, config)
+    with dataset_folder(out_dir, force=force) as folder:
+        specs = plan_records(config, base_dir)  # errors in the config stop before any file
+        out = folder.path
+        wanted = _comparable(config)
+        built = _built_from(folder)
+        ours = folder.previous  # the folder holds an earlier build: its files are ours
+        if built is not None and built != wanted and not force:
+            diff = config_differences(built, wanted)
+            shown = "; ".join(diff[:3]) + (f" and {len(diff) - 3} more" if len(diff) > 3 else "")
+            raise OutputError(
+                f"--out {out}: holds a dataset built from a different config ({shown}); "
+                "choose another folder, or add --force to rebuild it"
+            )
+        folder.write_marker(config=wanted, complete=False)
+        (out / RECORDS).mkdir(exist_ok=True)
+        if ours:
+            for stale in (out / RECORDS).glob(".tmp-*"):
+                stale.unlink()
+        rows: dict[str, dict[str, Any]] = {}
+        todo = []
+        for spec in specs:
+            row = _complete(out / RECORDS / f"{spec.record_id}.npz")
+            if row is None:
+                todo.append(spec)
+            else:
+                rows[spec.record_id] = row
+        bar = tqdm(
+            total=len(specs), initial=len(rows), desc="records", unit="rec", disable=not progress
+        )
+        executor = _executor(config, workers, scheduler)
+        with closing(executor), bar:  # closing: workers stop at once on Ctrl-C or an error
+            for run in executor:
+                for row in run(todo, str(out)):
+                    rows[row["id"]] = row
+                    bar.update(1)
+        ordered = [rows[s.record_id] for s in specs]
+        _write_index(out, ordered, config)
+        if ours:  # records of an earlier config, now that the new index is in place
+            keep = {f"{s.record_id}.npz" for s in specs}
+            for old in (out / RECORDS).glob("*.npz"):
+                if old.name not in keep:
+                    old.unlink()
+        folder.write_marker(config=wanted, complete=True)
     return ordered
 
 
@@ -480,7 +567,7 @@ def _write_index(out: Path, rows: list[dict[str, Any]], config: DatasetConfig) -
     writer = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
     writer.writeheader()
     writer.writerows(rows)
-    _atomic_write_text(out / INDEX, buf.getvalue())
+    atomic_write_text(out / INDEX, buf.getvalue())
     manifest = {
         "n_records": len(rows),
         "feature_names": list(FEATURE_NAMES),
@@ -488,7 +575,7 @@ def _write_index(out: Path, rows: list[dict[str, Any]], config: DatasetConfig) -
         "labels": sorted({r["label"] for r in rows}),
         "config": json.loads(config.model_dump_json()),
     }
-    _atomic_write_text(out / MANIFEST, json.dumps(manifest, indent=2) + "\n")
+    atomic_write_text(out / MANIFEST, json.dumps(manifest, indent=2) + "\n")
 
 
 @dataclass(frozen=True)
