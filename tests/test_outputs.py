@@ -20,6 +20,7 @@ import pytest
 from conftest import EXAMPLES
 
 from mdframework import cli
+from mdframework.dataset import read_record
 from mdframework.outdir import LOCK, safe_name
 
 POINT = EXAMPLES / "point_target.toml"
@@ -410,3 +411,126 @@ def test_files_get_the_umask_permissions(tmp_path: Path, umask: int) -> None:
         for p in [out, *out.rglob("*")]:
             mode = stat.S_IMODE(p.stat().st_mode)
             assert mode == (expected_dir if p.is_dir() else expected_file), (p, oct(mode))
+
+
+# --------------------------------------------------------------------------- processes
+
+
+def descendants(pid: int) -> list[int]:
+    """All processes below ``pid`` (from /proc)."""
+    found = []
+    for task in Path(f"/proc/{pid}/task").glob("*"):
+        try:
+            kids = [int(k) for k in (task / "children").read_text().split()]
+        except OSError:
+            continue
+        for kid in kids:
+            found += [kid, *descendants(kid)]
+    return found
+
+
+def running(pid: int) -> bool:
+    """Alive and not a zombie (an orphan's zombie waits for a reaper that may never come)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state not in ("Z", "X")
+
+
+def long_dataset(tmp_path: Path) -> Path:
+    p = tmp_path / "long.toml"
+    p.write_text(f"""
+[[sources]]
+label = "walk"
+motion = {{ kind = "cmu", file = "{CMU / "asf-amc" / "02_01.amc"}" }}
+hop = 0.05
+[record_lengths]
+walk = 1.0
+[variations]
+aspect_deg = [0.0, 30.0, 60.0]
+[base.processing]
+nfft = 256
+""")
+    return p
+
+
+def start_build(tmp_path: Path, *extra: str) -> tuple[subprocess.Popen[str], Path, list[int]]:
+    """A dataset build with two workers, once both workers exist and a record is written."""
+    out = tmp_path / "ds"
+    args = ["dataset", "build", str(long_dataset(tmp_path)), "--out", str(out), "--no-progress"]
+    proc = mdf_process([*args, "--workers", "2", *extra])
+    deadline = time.monotonic() + 240
+    while time.monotonic() < deadline and proc.poll() is None:
+        workers = descendants(proc.pid)
+        if len(workers) >= 2 and any((out / "records").glob("*.npz")):
+            return proc, out, workers
+        time.sleep(0.1)
+    proc.kill()
+    raise AssertionError(f"the build did not get going: {proc.communicate()[1]}")
+
+
+@pytest.mark.parametrize("scheduler", [[], ["--scheduler", "local"]], ids=["pool", "dask"])
+def test_workers_end_when_the_parent_is_killed(tmp_path: Path, scheduler: list[str]) -> None:
+    if scheduler:
+        pytest.importorskip("distributed")
+    proc, out, workers = start_build(tmp_path, *scheduler)
+    assert all(running(w) for w in workers)
+    os.kill(proc.pid, signal.SIGKILL)  # the parent only, as the out-of-memory killer would
+    proc.wait()
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and any(running(w) for w in workers):
+        time.sleep(0.1)
+    assert not [w for w in workers if running(w)], "workers outlived their parent"
+    # the killed build's lock is stale: the next build takes it over and finishes
+    assert (out / LOCK).exists()
+    args = ["dataset", "build", str(tmp_path / "long.toml"), "--out", str(out), "--no-progress"]
+    again = subprocess.run(
+        [sys.executable, "-m", "mdframework.cli", *args, "--workers", "2"],
+        capture_output=True,
+        text=True,
+    )
+    assert again.returncode == 0, again.stderr
+    assert not (out / LOCK).exists()
+
+
+def test_ctrl_c_during_a_build_is_one_line(tmp_path: Path) -> None:
+    proc, out, workers = start_build(tmp_path)
+    os.killpg(proc.pid, signal.SIGINT)  # Ctrl-C reaches the whole foreground process group
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130
+    assert err.strip() == "mdf: interrupted"
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and any(running(w) for w in workers):
+        time.sleep(0.1)
+    assert not [w for w in workers if running(w)]
+    assert not (out / LOCK).exists()
+    for record in (out / "records").glob("[!.]*.npz"):  # every record file is complete
+        read_record(record)
+
+
+@pytest.mark.parametrize("delay", [0.0, 0.05, 0.15, 0.3, 0.6, 1.0, 2.0])
+def test_ctrl_c_during_start_up_is_one_line(tmp_path: Path, delay: float) -> None:
+    """From the moment ``main`` runs (plugin loading, config loading, the simulation), Ctrl-C
+    prints one line and exits 130. ``delay`` counts from the call of ``main``: the child reports
+    when the command-line module is imported (the interpreter's own start and that module's
+    standard-library imports come before any code of mdf can handle a signal)."""
+    script = (
+        "import sys; import mdframework.cli as c; print('ready', flush=True); "
+        "sys.exit(c.main(sys.argv[1:]))"
+    )
+    out = tmp_path / "o"
+    proc = subprocess.Popen(
+        [sys.executable, "-c", script, "run", str(POINT), "--out", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    assert proc.stdout is not None and proc.stdout.readline().strip() == "ready"
+    time.sleep(delay)
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    assert err.strip() == "mdf: interrupted"
+    assert not (out / LOCK).exists()

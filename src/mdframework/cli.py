@@ -20,7 +20,9 @@ from pathlib import Path
 from typing import Any
 
 from .errors import DataFileError, MdfError, OutputError
-from .plugins import INTERFACES, PluginError, default_registry, make_plugin_manager
+
+# Only light imports at the top: everything heavy (numpy, pydantic, the plugins) is imported once
+# main() has installed its Ctrl-C handling.
 
 EXIT_USAGE = 2
 EXIT_INTERRUPTED = 130
@@ -55,6 +57,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _cmd_plugins(args: argparse.Namespace) -> int:
+    from .plugins import INTERFACES, default_registry
+
     registry = default_registry()
     for interface in INTERFACES:
         print(f"{interface}:")
@@ -167,6 +171,8 @@ def build_parser() -> argparse.ArgumentParser:
     schema = config_sub.add_parser("schema", help="print the JSON schema of run configs")
     schema.set_defaults(func=_cmd_schema)
 
+    from .plugins import make_plugin_manager
+
     make_plugin_manager().hook.mdframework_add_cli_commands(subparsers=sub)
     return parser
 
@@ -214,6 +220,8 @@ def _catch_interrupts() -> Any:
 
 
 def _main(argv: Sequence[str] | None) -> int:
+    from .plugins import PluginError
+
     debug = "--debug" in (sys.argv[1:] if argv is None else argv)
     try:
         parser = build_parser()

@@ -394,7 +394,8 @@ def _executor(
 ) -> Generator[Callable[[list[RecordSpec], str], Iterator[dict[str, Any]]], None, None]:
     """Yield a map function running records locally or on Dask (a generator so that clusters
     are closed afterwards). Local worker processes end when this process ends, however it ends
-    (:func:`mdframework.workers.die_with_parent`)."""
+    (:func:`mdframework.workers.die_with_parent` for the process pool; a local Dask cluster's
+    workers watch their parent themselves; both tested by killing the parent)."""
     from .workers import die_with_parent, stop_pool
 
     address = scheduler or config.scheduler
@@ -431,10 +432,6 @@ def _executor(
     )
     client = Client(cluster if cluster is not None else address)
     try:
-        if cluster is not None:
-            from .workers import dask_die_with_parent_plugin
-
-            client.register_plugin(dask_die_with_parent_plugin())
 
         def run_dask(specs: list[RecordSpec], out: str) -> Iterator[dict[str, Any]]:
             futures = client.map(build_record, specs, out_dir=out, pure=False)

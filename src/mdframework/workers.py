@@ -1,11 +1,12 @@
 """Worker processes that never outlive the command that started them.
 
-A dataset build runs records in local worker processes (a process pool or a local Dask
-cluster). If the command is killed (``kill -9``, a closed terminal, an out-of-memory kill), its
-workers must not linger: each worker asks the kernel to kill it when its parent process dies
-(Linux ``PR_SET_PDEATHSIG``) and, as a fallback on other systems, watches its parent from a
-thread and exits when it is gone. Ctrl-C is the command's to handle: workers ignore it, and the
-command stops them (:func:`stop_pool`) and prints one line.
+A dataset build runs records in local worker processes (a process pool, or a local Dask
+cluster whose workers end with their parent by themselves). If the command is killed (``kill
+-9``, a closed terminal, an out-of-memory kill), its pool workers must not linger: each asks the
+kernel to kill it when its parent process dies (Linux ``PR_SET_PDEATHSIG``) and, as a fallback on
+other systems, watches its parent from a thread and exits when it is gone. Ctrl-C is the
+command's to handle: workers ignore it, and the command stops them (:func:`stop_pool`) and
+prints one line.
 """
 
 from __future__ import annotations
@@ -73,17 +74,3 @@ def stop_pool(pool: ProcessPoolExecutor) -> None:
         proc.terminate()
     for proc in processes.values():
         proc.join(timeout=5)
-
-
-def dask_die_with_parent_plugin() -> Any:
-    """A Dask worker plugin that makes each worker process of a local cluster end with the
-    process that started it (see :func:`die_with_parent`)."""
-    from distributed.diagnostics.plugin import WorkerPlugin
-
-    class DieWithParent(WorkerPlugin):
-        name = "mdf-die-with-parent"
-
-        def setup(self, worker: Any) -> None:
-            die_with_parent(ignore_interrupt=False)
-
-    return DieWithParent()
