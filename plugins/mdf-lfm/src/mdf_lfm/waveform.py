@@ -24,15 +24,16 @@ from typing import Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from mdframework import PluginConfig, RadarWaveform, Received
+from mdframework import RadarWaveform, Received
 from mdframework.constants import SPEED_OF_LIGHT
 from mdframework.physics import radar
+from mdframework.settings import RadarPowerConfig
 
 #: Pulses per block on the raw path (bounds memory to ~ block x n_fast complex samples).
 RAW_BLOCK = 1024
 
 
-class LfmConfig(PluginConfig):
+class LfmConfig(RadarPowerConfig):
     """LFM pulse-Doppler radar. Defaults: the paper's radar (15 GHz, 150 MHz, PRF 2400 Hz)."""
 
     kind: Literal["lfm"] = "lfm"
@@ -40,10 +41,6 @@ class LfmConfig(PluginConfig):
     bandwidth: float = Field(150e6, gt=0, description="Chirp bandwidth [Hz].")
     prf: float = Field(2400.0, gt=0, description="Pulse repetition frequency [Hz].")
     pulse_width: float = Field(1e-6, gt=0, description="Pulse length tau [s].")
-    transmit_power: float = Field(1.0, gt=0, description="Peak transmit power [W].")
-    gain_dbi: float = Field(0.0, description="Antenna gain (transmit = receive) [dBi].")
-    system_loss_db: float = Field(0.0, ge=0, description="System loss L_s [dB].")
-    atmospheric_loss_db: float = Field(0.0, ge=0, description="Atmospheric loss L_a [dB].")
     path: Literal["analytic", "raw"] = Field(
         "analytic", description="analytic: closed-form compressed return; raw: sampled chirps."
     )
@@ -93,17 +90,9 @@ class LfmPulseDoppler(RadarWaveform):
         return self.config.prf
 
     def amplitudes(self, ranges: np.ndarray, rcs: np.ndarray) -> np.ndarray:
-        """Range-equation amplitudes [sqrt(W)], same shape as ``ranges``."""
-        c = self.config
-        return radar.range_equation_amplitude(
-            rcs,
-            ranges,
-            wavelength=radar.wavelength(c.carrier_frequency),
-            transmit_power=c.transmit_power,
-            gain=10.0 ** (c.gain_dbi / 10.0),
-            system_loss=10.0 ** (c.system_loss_db / 10.0),
-            atmospheric_loss=10.0 ** (c.atmospheric_loss_db / 10.0),
-        )
+        """Scatterer amplitudes [sqrt(W)] (range equation or sqrt(rcs), ``amplitude``), same
+        shape as ``ranges``."""
+        return self.config.amplitudes(rcs, ranges, radar.wavelength(self.config.carrier_frequency))
 
     def receive(self, ranges: np.ndarray, rcs: np.ndarray, gate_range: np.ndarray) -> Received:
         """Compressed slow-time return at the gate (and a range-time map on the raw path)."""
