@@ -180,6 +180,13 @@ class RadarWaveform(Plugin):
         ``gate_range``: (n_pulses,) float64 [m], the range gate to report in ``signal``.
         """
 
+    def gate_gain(self, ranges: FloatArray, gate_range: FloatArray) -> FloatArray | None:
+        """Power gain (n_pulses, n_scatterers) of each scatterer in the range gate of
+        ``Received.signal`` (1 at the gate, 0 outside it), for the empty-result check
+        (:mod:`mdframework.emptiness`). Default None: the radar has no single range gate, and
+        no scatterer counts as lost to gating."""
+        return None
+
 
 # --------------------------------------------------------------------------- classifiers
 

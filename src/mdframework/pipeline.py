@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from . import conditioning
+from . import conditioning, emptiness
 from .errors import SceneError
 from .interfaces import (
     Effect,
@@ -38,6 +38,10 @@ FloatArray = NDArray[np.float64]
 
 class AliasingWarning(UserWarning):
     """A scatterer moves faster than the PRF can represent without Doppler aliasing."""
+
+
+class EmptyResultWarning(UserWarning):
+    """The record holds (almost) nothing of the target (see :mod:`mdframework.emptiness`)."""
 
 
 @dataclass(frozen=True)
@@ -193,6 +197,7 @@ def simulate_motion(
 
     clock = time.perf_counter()
     scat = stages.model.scatterers(motion, at_pulses, radar_pos, lam)
+    rcs_model = scat.rcs
     gate = _gate(sc.gate, at_pulses, radar_pos)
     effects_ran: list[dict[str, Any]] = []
     seeds = np.random.SeedSequence(config.seed).spawn(len(stages.effects) + 1)
@@ -223,7 +228,10 @@ def simulate_motion(
 
     clock = time.perf_counter()
     received = wf.receive(ranges, scat.rcs, gate)
+    losses = emptiness.count_losses(ranges, gate, rcs_model, scat.rcs, wf.gate_gain(ranges, gate))
+    echo = received.signal
     received = _apply_effects(stages, "received", received, context, effects_ran)
+    _check_empty(echo, losses, proc, fixed_gate=sc.gate != "track")
     timings["receive"] = time.perf_counter() - clock
 
     clock = time.perf_counter()
@@ -307,6 +315,22 @@ def _check_ranges(ranges: FloatArray, scat: Scatterers, t: FloatArray, min_range
             f"t = {t[p] - t[0]:.3f} s (scene.min_range = {min_range:g} m): the range equation "
             "and far-field RCS do not hold there"
         )
+
+
+def _check_empty(
+    echo: NDArray[np.complex128], losses: emptiness.Losses, proc: Any, *, fixed_gate: bool
+) -> None:
+    """Warn (or stop, with ``processing.empty = "error"``) when the record is empty."""
+    why = emptiness.empty_result(
+        echo, losses, max_lost_fraction=proc.max_lost_fraction, fixed_gate=fixed_gate
+    )
+    if why is None:
+        return
+    if proc.empty == "error":
+        raise SceneError(f"{why} (processing.empty = 'error')")
+    warnings.warn(
+        f"{why} (processing.empty = 'error' makes this an error)", EmptyResultWarning, stacklevel=3
+    )
 
 
 def _max_radial_speed(ranges: FloatArray, prf: float) -> float:

@@ -169,6 +169,20 @@ class ProcessingConfig(StrictModel):
         "warn",
         description="When a scatterer's radial speed exceeds lambda*PRF/4: warn, or stop.",
     )
+    empty: Literal["warn", "error"] = Field(
+        "warn",
+        description="When the result is empty (an all-zero or underflowed echo, or more than "
+        "max_lost_fraction of the scatterer returns lost to the range gate or to the scene "
+        "effects): warn with the cause, or stop.",
+    )
+    max_lost_fraction: float = Field(
+        0.5,
+        gt=0,
+        le=1,
+        description="Largest share of scatterer returns (scatterer x pulse) that may be lost "
+        "(weighted by -20 dB or less by the range gate or the scene effects) before the result "
+        "counts as empty.",
+    )
 
     @model_validator(mode="after")
     def _check(self) -> ProcessingConfig:

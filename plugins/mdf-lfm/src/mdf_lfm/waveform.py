@@ -113,6 +113,19 @@ class LfmPulseDoppler(RadarWaveform):
             return Received(signal)
         return self._receive_raw(ranges, amp, gate_range)
 
+    def gate_gain(self, ranges: np.ndarray, gate_range: np.ndarray) -> np.ndarray:
+        """Power gain of each scatterer in the range gate: the squared gate weight of the
+        analytic path's response (the raw path reads the exact compressed envelope)."""
+        c = self.config
+        w = radar.gate_weights(
+            ranges,
+            gate_range,
+            pulse_width=c.pulse_width,
+            bandwidth=c.bandwidth,
+            response=c.gate_response if c.path == "analytic" else "exact",
+        )
+        return np.asarray(w * w, dtype=np.float64)
+
     def _receive_float32(
         self, ranges: np.ndarray, amp: np.ndarray, gate_range: np.ndarray
     ) -> np.ndarray:
