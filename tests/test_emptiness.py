@@ -9,6 +9,7 @@ import pytest
 
 from mdframework import cli
 from mdframework.emptiness import LOST_GAIN, MIN_POWER_W, Losses, count_losses, empty_result
+from mdframework.settings import ProcessingConfig
 
 POINT = """
 [motion]
@@ -131,3 +132,12 @@ def test_attenuation_underflow_with_snr_noise_is_all_zeros(
     assert "empty result: the received signal is all zeros: the scene effects" in err
     with np.load(out / "result.npz") as d:
         assert not np.any(d["signal"])  # the noise in SNR mode is zero too: truly empty
+    # the getting-started page quotes this very warning, and the limits it states
+    from conftest import ROOT
+
+    page = (ROOT / "docs" / "getting-started.md").read_text()
+    quoted = page.split("```text\n", 1)[1].split("```", 1)[0]
+    assert " ".join(quoted.split()) == err.strip()
+    assert "(below 2.2e-308 W)" in page and f"{MIN_POWER_W:.2g}" == "2.2e-308"
+    assert "(default 0.5)" in page and ProcessingConfig().max_lost_fraction == 0.5
+    assert "-20 dB" in page and LOST_GAIN == 10 ** (-20 / 10)
