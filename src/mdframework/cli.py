@@ -94,7 +94,10 @@ def _cmd_dataset_build(args: argparse.Namespace) -> int:
             progress=not args.no_progress,
             force=args.force,
         )
-    print(f"{len(rows)} records in {args.out}")
+    manifest = json.loads((Path(args.out) / "dataset.json").read_text())
+    skipped = manifest.get("n_skipped", 0)
+    note = f"; {skipped} skipped, see {Path(args.out) / 'skipped.csv'}" if skipped else ""
+    print(f"{len(rows)} records in {args.out}{note}")
     return 0
 
 
