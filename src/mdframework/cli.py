@@ -187,14 +187,15 @@ def _one_line(message: str) -> str:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point; returns the exit code. Ctrl-C at any moment (plugin loading included) prints
     one line and returns 130."""
-    previous = _catch_interrupts()
     try:
-        return _main(argv)
+        previous = _catch_interrupts()
+        try:
+            return _main(argv)
+        finally:
+            if previous is not None:
+                signal.signal(signal.SIGINT, previous)
     except KeyboardInterrupt:
         return _interrupted()
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGINT, previous)
 
 
 def _interrupted() -> int:

@@ -53,10 +53,10 @@ from pydantic import Field, ValidationError, field_validator, model_validator
 
 from .augment import augment_motion
 from .config import format_validation_error, read_config_file, validate_run_config
-from .errors import ConfigError, MdfError, OutputError, SceneError
+from .errors import ConfigError, DataFileError, MdfError, OutputError, SceneError
 from .features import FEATURE_NAMES, spectrogram_features
 from .interfaces import Motion, RadarRecordingSource, Recording
-from .outdir import OutputFolder, atomic_savez, atomic_write_text, output_folder
+from .outdir import OutputFolder, atomic_savez, atomic_write_text, output_folder, safe_name
 from .pipeline import build_stages, load_motion, simulate_motion
 from .plugins import default_registry
 from .pointcloud import (
@@ -1119,7 +1119,9 @@ def load_dataset(
     hists: list[NDArray[np.float32] | None] | None = [] if histograms else None
     if spectrograms or histograms:
         maps = []
-        for rid in table["id"]:
+        for line, rid in enumerate(table["id"], start=2):
+            if safe_name(str(rid)) != rid:  # a record id names a file inside records/ only
+                raise DataFileError(index, f"record id {str(rid)!r} is not a plain name", line)
             arrays, _ = read_record(root / RECORDS / f"{rid}.npz")
             maps.append(arrays["spectrogram_db"])
             velocity = arrays["velocity_mps"] if velocity is None else velocity

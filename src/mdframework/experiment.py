@@ -57,6 +57,7 @@ EXPERIMENT_FILES = (
     "summary.json",
     "within_*",
     "cross_confusion.*",
+    "train_test_confusion.*",
     "feature_stats.*",
     "scatter_*.png",
     "dataset",
