@@ -21,6 +21,7 @@ if TYPE_CHECKING:
         Motion,
         MotionSource,
         PluginConfig,
+        PulseBlock,
         RadarRecordingSource,
         RadarWaveform,
         Received,
@@ -28,6 +29,7 @@ if TYPE_CHECKING:
         ScattererModel,
         Scatterers,
         SceneContext,
+        receive_points,
     )
     from .settings import DataPath, MotionConfig
     from .skeleton import CANONICAL_JOINTS, CANONICAL_SEGMENTS, Skeleton, to_canonical
@@ -45,6 +47,7 @@ _EXPORTS = {
     "Motion": "interfaces",
     "MotionSource": "interfaces",
     "PluginConfig": "interfaces",
+    "PulseBlock": "interfaces",
     "RadarRecordingSource": "interfaces",
     "RadarWaveform": "interfaces",
     "Received": "interfaces",
@@ -52,6 +55,7 @@ _EXPORTS = {
     "ScattererModel": "interfaces",
     "Scatterers": "interfaces",
     "SceneContext": "interfaces",
+    "receive_points": "interfaces",
     "DataPath": "settings",
     "MotionConfig": "settings",
     "CANONICAL_JOINTS": "skeleton",
@@ -89,6 +93,7 @@ __all__ = [
     "MotionConfig",
     "MotionSource",
     "PluginConfig",
+    "PulseBlock",
     "RadarRecordingSource",
     "RadarWaveform",
     "Received",
@@ -99,5 +104,6 @@ __all__ = [
     "SceneError",
     "Skeleton",
     "hookimpl",
+    "receive_points",
     "to_canonical",
 ]

@@ -12,8 +12,9 @@ The checks, in order:
 2. **no power**: the echo's mean power is below :data:`MIN_POWER_W` (float64's smallest normal
    number: the echoes underflowed);
 3. **lost scatterers**: more than ``max_lost_fraction`` of the scatterer returns (one per
-   scatterer and pulse) are lost, i.e. weighted by :data:`LOST_GAIN` or less (-20 dB) by the
-   range gate, or cut to that by the scatterer-stage effects (shadowing, attenuation).
+   scatterer and pulse, counted on every :data:`SAMPLE_EVERY`-th pulse) are lost, i.e. weighted
+   by :data:`LOST_GAIN` or less (-20 dB) by the range gate, or cut to that by the
+   scatterer-stage effects (shadowing, attenuation, antenna pattern).
 """
 
 from __future__ import annotations
@@ -27,6 +28,8 @@ FloatArray = NDArray[np.float64]
 
 #: a scatterer return weighted by this power gain or less (-20 dB) counts as lost
 LOST_GAIN = 0.01
+#: the pipeline counts lost returns on every this many-th pulse (the share, not every pulse)
+SAMPLE_EVERY = 8
 #: an echo whose mean power [W] is below this has underflowed (float64's smallest normal)
 MIN_POWER_W = float(np.finfo(np.float64).tiny)
 

@@ -26,6 +26,7 @@ import csv
 import io
 import json
 from collections.abc import Callable, Sequence
+from functools import partial
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -539,8 +540,11 @@ def _report(
     out: Path,
 ) -> dict[str, Any]:
     """Run the experiments on ``data`` (classifier inputs ``x_all`` named ``names``) and write
-    every report file into ``out``."""
+    every report file into ``out``. The figures are drawn together at the end, once every number
+    is computed (matplotlib loads only then)."""
     from .figures import plot_confusion, plot_feature_scatter
+
+    figures: list[Callable[[], None]] = []  # drawn at the end
 
     summary: dict[str, Any] = {
         "dataset": str(data_dir),
@@ -602,12 +606,15 @@ def _report(
                 ]
             )
         )
-        plot_confusion(
-            out / f"{stem}_confusion.png",
-            classes,
-            res["confusion_mean"],
-            res["confusion_std"],
-            title=f"{group}: within-source",
+        figures.append(
+            partial(
+                plot_confusion,
+                out / f"{stem}_confusion.png",
+                classes,
+                res["confusion_mean"],
+                res["confusion_std"],
+                title=f"{group}: within-source",
+            )
         )
         summary["within"][group] = {
             k: v for k, v in res.items() if k not in ("confusion_mean", "confusion_std")
@@ -636,12 +643,15 @@ def _report(
         (out / "cross_confusion.csv").write_text(
             _csv(_matrix_rows(res["classes"], res["confusion"]))
         )
-        plot_confusion(
-            out / "cross_confusion.png",
-            res["classes"],
-            res["confusion"],
-            None,
-            title=f"train {cfg.cross_source.train} -> test {cfg.cross_source.test}",
+        figures.append(
+            partial(
+                plot_confusion,
+                out / "cross_confusion.png",
+                res["classes"],
+                res["confusion"],
+                None,
+                title=f"train {cfg.cross_source.train} -> test {cfg.cross_source.test}",
+            )
         )
         summary["cross"] = {**res, "confusion": res["confusion"].tolist()}
         report += [
@@ -690,16 +700,21 @@ def _report(
     report += ["## Feature statistics", "", md, ""]
     for f1, f2 in cfg.report.scatter_pairs:
         name = f"scatter_{f1}_{f2}.png"
-        plot_feature_scatter(
-            out / name,
-            data.features[:, FEATURE_NAMES.index(f1)],
-            data.features[:, FEATURE_NAMES.index(f2)],
-            data.labels,
-            data.groups,
-            f1,
-            f2,
+        figures.append(
+            partial(
+                plot_feature_scatter,
+                out / name,
+                data.features[:, FEATURE_NAMES.index(f1)],
+                data.features[:, FEATURE_NAMES.index(f2)],
+                data.labels,
+                data.groups,
+                f1,
+                f2,
+            )
         )
         report += [f"![{f1} vs {f2}]({name})", ""]
+    for draw in figures:
+        draw()
     (out / "report.md").write_text("\n".join(report))
     (out / "summary.json").write_text(json.dumps(summary, indent=2, default=str) + "\n")
     return summary
