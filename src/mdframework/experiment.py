@@ -25,6 +25,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+from collections import Counter
 from collections.abc import Callable, Sequence
 from functools import partial
 from pathlib import Path
@@ -33,7 +34,6 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field, ValidationError, model_validator
-from sklearn.model_selection import StratifiedShuffleSplit
 
 from .classify import (
     Selection,
@@ -50,6 +50,7 @@ from .interfaces import Classifier
 from .outdir import output_folder, safe_name
 from .plugins import Registry, default_registry
 from .pointcloud import histogram_vector, histogram_vector_names, velocity_bins
+from .progress import note
 from .settings import StrictModel
 
 #: every name an experiment writes in its folder (group names are made safe by ``safe_name``)
@@ -188,7 +189,7 @@ def load_experiment_config(path: str | Path) -> ExperimentConfig:
     try:
         cfg = ExperimentConfig.model_validate(data)
     except ValidationError as exc:
-        raise ConfigError(format_validation_error(exc, str(p), data)) from None
+        raise ConfigError(format_validation_error(exc, str(p), data, ExperimentConfig)) from None
     if cfg.input == "histogram" and cfg.selection.method != "none":
         raise ConfigError(f"{p}: input = 'histogram' needs selection.method = 'none'")
     for pair in cfg.report.scatter_pairs:
@@ -212,7 +213,7 @@ def classifier_factory(
         cfg = cls.Config.model_validate(section)
     except ValidationError as exc:
         raise ConfigError(
-            format_validation_error(exc, source, section).replace(
+            format_validation_error(exc, source, section, cls.Config).replace(
                 f"{source}: ", f"{source}: classifier.", 1
             )
         ) from None
@@ -350,10 +351,12 @@ def within_source(
     y: NDArray[Any],
     recordings: NDArray[Any] | None = None,
     names: Sequence[str] = FEATURE_NAMES,
+    progress: str | None = None,
 ) -> dict[str, Any]:
     """Repeated stratified splits of one group's records; returns matrices and scores.
     ``recordings`` (n_records,) names each record's source file (for ``split = 'recording'``);
-    ``names`` the columns of ``x``."""
+    ``names`` the columns of ``x``; ``progress``: a progress bar with this label over the
+    splits (on stderr), or none."""
     classes = sorted(set(y.tolist()))
     ev = cfg.evaluation
     if ev.split == "groups":
@@ -365,12 +368,17 @@ def within_source(
             raise MdfError("evaluation.split = 'recording' needs each record's recording")
         splits = recording_splits(y, recordings, ev.repeats, ev.test_fraction, cfg.seed)
     else:
+        from sklearn.model_selection import StratifiedShuffleSplit
+
         splitter = StratifiedShuffleSplit(
             n_splits=ev.repeats, test_size=ev.test_fraction, random_state=cfg.seed
         )
         splits = list(splitter.split(x, y))
     mats, accs, optimistic, subsets = [], [], [], []
-    for rep, (train, test) in enumerate(splits):
+    from tqdm import tqdm
+
+    bar = tqdm(splits, desc=progress, unit="split", disable=progress is None, leave=False)
+    for rep, (train, test) in enumerate(bar):
         sel = _select(cfg, factory, x[train], y[train], cfg.seed + rep)
         pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
         mats.append(confusion_matrix(y[test], pred, classes))
@@ -499,6 +507,21 @@ def classifier_inputs(
     return data, x, list(histogram_vector_names(centres))
 
 
+def selected_features_markdown(subsets: Sequence[Sequence[str]], method: str) -> list[str]:
+    """Report lines saying which inputs feature selection chose: how often each was chosen over
+    the splits, and the most frequent subset."""
+    if method == "none" or not subsets:
+        return ["Inputs: all (no feature selection).", ""]
+    counts = Counter(name for subset in subsets for name in subset)
+    per_feature = ", ".join(f"{name} {n}" for name, n in counts.most_common())
+    best, times = Counter(tuple(s) for s in subsets).most_common(1)[0]
+    return [
+        f"Selected features (times chosen in {len(subsets)} splits): {per_feature}; most "
+        f"frequent subset: {', '.join(best)} ({times} of {len(subsets)}).",
+        "",
+    ]
+
+
 def run_experiment(
     cfg: ExperimentConfig,
     out_dir: Path,
@@ -523,9 +546,10 @@ def run_experiment(
         else:
             assert cfg.dataset.path is not None
             data_dir = cfg.dataset.path
+        note(f"loading the dataset {data_dir}", progress)
         data, x_all, names = classifier_inputs(cfg, data_dir)
         stage = folder.stage()
-        summary = _report(cfg, factory, data, x_all, names, data_dir, stage)
+        summary = _report(cfg, factory, data, x_all, names, data_dir, stage, progress)
         folder.commit(stage, keep=("dataset",))  # a built dataset is never deleted
     return summary
 
@@ -538,6 +562,7 @@ def _report(
     names: list[str],
     data_dir: Path,
     out: Path,
+    progress: bool = True,
 ) -> dict[str, Any]:
     """Run the experiments on ``data`` (classifier inputs ``x_all`` named ``names``) and write
     every report file into ``out``. The figures are drawn together at the end, once every number
@@ -580,6 +605,7 @@ def _report(
                 data.labels[mask],
                 np.array([_text(v) for v in data.table[column][mask]]),
                 names,
+                progress=f"within {group}" if progress else None,
             )
         except MdfError as exc:  # e.g. a class with a single recording cannot be held out
             report += [f"## Within-source: {group}", "", f"Not evaluated: {exc}.", ""]
@@ -630,6 +656,7 @@ def _report(
             "",
             _markdown_matrix(classes, res["confusion_mean"], res["confusion_std"]),
             "",
+            *selected_features_markdown(res["subsets"], cfg.selection.method),
         ]
         if opt is not None:
             report += [
@@ -693,6 +720,7 @@ def _report(
             "![train/test](train_test_confusion.png)",
             "",
         ]
+    note("feature statistics and figures", progress)
     stats = feature_statistics(data)
     (out / "feature_stats.csv").write_text(_csv(stats))
     md = _stats_markdown(stats)
