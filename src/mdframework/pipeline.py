@@ -35,7 +35,7 @@ from .interfaces import (
 )
 from .physics import interpolation, radar, scene
 from .physics.spectrogram import RecordTooShortError, Spectrogram, power_to_db, spectrogram
-from .plugins import Registry, default_registry
+from .plugins import PluginError, Registry, default_registry
 from .settings import ConditioningConfig, PersonConfig, RunConfigBase, SanityConfig
 from .skeleton import Skeleton
 
@@ -106,9 +106,16 @@ def build_stages(config: RunConfigBase, registry: Registry | None = None) -> Sta
 
 
 def _apply_effects(stages: Stages, stage: str, data: Any, context: SceneContext) -> Any:
+    expected = type(data)
     for effect in stages.effects:
         if effect.stage == stage:
             data = effect.apply(data, context)
+            if not isinstance(data, expected):
+                raise PluginError(
+                    f"effect {effect.name!r} ({type(effect).__module__}.{type(effect).__name__}) "
+                    f"returned {type(data).__name__} from apply() on the {stage!r} stage instead "
+                    f"of {expected.__name__}; check it with mdframework.testing.check_effect"
+                )
     return data
 
 
@@ -435,7 +442,8 @@ class _Stream:
             self._blocks.append(scat)
         if rec.range_time is not None:
             first = (-lo) % self._rt_step
-            self._rt.append(np.asarray(rec.range_time[first :: self._rt_step]))
+            # a copy: a view would keep the whole block's map alive
+            self._rt.append(np.array(rec.range_time[first :: self._rt_step]))
             self._rt_axis = rec.range_axis
         for key, value in rec.products.items():
             self._products.setdefault(key, []).append(np.asarray(value))
