@@ -19,8 +19,6 @@ matplotlib is imported inside the functions that draw.
 
 from __future__ import annotations
 
-import shutil
-import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,7 +29,6 @@ from numpy.typing import NDArray
 
 from .errors import MdfError
 from .figures import COLORMAP, DYNAMIC_RANGE_DB, draw_spectrogram, run_caption, save, style
-from .output import move_in
 from .skeleton import CANONICAL_JOINTS, CANONICAL_SEGMENTS, Skeleton
 
 if TYPE_CHECKING:
@@ -326,23 +323,19 @@ def _ffmpeg() -> str:
     return str(imageio_ffmpeg.get_ffmpeg_exe())
 
 
-#: The files :func:`write_preview` adds to a run's folder (the animation's suffix is its format).
-PREVIEW_FILES = ("motion.gif", "motion.mp4", "skeleton.png")
-
-
-def write_preview(
+def stage_preview(
     result: RunResult,
     resolved_config: Mapping[str, Any],
-    out_dir: Path,
+    stage: Path,
     *,
     fmt: str = "gif",
     fps: int = 12,
     instants: Sequence[float] | None = None,
-) -> list[Path]:
+) -> None:
     """Write ``motion.<fmt>`` (:func:`animate`) and ``skeleton.png`` (:func:`plot_stills`) of a
-    run into ``out_dir``: both are made in a temporary folder beside it and moved in only when
-    both succeeded. The body is ``result.body`` (times from the first pulse); the figures carry
-    the run's title and caption and its ``[figures]`` options. Returns the written paths."""
+    run into the staging folder ``stage`` (``mdf show`` commits them with the run's files). The
+    body is ``result.body`` (times from the first pulse); the figures carry the run's title and
+    caption and its ``[figures]`` options."""
     if fmt not in FORMATS:
         raise PreviewError(f"--format: {fmt!r} is not one of {', '.join(FORMATS)}")
     body = result.body
@@ -359,12 +352,5 @@ def write_preview(
     )
     gate = (float(result.gate_range[0]), float(result.gate_range[-1]))
     title, caption = run_caption(result.metadata, resolved_config, gate)
-    out_dir = Path(out_dir)
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.preview.", dir=out_dir.parent))
-    try:
-        animate(stage / f"motion.{fmt}", body, radar, spec, fps=fps, title=title, caption=caption)
-        plot_stills(stage / "skeleton.png", body, radar, spec, at, title=title, caption=caption)
-        return move_in(stage, out_dir, PREVIEW_FILES)  # drops an animation in the other format
-    finally:
-        shutil.rmtree(stage, ignore_errors=True)
+    animate(stage / f"motion.{fmt}", body, radar, spec, fps=fps, title=title, caption=caption)
+    plot_stills(stage / "skeleton.png", body, radar, spec, at, title=title, caption=caption)
