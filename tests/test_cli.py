@@ -83,7 +83,7 @@ BAD_CONFIGS = {
     "field.toml": (
         '[motion]\nkind = "point_targets"\nlength = 1.0\n'
         "targets = [{ position = [10, 0, 0] }]\n[radar]\nkind = 'lfm'\nprf = -5\n",
-        "radar.prf: Input should be greater than 0",
+        "radar.prf: Input should be greater than or equal to 1",
     ),
     "extra.toml": (
         '[motion]\nkind = "point_targets"\nlength = 1.0\nspeed = 3\n'

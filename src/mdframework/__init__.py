@@ -9,6 +9,7 @@ See ``docs/plugins.md`` for writing a plugin distribution.
 
 from __future__ import annotations
 
+from . import limits
 from .errors import ConfigError, DataFileError, MdfError, SceneError
 from .hookspecs import hookimpl
 from .interfaces import (
@@ -49,5 +50,6 @@ __all__ = [
     "SceneError",
     "Skeleton",
     "hookimpl",
+    "limits",
     "to_canonical",
 ]

@@ -93,7 +93,13 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
 
     config = load_experiment_config(args.config)
     with _naming(args.config):
-        run_experiment(config, Path(args.out), source=args.config, progress=not args.no_progress)
+        run_experiment(
+            config,
+            Path(args.out),
+            source=args.config,
+            progress=not args.no_progress,
+            allow_import=args.allow_import,
+        )
     print(Path(args.out) / "report.md")
     return 0
 
@@ -120,7 +126,9 @@ def build_parser() -> argparse.ArgumentParser:
     build.add_argument(
         "--scheduler",
         default=None,
-        help="Dask scheduler address, or 'local' for a local Dask cluster",
+        help="Dask scheduler address, or 'local' for a local Dask cluster (default: the "
+        "MDF_DASK_SCHEDULER environment variable, else local processes; connection timeout "
+        "MDF_DASK_TIMEOUT seconds, default 10)",
     )
     build.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     build.set_defaults(func=_cmd_dataset_build)
@@ -129,6 +137,12 @@ def build_parser() -> argparse.ArgumentParser:
     experiment.add_argument("config", help="experiment config file")
     experiment.add_argument("--out", required=True, help="report folder")
     experiment.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    experiment.add_argument(
+        "--allow-import",
+        action="store_true",
+        help="let the config's classifier name any import path (importing runs that module's "
+        "code: use only with configs you trust); default: scikit-learn's classifiers only",
+    )
     experiment.set_defaults(func=_cmd_experiment)
 
     plugins = sub.add_parser("plugins", help="list installed plugins by interface")

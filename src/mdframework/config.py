@@ -19,10 +19,12 @@ from typing import Annotated, Any, Union
 import yaml
 from pydantic import Field, ValidationError, create_model
 
-from .errors import ConfigError
+from . import limits
+from .errors import ConfigError, SceneError
 from .interfaces import PluginConfig
 from .plugins import Registry, default_registry
 from .settings import RunConfigBase
+from .skeleton import CANONICAL_JOINTS
 
 
 def _union(registry: Registry, interface: str) -> Any:
@@ -35,8 +37,21 @@ def _union(registry: Registry, interface: str) -> Any:
 
 
 def run_config_model(registry: Registry | None = None) -> type[RunConfigBase]:
-    """The run-config model for the plugins in ``registry`` (default: the installed ones)."""
+    """The run-config model for the plugins in ``registry`` (default: the installed ones); the
+    model of the last registry asked for is kept (building one takes tens of milliseconds, and
+    datasets validate one config per record)."""
     reg = registry or default_registry()
+    if _LAST_MODEL and _LAST_MODEL[0][0] is reg:
+        return _LAST_MODEL[0][1]
+    model = _build_run_config_model(reg)
+    _LAST_MODEL[:] = [(reg, model)]
+    return model
+
+
+_LAST_MODEL: list[tuple[Registry, type[RunConfigBase]]] = []
+
+
+def _build_run_config_model(reg: Registry) -> type[RunConfigBase]:
 
     def default(interface: str, name: str) -> Any:
         if name in reg.plugins[interface]:
@@ -61,23 +76,73 @@ def run_config_model(registry: Registry | None = None) -> type[RunConfigBase]:
     return model
 
 
-def read_config_file(path: str | Path) -> dict[str, Any]:
-    """Parse a TOML, YAML or JSON file into a dict; errors name the file and line."""
-    p = Path(path)
+def _decode(p: Path, raw: bytes) -> str:
+    """UTF-8 text, with or without a byte-order mark; anything else is a ConfigError."""
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
+        raise ConfigError(f"{p}: the file is UTF-16; save it as UTF-8")
+    if b"\0" in raw:
+        line = raw[: raw.index(b"\0")].count(b"\n") + 1
+        raise ConfigError(
+            f"{p}: line {line}: a NUL byte: not UTF-8 text (UTF-16 or binary?); save the config "
+            "as UTF-8"
+        )
     try:
-        text = p.read_text(encoding="utf-8")
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        raise ConfigError(
+            f"{p}: line {line}: not UTF-8 text (byte 0x{raw[exc.start]:02x}); save the config "
+            "as UTF-8"
+        ) from None
+
+
+def _check_depth(p: Path, data: Any) -> None:
+    """Refuse tables and lists nested deeper than ``limits.MAX_CONFIG_DEPTH`` (iteratively, so
+    that the check itself cannot overflow the stack)."""
+    stack: list[tuple[Any, int]] = [(data, 1)]
+    while stack:
+        node, depth = stack.pop()
+        if depth > limits.MAX_CONFIG_DEPTH:
+            raise ConfigError(
+                f"{p}: tables and lists are nested more than {limits.MAX_CONFIG_DEPTH} deep"
+            )
+        if isinstance(node, dict):
+            stack.extend((v, depth + 1) for v in node.values())
+        elif isinstance(node, list):
+            stack.extend((v, depth + 1) for v in node)
+
+
+def read_config_file(path: str | Path) -> dict[str, Any]:
+    """Parse a TOML, YAML or JSON file into a dict; errors name the file and line.
+
+    The file must be UTF-8 (a byte-order mark is allowed), at most ``limits.MAX_CONFIG_BYTES``
+    long, with tables and lists nested at most ``limits.MAX_CONFIG_DEPTH`` deep.
+    """
+    p = Path(path)
+    suffix = p.suffix.lower()
+    if suffix not in (".toml", ".yaml", ".yml", ".json"):
+        raise ConfigError(f"{p}: unknown config format {suffix!r} (use .toml, .yaml or .json)")
+    try:
+        size = p.stat().st_size
+        if size > limits.MAX_CONFIG_BYTES:
+            raise ConfigError(
+                f"{p}: {size:,} bytes; a config file may hold at most "
+                f"{limits.MAX_CONFIG_BYTES:,} bytes"
+            )
+        with p.open("rb") as fh:
+            raw = fh.read(limits.MAX_CONFIG_BYTES + 1)
     except OSError as exc:
         raise ConfigError(f"{p}: cannot read: {exc.strerror or exc}") from None
-    suffix = p.suffix.lower()
+    if len(raw) > limits.MAX_CONFIG_BYTES:  # grew while reading, or not a regular file
+        raise ConfigError(f"{p}: a config file may hold at most {limits.MAX_CONFIG_BYTES:,} bytes")
+    text = _decode(p, raw)
     try:
         if suffix == ".toml":
             data: Any = tomllib.loads(text)
-        elif suffix in (".yaml", ".yml"):
-            data = yaml.safe_load(text)
         elif suffix == ".json":
             data = json.loads(text)
         else:
-            raise ConfigError(f"{p}: unknown config format {suffix!r} (use .toml, .yaml or .json)")
+            data = yaml.safe_load(text)
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{p}: invalid TOML: {exc}") from None
     except yaml.YAMLError as exc:
@@ -87,27 +152,51 @@ def read_config_file(path: str | Path) -> dict[str, Any]:
         raise ConfigError(f"{p}: invalid YAML: {where}{problem}") from None
     except json.JSONDecodeError as exc:
         raise ConfigError(f"{p}: invalid JSON: line {exc.lineno}: {exc.msg}") from None
+    except RecursionError:
+        raise ConfigError(
+            f"{p}: tables and lists are nested more than {limits.MAX_CONFIG_DEPTH} deep"
+        ) from None
     if not isinstance(data, dict):
         raise ConfigError(f"{p}: the top level must be a table of sections")
+    _check_depth(p, data)
     return data
 
 
-def format_validation_error(exc: ValidationError, source: str, data: Any = None) -> str:
-    """One line naming the file and the first invalid field (``section.field``)."""
-    errors = exc.errors(include_url=False)
-    first = errors[0]
+def _field_path(loc: tuple[Any, ...], data: Any) -> str:
+    """``section.field`` of an error location, without the tags pydantic inserts for the
+    members of a union (a plugin's ``kind``, or ``literal['track']`` under a number)."""
     parts: list[str] = []
     node = data
-    for part in first["loc"]:
+    for part in loc:
         if isinstance(node, dict) and part not in node and node.get("kind") == part:
             continue  # the discriminator tag pydantic inserts for plugin sections
+        if node is not None and not isinstance(node, dict | list) and isinstance(part, str):
+            continue  # a union member's tag under a scalar value
         parts.append(str(part))
-        node = node.get(part) if isinstance(node, dict) else None
-    more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
+        if isinstance(node, dict):
+            node = node.get(part)
+        elif isinstance(node, list) and isinstance(part, int) and 0 <= part < len(node):
+            node = node[part]
+        else:
+            node = None
+    return ".".join(parts)
+
+
+def format_validation_error(exc: ValidationError, source: str, data: Any = None) -> str:
+    """One line naming the file and the first invalid field (``section.field``); the errors of
+    the members of a union on that field are joined with "or"."""
+    errors = exc.errors(include_url=False)
+    first = errors[0]
+    field = _field_path(first["loc"], data)
+    same = [e for e in errors if _field_path(e["loc"], data) == field]
+    more = len(errors) - len(same)
+    more_text = f" (and {more} more)" if more else ""
     msg = first["msg"]
     if first["type"] == "union_tag_invalid":
         msg = f"unknown kind {first['input'].get('kind')!r}; " + msg.split(";")[-1].strip()
-    return f"{source}: {'.'.join(parts) or '(top level)'}: {msg}{more}"
+    elif len(same) > 1:
+        msg = " or ".join(dict.fromkeys(e["msg"] for e in same))
+    return f"{source}: {field or '(top level)'}: {msg}{more_text}"
 
 
 def load_run_config(path: str | Path, registry: Registry | None = None) -> RunConfigBase:
@@ -127,6 +216,24 @@ def validate_run_config(
     """Validate a config dict; errors are :class:`ConfigError` naming ``source`` and the field."""
     model = run_config_model(registry)
     try:
-        return model.model_validate(data, context={"base_dir": base_dir})
+        config = model.model_validate(data, context={"base_dir": base_dir})
     except ValidationError as exc:
         raise ConfigError(format_validation_error(exc, source, data)) from None
+    _check_pulse_budget(config, source)
+    return config
+
+
+def _check_pulse_budget(config: RunConfigBase, source: str) -> None:
+    """When the config alone fixes the record length, refuse a record of more than
+    ``limits.MAX_PULSES`` pulses now (the pipeline checks the others once the motion is
+    loaded)."""
+    cfg: Any = config
+    length = cfg.motion.known_length() if hasattr(cfg.motion, "known_length") else None
+    prf = getattr(cfg.radar, "prf", None)
+    if length is None or prf is None:
+        return
+    n_points = len(getattr(cfg.motion, "targets", ())) or len(CANONICAL_JOINTS)
+    try:
+        limits.check_pulses(length, prf, n_points, "motion.duration")
+    except SceneError as exc:
+        raise ConfigError(f"{source}: {exc}") from None

@@ -51,15 +51,45 @@ def _default(field: FieldInfo) -> str:
     return f"`{field.default!r}`".replace("(", "[").replace(")", "]")
 
 
+def _number(value: float) -> str:
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def numeric_ranges(schema: dict[str, Any]) -> list[str]:
+    """The intervals of every number in a field's JSON schema (members of unions, items of lists
+    and tuples, values of tables), as ``[lo, hi]`` with round brackets for open ends; a number
+    without a bound on one side gives an infinite end (which ``tests`` refuse)."""
+    found: list[str] = []
+    stack = [schema]
+    while stack:
+        node = stack.pop()
+        if node.get("type") in ("number", "integer"):
+            lo, hi = node.get("minimum"), node.get("maximum")
+            lo_open, hi_open = "exclusiveMinimum" in node, "exclusiveMaximum" in node
+            lo = node.get("exclusiveMinimum", lo)
+            hi = node.get("exclusiveMaximum", hi)
+            left = "(-inf" if lo is None else ("(" if lo_open else "[") + _number(lo)
+            right = "inf)" if hi is None else _number(hi) + (")" if hi_open else "]")
+            found.append(f"{left}, {right}")
+        for key in ("anyOf", "oneOf", "allOf", "prefixItems"):
+            stack.extend(reversed(node.get(key, [])))
+        for key in ("items", "additionalProperties"):
+            if isinstance(node.get(key), dict):
+                stack.append(node[key])
+    return list(dict.fromkeys(found))
+
+
 def model_table(model: type[BaseModel], skip: tuple[str, ...] = ()) -> str:
-    """A Markdown table of a model's fields: name, type, default, description."""
-    rows = ["| field | type | default | description |", "|---|---|---|---|"]
+    """A Markdown table of a model's fields: name, type, default, allowed range, description."""
+    rows = ["| field | type | default | range | description |", "|---|---|---|---|---|"]
+    props = model.model_json_schema().get("properties", {})
     for name, field in model.model_fields.items():
         if name in skip:
             continue
         desc = (field.description or "").replace("|", "\\|").replace("\n", " ")
         typ = _type_name(field.annotation).replace("|", "\\|")
-        rows.append(f"| `{name}` | `{typ}` | {_default(field)} | {desc} |")
+        ranges = " or ".join(numeric_ranges(props.get(field.alias or name, {})))
+        rows.append(f"| `{name}` | `{typ}` | {_default(field)} | {ranges} | {desc} |")
     return "\n".join(rows)
 
 
@@ -73,6 +103,8 @@ def render(registry: Registry | None = None) -> str:
         "Run configs are TOML, YAML or JSON. Unknown fields are errors. Relative paths are",
         "relative to the config file. Units are SI unless a field name says otherwise",
         "(`_deg`, `_db`, `_dbi`). `mdf config schema` prints the same as a JSON schema.",
+        "Every number must be finite and lie in its range (`[a, b]` includes the ends, `(a, b)`",
+        "excludes them); see [input rules](input-rules.md) for the limits and why.",
         "",
         "## Top level",
         "",

@@ -42,7 +42,7 @@ from .errors import ConfigError, MdfError
 from .features import FEATURE_NAMES
 from .interfaces import Classifier
 from .plugins import Registry, default_registry
-from .settings import StrictModel
+from .settings import Seed, StrictModel, Workers
 
 
 class DatasetRef(StrictModel):
@@ -67,7 +67,7 @@ class SelectionConfig(StrictModel):
     sizes: list[Annotated[int, Field(ge=1, le=len(FEATURE_NAMES))]] = Field(
         [4], min_length=1, description="Subset sizes to try (the paper: 4 of 7)."
     )
-    folds: int = Field(5, ge=2, description="Cross-validation folds.")
+    folds: int = Field(5, ge=2, le=100, description="Cross-validation folds.")
     optimistic: bool = Field(
         True, description="Also report the paper's optimistic selection on the test split."
     )
@@ -76,7 +76,7 @@ class SelectionConfig(StrictModel):
 class EvaluationConfig(StrictModel):
     """Repeated stratified splits."""
 
-    repeats: int = Field(10, ge=1, description="Number of random splits.")
+    repeats: int = Field(10, ge=1, le=10_000, description="Number of random splits.")
     test_fraction: float = Field(0.4, gt=0, lt=1, description="Test share (the paper: 40 %).")
     split: Literal["record", "recording"] = Field(
         "record",
@@ -108,7 +108,7 @@ class ReportConfig(StrictModel):
 class ExperimentConfig(StrictModel):
     """An experiment."""
 
-    seed: int = Field(0, ge=0)
+    seed: Seed = Field(0)
     dataset: DatasetRef
     classifier: dict[str, Any] = Field(
         default_factory=lambda: {"kind": "knn"}, description="A [classifier] section."
@@ -117,7 +117,7 @@ class ExperimentConfig(StrictModel):
     evaluation: EvaluationConfig = Field(default_factory=EvaluationConfig)
     cross_source: CrossSourceConfig | None = None
     report: ReportConfig = Field(default_factory=ReportConfig)
-    workers: int | None = Field(None, ge=1, description="Processes for building the dataset.")
+    workers: Workers | None = Field(None, description="Processes for building the dataset.")
 
 
 def load_experiment_config(path: str | Path) -> ExperimentConfig:
@@ -142,9 +142,16 @@ def load_experiment_config(path: str | Path) -> ExperimentConfig:
 
 
 def classifier_factory(
-    section: dict[str, Any], source: str, registry: Registry | None = None
+    section: dict[str, Any],
+    source: str,
+    registry: Registry | None = None,
+    *,
+    allow_import: bool = False,
 ) -> Callable[[], Classifier]:
-    """A factory of fresh classifiers from a [classifier] section (validated once)."""
+    """A factory of fresh classifiers from a [classifier] section (validated once).
+
+    ``allow_import`` (the command line's ``--allow-import``) lets a plugin accept import paths
+    outside its allowlist (the validation context key ``allow_import``)."""
     reg = registry or default_registry()
     kind = section.get("kind")
     try:
@@ -152,7 +159,7 @@ def classifier_factory(
     except KeyError as exc:
         raise ConfigError(f"{source}: classifier.kind: {exc.args[0]}") from None
     try:
-        cfg = cls.Config.model_validate(section)
+        cfg = cls.Config.model_validate(section, context={"allow_import": allow_import})
     except ValidationError as exc:
         raise ConfigError(
             format_validation_error(exc, source, section).replace(
@@ -334,13 +341,15 @@ def run_experiment(
     source: str = "<experiment>",
     progress: bool = True,
     registry: Registry | None = None,
+    allow_import: bool = False,
 ) -> dict[str, Any]:
-    """Build or load the dataset, run the experiments, write the report."""
+    """Build or load the dataset, run the experiments, write the report (``allow_import``: see
+    :func:`classifier_factory`)."""
     from .figures import plot_confusion, plot_feature_scatter
 
+    factory = classifier_factory(cfg.classifier, source, registry, allow_import=allow_import)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    factory = classifier_factory(cfg.classifier, source, registry)
     if cfg.dataset.config is not None:
         dcfg, base = load_dataset_config(cfg.dataset.config)
         build_dataset(dcfg, base, out / "dataset", workers=cfg.workers, progress=progress)

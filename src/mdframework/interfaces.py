@@ -33,9 +33,10 @@ ComplexArray = NDArray[np.complex128]
 
 
 class PluginConfig(BaseModel):
-    """Base of every plugin's config model: unknown fields are errors."""
+    """Base of every plugin's config model: unknown fields are errors, and float fields must be
+    finite (a field that gives ``inf`` a meaning says so with ``Field(allow_inf_nan=True)``)."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
     kind: str
 
 

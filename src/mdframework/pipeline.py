@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from . import conditioning
+from . import conditioning, limits
 from .errors import SceneError
 from .interfaces import (
     Effect,
@@ -184,6 +184,7 @@ def simulate_motion(
     t_start, t_end = _window(body, cfg.motion.start, cfg.motion.duration)
 
     # the spline sees the whole recording, so a record has no end effects of its own
+    limits.check_pulses(t_end - t_start, wf.prf, body.n_joints, "motion.duration")
     t = interpolation.pulse_times(t_start, t_end, wf.prf)
     joints = interpolation.resample_tracks(
         body.time, body.positions, body.valid, t, proc.interpolation

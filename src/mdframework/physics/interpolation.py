@@ -76,5 +76,9 @@ def _interp(t: FloatArray, y: FloatArray, t_out: FloatArray, method: Method) -> 
             return np.asarray(CubicSpline(t, y, axis=0, bc_type="natural")(tq), np.float64)
         return np.asarray(CubicSpline(t, y, axis=0)(tq), dtype=np.float64)
     if method == "pchip":
-        return np.asarray(PchipInterpolator(t, y, axis=0)(tq), dtype=np.float64)
+        # scipy forms the harmonic mean of neighbouring slopes as 1 / (w1/m1 + w2/m2); slopes
+        # below ~1e-300 (a track that all but stands still) overflow the reciprocals to inf,
+        # whose reciprocal, the derivative, is then exactly its limit 0: harmless, not reported
+        with np.errstate(over="ignore"):
+            return np.asarray(PchipInterpolator(t, y, axis=0)(tq), dtype=np.float64)
     return np.asarray(Akima1DInterpolator(t, y, axis=0, method="makima")(tq), np.float64)

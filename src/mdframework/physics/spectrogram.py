@@ -82,5 +82,7 @@ def power_to_db(power: FloatArray, floor_db: float = -60.0) -> FloatArray:
         raise ValueError("the power has non-finite values")
     if p_max <= 0.0:
         return np.full(p.shape, float(floor_db))
-    floor = p_max * 10.0 ** (floor_db / 10.0)
-    return np.asarray(10.0 * np.log10(np.maximum(p, floor) / p_max), dtype=np.float64)
+    # relative to the peak first: for a peak near the smallest float the absolute floor
+    # p_max * 10**(floor_db / 10) would underflow to 0 (and the log to -inf)
+    floor = 10.0 ** (floor_db / 10.0)
+    return np.asarray(10.0 * np.log10(np.maximum(p / p_max, floor)), dtype=np.float64)

@@ -39,6 +39,7 @@ from pydantic import Field, model_validator
 from scipy.optimize import brentq
 
 from mdframework import Effect, PluginConfig, Scatterers, SceneContext
+from mdframework.settings import AngleDeg
 
 FloatArray = NDArray[np.float64]
 
@@ -75,7 +76,7 @@ class AntennaConfig(PluginConfig):
         description="pointing 'target': fixed at the record's mean position, or re-aimed on "
         "every pulse.",
     )
-    azimuth_deg: float = Field(
+    azimuth_deg: AngleDeg = Field(
         180.0, description="pointing 'angles': boresight azimuth, from +x toward +y [deg]."
     )
     elevation_deg: float = Field(
