@@ -313,3 +313,20 @@ def test_the_documented_limits_are_the_code_s() -> None:
         assert float(value) == getattr(limits, name), name
     assert f"`MDF_DASK_TIMEOUT` seconds (default {SCHEDULER_TIMEOUT_S:g})" in page
     assert scheduler_timeout() == SCHEDULER_TIMEOUT_S == 10
+
+
+def test_a_numerical_warning_in_our_code_stops_the_command(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An overflow inside mdframework (or a plugin) is never a bare warning followed by a
+    result: the command stops with one line and exit 1 (an internal error: valid inputs never
+    cause one)."""
+    from mdframework import cli
+
+    namespace: dict[str, Any] = {"__name__": "mdframework.stage", "np": np}
+    exec("def stage(args):\n    return int(np.float64(1e308) * 10.0 > 0)\n", namespace)
+    monkeypatch.setattr(cli, "_cmd_plugins", namespace["stage"])
+    assert cli.main(["plugins"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "overflow encountered" in err[0], err
+    assert "Traceback" not in err[0]

@@ -86,6 +86,25 @@ def test_range_equation_reference_values() -> None:
     assert float(a2 / a) == pytest.approx(2 * 3 * 2 / 2, rel=1e-14)
 
 
+def test_chen_amplitude_model_is_sqrt_rcs_at_any_range() -> None:
+    """amplitude = "sqrt_rcs" (Chen's walker code): sqrt(sigma), no range dependence, on a
+    radar config as on the physics function; the default stays the range equation."""
+    from mdf_lfm.waveform import LfmConfig, LfmPulseDoppler
+
+    rcs = np.array([[0.25, 1.0], [0.04, 2.0]])
+    ranges = np.array([[5.0, 10.0], [7.5, 1000.0]])
+    a = radar.scatterer_amplitudes(rcs, ranges, model="sqrt_rcs", wavelength=0.02)
+    np.testing.assert_allclose(a, np.sqrt(rcs), rtol=0, atol=0)
+    chen = LfmPulseDoppler(LfmConfig(amplitude="sqrt_rcs", transmit_power=50.0))
+    np.testing.assert_allclose(chen.amplitudes(ranges, rcs), np.sqrt(rcs), rtol=0, atol=0)
+    default = LfmPulseDoppler(LfmConfig())
+    np.testing.assert_allclose(
+        default.amplitudes(ranges, rcs),
+        radar.range_equation_amplitude(rcs, ranges, wavelength=radar.wavelength(15e9)),
+        rtol=1e-15,
+    )
+
+
 def test_range_equation_refuses_zero_range() -> None:
     with pytest.raises(ValueError, match="positive"):
         radar.range_equation_amplitude(1.0, np.array([1.0, 0.0]), wavelength=0.02)

@@ -177,6 +177,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"mdf: warning: {_one_line(str(message))}", file=sys.stderr)
 
     warnings.showwarning = show_warning
+    # a numerical warning (overflow, invalid value) in our own code means a result would not be
+    # trustworthy: stop there instead of writing it (valid inputs never cause one; see
+    # benchmarks/fuzz_scenes.py)
+    warnings.filterwarnings("error", category=RuntimeWarning, module=r"(mdframework|mdf_\w+)\b")
     try:
         return int(args.func(args))
     except (MdfError, PluginError) as exc:

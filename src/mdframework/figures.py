@@ -160,3 +160,68 @@ def plot_feature_scatter(
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
+
+
+def plot_range_doppler(
+    path: Path,
+    power: NDArray[np.floating[Any]],
+    range_m: NDArray[np.float64],
+    velocity: NDArray[np.float64],
+    *,
+    title: str = "",
+    dynamic_range_db: float = 50.0,
+) -> None:
+    """Save one range-Doppler map: ``power`` (n_doppler, n_range) linear [W], range [m] across,
+    radial velocity [m/s] up (positive = approaching), in dB re the map's peak."""
+    from .physics.spectrogram import power_to_db
+
+    plt = _pyplot()
+    db = power_to_db(np.asarray(power, np.float64), -dynamic_range_db)
+    fig, ax = plt.subplots(figsize=(7, 4), dpi=110)
+    dr = range_m[1] - range_m[0] if range_m.size > 1 else 1.0
+    dv = velocity[1] - velocity[0] if velocity.size > 1 else 1.0
+    extent = (
+        range_m[0] - dr / 2,
+        range_m[-1] + dr / 2,
+        velocity[0] - dv / 2,
+        velocity[-1] + dv / 2,
+    )
+    im = ax.imshow(
+        db, origin="lower", aspect="auto", extent=extent, cmap="viridis", interpolation="nearest"
+    )
+    ax.set_xlabel("range [m]")
+    ax.set_ylabel("radial velocity [m/s] (+ approaching)")
+    fig.colorbar(im, ax=ax, label="power [dB re peak]")
+    if title:
+        ax.set_title(title)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def plot_point_cloud(
+    path: Path, points: NDArray[np.float64], *, title: str = "", v_limit: float | None = None
+) -> None:
+    """Save a point cloud, ``points`` (n, 7) with columns frame, t, x, y, z, v, intensity: a top
+    view (x across, y = boresight up) and a side view (y across, z up) in the sensor frame [m],
+    coloured by radial velocity [m/s] (+ approaching), marker area by intensity."""
+    plt = _pyplot()
+    fig, (top, side) = plt.subplots(1, 2, figsize=(9, 4.2), dpi=110)
+    x, y, z, v, snr = (points[:, k] for k in range(2, 7))
+    lim = v_limit or max(float(np.max(np.abs(v))) if v.size else 1.0, 0.1)
+    size = 6 + 2 * np.clip(snr, 0, 40) if snr.size else 6
+    kw = dict(c=v, s=size, cmap="coolwarm", vmin=-lim, vmax=lim, edgecolors="none")
+    top.scatter(x, y, **kw)
+    sc = side.scatter(y, z, **kw)
+    top.set_xlabel("x [m] (right)")
+    top.set_ylabel("y [m] (boresight)")
+    side.set_xlabel("y [m] (boresight)")
+    side.set_ylabel("z [m] (up)")
+    for ax in (top, side):
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.grid(alpha=0.3)
+    fig.colorbar(sc, ax=[top, side], label="radial velocity [m/s] (+ approaching)")
+    if title:
+        fig.suptitle(title)
+    fig.savefig(path)
+    plt.close(fig)

@@ -61,6 +61,9 @@ MAX_CONFIG_BYTES = 4 * 1024 * 1024
 MAX_CONFIG_DEPTH = 32
 #: Most records one dataset config may plan.
 MAX_RECORDS = 1_000_000
+#: Largest |value| of a random distribution's parameters in a dataset config (what is drawn
+#: must then lie in the range of the field it is drawn into).
+MAX_DRAWN_NUMBER = 1e12
 
 #: Bytes held per pulse and scatterer in a run (positions (3), RCS and range, float64) and per
 #: pulse (time, gate, complex signal): the basis of the memory estimate in :func:`check_pulses`.

@@ -31,7 +31,8 @@ from pydantic import (
 )
 
 from . import limits
-from .interfaces import PluginConfig
+from .interfaces import FloatArray, PluginConfig
+from .physics import radar
 from .physics.interpolation import Method
 
 # ----------------------------------------------------------------- bounded numeric types
@@ -94,6 +95,35 @@ class MotionConfig(PluginConfig):
         """Length of the record [s] when the config alone fixes it (``duration``), else
         ``None`` (known once the motion is loaded). Generators override it."""
         return self.duration
+
+
+class RadarPowerConfig(PluginConfig):
+    """Base of radar configs: transmit power, gains and losses, and the amplitude model."""
+
+    transmit_power: float = Field(
+        1.0, gt=0, le=1e9, description="Peak transmit power [W], at most 1 GW."
+    )
+    gain_dbi: Decibels = Field(0.0, description="Antenna gain (transmit = receive) [dBi].")
+    system_loss_db: LossDb = Field(0.0, description="System loss L_s [dB].")
+    atmospheric_loss_db: LossDb = Field(0.0, description="Atmospheric loss L_a [dB].")
+    amplitude: radar.AmplitudeModel = Field(
+        "range_equation",
+        description="Scatterer amplitude: the radar range equation, or sqrt(rcs) with no range "
+        "dependence (Chen's walker code; power, gain and losses unused).",
+    )
+
+    def amplitudes(self, rcs: FloatArray, ranges: FloatArray, wavelength: float) -> FloatArray:
+        """Amplitude [sqrt(W)] of each scatterer (:func:`physics.radar.scatterer_amplitudes`)."""
+        return radar.scatterer_amplitudes(
+            rcs,
+            ranges,
+            model=self.amplitude,
+            wavelength=wavelength,
+            transmit_power=self.transmit_power,
+            gain=10.0 ** (self.gain_dbi / 10.0),
+            system_loss=10.0 ** (self.system_loss_db / 10.0),
+            atmospheric_loss=10.0 ** (self.atmospheric_loss_db / 10.0),
+        )
 
 
 class StrictModel(BaseModel):

@@ -22,6 +22,7 @@ FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
 
 GateResponse = Literal["exact", "sinc", "phase_only"]
+AmplitudeModel = Literal["range_equation", "sqrt_rcs"]
 
 
 def wavelength(carrier_frequency: float) -> float:
@@ -75,6 +76,39 @@ def range_equation_amplitude(
     num = transmit_power * gain**2 * wavelength**2 * sigma
     den = (4.0 * np.pi) ** 3 * r**4 * system_loss * atmospheric_loss
     return np.asarray(np.sqrt(num / den), dtype=np.float64)
+
+
+def scatterer_amplitudes(
+    rcs: ArrayLike,
+    ranges: ArrayLike,
+    *,
+    model: AmplitudeModel,
+    wavelength: float,
+    transmit_power: float = 1.0,
+    gain: float = 1.0,
+    system_loss: float = 1.0,
+    atmospheric_loss: float = 1.0,
+) -> FloatArray:
+    """Amplitude of each scatterer's return [sqrt(W)], shaped like ``ranges``.
+
+    ``range_equation``: :func:`range_equation_amplitude`. ``sqrt_rcs``: ``sqrt(sigma)`` with no
+    range dependence (Chen's MATLAB walker and the paper's amplitude model); the other arguments
+    are then unused.
+    """
+    if model == "sqrt_rcs":
+        shape = np.broadcast_shapes(np.shape(rcs), np.shape(ranges))
+        return np.asarray(np.broadcast_to(np.sqrt(np.asarray(rcs, np.float64)), shape), np.float64)
+    if model == "range_equation":
+        return range_equation_amplitude(
+            rcs,
+            ranges,
+            wavelength=wavelength,
+            transmit_power=transmit_power,
+            gain=gain,
+            system_loss=system_loss,
+            atmospheric_loss=atmospheric_loss,
+        )
+    raise ValueError(f"unknown amplitude model {model!r}")
 
 
 def carrier_cycles_fraction(ranges: ArrayLike, carrier_frequency: float) -> FloatArray:

@@ -24,16 +24,16 @@ from typing import Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from mdframework import PluginConfig, RadarWaveform, Received, limits
+from mdframework import RadarWaveform, Received, limits
 from mdframework.constants import SPEED_OF_LIGHT
 from mdframework.physics import radar
-from mdframework.settings import Bandwidth, Decibels, LossDb
+from mdframework.settings import Bandwidth, RadarPowerConfig
 
 #: Pulses per block on the raw path (bounds memory to ~ block x n_fast complex samples).
 RAW_BLOCK = 1024
 
 
-class LfmConfig(PluginConfig):
+class LfmConfig(RadarPowerConfig):
     """LFM pulse-Doppler radar. Defaults: the paper's radar (15 GHz, 150 MHz, PRF 2400 Hz)."""
 
     kind: Literal["lfm"] = "lfm"
@@ -53,12 +53,6 @@ class LfmConfig(PluginConfig):
     pulse_width: float = Field(
         1e-6, gt=0, le=0.1, description="Pulse length tau [s] (at most 1/PRF)."
     )
-    transmit_power: float = Field(
-        1.0, gt=0, le=1e9, description="Peak transmit power [W], at most 1 GW."
-    )
-    gain_dbi: Decibels = Field(0.0, description="Antenna gain (transmit = receive) [dBi].")
-    system_loss_db: LossDb = Field(0.0, description="System loss L_s [dB].")
-    atmospheric_loss_db: LossDb = Field(0.0, description="Atmospheric loss L_a [dB].")
     path: Literal["analytic", "raw"] = Field(
         "analytic", description="analytic: closed-form compressed return; raw: sampled chirps."
     )
@@ -118,17 +112,9 @@ class LfmPulseDoppler(RadarWaveform):
         return self.config.prf
 
     def amplitudes(self, ranges: np.ndarray, rcs: np.ndarray) -> np.ndarray:
-        """Range-equation amplitudes [sqrt(W)], same shape as ``ranges``."""
-        c = self.config
-        return radar.range_equation_amplitude(
-            rcs,
-            ranges,
-            wavelength=radar.wavelength(c.carrier_frequency),
-            transmit_power=c.transmit_power,
-            gain=10.0 ** (c.gain_dbi / 10.0),
-            system_loss=10.0 ** (c.system_loss_db / 10.0),
-            atmospheric_loss=10.0 ** (c.atmospheric_loss_db / 10.0),
-        )
+        """Scatterer amplitudes [sqrt(W)] (range equation or sqrt(rcs), ``amplitude``), same
+        shape as ``ranges``."""
+        return self.config.amplitudes(rcs, ranges, radar.wavelength(self.config.carrier_frequency))
 
     def receive(self, ranges: np.ndarray, rcs: np.ndarray, gate_range: np.ndarray) -> Received:
         """Compressed slow-time return at the gate (and a range-time map on the raw path)."""

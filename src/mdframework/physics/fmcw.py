@@ -1,0 +1,858 @@
+"""Chirp-sequence FMCW radar: timing, de-chirped IF, range and Doppler processing, CFAR
+detection, angle estimation and point clouds. Pure functions on arrays.
+
+Chirp model. Chirp ``n`` starts its ramp at ``t_n``; over the ramp the transmitted frequency is
+``f0 + S t`` (``t`` from the ramp start). The ADC takes ``N`` complex samples at ``fs`` from
+``adc_start_time``: ``t_m = adc_start_time + m / fs``. An echo with round-trip delay ``tau`` mixes
+down to the de-chirped IF
+
+    ``y(m) = a exp(-j 2 pi (f0 tau + S tau t_m - S tau^2 / 2))``                      (IF)
+
+(stop-and-hop: ``tau`` held at its value at ``t_n``). This is the conjugate of the mixer product
+``TX x RX*``, chosen so that the slow-time phase is ``-4 pi f R / c`` like every other radar of the
+project: an approaching target has positive Doppler. Its beat frequency ``S tau = 2 S R / c``
+therefore sits at ``-f_b``; the range profile evaluates the spectrum there,
+
+    ``X_k = sum_m w_m y_m exp(+j 2 pi k m / K) / sum_m w_m``                           (range FFT)
+
+with a window ``w`` and ``K >= N`` bins, so a lone target of amplitude ``a`` on a bin peaks at
+``|X| = a``, range bin ``k`` is at ``k c fs / (2 S K)`` [m], and complex sampling maps beat
+frequencies ``[0, fs)`` to ranges ``[0, c fs / (2 S))``: a farther target aliases (wraps) in the IF.
+
+Frames. A frame is ``n_loops`` loops of ``n_tx`` chirps (time-division MIMO: chirp slot ``s`` of
+every loop transmits on TX ``tdm_order[s]``); chirps follow each other every ``idle_time +
+ramp_end_time``; frames start every ``frame_period``. Each virtual channel (TX, RX) is sampled in
+slow time once per loop, so the unambiguous velocity is ``lambda / (4 n_tx T_chirp)``.
+
+Frames of the sensor: ``x`` to the right (looking along boresight), ``y`` along boresight, ``z``
+up (the convention of the TI mmWave sensors' point clouds). Antenna positions lie in the ``x-z``
+plane. Directions are given by their cosines ``u_x = sin(az) cos(el)``, ``u_z = sin(el)``.
+
+Array shapes are in each docstring: ``n_chirps`` chirps, ``n_scat`` scatterers, ``n_rx`` receive
+antennas, ``n_virt = n_tx n_rx`` virtual antennas, ``n_bins`` range bins, ``n_doppler`` Doppler
+bins.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..constants import SPEED_OF_LIGHT
+
+FloatArray = NDArray[np.float64]
+ComplexArray = NDArray[np.complex128]
+BoolArray = NDArray[np.bool_]
+IntArray = NDArray[np.int64]
+
+WindowName = Literal["rect", "hann", "hamming", "blackman"]
+CfarMode = Literal["ca", "so", "go"]
+
+#: Cosine-sum coefficients ``a_c`` of ``w_m = sum_c (-1)^c a_c cos(2 pi c m / N)`` (periodic).
+WINDOWS: dict[str, tuple[float, ...]] = {
+    "rect": (1.0,),
+    "hann": (0.5, 0.5),
+    "hamming": (0.54, 0.46),
+    "blackman": (0.42, 0.5, 0.08),
+}
+
+#: Columns of a point cloud array (``n_points``, 7).
+POINT_COLUMNS = ("frame", "t", "x", "y", "z", "v", "intensity")
+
+
+# --------------------------------------------------------------------------- chirp timing
+
+
+@dataclass(frozen=True)
+class ChirpSequence:
+    """The timing of a chirp-sequence FMCW radar (TI ``profileCfg``/``frameCfg`` terms).
+
+    ``start_frequency`` f0 [Hz]; ``slope`` S [Hz/s]; ``idle_time``, ``adc_start_time``,
+    ``ramp_end_time`` [s]; ``sample_rate`` fs [Hz] of the complex ADC; ``n_samples`` N per chirp;
+    ``n_loops`` per frame; ``tdm_order``: the TX index of each chirp slot of a loop;
+    ``frame_period`` [s].
+    """
+
+    start_frequency: float
+    slope: float
+    idle_time: float
+    adc_start_time: float
+    ramp_end_time: float
+    sample_rate: float
+    n_samples: int
+    n_loops: int
+    tdm_order: tuple[int, ...]
+    frame_period: float
+
+    @property
+    def n_tx(self) -> int:
+        """Chirps per loop (transmitters in the TDM order)."""
+        return len(self.tdm_order)
+
+    @property
+    def chirp_period(self) -> float:
+        """Time from one chirp's start to the next [s]: idle plus ramp."""
+        return self.idle_time + self.ramp_end_time
+
+    @property
+    def loop_period(self) -> float:
+        """Slow-time sample interval of one virtual channel [s]: ``n_tx`` chirp periods."""
+        return self.n_tx * self.chirp_period
+
+    @property
+    def chirps_per_frame(self) -> int:
+        """Chirps in one frame."""
+        return self.n_loops * self.n_tx
+
+    @property
+    def sampled_bandwidth(self) -> float:
+        """Bandwidth swept while the ADC samples [Hz]: ``S N / fs``."""
+        return self.slope * self.n_samples / self.sample_rate
+
+    @property
+    def centre_frequency(self) -> float:
+        """Frequency at the middle of the ADC samples [Hz]; Doppler and angles refer to it."""
+        mid = self.adc_start_time + (self.n_samples - 1) / (2.0 * self.sample_rate)
+        return self.start_frequency + self.slope * mid
+
+    @property
+    def wavelength(self) -> float:
+        """Wavelength at :attr:`centre_frequency` [m]."""
+        return SPEED_OF_LIGHT / self.centre_frequency
+
+    @property
+    def range_resolution(self) -> float:
+        """``c / (2 B)`` with the sampled bandwidth [m]."""
+        return SPEED_OF_LIGHT / (2.0 * self.sampled_bandwidth)
+
+    @property
+    def max_range(self) -> float:
+        """Largest range whose beat frequency is below ``fs`` (complex sampling) [m]."""
+        return SPEED_OF_LIGHT * self.sample_rate / (2.0 * self.slope)
+
+    @property
+    def max_velocity(self) -> float:
+        """Unambiguous radial velocity of the TDM scheme, ``lambda / (4 n_tx T_chirp)`` [m/s]."""
+        return self.wavelength / (4.0 * self.loop_period)
+
+    @property
+    def velocity_resolution(self) -> float:
+        """``lambda / (2 n_loops n_tx T_chirp)`` [m/s]."""
+        return self.wavelength / (2.0 * self.n_loops * self.loop_period)
+
+    def problems(self, max_bandwidth: float | None = None) -> list[str]:
+        """What makes this timing impossible, one line per problem naming the field and the
+        limit (empty when it is consistent). ``max_bandwidth`` [Hz]: the device's sweep limit."""
+        out: list[str] = []
+        for name in ("slope", "sample_rate", "ramp_end_time", "frame_period"):
+            if not getattr(self, name) > 0:
+                out.append(f"{name} must be positive")
+        for name in ("idle_time", "adc_start_time"):
+            if not getattr(self, name) >= 0:
+                out.append(f"{name} must be >= 0")
+        if self.n_samples < 2 or self.n_loops < 1 or self.n_tx < 1:
+            out.append("n_samples must be >= 2, n_loops and tdm_order must not be empty")
+        if out:
+            return out
+        adc_end = self.adc_start_time + self.n_samples / self.sample_rate
+        if adc_end > self.ramp_end_time * (1 + 1e-9):
+            out.append(
+                f"ramp_end_time: the ADC samples until {adc_end * 1e6:.3f} us "
+                f"(adc_start_time + n_samples / sample_rate) but the ramp ends at "
+                f"{self.ramp_end_time * 1e6:.3f} us"
+            )
+        busy = self.chirps_per_frame * self.chirp_period
+        if busy > self.frame_period * (1 + 1e-9):
+            out.append(
+                f"frame_period: {self.chirps_per_frame} chirps of "
+                f"{self.chirp_period * 1e6:.3f} us need {busy * 1e3:.4f} ms, more than the "
+                f"frame period {self.frame_period * 1e3:.4f} ms"
+            )
+        swept = self.slope * self.ramp_end_time
+        if max_bandwidth is not None and swept > max_bandwidth * (1 + 1e-9):
+            out.append(
+                f"slope: slope x ramp_end_time sweeps {swept / 1e9:.4f} GHz, more than the "
+                f"sensor's {max_bandwidth / 1e9:.4f} GHz bandwidth"
+            )
+        return out
+
+
+def chirp_times(seq: ChirpSequence, start: float, end: float) -> FloatArray:
+    """Ramp-start times [s] of every chirp of every whole frame in ``[start, end]``.
+
+    Frame ``f`` starts at ``start + f T_frame``; its chirp ``j`` ramps from
+    ``start + f T_frame + j T_chirp + idle_time``. A frame is kept only if its last chirp's ramp
+    ends by ``end``. Returns (n_frames * chirps_per_frame,) float64.
+    """
+    per_frame = seq.idle_time + np.arange(seq.chirps_per_frame) * seq.chirp_period
+    last = per_frame[-1] + seq.ramp_end_time
+    n_frames = int(np.floor((end - start - last) / seq.frame_period * (1 + 1e-12))) + 1
+    n_frames = max(n_frames, 0)
+    frames = start + np.arange(n_frames, dtype=np.float64) * seq.frame_period
+    return np.asarray((frames[:, None] + per_frame[None, :]).ravel(), dtype=np.float64)
+
+
+def beat_frequency(ranges: FloatArray | float, slope: float) -> FloatArray:
+    """Beat frequency ``2 S R / c`` [Hz] of targets at ``ranges`` [m]."""
+    return np.asarray(2.0 * slope * np.asarray(ranges, np.float64) / SPEED_OF_LIGHT, np.float64)
+
+
+# --------------------------------------------------------------------------- windows
+
+
+def window(name: WindowName, n: int) -> FloatArray:
+    """Periodic cosine-sum window ``w_m = sum_c (-1)^c a_c cos(2 pi c m / n)``, (n,)."""
+    m = np.arange(n, dtype=np.float64)
+    w = np.zeros(n, dtype=np.float64)
+    for c, a in enumerate(WINDOWS[name]):
+        w += (-1) ** c * a * np.cos(2.0 * np.pi * c * m / n)
+    return w
+
+
+def dirichlet(nu: FloatArray, n: int) -> ComplexArray:
+    """``D_n(nu) = sum_{m=0}^{n-1} exp(j 2 pi m nu)`` in closed form (any shape of ``nu``)."""
+    nu = np.asarray(nu, dtype=np.float64)
+    s = np.sin(np.pi * nu)
+    near = np.abs(s) < 1e-12
+    ratio = np.where(near, float(n), np.sin(np.pi * n * nu) / np.where(near, 1.0, s))
+    # at integer nu the sum is n; the phase factor there is (-1)^((n-1) nu) and cancels the sign
+    # of the sine ratio's limit, so use the exact value n with zero phase
+    phase = np.where(near, 0.0, np.pi * (n - 1) * nu)
+    out = np.empty(nu.shape, dtype=np.complex128)
+    out.real = ratio * np.cos(phase)
+    out.imag = ratio * np.sin(phase)
+    return out
+
+
+def window_transform(name: WindowName, n: int, nu: FloatArray) -> ComplexArray:
+    """``W(nu) = sum_m w_m exp(j 2 pi m nu)`` of :func:`window` in closed form: a sum of shifted
+    Dirichlet kernels (any shape of ``nu`` [cycles per sample])."""
+    nu = np.asarray(nu, dtype=np.float64)
+    out = np.zeros(nu.shape, dtype=np.complex128)
+    for c, a in enumerate(WINDOWS[name]):
+        if c == 0:
+            out += a * dirichlet(nu, n)
+        else:
+            out += (-1) ** c * a / 2.0 * (dirichlet(nu + c / n, n) + dirichlet(nu - c / n, n))
+    return out
+
+
+# --------------------------------------------------------------------------- IF and range
+
+
+def _window_transform_on_bins(
+    name: WindowName, n: int, x: FloatArray, bins: IntArray
+) -> ComplexArray:
+    """:func:`window_transform` at ``nu = k / n - x`` for integer bins ``k`` of an unpadded
+    FFT, (*x.shape, n_bins): the same values with one sine per element. On bins,
+    ``D_n(k/n - x) = -(-1)^k sin(pi n x) exp(j pi (n-1)(k/n - x)) / sin(pi (k/n - x))``, and a
+    cosine-sum window's shifts by ``c / n`` are shifts by ``c`` bins, so ``D`` is evaluated once
+    on the bins ``k - C .. k + C`` and combined."""
+    coeffs = WINDOWS[name]
+    reach = len(coeffs) - 1
+    ext = np.unique((bins[:, None] + np.arange(-reach, reach + 1)[None, :]).ravel() % n)
+    pos = {int(k): i for i, k in enumerate(ext)}
+    xe = np.asarray(x, np.float64)[..., None]
+    den = np.sin(np.pi * (ext / n - xe))
+    near = np.abs(den) < 1e-12
+    num = -np.sin(np.pi * n * xe) * np.where(ext % 2 == 0, 1.0, -1.0)
+    ratio = np.where(near, float(n), num / np.where(near, 1.0, den))
+    # the phase factor exp(j pi (n-1) nu) is 1 where nu is an integer (D = n exactly there)
+    left = np.exp(1j * np.pi * (n - 1) * ext / n)
+    right = np.exp(-1j * np.pi * (n - 1) * np.asarray(x, np.float64))[..., None]
+    d = np.where(near, float(n) + 0j, ratio * (right * left))
+    out = np.zeros((*np.shape(x), bins.size), dtype=np.complex128)
+    for c, a in enumerate(coeffs):
+        if c == 0:
+            out += a * d[..., [pos[int(k)] for k in bins]]
+            continue
+        up = [pos[int(k)] for k in (bins + c) % n]
+        down = [pos[int(k)] for k in (bins - c) % n]
+        out += (-1) ** c * a / 2.0 * (d[..., up] + d[..., down])
+    return out
+
+
+def _if_cycles0(delays: FloatArray, seq: ChirpSequence) -> FloatArray:
+    """Fractional cycles of ``f0 tau + S tau t_0 - S tau^2 / 2`` (the IF phase at the first ADC
+    sample), reduced in float64."""
+    tau = np.asarray(delays, dtype=np.float64)
+    cyc = seq.start_frequency * tau
+    cyc = cyc - np.floor(cyc)
+    cyc = cyc + seq.slope * tau * seq.adc_start_time - 0.5 * seq.slope * tau * tau
+    return np.asarray(cyc - np.floor(cyc), dtype=np.float64)
+
+
+def if_samples(delays: FloatArray, amplitudes: FloatArray, seq: ChirpSequence) -> ComplexArray:
+    """De-chirped IF samples (eq. IF of the module docstring) summed over scatterers.
+
+    ``delays`` (n_chirps, n_scat) round-trip delays [s]; ``amplitudes`` (n_chirps, n_scat)
+    [sqrt(W)]. Returns (n_chirps, n_samples) complex128 [sqrt(W)].
+    """
+    m = np.arange(seq.n_samples, dtype=np.float64) / seq.sample_rate
+    out = np.zeros((delays.shape[0], seq.n_samples), dtype=np.complex128)
+    cyc0 = _if_cycles0(delays, seq)
+    for i in range(delays.shape[1]):
+        cycles = cyc0[:, i : i + 1] + (seq.slope * delays[:, i : i + 1]) * m[None, :]
+        phase = (-2.0 * np.pi) * cycles
+        out.real += amplitudes[:, i : i + 1] * np.cos(phase)
+        out.imag += amplitudes[:, i : i + 1] * np.sin(phase)
+    return out
+
+
+def range_profile(samples: ComplexArray, name: WindowName, n_fft: int) -> ComplexArray:
+    """Windowed range FFT of IF samples (..., n_samples) -> (..., n_fft), normalised so that a
+    lone on-bin target of amplitude ``a`` peaks at ``|X| = a`` (the range FFT of the module
+    docstring; bin ``k`` is range ``k c fs / (2 S n_fft)``)."""
+    n = samples.shape[-1]
+    w = window(name, n)
+    spec = np.fft.ifft(samples * w, n=n_fft, axis=-1) * (n_fft / float(np.sum(w)))
+    return np.asarray(spec, dtype=np.complex128)
+
+
+def analytic_range_profile(
+    delays: FloatArray,
+    amplitudes: FloatArray,
+    seq: ChirpSequence,
+    name: WindowName,
+    n_fft: int,
+    bins: IntArray,
+    phasors: ComplexArray | None = None,
+) -> ComplexArray:
+    """The range profile of :func:`range_profile` applied to :func:`if_samples`, in closed form
+    at the bins ``bins`` (n_sel,) only: ``X_k = sum_i a_i exp(-j 2 pi c0_i) W(k / K - S tau_i /
+    fs) / sum w`` (``c0`` the IF phase at the first sample, ``W`` :func:`window_transform`).
+    Exact at those bins. ``delays``, ``amplitudes`` (n_chirps, n_scat). Without ``phasors``
+    returns (n_chirps, n_sel); with ``phasors`` (n_chirps, n_ch, n_scat), one profile per
+    channel with scatterer ``i`` multiplied by its phasor, (n_chirps, n_ch, n_sel).
+    """
+    c0 = _if_cycles0(delays, seq)
+    x = seq.slope * delays / seq.sample_rate  # beat frequency in cycles per sample
+    if n_fft == seq.n_samples:
+        kern = _window_transform_on_bins(name, seq.n_samples, x, np.asarray(bins, np.int64))
+    else:
+        nu = np.asarray(bins, np.float64)[None, None, :] / n_fft - x[:, :, None]
+        kern = window_transform(name, seq.n_samples, nu)
+    phase = (-2.0 * np.pi) * c0
+    coef = np.empty(c0.shape, dtype=np.complex128)
+    coef.real = amplitudes * np.cos(phase)
+    coef.imag = amplitudes * np.sin(phase)
+    scale = 1.0 / float(np.sum(window(name, seq.n_samples)))
+    if phasors is None:
+        return np.asarray(np.einsum("cs,csk->ck", coef, kern) * scale, np.complex128)
+    total = np.einsum("crs,csk->crk", phasors * coef[:, None, :], kern)
+    return np.asarray(total * scale, np.complex128)
+
+
+def range_axis(seq: ChirpSequence, n_fft: int) -> FloatArray:
+    """Range of each range bin [m], (n_fft,): ``k c fs / (2 S n_fft)``."""
+    return np.arange(n_fft, dtype=np.float64) * seq.max_range / n_fft
+
+
+def bins_near(ranges: FloatArray, seq: ChirpSequence, n_fft: int, margin: int) -> IntArray:
+    """Range bins within ``margin`` bins of any of ``ranges`` [m] (after IF aliasing), sorted."""
+    pos = np.mod(np.asarray(ranges, np.float64).ravel() / seq.max_range * n_fft, n_fft)
+    base = np.floor(pos).astype(np.int64)
+    near = (base[:, None] + np.arange(-margin, margin + 2)[None, :]) % n_fft
+    return np.unique(near).astype(np.int64)
+
+
+# --------------------------------------------------------------------------- Doppler
+
+
+def doppler_axis(seq: ChirpSequence, n_doppler: int) -> FloatArray:
+    """Doppler of each bin of :func:`range_doppler` [Hz], ascending, (n_doppler,):
+    ``(d - n/2) / (n T_loop)``; positive = approaching."""
+    k = np.arange(-(n_doppler // 2), n_doppler - n_doppler // 2, dtype=np.float64)
+    return np.asarray(k / (n_doppler * seq.loop_period), np.float64)
+
+
+def virtual_cube(profiles: ComplexArray, seq: ChirpSequence, n_tx_total: int) -> ComplexArray:
+    """Rearrange one frame's range profiles into the virtual-array cube.
+
+    ``profiles`` (chirps_per_frame, n_rx, n_bins), chirps in time order. Returns
+    (n_tx_total * n_rx, n_loops, n_bins): virtual antenna ``tx * n_rx + rx`` (by TX index, not
+    slot); TXs that the TDM order never uses stay zero.
+    """
+    n_rx, n_bins = profiles.shape[1], profiles.shape[2]
+    by_slot = profiles.reshape(seq.n_loops, seq.n_tx, n_rx, n_bins)
+    cube = np.zeros((n_tx_total, n_rx, seq.n_loops, n_bins), dtype=np.complex128)
+    for slot, tx in enumerate(seq.tdm_order):
+        cube[tx] = np.moveaxis(by_slot[:, slot], 0, 1)
+    return cube.reshape(n_tx_total * n_rx, seq.n_loops, n_bins)
+
+
+def range_doppler(
+    cube: ComplexArray, name: WindowName, n_doppler: int, clutter_removal: bool = False
+) -> ComplexArray:
+    """Doppler FFT over loops: (n_virt, n_loops, n_bins) -> (n_virt, n_doppler, n_bins),
+    zero-Doppler in the middle (row ``n_doppler // 2``), normalised so that a lone on-bin
+    target of amplitude ``a`` peaks at ``a``. ``clutter_removal`` subtracts each channel's and
+    bin's mean over the loops first (static clutter removal)."""
+    x = cube - cube.mean(axis=1, keepdims=True) if clutter_removal else cube
+    w = window(name, cube.shape[1])
+    spec = np.fft.fft(x * w[None, :, None], n=n_doppler, axis=1) / float(np.sum(w))
+    return np.asarray(np.fft.fftshift(spec, axes=1), dtype=np.complex128)
+
+
+def detection_map(rd: ComplexArray) -> FloatArray:
+    """Non-coherent sum of ``|RD|^2`` over virtual antennas, (n_doppler, n_bins) [W]."""
+    return np.asarray(np.sum(rd.real**2 + rd.imag**2, axis=0), dtype=np.float64)
+
+
+# --------------------------------------------------------------------------- detection
+
+
+@dataclass(frozen=True)
+class Cfar:
+    """One-dimensional CFAR along an axis: ``mode`` ca (cell averaging), so (smallest of the
+    two sides' means), go (greatest of); ``train`` and ``guard`` cells on each side; a cell is
+    detected when its power exceeds ``10^(threshold_db / 10)`` times the noise estimate."""
+
+    mode: CfarMode = "ca"
+    train: int = 8
+    guard: int = 4
+    threshold_db: float = 15.0
+
+
+def cfar(
+    power: FloatArray, settings: Cfar, *, axis: int, cyclic: bool
+) -> tuple[BoolArray, FloatArray]:
+    """CFAR detection of ``power`` (any shape, linear) along ``axis``.
+
+    ``cyclic``: the axis wraps (Doppler); otherwise a cell near an edge uses only the training
+    cells that exist (one side only at the very edge). Returns the detections (bool, same shape)
+    and the noise estimate (same shape, linear; NaN where no training cell exists).
+    """
+    x = np.moveaxis(np.asarray(power, np.float64), axis, -1)
+    n = x.shape[-1]
+    g, t = settings.guard, settings.train
+    pad = g + t
+    ones = np.ones(n)
+    if cyclic:
+        xp = np.concatenate([x[..., n - pad :], x, x[..., :pad]], axis=-1) if pad <= n else None
+        cp = np.concatenate([ones[n - pad :], ones, ones[:pad]]) if pad <= n else None
+        if xp is None or cp is None:
+            idx = np.arange(-pad, n + pad) % n
+            xp, cp = x[..., idx], ones[idx]
+    else:
+        zeros = np.zeros((*x.shape[:-1], pad))
+        xp = np.concatenate([zeros, x, zeros], axis=-1)
+        cp = np.concatenate([np.zeros(pad), ones, np.zeros(pad)])
+    cs = np.concatenate([np.zeros((*x.shape[:-1], 1)), np.cumsum(xp, axis=-1)], axis=-1)
+    cc = np.concatenate([[0.0], np.cumsum(cp)])
+    i = np.arange(n) + pad  # index of each cell in the padded arrays
+    left_sum = cs[..., i - g] - cs[..., i - g - t]
+    right_sum = cs[..., i + g + t + 1] - cs[..., i + g + 1]
+    left_n = cc[i - g] - cc[i - g - t]
+    right_n = cc[i + g + t + 1] - cc[i + g + 1]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        left = np.where(left_n > 0, left_sum / np.maximum(left_n, 1), np.nan)
+        right = np.where(right_n > 0, right_sum / np.maximum(right_n, 1), np.nan)
+        if settings.mode == "ca":
+            total = left_n + right_n
+            noise = np.where(total > 0, (left_sum + right_sum) / np.maximum(total, 1), np.nan)
+        elif settings.mode == "so":
+            noise = np.where(
+                np.isnan(left), right, np.where(np.isnan(right), left, np.minimum(left, right))
+            )
+        elif settings.mode == "go":
+            noise = np.where(
+                np.isnan(left), right, np.where(np.isnan(right), left, np.maximum(left, right))
+            )
+        else:
+            raise ValueError(f"unknown CFAR mode {settings.mode!r}")
+        alpha = 10.0 ** (settings.threshold_db / 10.0)
+        detected = np.where(np.isnan(noise), False, x > alpha * np.nan_to_num(noise))
+    return np.moveaxis(detected, -1, axis), np.moveaxis(noise, -1, axis)
+
+
+def peak_grouping(power: FloatArray, mask: BoolArray, *, doppler: bool, range_: bool) -> BoolArray:
+    """Keep a detection of a (n_doppler, n_bins) map only where its power is at least that of
+    its neighbours along Doppler (cyclic) and/or range (TI's peak grouping)."""
+    keep = mask.copy()
+    if doppler:
+        keep &= (power >= np.roll(power, 1, axis=0)) & (power >= np.roll(power, -1, axis=0))
+    if range_:
+        left = np.concatenate([np.full((power.shape[0], 1), -np.inf), power[:, :-1]], axis=1)
+        right = np.concatenate([power[:, 1:], np.full((power.shape[0], 1), -np.inf)], axis=1)
+        keep &= (power >= left) & (power >= right)
+    return keep
+
+
+# --------------------------------------------------------------------------- angles
+
+
+def virtual_positions(tx: FloatArray, rx: FloatArray) -> FloatArray:
+    """Virtual antenna positions ``p_tx + p_rx``, (n_tx * n_rx, 2) as (x, z) [m], virtual index
+    ``tx * n_rx + rx``. ``tx`` (n_tx, 2), ``rx`` (n_rx, 2) [m] in the sensor's x-z plane."""
+    return np.asarray((tx[:, None, :] + rx[None, :, :]).reshape(-1, 2), dtype=np.float64)
+
+
+def steering(
+    positions: FloatArray, ux: FloatArray, uz: FloatArray, wavelength: float
+) -> ComplexArray:
+    """Steering vectors ``exp(+j 2 pi (x u_x + z u_z) / lambda)`` for directions (n_dir,),
+    (n_dir, n_virt): a path shorter by ``p . u`` on the way out and back advances the phase."""
+    arg = (2.0 * np.pi / wavelength) * (
+        np.outer(ux, positions[:, 0]) + np.outer(uz, positions[:, 1])
+    )
+    return np.asarray(np.exp(1j * arg), dtype=np.complex128)
+
+
+@dataclass(frozen=True)
+class AngleGrid:
+    """A beam-scan grid of direction cosines: ``ux`` (n_x,), ``uz`` (n_z,) (``uz = [0]`` for
+    an array without vertical extent) and the conjugated steering vectors of the visible ones,
+    ``weights`` (n_virt, n_visible) (contiguous, for one matrix product per frame), with their
+    grid indices ``ix``, ``iz`` (n_visible,)."""
+
+    ux: FloatArray
+    uz: FloatArray
+    weights: ComplexArray
+    ix: IntArray
+    iz: IntArray
+
+
+def angle_grid(positions: FloatArray, wavelength: float, n_x: int = 65, n_z: int = 33) -> AngleGrid:
+    """The beam-scan grid for an array: ``u_x`` over [-1, 1] in ``n_x`` steps, ``u_z`` likewise
+    when the array has vertical extent (else only 0); directions with ``u_x^2 + u_z^2 > 1`` are
+    left out."""
+    ux = np.linspace(-1.0, 1.0, n_x)
+    has_z = np.ptp(positions[:, 1]) > 1e-9 * max(1.0, float(np.ptp(positions[:, 0])))
+    uz = np.linspace(-1.0, 1.0, n_z) if has_z else np.zeros(1)
+    gx, gz = np.meshgrid(np.arange(ux.size), np.arange(uz.size), indexing="ij")
+    visible = ux[gx] ** 2 + uz[gz] ** 2 <= 1.0 + 1e-12
+    ix, iz = gx[visible].astype(np.int64), gz[visible].astype(np.int64)
+    weights = np.ascontiguousarray(steering(positions, ux[ix], uz[iz], wavelength).conj().T)
+    return AngleGrid(ux, uz, weights, ix, iz)
+
+
+def _refine(
+    maps: FloatArray, d: IntArray, i: IntArray, k: IntArray, axis: FloatArray, along: int
+) -> FloatArray:
+    """Parabolic interpolation of peaks ``maps[d, i, k]`` along grid axis ``along`` (1: u_x,
+    2: u_z) on the grid ``axis``; a peak at the grid's edge or beside a non-visible direction
+    stays on its grid point."""
+    idx = i if along == 1 else k
+    n = maps.shape[along]
+    out = axis[idx].astype(np.float64)
+    if n < 3:
+        return out
+    lo, hi = np.clip(idx - 1, 0, n - 1), np.clip(idx + 1, 0, n - 1)
+    if along == 1:
+        a, b, c = maps[d, lo, k], maps[d, i, k], maps[d, hi, k]
+    else:
+        a, b, c = maps[d, i, lo], maps[d, i, k], maps[d, i, hi]
+    ok = (idx > 0) & (idx < n - 1) & np.isfinite(a) & np.isfinite(c)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        den = np.where(ok, a - 2 * b + c, -1.0)
+        off = np.where(ok & (den < 0), 0.5 * (np.where(ok, a - c, 0.0)) / den, 0.0)
+    return np.asarray(out + np.clip(off, -0.5, 0.5) * (axis[1] - axis[0] if n > 1 else 0.0))
+
+
+def estimate_angles(
+    snapshots: ComplexArray, grid: AngleGrid, multi_peak: float | None = None
+) -> tuple[IntArray, FloatArray, FloatArray, FloatArray]:
+    """Bartlett beam scan of each detection's virtual-array snapshot.
+
+    ``snapshots`` (n_det, n_virt). For each detection the direction of the beam map's maximum,
+    refined by parabolic interpolation along ``u_x`` and ``u_z``; with ``multi_peak`` (0..1),
+    also the strongest other local maximum of at least that fraction of the maximum (TI's
+    multi-object beamforming). Returns the detection index of each direction (n_out,), its
+    ``u_x``, ``u_z`` (n_out,) and beam power (n_out,) [|snapshot|^2 units x n_virt].
+    """
+    n_det = snapshots.shape[0]
+    if n_det == 0:
+        e = np.zeros(0)
+        return np.zeros(0, np.int64), e, e.copy(), e.copy()
+    product = snapshots @ grid.weights
+    beams = (product.real**2 + product.imag**2) / snapshots.shape[1]
+    maps = np.full((n_det, grid.ux.size, grid.uz.size), -np.inf)
+    maps[:, grid.ix, grid.iz] = beams
+    flat = maps.reshape(n_det, -1)
+    det = np.arange(n_det)
+    best = np.argmax(flat, axis=1)
+    if multi_peak is not None:
+        from scipy.ndimage import maximum_filter
+
+        finite = np.where(np.isfinite(maps), maps, -1.0)
+        local = finite == maximum_filter(finite, size=(1, 3, 3), mode="nearest")
+        strong = finite >= multi_peak * flat[det, best][:, None, None]
+        cand = np.where(local & strong, finite, -np.inf).reshape(n_det, -1)
+        cand[det, best] = -np.inf
+        second = np.argmax(cand, axis=1)
+        has = np.isfinite(cand[det, second])
+        det = np.concatenate([det, det[has]])
+        best = np.concatenate([best, second[has]])
+        order = np.argsort(det, kind="stable")
+        det, best = det[order], best[order]
+    i, k = np.divmod(best, grid.uz.size)
+    ux = _refine(maps, det, i, k, grid.ux, 1)
+    uz = _refine(maps, det, i, k, grid.uz, 2) if grid.uz.size > 1 else np.zeros(det.size)
+    return det.astype(np.int64), ux, uz, flat[det, best]
+
+
+def tdm_compensation(
+    snapshots: ComplexArray, doppler: FloatArray, slot_of_virtual: IntArray, chirp_period: float
+) -> ComplexArray:
+    """Remove the phase a moving target gains between the TDM slots of one loop:
+    multiply virtual antenna ``v`` by ``exp(-j 2 pi f_D s_v T_chirp)``, ``s_v`` its TX's slot.
+    ``snapshots`` (n_det, n_virt), ``doppler`` (n_det,) [Hz], ``slot_of_virtual`` (n_virt,)."""
+    phase = -2.0 * np.pi * np.outer(doppler, slot_of_virtual) * chirp_period
+    return np.asarray(snapshots * np.exp(1j * phase), dtype=np.complex128)
+
+
+# --------------------------------------------------------------------------- point clouds
+
+
+@dataclass(frozen=True)
+class Detection:
+    """Detection settings of :func:`detect_points`: CFAR along range and/or Doppler (both must
+    detect a cell when both are given), peak grouping along Doppler and/or range, the range
+    interval searched ``[min_range, max_range]`` [m], multi-object beamforming threshold (or
+    None), velocity-induced TDM phase compensation, and the angle grid."""
+
+    cfar_range: Cfar | None = Cfar("so", 8, 4, 15.0)
+    cfar_doppler: Cfar | None = None
+    group_doppler: bool = True
+    group_range: bool = False
+    min_range: float = 0.1
+    max_range: float = float("inf")
+    multi_peak: float | None = 0.5
+    tdm_compensation: bool = True
+
+
+def detect_points(
+    rd: ComplexArray,
+    ranges: FloatArray,
+    doppler: FloatArray,
+    grid: AngleGrid,
+    slot_of_virtual: IntArray,
+    chirp_period: float,
+    wavelength: float,
+    settings: Detection,
+) -> FloatArray:
+    """One frame's point cloud from its range-Doppler cube.
+
+    ``rd`` (n_virt, n_doppler, n_bins) complex from :func:`range_doppler`; ``ranges`` (n_bins,)
+    [m]; ``doppler`` (n_doppler,) [Hz]. CFAR on the :func:`detection_map`, peak grouping, angle
+    estimation of each detected cell. Returns (n_points, 5) float64: ``x, y, z`` [m] in the
+    sensor frame, radial velocity ``v`` [m/s] (positive approaching) and intensity [dB]: the
+    cell's power over its CFAR noise estimate (the range CFAR's, else the Doppler CFAR's;
+    without CFAR, the cell's power in dB re 1 W).
+    """
+    power = detection_map(rd)
+    mask = np.ones(power.shape, dtype=bool)
+    noise = np.full(power.shape, np.nan)
+    if settings.cfar_doppler is not None:
+        det, noise = cfar(power, settings.cfar_doppler, axis=0, cyclic=True)
+        mask &= det
+    if settings.cfar_range is not None:
+        det, noise = cfar(power, settings.cfar_range, axis=1, cyclic=False)
+        mask &= det
+    if settings.cfar_range is None and settings.cfar_doppler is None:
+        mask &= power > 0
+    mask &= ((ranges >= settings.min_range) & (ranges <= settings.max_range))[None, :]
+    mask = peak_grouping(power, mask, doppler=settings.group_doppler, range_=settings.group_range)
+    di, ri = np.nonzero(mask)
+    snaps = np.ascontiguousarray(rd[:, di, ri].T)
+    fd = doppler[di]
+    if settings.tdm_compensation:
+        snaps = tdm_compensation(snaps, fd, slot_of_virtual, chirp_period)
+    which, ux, uz, _ = estimate_angles(snaps, grid, settings.multi_peak)
+    r = ranges[ri][which]
+    uy = np.sqrt(np.clip(1.0 - ux**2 - uz**2, 0.0, None))
+    v = fd[which] * wavelength / 2.0
+    ref = np.nan_to_num(noise[di, ri], nan=1.0) if np.any(mask) else np.zeros(0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        snr = 10.0 * np.log10(power[di, ri] / ref)[which]
+    return np.column_stack([r * ux, r * uy, r * uz, v, snr]).astype(np.float64)
+
+
+# --------------------------------------------------------------------------- geometry
+
+
+def sensor_axes(azimuth: float, elevation: float) -> FloatArray:
+    """Rows ``x_s`` (right), ``y_s`` (boresight), ``z_s`` (up) of a sensor whose boresight points
+    at ``azimuth`` (from +x toward +y) and ``elevation`` (up) [rad], in the scene frame (z up).
+    (3, 3) float64, orthonormal and right-handed."""
+    ca, sa, ce, se = np.cos(azimuth), np.sin(azimuth), np.cos(elevation), np.sin(elevation)
+    y = np.array([ce * ca, ce * sa, se])
+    x = np.array([sa, -ca, 0.0])
+    z = np.cross(x, y)
+    return np.asarray(np.stack([x, y, z]), dtype=np.float64)
+
+
+def antenna_positions(
+    offsets: FloatArray, radar_position: FloatArray, axes: FloatArray
+) -> FloatArray:
+    """Scene positions [m] of antennas at sensor-plane ``offsets`` (n, 2) as (x, z) [m], (n, 3)."""
+    return np.asarray(
+        radar_position[None, :] + offsets[:, :1] * axes[0] + offsets[:, 1:2] * axes[2],
+        dtype=np.float64,
+    )
+
+
+def channel_delays(
+    positions: FloatArray, tx_position: FloatArray, rx_positions: FloatArray
+) -> FloatArray:
+    """Round-trip delays [s] TX -> scatterer -> each RX, exact (spherical).
+
+    ``positions`` (n, n_scat, 3); ``tx_position`` (n, 3) per chirp; ``rx_positions`` (n_rx, 3).
+    Returns (n, n_rx, n_scat)."""
+    out_leg = np.linalg.norm(positions - tx_position[:, None, :], axis=-1)
+    back = np.linalg.norm(positions[:, None, :, :] - rx_positions[None, :, None, :], axis=-1)
+    return np.asarray((out_leg[:, None, :] + back) / SPEED_OF_LIGHT, dtype=np.float64)
+
+
+def split_frames(n_chirps: int, seq: ChirpSequence) -> int:
+    """Number of whole frames in ``n_chirps`` chirps; ``ValueError`` when it is not whole."""
+    if n_chirps % seq.chirps_per_frame:
+        raise ValueError(
+            f"{n_chirps} chirps are not a whole number of frames of {seq.chirps_per_frame}"
+        )
+    return n_chirps // seq.chirps_per_frame
+
+
+def as_points(frames: Sequence[tuple[int, float, FloatArray]]) -> FloatArray:
+    """Stack per-frame points (frame index, frame time [s], (n, 5) array) into the point-cloud
+    array (n_points, 7) with columns :data:`POINT_COLUMNS`."""
+    rows = [
+        np.column_stack([np.full(len(p), f, np.float64), np.full(len(p), t), p])
+        for f, t, p in frames
+        if len(p)
+    ]
+    return np.concatenate(rows) if rows else np.zeros((0, len(POINT_COLUMNS)))
+
+
+# --------------------------------------------------------------------------- a block of chirps
+
+
+@dataclass(frozen=True)
+class Antennas:
+    """Antenna offsets in the sensor's x-z plane [m]: ``tx`` (n_tx, 2), ``rx`` (n_rx, 2)."""
+
+    tx: FloatArray
+    rx: FloatArray
+
+    def centred(self) -> Antennas:
+        """The same array moved so that its virtual array is centred on the sensor's position
+        (the TX and the RX offsets each centred on their mean)."""
+        return Antennas(self.tx - self.tx.mean(axis=0), self.rx - self.rx.mean(axis=0))
+
+    @property
+    def virtual(self) -> FloatArray:
+        """Virtual antenna positions, (n_tx * n_rx, 2) [m] (:func:`virtual_positions`)."""
+        return virtual_positions(self.tx, self.rx)
+
+    def slot_of_virtual(self, seq: ChirpSequence) -> IntArray:
+        """The TDM slot of each virtual antenna's TX (n_virt,); -1 for a TX never used."""
+        slot = np.full(self.tx.shape[0], -1, dtype=np.int64)
+        for s, tx in enumerate(seq.tdm_order):
+            slot[tx] = s
+        return np.repeat(slot, self.rx.shape[0])
+
+
+def chirp_profiles(
+    positions: FloatArray,
+    amplitudes: FloatArray,
+    radar_position: FloatArray,
+    axes: FloatArray,
+    seq: ChirpSequence,
+    antennas: Antennas,
+    *,
+    window_name: WindowName,
+    n_fft: int,
+    path: Literal["raw", "analytic"],
+    margin: int = 8,
+    extra_ranges: FloatArray | None = None,
+    noise: ComplexArray | None = None,
+) -> ComplexArray:
+    """Range profiles of every chirp and receive antenna, (n_chirps, n_rx, n_fft) complex128.
+
+    ``positions`` (n_chirps, n_scat, 3) [m] scene frame at each chirp (the first chirp is slot 0
+    of a loop); ``amplitudes`` (n_chirps, n_scat) [sqrt(W)]; ``axes`` from :func:`sensor_axes`.
+
+    ``raw``: exact spherical delays TX -> scatterer -> each RX, IF samples (:func:`if_samples`)
+    and the range FFT. ``analytic``: the closed-form profile (:func:`analytic_range_profile`)
+    at the bins within ``margin`` of the scatterers (and of ``extra_ranges`` [m]), with the
+    far-field delay to the chirp's TX and the receive array's centre
+    ``(2 R - (p_tx + p_rx_mean) . u) / c``, times the far-field phase of each RX's offset from
+    that centre ``exp(+j 2 pi f_c (p_rx - p_rx_mean) . u / c)``; other bins are 0 (the dropped
+    window sidelobes).
+    ``noise`` (n_chirps, n_rx, n_samples): IF noise added before the range FFT (both paths).
+    """
+    n = positions.shape[0]
+    n_rx = antennas.rx.shape[0]
+    slots = np.arange(n) % seq.n_tx
+    tx_index = np.asarray(seq.tdm_order, dtype=np.int64)[slots]
+    out = np.zeros((n, n_rx, n_fft), dtype=np.complex128)
+    if path == "raw":
+        tx_pos = antenna_positions(antennas.tx, radar_position, axes)[tx_index]
+        rx_pos = antenna_positions(antennas.rx, radar_position, axes)
+        delays = channel_delays(positions, tx_pos, rx_pos)
+        samples = np.empty((n, n_rx, seq.n_samples), dtype=np.complex128)
+        for r in range(n_rx):
+            samples[:, r] = if_samples(delays[:, r], amplitudes, seq)
+        if noise is not None:
+            samples += noise
+        return range_profile(samples, window_name, n_fft)
+    rel = positions - radar_position[None, None, :]
+    dist = np.sqrt(np.sum(rel * rel, axis=-1))
+    u = rel / dist[..., None]
+    ux, uz = u @ axes[0], u @ axes[2]
+    # envelope: the delay to the chirp's TX and the receive array's centre (far field);
+    # phase: each RX's offset from that centre, at the centre frequency
+    centre = antennas.tx[tx_index] + antennas.rx.mean(axis=0)[None, :]  # (n, 2)
+    delays = (2.0 * dist - (centre[:, 0:1] * ux + centre[:, 1:2] * uz)) / SPEED_OF_LIGHT
+    off = antennas.rx - antennas.rx.mean(axis=0)[None, :]  # (n_rx, 2)
+    arg = (2.0 * np.pi * seq.centre_frequency / SPEED_OF_LIGHT) * (
+        off[None, :, 0:1] * ux[:, None, :] + off[None, :, 1:2] * uz[:, None, :]
+    )
+    phasors = np.exp(1j * arg)
+    near = (
+        np.concatenate([dist.ravel(), np.asarray(extra_ranges, np.float64).ravel()])
+        if extra_ranges is not None
+        else dist
+    )
+    bins = bins_near(near, seq, n_fft, margin)
+    out[:, :, bins] = analytic_range_profile(
+        delays, amplitudes, seq, window_name, n_fft, bins, phasors
+    )
+    if noise is not None:
+        out += range_profile(noise, window_name, n_fft)
+    return out
+
+
+def gate_signal(
+    profiles: ComplexArray, ranges: FloatArray, gate_range: FloatArray, width: float
+) -> ComplexArray:
+    """Slow-time signal of each chirp: the first receive antenna's range profile summed over
+    the bins within ``width / 2`` of the gate. ``profiles`` (n_chirps, n_rx, n_bins); ``ranges``
+    (n_bins,) [m]; ``gate_range`` (n_chirps,) [m]. Returns (n_chirps,) complex128."""
+    inside = np.abs(ranges[None, :] - gate_range[:, None]) <= width / 2.0
+    return np.asarray(np.sum(profiles[:, 0, :] * inside, axis=1), dtype=np.complex128)
+
+
+def frame_spectrogram(
+    signal: ComplexArray, seq: ChirpSequence, window_name: str, nfft: int
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """One Doppler spectrum per frame of the slow-time signal of the first TDM slot.
+
+    ``signal`` (n_frames * chirps_per_frame,) one value per chirp. Each frame's ``n_loops``
+    samples of slot 0 are windowed (any scipy window) and transformed with ``nfft`` >= n_loops
+    points. Returns power (nfft, n_frames) [|signal|^2], Doppler (nfft,) [Hz] ascending and the
+    time of each frame's middle loop (n_frames,) [s from the first chirp].
+    """
+    from scipy.signal import get_window
+
+    frames = np.asarray(signal).reshape(-1, seq.chirps_per_frame)[:, :: seq.n_tx]
+    w = get_window(window_name, seq.n_loops, fftbins=True).astype(np.float64)
+    spec = np.fft.fftshift(np.fft.fft(frames * w, n=nfft, axis=1), axes=1)
+    power = np.ascontiguousarray((spec.real**2 + spec.imag**2).T)
+    time = np.arange(frames.shape[0]) * seq.frame_period + (seq.n_loops - 1) / 2 * seq.loop_period
+    return power, doppler_axis(seq, nfft), np.asarray(time, np.float64)

@@ -1,0 +1,297 @@
+"""FMCW chirp-sequence physics against analytic references (mdframework.physics.fmcw)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mdframework.constants import SPEED_OF_LIGHT as C
+from mdframework.physics import fmcw
+
+#: The IWR1443 short-range 3-D demo timing (start 77 GHz, 70 MHz/us, 240 samples at 4.884 Msps,
+#: idle 7 us, ramp 57.14 us, TX order 1-3-2, 16 loops, 33.333 ms frames).
+SEQ = fmcw.ChirpSequence(77e9, 70e12, 7e-6, 7e-6, 57.14e-6, 4.884e6, 240, 16, (0, 2, 1), 33.333e-3)
+HALF = C / SEQ.centre_frequency / 2.0
+#: TX1 (0, 0), TX2 (lambda, lambda/2 up), TX3 (2 lambda, 0); four RX lambda/2 apart; the
+#: virtual array centred on the sensor's position.
+ANT = fmcw.Antennas(
+    tx=np.array([[0.0, 0.0], [2.0, 1.0], [4.0, 0.0]]) * HALF,
+    rx=np.array([[k, 0.0] for k in range(4)]) * HALF,
+).centred()
+AXES = fmcw.sensor_axes(0.0, 0.0)  # boresight along +x of the scene, x_s = -y, z_s = +z
+RADAR = np.array([0.0, 0.0, 1.0])
+
+
+def scene_point(rng: float, az_deg: float, el_deg: float) -> np.ndarray:
+    """Scene position of a point at sensor range, azimuth (to the sensor's right), elevation."""
+    az, el = np.deg2rad(az_deg), np.deg2rad(el_deg)
+    local = rng * np.array([np.sin(az) * np.cos(el), np.cos(az) * np.cos(el), np.sin(el)])
+    return np.asarray(RADAR + local @ AXES)
+
+
+def one_frame(
+    start: np.ndarray, velocity: np.ndarray, path: str, seq: fmcw.ChirpSequence = SEQ
+) -> np.ndarray:
+    """Range profiles (chirps_per_frame, n_rx, n_samples) of a point moving at ``velocity``."""
+    t = fmcw.chirp_times(seq, 0.0, seq.frame_period)
+    pos = (start[None, :] + t[:, None] * velocity[None, :])[:, None, :]
+    return fmcw.chirp_profiles(
+        pos,
+        np.ones((t.size, 1)),
+        RADAR,
+        AXES,
+        seq,
+        ANT,
+        window_name="hann",
+        n_fft=seq.n_samples,
+        path=path,  # type: ignore[arg-type]
+    )
+
+
+def frame_points(profiles: np.ndarray, seq: fmcw.ChirpSequence = SEQ, **kw: object) -> np.ndarray:
+    cube = fmcw.virtual_cube(profiles, seq, 3)
+    rd = fmcw.range_doppler(cube, "hann", seq.n_loops)
+    grid = fmcw.angle_grid(ANT.virtual, seq.wavelength)
+    settings = fmcw.Detection(cfar_range=None, multi_peak=None, **kw)  # type: ignore[arg-type]
+    pts = fmcw.detect_points(
+        rd,
+        fmcw.range_axis(seq, seq.n_samples),
+        fmcw.doppler_axis(seq, seq.n_loops),
+        grid,
+        ANT.slot_of_virtual(seq),
+        seq.chirp_period,
+        seq.wavelength,
+        settings,
+    )
+    # the strongest point (no noise: every other "detection" is a sidelobe)
+    power = fmcw.detection_map(rd)
+    return pts, power
+
+
+def test_derived_quantities_of_the_iwr1443_demo() -> None:
+    # the values the RadHAR driver used: range bin 0.043577 m, 10.46 m, 4.92 m/s
+    assert SEQ.range_resolution == pytest.approx(C / (2 * 70e12 * 240 / 4.884e6), rel=1e-12)
+    assert SEQ.range_resolution == pytest.approx(0.043577, abs=1e-6)
+    assert SEQ.max_range == pytest.approx(10.4585, abs=1e-4)
+    assert SEQ.max_velocity == pytest.approx(C / SEQ.centre_frequency / (4 * 3 * 64.14e-6))
+    assert SEQ.max_velocity == pytest.approx(4.918, abs=2e-3)
+    assert SEQ.velocity_resolution == pytest.approx(2 * SEQ.max_velocity / 16)
+    assert SEQ.problems(4e9) == []
+
+
+def test_beat_frequency_is_2SR_over_c() -> None:
+    """The IF of a point at R is a tone at -2 S R / c (the conjugate-mixer convention)."""
+    r = np.array([[1.7], [4.5]])  # beat frequencies below fs / 2 for the phase estimator
+    y = fmcw.if_samples(2 * r / C, np.ones_like(r), SEQ)
+    est = np.angle(np.sum(y[:, 1:] * np.conj(y[:, :-1]), axis=1)) * SEQ.sample_rate / (2 * np.pi)
+    np.testing.assert_allclose(-est, fmcw.beat_frequency(r[:, 0], SEQ.slope), rtol=1e-9)
+    assert float(fmcw.beat_frequency(1.0, 70e12)) == pytest.approx(2 * 70e12 / C, rel=1e-15)
+    # the range profile peaks at the bin of that range, refined to well within a bin
+    prof = np.abs(fmcw.range_profile(y, "hann", 1024))
+    axis = fmcw.range_axis(SEQ, 1024)
+    np.testing.assert_allclose(axis[np.argmax(prof, axis=1)], r[:, 0], atol=axis[1] / 2 + 1e-12)
+
+
+def test_range_resolution_is_c_over_2B() -> None:
+    """With a rectangular window, bins c/2B apart are orthogonal: an on-bin target leaves every
+    other bin at zero, and two targets one resolution cell apart are both resolved exactly."""
+    assert SEQ.range_resolution == pytest.approx(C / (2 * SEQ.sampled_bandwidth), rel=1e-15)
+    dr = SEQ.range_resolution
+    r = np.array([[40 * dr, 41 * dr]])
+    prof = fmcw.range_profile(fmcw.if_samples(2 * r / C, np.ones_like(r), SEQ), "rect", 240)
+    mag = np.abs(prof[0])
+    np.testing.assert_allclose(mag[[40, 41]], 1.0, rtol=1e-9)
+    assert np.max(np.delete(mag, [40, 41])) < 1e-9
+
+
+def test_raw_and_analytic_range_profiles_are_identical() -> None:
+    """The closed form equals the sampled IF and FFT at every bin (1e-12 of the peak), for every
+    window and with zero-padding."""
+    rng = np.random.default_rng(1)
+    r = rng.uniform(0.5, 9.0, (5, 7))
+    a = rng.uniform(0.1, 1.0, (5, 7))
+    y = fmcw.if_samples(2 * r / C, a, SEQ)
+    for name in fmcw.WINDOWS:
+        for n_fft in (240, 512):
+            raw = fmcw.range_profile(y, name, n_fft)  # type: ignore[arg-type]
+            ana = fmcw.analytic_range_profile(
+                2 * r / C,
+                a,
+                SEQ,
+                name,
+                n_fft,
+                np.arange(n_fft),  # type: ignore[arg-type]
+            )
+            assert np.max(np.abs(raw - ana)) < 1e-12 * np.max(np.abs(raw))
+
+
+def test_target_beyond_max_range_aliases_in_the_if() -> None:
+    """Hard case: at 1.3 x the maximum range the beat frequency exceeds fs and the target
+    appears at 0.3 x, in the raw and the analytic path alike."""
+    r = np.array([[1.3 * SEQ.max_range]])
+    y = fmcw.if_samples(2 * r / C, np.ones_like(r), SEQ)
+    raw = np.abs(fmcw.range_profile(y, "hann", 240))[0]
+    ana = np.abs(
+        fmcw.analytic_range_profile(2 * r / C, np.ones_like(r), SEQ, "hann", 240, np.arange(240))
+    )[0]
+    axis = fmcw.range_axis(SEQ, 240)
+    assert axis[np.argmax(raw)] == pytest.approx(0.3 * SEQ.max_range, abs=SEQ.range_resolution)
+    np.testing.assert_allclose(raw, ana, atol=1e-12)
+    assert fmcw.bins_near(r[0], SEQ, 240, 0)[0] == int(0.3 * 240)
+
+
+def test_doppler_is_2v_over_lambda() -> None:
+    """A target approaching at v peaks at Doppler 2 v / lambda (lambda at the centre of the
+    sampled band); on a bin exactly, at that bin."""
+    v = 3 * SEQ.velocity_resolution  # on bin +3
+    start = scene_point(4.0, 0.0, 0.0)
+    prof = one_frame(start, -v * (start - RADAR) / np.linalg.norm(start - RADAR), "raw")
+    rd = fmcw.range_doppler(fmcw.virtual_cube(prof, SEQ, 3), "hann", 16)
+    power = fmcw.detection_map(rd)
+    d, _ = np.unravel_index(np.argmax(power), power.shape)
+    fd = fmcw.doppler_axis(SEQ, 16)
+    assert fd[d] == pytest.approx(2 * v / SEQ.wavelength, rel=1e-9)
+    # phase increment of one virtual channel across loops: 2 v / lambda to 0.1 % of a bin
+    k = int(np.argmax(np.abs(prof[0, 0])))
+    x = prof[0::3, 0, k]
+    est = np.angle(np.sum(x[1:] * np.conj(x[:-1]))) / (2 * np.pi * SEQ.loop_period)
+    assert est == pytest.approx(2 * v / SEQ.wavelength, abs=1e-3 / (16 * SEQ.loop_period))
+
+
+def test_velocity_beyond_the_tdm_limit_aliases() -> None:
+    """Hard case: the unambiguous velocity is lambda / (4 n_tx T_chirp) (TDM: one sample per
+    loop); at 1.25 x it the peak wraps to 1.25 v_max - 2 v_max = -0.75 v_max."""
+    vmax = SEQ.max_velocity
+    assert vmax == pytest.approx(SEQ.wavelength / (4 * SEQ.n_tx * SEQ.chirp_period), rel=1e-15)
+    start = scene_point(4.0, 0.0, 0.0)
+    los = (start - RADAR) / np.linalg.norm(start - RADAR)
+    fd = fmcw.doppler_axis(SEQ, 16)
+    peaks = []
+    for v in (0.75 * vmax, 1.25 * vmax):
+        rd = fmcw.range_doppler(
+            fmcw.virtual_cube(one_frame(start, -v * los, "raw"), SEQ, 3), "hann", 16
+        )
+        d, _ = np.unravel_index(np.argmax(fmcw.detection_map(rd)), rd.shape[1:])
+        peaks.append(fd[d] * SEQ.wavelength / 2)
+    assert peaks[0] == pytest.approx(0.75 * vmax, rel=1e-9)
+    assert peaks[1] == pytest.approx(-0.75 * vmax, rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("az", "el"), [(0.0, 0.0), (20.0, 0.0), (-35.0, 10.0), (25.0, -15.0), (65.0, 0.0)]
+)
+def test_angle_of_a_point_target_within_one_resolution_cell(az: float, el: float) -> None:
+    """A point at (az, el) is placed within one resolution cell in u_x (2 / 8 for the
+    8-antenna azimuth row) and u_z (2 / 2 for the two rows); straight ahead its direction
+    cosines are 0 to 0.0025 (1/100 of an azimuth cell; what is left is the near-field phase of
+    the exact delays at 3 m). 65 deg is the edge of the field of view."""
+    start = scene_point(3.0, az, el)
+    pts, _ = frame_points(one_frame(start, np.zeros(3), "raw"))
+    best = pts[np.argmax(pts[:, 4])]
+    ux, uz = np.sin(np.deg2rad(az)) * np.cos(np.deg2rad(el)), np.sin(np.deg2rad(el))
+    r = np.linalg.norm(best[:3])
+    assert r == pytest.approx(3.0, abs=SEQ.range_resolution)
+    assert best[0] / r == pytest.approx(ux, abs=2 / 8 / 4)  # a quarter of a cell in practice
+    assert best[2] / r == pytest.approx(uz, abs=2 / 2 / 4)
+    if az == 0.0 and el == 0.0:
+        assert abs(best[0] / r) < 0.0025 and abs(best[2] / r) < 0.0025
+
+
+def test_tdm_phase_compensation_restores_the_angle_of_a_fast_target() -> None:
+    """Hard case at the edge of the field of view: a target moving at 0.8 v_max gains phase
+    between TDM slots; without compensation the angle is off, with it within 0.02 in u_x."""
+    az = 50.0
+    start = scene_point(3.0, az, 0.0)
+    los = (start - RADAR) / np.linalg.norm(start - RADAR)
+    prof = one_frame(start, -0.8 * SEQ.max_velocity * los, "raw")
+    ux = np.sin(np.deg2rad(az))
+    errs = []
+    for comp in (True, False):
+        pts, _ = frame_points(prof, tdm_compensation=comp)
+        best = pts[np.argmax(pts[:, 4])]
+        errs.append(abs(best[0] / np.linalg.norm(best[:3]) - ux))
+    assert errs[0] < 0.02
+    assert errs[1] > 5 * errs[0]
+
+
+def test_raw_and_analytic_frames_agree() -> None:
+    """The analytic path (far-field phases, 2R/c envelope, bins near the scatterers) against
+    the raw path (exact spherical delays per channel, sampled IF): range-Doppler power within
+    0.01 dB at the cells above -10 dB and 1e-3 of the peak elsewhere (the bins the analytic
+    path leaves out are 67 dB down); the points fall in the same range and Doppler bins and
+    their direction cosines agree to 0.005 (1/50 of an azimuth resolution cell)."""
+    start = scene_point(3.0, 15.0, 5.0)
+    los = (start - RADAR) / np.linalg.norm(start - RADAR)
+    raw = one_frame(start, -1.1 * los, "raw")
+    ana = one_frame(start, -1.1 * los, "analytic")
+    p_raw, pw_raw = frame_points(raw)
+    p_ana, pw_ana = frame_points(ana)
+    peak = pw_raw.max()
+    assert np.max(np.abs(pw_raw - pw_ana)) < 1e-3 * peak
+    top = pw_raw > 0.1 * peak
+    assert np.max(np.abs(10 * np.log10(pw_ana[top] / pw_raw[top]))) < 0.01
+    b_raw, b_ana = p_raw[np.argmax(p_raw[:, 4])], p_ana[np.argmax(p_ana[:, 4])]
+    r = np.linalg.norm(b_raw[:3])
+    assert np.linalg.norm(b_ana[:3]) == pytest.approx(r, rel=1e-12)  # the same range bin
+    assert b_ana[3] == b_raw[3]  # the same Doppler bin
+    np.testing.assert_allclose(b_ana[:3] / r, b_raw[:3] / r, atol=0.005)  # 1/50 of a cell
+
+
+def test_chirp_times_follow_idle_time_and_frame_gaps() -> None:
+    t = fmcw.chirp_times(SEQ, 1.0, 1.0 + 3.5 * SEQ.frame_period)
+    assert t.shape == (4 * 48,)  # the fourth frame's chirps end 3.08 ms after it starts
+    assert t[0] == pytest.approx(1.0 + 7e-6)
+    np.testing.assert_allclose(np.diff(t[:48]), 64.14e-6, rtol=1e-9)
+    assert t[48] - t[0] == pytest.approx(SEQ.frame_period)
+    # a frame whose last chirp would end after `end` is left out
+    last = 7e-6 + 47 * 64.14e-6 + 57.14e-6
+    assert fmcw.chirp_times(SEQ, 0.0, last - 1e-9).size == 0
+    assert fmcw.chirp_times(SEQ, 0.0, last).size == 48
+
+
+def test_impossible_timing_names_the_field_and_the_limit() -> None:
+    from dataclasses import replace
+
+    msgs = replace(SEQ, frame_period=2e-3).problems()
+    assert len(msgs) == 1 and msgs[0].startswith("frame_period:") and "3.0787 ms" in msgs[0]
+    msgs = replace(SEQ, slope=80e12).problems(4e9)
+    assert msgs[0].startswith("slope:") and "4.5712 GHz" in msgs[0] and "4.0000 GHz" in msgs[0]
+    msgs = replace(SEQ, n_samples=256).problems()
+    assert msgs[0].startswith("ramp_end_time:") and "57.140 us" in msgs[0]
+
+
+def test_ca_cfar_false_alarm_rate_matches_theory() -> None:
+    """CA-CFAR on exponential noise: P_fa = (1 + alpha / N)^-N for N training cells and the
+    threshold alpha times their mean (cyclic, so every cell has all N)."""
+    rng = np.random.default_rng(7)
+    noise = rng.exponential(1.0, (20000, 128))
+    settings = fmcw.Cfar("ca", train=8, guard=2, threshold_db=10.0)
+    det, est = fmcw.cfar(noise, settings, axis=1, cyclic=True)
+    n = 16
+    expected = (1 + 10.0 / n) ** -n
+    assert det.mean() == pytest.approx(expected, rel=0.1)  # 3 sigma of 1080 expected
+    assert np.nanmean(est) == pytest.approx(1.0, rel=0.01)
+
+
+def test_cfar_modes_at_a_clutter_edge() -> None:
+    """At a step in the noise level, smallest-of takes the quiet side, greatest-of the loud
+    side, cell averaging the mean; without wrapping, an edge cell uses one side only."""
+    p = np.r_[np.ones(20), 100 * np.ones(20)][None, :]
+    for mode, want in (("so", 1.0), ("go", 100.0), ("ca", 50.5)):
+        _, est = fmcw.cfar(p, fmcw.Cfar(mode, 4, 1, 10.0), axis=1, cyclic=False)  # type: ignore[arg-type]
+        assert est[0, 20] == pytest.approx(want)
+    _, est = fmcw.cfar(p, fmcw.Cfar("ca", 4, 1, 10.0), axis=1, cyclic=False)
+    assert est[0, 0] == pytest.approx(1.0) and est[0, 39] == pytest.approx(100.0)
+    # a target 20 dB above a flat floor is detected at 15 dB, not at 25 dB
+    q = np.ones((1, 64))
+    q[0, 30] = 100.0
+    assert fmcw.cfar(q, fmcw.Cfar("ca", 8, 2, 15.0), axis=1, cyclic=False)[0][0].sum() == 1
+    assert fmcw.cfar(q, fmcw.Cfar("ca", 8, 2, 25.0), axis=1, cyclic=False)[0][0].sum() == 0
+
+
+def test_sensor_axes_are_a_right_handed_frame() -> None:
+    a = fmcw.sensor_axes(np.deg2rad(30.0), np.deg2rad(-10.0))
+    np.testing.assert_allclose(a @ a.T, np.eye(3), atol=1e-15)
+    assert np.linalg.det(a) == pytest.approx(1.0)
+    np.testing.assert_allclose(a[0, 2], 0.0, atol=1e-15)  # x_s is horizontal
+    assert a[2, 2] > 0  # z_s points up
