@@ -125,10 +125,17 @@ def test_the_pulse_limit_names_the_memory_a_run_would_take() -> None:
     with pytest.raises(ConfigError) as exc:
         validate_run_config(cfg)
     n = math.floor(3000.0 * 2400.0) + 1  # 7.2e6 pulses
-    mib = n * (5 * 8 * 1 + 4 * 8) / 1024**2  # positions, rcs, range per scatterer; signal
+    mib = n * (8 + 8 + 16 + 8) / 1024**2  # time, gate, complex signal, STFT input
     assert f"{n:.4g} pulses" in str(exc.value)
-    assert f"about {mib:.3g} MiB" in str(exc.value)
+    assert f"about {mib:.3g} MiB of memory)" in str(exc.value)
     assert "motion.duration" in str(exc.value)
+    # keeping every scatterer adds positions, RCS and range per pulse and scatterer
+    cfg["processing"] = {"keep_scatterers": True}
+    with pytest.raises(ConfigError) as exc:
+        validate_run_config(cfg)
+    gib = n * (8 + 8 + 16 + 8 + 5 * 8 * 1) / 1024**2
+    assert f"about {gib:.3g} MiB of memory, keeping 1 scatterer(s) per pulse" in str(exc.value)
+    del cfg["processing"]
     # just below the limit the config is valid
     cfg["motion"]["length"] = (limits.MAX_PULSES - 2) / 2400.0
     validate_run_config(cfg)

@@ -18,6 +18,7 @@ from .interfaces import (
     Motion,
     MotionSource,
     PluginConfig,
+    PulseBlock,
     RadarRecordingSource,
     RadarWaveform,
     Received,
@@ -25,6 +26,7 @@ from .interfaces import (
     ScattererModel,
     Scatterers,
     SceneContext,
+    receive_points,
 )
 from .settings import DataPath, MotionConfig
 from .skeleton import CANONICAL_JOINTS, CANONICAL_SEGMENTS, Skeleton, to_canonical
@@ -44,6 +46,7 @@ __all__ = [
     "MotionConfig",
     "MotionSource",
     "PluginConfig",
+    "PulseBlock",
     "RadarRecordingSource",
     "RadarWaveform",
     "Received",
@@ -55,5 +58,6 @@ __all__ = [
     "Skeleton",
     "hookimpl",
     "limits",
+    "receive_points",
     "to_canonical",
 ]

@@ -234,6 +234,8 @@ def _check_pulse_budget(config: RunConfigBase, source: str) -> None:
         return
     n_points = len(getattr(cfg.motion, "targets", ())) or len(CANONICAL_JOINTS)
     try:
-        limits.check_pulses(length, prf, n_points, "motion.duration")
+        limits.check_pulses(
+            length, prf, n_points, "motion.duration", cfg.processing.keep_scatterers
+        )
     except SceneError as exc:
         raise ConfigError(f"{source}: {exc}") from None

@@ -65,15 +65,23 @@ MAX_RECORDS = 1_000_000
 #: must then lie in the range of the field it is drawn into).
 MAX_DRAWN_NUMBER = 1e12
 
-#: Bytes held per pulse and scatterer in a run (positions (3), RCS and range, float64) and per
-#: pulse (time, gate, complex signal): the basis of the memory estimate in :func:`check_pulses`.
+#: Bytes the streaming pipeline holds per pulse of a record (time, gate range, the complex
+#: slow-time signal and its float32 STFT input), and per pulse and scatterer when the result keeps
+#: every scatterer (``processing.keep_scatterers``: positions, RCS, range): the basis of the
+#: memory estimate in :func:`check_pulses`.
+_BYTES_PER_PULSE = 8 + 8 + 16 + 8
 _BYTES_PER_PULSE_SCATTERER = 5 * 8
-_BYTES_PER_PULSE = 4 * 8
 
 
-def memory_estimate_bytes(n_pulses: float, n_scatterers: int) -> float:
-    """Approximate bytes a run of ``n_pulses`` over ``n_scatterers`` holds at once."""
-    return n_pulses * (_BYTES_PER_PULSE_SCATTERER * max(n_scatterers, 1) + _BYTES_PER_PULSE)
+def memory_estimate_bytes(
+    n_pulses: float, n_scatterers: int, keep_scatterers: bool = False
+) -> float:
+    """Approximate bytes a run of ``n_pulses`` holds for the whole record (the per-block
+    arrays of the streaming pipeline do not grow with it, unless every scatterer is kept)."""
+    per_pulse = _BYTES_PER_PULSE
+    if keep_scatterers:
+        per_pulse += _BYTES_PER_PULSE_SCATTERER * max(n_scatterers, 1)
+    return n_pulses * per_pulse
 
 
 def _size(n_bytes: float) -> str:
@@ -89,18 +97,25 @@ def pulse_count(duration_s: float, prf_hz: float) -> float:
     return float(np.floor(duration_s * prf_hz)) + 1.0
 
 
-def check_pulses(duration_s: float, prf_hz: float, n_scatterers: int, where: str) -> None:
+def check_pulses(
+    duration_s: float,
+    prf_hz: float,
+    n_scatterers: int,
+    where: str,
+    keep_scatterers: bool = False,
+) -> None:
     """Refuse a run of more than :data:`MAX_PULSES` pulses, saying how much memory it would take.
 
     ``where`` names what to change (e.g. ``"motion.duration"``). Raises :class:`SceneError`.
     """
     n = pulse_count(duration_s, prf_hz)
     if n > MAX_PULSES:
-        need = _size(memory_estimate_bytes(n, n_scatterers))
+        need = _size(memory_estimate_bytes(n, n_scatterers, keep_scatterers))
+        kept = f", keeping {n_scatterers} scatterer(s) per pulse" if keep_scatterers else ""
         raise SceneError(
             f"{where}: a record of {duration_s:g} s at PRF {prf_hz:g} Hz is {n:.4g} pulses "
-            f"(about {need} of memory for {n_scatterers} scatterer(s)); the limit is "
-            f"{MAX_PULSES:,} pulses: shorten the record or lower the PRF"
+            f"(about {need} of memory{kept}); the limit is {MAX_PULSES:,} pulses: shorten the "
+            "record or lower the PRF"
         )
 
 
