@@ -22,6 +22,7 @@ Every problem raises :class:`mdframework.DataFileError` with the file and 1-base
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -135,18 +136,23 @@ class _BoneDraft:
     dof: tuple[str, ...] = ()
 
 
-def _floats(path: Path, tokens: list[str], count: int, what: str, line: int) -> FloatArray:
+def _float_list(path: Path, tokens: list[str], count: int, what: str, line: int) -> list[float]:
     if len(tokens) != count:
         raise DataFileError(path, f"{what} needs {count} numbers, found {len(tokens)}", line)
     try:
-        out = np.array([float(t) for t in tokens], dtype=np.float64)
+        out = [float(t) for t in tokens]
     except ValueError:
         bad = next(t for t in tokens if not _is_float(t))
         raise DataFileError(path, f"bad number {bad!r} in {what}", line) from None
-    if not np.all(np.isfinite(out)):
+    if not all(map(math.isfinite, out)):
         raise DataFileError(path, f"non-finite number in {what}", line)
-    limits.check_values(path, out[None], limits.MAX_FILE_COORDINATE, f"{what}:", [line])
+    if max(map(abs, out), default=0.0) > limits.MAX_FILE_COORDINATE:
+        limits.check_values(path, [out], limits.MAX_FILE_COORDINATE, f"{what}:", [line])
     return out
+
+
+def _floats(path: Path, tokens: list[str], count: int, what: str, line: int) -> FloatArray:
+    return np.array(_float_list(path, tokens, count, what, line), dtype=np.float64)
 
 
 # ----------------------------------------------------------------- checks of values read
@@ -159,13 +165,19 @@ def _check_length_unit(path: Path, scale: float, line: int) -> None:
 
 
 def _check_amc_angles(
-    path: Path, bone: str, vals: FloatArray, order: tuple[str, ...], degrees: bool, line: int
+    path: Path,
+    bone: str,
+    vals: FloatArray,
+    order: tuple[str, ...],
+    degrees: bool,
+    lines: list[int],
 ) -> None:
-    """Rotation values of one AMC bone line within +-``limits.MAX_ANGLE_DEG``."""
+    """Rotation values of one AMC bone (n_frames, n_values) within +-``limits.MAX_ANGLE_DEG``;
+    ``lines``: the file line of each frame's values."""
     rot = [k for k, c in enumerate(order) if c.upper().startswith("R")]
     limit = limits.MAX_ANGLE_DEG if degrees else np.deg2rad(limits.MAX_ANGLE_DEG)
     unit = " deg" if degrees else " rad"
-    limits.check_values(path, vals[None, rot], limit, f"angle of bone {bone!r}:", [line], unit)
+    limits.check_values(path, vals[:, rot], limit, f"angle of bone {bone!r}:", lines, unit)
 
 
 def _is_float(text: str) -> bool:
@@ -414,6 +426,7 @@ def read_amc(path: str | Path, asf: AsfSkeleton) -> AmcMotion:
     lines = read_lines(p)
     counts = {"root": 6, **{b.name: len(b.dof) for b in asf.bones}}
     orders = {"root": asf.root_order, **{b.name: b.dof for b in asf.bones}}
+    bone_lines: dict[str, list[int]] = {}
     degrees = asf.angles_in_degrees
     rows: dict[str, list[list[float]]] = {}
     numbers: list[int] = []
@@ -467,16 +480,17 @@ def read_amc(path: str | Path, asf: AsfSkeleton) -> AmcMotion:
             raise DataFileError(p, f"bone {key!r} is not in the skeleton {asf.path.name}", ln)
         if key in in_frame:
             raise DataFileError(p, f"bone {key!r} appears twice in frame {numbers[-1]}", ln)
-        vals = _floats(p, toks[1:], counts[key], f"the values of bone {key!r}", ln)
-        _check_amc_angles(p, key, vals, orders[key], degrees, ln)
+        vals = _float_list(p, toks[1:], counts[key], f"the values of bone {key!r}", ln)
+        bone_lines.setdefault(key, []).append(ln)
         in_frame.add(key)
-        rows.setdefault(key, []).append(vals.tolist())
+        rows.setdefault(key, []).append(vals)
     if not numbers:
         raise DataFileError(p, "the file holds zero frames", max(len(lines), 1))
     close_frame(len(lines))
     values: dict[str, FloatArray] = {}
     for name, r in rows.items():
         arr = np.asarray(r, dtype=np.float64).reshape(len(numbers), counts[name])
+        _check_amc_angles(p, name, arr, orders[name], degrees, bone_lines[name])
         if not degrees:
             if name == "root":
                 rot = [k for k, c in enumerate(asf.root_order) if c.startswith("R")]
