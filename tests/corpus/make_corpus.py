@@ -599,7 +599,12 @@ def _field_cases(c: _Corpus) -> None:
         "pulses",
     )
     case("radar-position-inf", "scene", {"radar_position": [inf, 0, 0]}, "scene.radar_position")
-    case("gate-inf", "scene", {"gate": inf}, "scene.gate: Input should be 'track' or")
+    case(
+        "gate-inf",
+        "scene",
+        {"gate": inf},
+        "scene.gate: must be one of 'track' (got inf) or must be a finite number",
+    )
     case("min-range-inf", "scene", {"min_range": inf}, "scene.min_range")
     case("person-nan", "scene", {"person": {"position": [nan, 0]}}, "scene.person.position")
     case("heading-1e9", "scene", {"person": {"heading_deg": 1e9}}, "scene.person.heading_deg")
@@ -673,7 +678,7 @@ def _field_cases(c: _Corpus) -> None:
     body_case(
         "kinect-floor-inf",
         {"motion": {"kind": "kinect", "format": "utkinect", "file": str(UTK), "floor": inf}},
-        "motion.floor: Input should be 'auto' or",
+        "motion.floor: must be one of 'auto' (got inf) or must be a finite number",
     )
     body_case("boulic-speed-inf", {"motion": {"kind": "boulic", "speed": inf}}, "motion.speed")
     body_case(
@@ -754,7 +759,7 @@ def _dataset_cases(c: _Corpus) -> None:
         out = d / "out"
         c.command(
             f"experiment-{name}",
-            ["experiment", str(f), "--out", str(out), *argv],
+            ["experiment", str(f), "--out", str(out), "--no-progress", *argv],
             out,
             f.name,
             *expect,
