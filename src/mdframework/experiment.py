@@ -25,7 +25,6 @@ from __future__ import annotations
 import csv
 import io
 import json
-import sys
 from collections import Counter
 from collections.abc import Callable, Sequence
 from functools import partial
@@ -48,9 +47,23 @@ from .dataset import Dataset, build_dataset, load_dataset, load_dataset_config
 from .errors import ConfigError, MdfError
 from .features import FEATURE_NAMES
 from .interfaces import Classifier
+from .outdir import output_folder, safe_name
 from .plugins import Registry, default_registry
 from .pointcloud import histogram_vector, histogram_vector_names, velocity_bins
+from .progress import note
 from .settings import Seed, StrictModel, Workers
+
+#: every name an experiment writes in its folder (group names are made safe by ``safe_name``)
+EXPERIMENT_FILES = (
+    "report.md",
+    "summary.json",
+    "within_*",
+    "cross_confusion.*",
+    "train_test_confusion.*",
+    "feature_stats.*",
+    "scatter_*.png",
+    "dataset",
+)
 
 
 class DatasetRef(StrictModel):
@@ -502,11 +515,6 @@ def classifier_inputs(
     return data, x, list(histogram_vector_names(centres))
 
 
-def _status(progress: bool, message: str) -> None:
-    if progress:
-        print(f"mdf: {message} ...", file=sys.stderr, flush=True)
-
-
 def selected_features_markdown(subsets: Sequence[Sequence[str]], method: str) -> list[str]:
     """Report lines saying which inputs feature selection chose: how often each was chosen over
     the splits, and the most frequent subset."""
@@ -529,25 +537,48 @@ def run_experiment(
     source: str = "<experiment>",
     progress: bool = True,
     registry: Registry | None = None,
+    force: bool = False,
+    staging_dir: Path | str | None = None,
     allow_import: bool = False,
 ) -> dict[str, Any]:
-    """Build or load the dataset, run the experiments, write the report. The figures are drawn
-    together at the end, once every number is computed (matplotlib loads only then).
+    """Build or load the dataset, run the experiments, write the report. ``out_dir`` follows
+    the rules of :mod:`mdframework.outdir` (``force``, ``staging_dir``); a dataset the
+    experiment builds goes to ``out_dir/dataset`` (resumable, see :func:`build_dataset`).
     ``allow_import``: see :func:`classifier_factory`."""
+    with output_folder(
+        out_dir, "experiment", EXPERIMENT_FILES, force=force, staging_dir=staging_dir
+    ) as folder:
+        factory = classifier_factory(cfg.classifier, source, registry, allow_import=allow_import)
+        if cfg.dataset.config is not None:
+            dcfg, base = load_dataset_config(cfg.dataset.config)
+            data_dir = folder.path / "dataset"
+            build_dataset(dcfg, base, data_dir, workers=cfg.workers, progress=progress, force=force)
+        else:
+            assert cfg.dataset.path is not None
+            data_dir = cfg.dataset.path
+        note(f"loading the dataset {data_dir}", progress)
+        data, x_all, names = classifier_inputs(cfg, data_dir)
+        stage = folder.stage()
+        summary = _report(cfg, factory, data, x_all, names, data_dir, stage, progress)
+        folder.commit(stage, keep=("dataset",))  # a built dataset is never deleted
+    return summary
+
+
+def _report(
+    cfg: ExperimentConfig,
+    factory: Callable[[], Classifier],
+    data: Dataset,
+    x_all: NDArray[np.float64],
+    names: list[str],
+    data_dir: Path,
+    out: Path,
+    progress: bool = True,
+) -> dict[str, Any]:
+    """Run the experiments on ``data`` (classifier inputs ``x_all`` named ``names``) and write
+    every report file into ``out``. The figures are drawn together at the end, once every number
+    is computed (matplotlib loads only then)."""
     from .figures import plot_confusion, plot_feature_scatter
 
-    factory = classifier_factory(cfg.classifier, source, registry, allow_import=allow_import)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    if cfg.dataset.config is not None:
-        dcfg, base = load_dataset_config(cfg.dataset.config)
-        build_dataset(dcfg, base, out / "dataset", workers=cfg.workers, progress=progress)
-        data_dir = out / "dataset"
-    else:
-        assert cfg.dataset.path is not None
-        data_dir = cfg.dataset.path
-    _status(progress, f"loading the dataset {data_dir}")
-    data, x_all, names = classifier_inputs(cfg, data_dir)
     figures: list[Callable[[], None]] = []  # drawn at the end
 
     summary: dict[str, Any] = {
@@ -591,7 +622,7 @@ def run_experiment(
             summary["within"][group] = {"skipped": str(exc)}
             continue
         classes = res["classes"]
-        stem = f"within_{group}"
+        stem = f"within_{safe_name(group)}"
         (out / f"{stem}_confusion.csv").write_text(
             _csv(_matrix_rows(classes, res["confusion_mean"]))
         )
@@ -699,7 +730,7 @@ def run_experiment(
             "![train/test](train_test_confusion.png)",
             "",
         ]
-    _status(progress, "feature statistics and figures")
+    note("feature statistics and figures", progress)
     stats = feature_statistics(data)
     (out / "feature_stats.csv").write_text(_csv(stats))
     md = _stats_markdown(stats)
