@@ -17,6 +17,7 @@ from mdframework.testing import (
     check_effect_class,
     check_motion_source,
     check_plugin_class,
+    check_recording_source,
     check_scatterer_model,
     check_waveform,
 )
@@ -47,6 +48,19 @@ def test_motion_source_contract(name: str) -> None:
     assert name in SOURCE_EXAMPLES, f"add an example using the {name!r} source"
     config = load_run_config(EXAMPLES / SOURCE_EXAMPLES[name])
     check_motion_source(build_stages(config).source)
+
+
+#: a recording each recording source reads in its contract check
+RECORDING_EXAMPLES = {"radhar": {"file": "data/radhar/radhar_walk_subset.npz"}}
+
+
+@pytest.mark.parametrize("name", REGISTRY.names("recording"))
+def test_recording_source_contract(name: str) -> None:
+    assert name in RECORDING_EXAMPLES, f"add an example recording for the {name!r} source"
+    cls: Any = REGISTRY.get("recording", name)
+    section = {"kind": name, **RECORDING_EXAMPLES[name]}
+    config = cls.Config.model_validate(section, context={"base_dir": EXAMPLES})
+    check_recording_source(cls(config))
 
 
 @pytest.fixture(scope="module")

@@ -24,7 +24,7 @@ def test_every_hook_is_documented_in_the_plugin_guide() -> None:
         for n, f in inspect.getmembers(hookspecs, inspect.isfunction)
         if n.startswith("mdframework_")
     ]
-    assert len(hooks) == 6
+    assert len(hooks) == 7
     for name in hooks:
         assert name in guide, f"{name} missing from docs/plugins.md"
 

@@ -2,15 +2,23 @@
 
 A dataset config lists motion sources with their activity labels, cuts long recordings into
 records of a fixed length, and multiplies them by scene variations (aspect angle, radar range and
-height, the person's height for sources that have one). Every record is one run of the pipeline
-followed by the seven features. ``build_dataset`` writes::
+height, the person's height for sources that have one) on a fixed grid and by per-record random
+draws (``[randomize]``, :mod:`mdframework.randomize`: scene parameters and motion augmentation).
+Every record is one run of the pipeline followed by the seven features. Sources can also be
+recordings of a real radar (``recording = {kind = ...}``, point clouds): their records are
+windows of frames turned into per-frame Doppler histograms (:mod:`mdframework.pointcloud`), the
+representation simulated records get with ``representation = "histogram"``.
+``build_dataset`` writes::
 
     DIR/records/<id>.npz   one file per record, written atomically (temp file + rename):
                            spectrogram_db (n_doppler, n_frames) float32 [dB re peak],
                            velocity_mps (n_doppler,), time_s (n_frames,), features (7,) [m/s],
-                           meta: JSON string (label, source, file, window, scene, radar, units)
+                           meta: JSON string (label, source, file, window, scene, radar, units);
+                           histogram records also: histograms (n_frames, n_bins) float32
+                           (points, or intensity weights, per velocity bin and frame)
     DIR/index.csv          one row per record: id, label, source, file, start_s, duration_s,
-                           aspect_deg, radar_x/y/z_m, height_m, seed, then the 7 features
+                           aspect_deg, radar_x/y/z_m, height_m, seed, the 7 features, then
+                           draw.<name> for every randomised parameter
     DIR/dataset.json       the config, the feature names and units, the record count
 
 Records are independent pure functions of their spec (including a seed derived from the
@@ -39,11 +47,22 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field, ValidationError, model_validator
 
+from .augment import augment_motion
 from .config import format_validation_error, read_config_file, validate_run_config
-from .errors import ConfigError, MdfError
+from .errors import ConfigError, MdfError, SceneError
 from .features import FEATURE_NAMES, spectrogram_features
-from .interfaces import Motion
+from .interfaces import Motion, RadarRecordingSource, Recording
 from .pipeline import build_stages, load_motion, simulate_motion
+from .plugins import default_registry
+from .pointcloud import (
+    IWR1443_BIN_WIDTH,
+    HistogramSettings,
+    PointCloud,
+    cloud_histograms,
+    histogram_features,
+    velocity_bins,
+)
+from .randomize import Randomization, set_path
 from .settings import StrictModel
 
 RECORDS = "records"
@@ -65,13 +84,43 @@ class FeatureConfig(StrictModel):
     )
 
 
+class HistogramConfig(StrictModel):
+    """Per-frame Doppler histograms of point clouds (:mod:`mdframework.pointcloud`)."""
+
+    bin_width: float = Field(
+        IWR1443_BIN_WIDTH, gt=0, description="Velocity bin [m/s] (default: the IWR1443's)."
+    )
+    n_bins: int = Field(17, ge=1, description="Number of bins (odd), centred on 0 m/s.")
+    weighting: Literal["count", "intensity", "power"] = Field(
+        "count", description="Point weight: 1, intensity [dB] (>= 0), or linear power."
+    )
+    min_range: float = Field(0.5, ge=0, description="Ignore points nearer than this [m].")
+    max_range: float = Field(3.0, gt=0, description="Ignore points farther than this [m].")
+
+    @model_validator(mode="after")
+    def _check(self) -> HistogramConfig:
+        if self.n_bins % 2 == 0:
+            raise ValueError("n_bins must be odd (a bin centred on 0 m/s)")
+        if self.max_range <= self.min_range:
+            raise ValueError("max_range must exceed min_range")
+        return self
+
+    def settings(self) -> HistogramSettings:
+        """As the pure-function settings."""
+        return HistogramSettings(**self.model_dump())
+
+
 class SourceEntry(StrictModel):
-    """One recording (or generator) and its label."""
+    """One recording (or generator) and its label: a motion to simulate, or recordings of a
+    real radar."""
 
     label: str = Field(description="Activity label, e.g. 'walk'.")
-    motion: dict[str, Any] = Field(description="A [motion] section (with its kind).")
+    motion: dict[str, Any] | None = Field(None, description="A [motion] section (with its kind).")
+    recording: dict[str, Any] | None = Field(
+        None, description="A real radar's recordings (with its kind, e.g. 'radhar')."
+    )
     group: str | None = Field(
-        None, description="Source group for cross-source experiments; default: motion.kind."
+        None, description="Source group for cross-source experiments; default: the kind."
     )
     record_length: float | None = Field(
         None, gt=0, description="Record length [s]; default: record_lengths[label], else all."
@@ -83,6 +132,15 @@ class SourceEntry(StrictModel):
         description="Run-config sections for this source only, merged over `base` (e.g. "
         "conditioning for Kinect recordings, or its own scene).",
     )
+    randomize: Randomization | None = Field(
+        None, description="Random draws for this source only, instead of the dataset's."
+    )
+
+    @model_validator(mode="after")
+    def _one_kind(self) -> SourceEntry:
+        if (self.motion is None) == (self.recording is None):
+            raise ValueError("give exactly one of motion and recording")
+        return self
 
 
 class Variations(StrictModel):
@@ -128,6 +186,13 @@ class DatasetConfig(StrictModel):
         "processing, effects).",
     )
     features: FeatureConfig = Field(default_factory=FeatureConfig)
+    representation: Literal["spectrogram", "histogram"] = Field(
+        "spectrogram",
+        description="Simulated records: the spectrogram, or per-frame Doppler histograms of the "
+        "radar's point clouds (as recordings of a real radar always are).",
+    )
+    histogram: HistogramConfig = Field(default_factory=HistogramConfig)
+    randomize: Randomization = Field(default_factory=Randomization)
     workers: int | None = Field(None, ge=1, description="Local processes; default: CPU count.")
     scheduler: str | None = Field(
         None, description="Dask scheduler address, or 'local' for a local Dask cluster."
@@ -145,6 +210,10 @@ class RecordSpec:
     run_config: dict[str, Any]
     base_dir: str
     features: dict[str, Any]
+    #: values drawn for this record (scene and augmentation), for the table
+    draws: dict[str, Any] | None = None
+    #: ``{"histogram": settings}`` for histogram records, else None
+    histogram: dict[str, Any] | None = None
 
 
 def load_dataset_config(path: str | Path) -> tuple[DatasetConfig, Path]:
@@ -203,9 +272,122 @@ def _merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
+@lru_cache(maxsize=8)
+def _load_recordings(section_json: str, base_dir: str) -> tuple[Recording, ...]:
+    """Load a real radar's recordings once per process."""
+    section = json.loads(section_json)
+    kind = section.get("kind")
+    try:
+        cls = default_registry().get("recording", str(kind))
+    except KeyError as exc:
+        raise ConfigError(f"recording.kind: {exc.args[0]}") from None
+    try:
+        cfg = cls.Config.model_validate(section, context={"base_dir": Path(base_dir)})
+    except ValidationError as exc:
+        raise ConfigError(format_validation_error(exc, "recording", section)) from None
+    source: Any = cls(cfg)
+    assert isinstance(source, RadarRecordingSource)
+    return tuple(source.load())
+
+
+def _plan_recordings(
+    config: DatasetConfig, entry_no: int, entry: SourceEntry, base_dir: Path, first_index: int
+) -> list[RecordSpec]:
+    """Records of a real radar's recordings: windows of whole frames."""
+    section = dict(entry.recording or {})
+    where = f"sources[{entry_no}]"
+    if "kind" not in section:
+        raise ConfigError(f"{where}.recording: a kind is required")
+    try:
+        recordings = _load_recordings(json.dumps(section, sort_keys=True), str(base_dir))
+    except ConfigError as exc:
+        raise ConfigError(f"{where}.{exc}") from None
+    hist = config.histogram.model_dump()
+    specs: list[RecordSpec] = []
+    for rec in recordings:
+        period = rec.cloud.frame_period
+        length_s = entry.record_length or config.record_lengths.get(entry.label)
+        length = rec.cloud.n_frames if length_s is None else round(length_s / period)
+        hop = length if entry.hop is None else max(1, round(entry.hop / period))
+        if length < 1 or length > rec.cloud.n_frames:
+            raise ConfigError(
+                f"{where}: record length {length} frames does not fit the "
+                f"{rec.cloud.n_frames} frames of {rec.name}"
+            )
+        starts = range(0, rec.cloud.n_frames - length + 1, hop)
+        for n, first in enumerate(starts):
+            if entry.max_records is not None and n >= entry.max_records:
+                break
+            run = {"recording": section, "name": rec.name, "first_frame": first, "frames": length}
+            specs.append(
+                _spec(
+                    config,
+                    first_index + len(specs),
+                    entry,
+                    section["kind"],
+                    run,
+                    base_dir,
+                    None,
+                    hist,
+                )
+            )
+    return specs
+
+
+def _spec(
+    config: DatasetConfig,
+    index: int,
+    entry: SourceEntry,
+    kind: str,
+    run: dict[str, Any],
+    base_dir: Path,
+    draws: dict[str, Any] | None,
+    hist: dict[str, Any] | None,
+) -> RecordSpec:
+    """A record's spec; its id ends with a digest of everything that makes the record."""
+    features = config.features.model_dump()
+    payload = [run, features] + [x for x in (draws, hist) if x is not None]
+    digest = hashlib.sha1(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:10]
+    return RecordSpec(
+        index,
+        f"{index:05d}-{digest}",
+        entry.label,
+        entry.group or kind,
+        run,
+        str(base_dir),
+        features,
+        draws,
+        None if hist is None else {"histogram": hist},
+    )
+
+
+def _apply_draws(
+    run: dict[str, Any], section: dict[str, Any], draws: dict[str, Any], where: str
+) -> None:
+    """Put one record's drawn scene values into its run config (in place)."""
+    scene_keys = {k: draws.get(k) for k in ("aspect_deg", "radar_range", "radar_height")}
+    if any(v is not None for v in scene_keys.values()):
+        run["scene"] = _scene_for(run.get("scene", {}), {**scene_keys, "radar_position": None})
+    if "height" in draws:
+        section["height"] = draws["height"]
+    for path, value in draws.items():
+        if "." in path:
+            try:
+                set_path(run, path, value)
+            except KeyError as exc:
+                raise ConfigError(f"{where}: randomize.params: {exc.args[0]}") from None
+
+
 def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
-    """Expand sources x windows x variations into record specs, in a fixed order."""
+    """Expand sources x windows x variations x random draws into record specs, in a fixed
+    order."""
     v = config.variations
+    for rz in [config.randomize] + [e.randomize for e in config.sources if e.randomize]:
+        for name in ("aspect_deg", "radar_range", "radar_height", "height"):
+            if getattr(v, name) is not None and getattr(rz, name) is not None:
+                raise ConfigError(f"{name}: give it as a variation or as a random draw, not both")
+        if (rz.radar_range is not None or rz.radar_height is not None) and v.radar_position:
+            raise ConfigError("randomize.radar_range/height cannot combine with radar_position")
     none: list[Any] = [None]
     grid = list(
         itertools.product(
@@ -216,9 +398,13 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
             v.height or none,
         )
     )
+    hist = config.histogram.model_dump() if config.representation == "histogram" else None
     specs: list[RecordSpec] = []
     for entry_no, entry in enumerate(config.sources):
-        motion = dict(entry.motion)
+        if entry.recording is not None:
+            specs += _plan_recordings(config, entry_no, entry, base_dir, len(specs))
+            continue
+        motion = dict(entry.motion or {})
         if "kind" not in motion:
             raise ConfigError(f"sources[{entry_no}].motion: a kind is required")
         # a source's own start/duration limit the span that records are cut from
@@ -236,11 +422,14 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
                 f"{duration:.3f} s recording ({motion.get('file', motion['kind'])})"
             )
         hop = entry.hop or length
+        rz = entry.randomize or config.randomize
         starts = float(motion.get("start", 0.0)) + np.arange(0.0, duration - length + 1e-9, hop)
         if entry.max_records is not None:
             starts = starts[: entry.max_records]
         for start in starts:
-            for aspect, rng_, rheight, rpos, height in grid:
+            for (aspect, rng_, rheight, rpos, height), _draw in itertools.product(
+                grid, range(rz.draws if rz.active() else 1)
+            ):
                 section = {**motion, "start": round(float(start), 9), "duration": length}
                 if height is not None:
                     section["height"] = height
@@ -255,48 +444,152 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
                     },
                 )
                 index = len(specs)
+                draws = None
+                if rz.active():
+                    rng = np.random.default_rng(np.random.SeedSequence([config.seed, index, 1]))
+                    draws = rz.sample(rng)
+                    _apply_draws(run, section, draws, f"sources[{entry_no}]")
                 run["seed"] = _record_seed(config.seed, index)
-                digest = hashlib.sha1(
-                    json.dumps([run, config.features.model_dump()], sort_keys=True).encode()
-                ).hexdigest()[:10]
                 specs.append(
-                    RecordSpec(
-                        index,
-                        f"{index:05d}-{digest}",
-                        entry.label,
-                        entry.group or motion["kind"],
-                        run,
-                        str(base_dir),
-                        config.features.model_dump(),
-                    )
+                    _spec(config, index, entry, motion["kind"], run, base_dir, draws, hist)
                 )
     return specs
 
 
+def _feature_options(fcfg: dict[str, Any]) -> dict[str, Any]:
+    return {
+        "method": fcfg["method"],
+        "threshold_db": fcfg["threshold_db"],
+        "floor_db": fcfg["floor_db"],
+        "percentiles": tuple(fcfg["percentiles"]),
+        "torso_method": fcfg["torso"],
+    }
+
+
+def _histogram_arrays(
+    cloud: PointCloud, hist: dict[str, Any], fcfg: dict[str, Any], record: str
+) -> dict[str, Any]:
+    """The arrays of a histogram record: histograms, their dB map, axes and features."""
+    settings = HistogramSettings(**hist)
+    h = cloud_histograms(cloud, settings)
+    centres, _ = velocity_bins(settings.bin_width, settings.n_bins)
+    try:
+        feats = histogram_features(h, centres, **_feature_options(fcfg))
+    except ValueError:
+        raise SceneError(
+            f"record {record}: no point within {settings.min_range:g}-{settings.max_range:g} m "
+            "in any frame (widen histogram.min_range/max_range)"
+        ) from None
+    peak = float(h.max())
+    with np.errstate(divide="ignore"):
+        db = 10.0 * np.log10(np.maximum(h.T / peak, 1e-12))
+    return {
+        "spectrogram_db": db.astype(np.float32),
+        "velocity_mps": centres,
+        "time_s": np.arange(cloud.n_frames) * cloud.frame_period,
+        "features": feats,
+        "histograms": h.astype(np.float32),
+    }
+
+
+def _build_recorded(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
+    run = spec.run_config
+    recordings = _load_recordings(json.dumps(run["recording"], sort_keys=True), spec.base_dir)
+    rec = next(r for r in recordings if r.name == run["name"])
+    cloud = rec.cloud.frames(run["first_frame"], run["frames"])
+    assert spec.histogram is not None
+    arrays = _histogram_arrays(cloud, spec.histogram["histogram"], spec.features, spec.record_id)
+    meta = {
+        "id": spec.record_id,
+        "label": spec.label,
+        "group": spec.group,
+        "source": run["recording"]["kind"],
+        "file": rec.name,
+        "start_s": run["first_frame"] * cloud.frame_period,
+        "duration_s": run["frames"] * cloud.frame_period,
+        "aspect_deg": None,
+        "radar_position_m": None,
+        "height_m": None,
+        "seed": None,
+        "frame_period_s": cloud.frame_period,
+        "first_frame": run["first_frame"],
+        "histogram": spec.histogram["histogram"],
+        "recording": dict(rec.metadata),
+        "units": {
+            "features": "m/s",
+            "spectrogram_db": "dB re peak",
+            "histograms": "points (or weights) per bin and frame",
+            "velocity": "m/s",
+            "time": "s",
+        },
+    }
+    _atomic_savez(
+        Path(out_dir) / RECORDS / f"{spec.record_id}.npz",
+        **arrays,
+        meta=np.array(json.dumps(meta)),
+    )
+    return _row(meta, arrays["features"])
+
+
+def _augmented(motion: Motion, draws: dict[str, Any], start: float, duration: float) -> Any:
+    """The augmented motion and the record's start in its time [s] (speed changes the
+    timeline: the record keeps the motion phase where it can, else ends at the end)."""
+    speed = float(draws.get("speed", 1.0))
+    warp = draws.get("time_warp")
+    out = augment_motion(
+        motion,
+        speed=speed,
+        height=float(draws.get("body_scale", 1.0)),
+        mirror=bool(draws.get("mirror", False)),
+        warp=None if warp is None else np.asarray(warp, dtype=np.float64),
+    )
+    span = out.skeleton.duration
+    if duration > span + 1e-9:
+        raise SceneError(
+            f"randomize.speed: a speed factor of {speed:.3f} leaves {span:.3f} s of motion, "
+            f"shorter than the {duration:g} s record"
+        )
+    return out, min(start / speed, span - duration)
+
+
 def build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
-    """Simulate one record and write it atomically; returns its index row."""
+    """Simulate (or read) one record and write it atomically; returns its index row."""
+    if "recording" in spec.run_config:
+        return _build_recorded(spec, out_dir)
+    run_config = spec.run_config
+    motion_section = {
+        k: v for k, v in run_config["motion"].items() if k not in ("start", "duration", "height")
+    }
+    motion_section.update({k: v for k, v in run_config["motion"].items() if k == "height"})
+    motion = _load_motion(json.dumps(motion_section, sort_keys=True), spec.base_dir)
+    draws = spec.draws or {}
+    if any(k in draws for k in ("speed", "body_scale", "mirror", "time_warp")):
+        motion, start = _augmented(
+            motion, draws, float(run_config["motion"]["start"]), run_config["motion"]["duration"]
+        )
+        run_config = {**run_config, "motion": {**run_config["motion"], "start": round(start, 9)}}
     config = validate_run_config(
-        spec.run_config, source=f"record {spec.record_id}", base_dir=Path(spec.base_dir)
+        run_config, source=f"record {spec.record_id}", base_dir=Path(spec.base_dir)
     )
     stages = build_stages(config)
-    motion_section = {
-        k: v
-        for k, v in spec.run_config["motion"].items()
-        if k not in ("start", "duration", "height")
-    }
-    motion_section.update({k: v for k, v in spec.run_config["motion"].items() if k == "height"})
-    motion = _load_motion(json.dumps(motion_section, sort_keys=True), spec.base_dir)
     result = simulate_motion(config, stages, motion)
     fcfg = spec.features
-    feats = spectrogram_features(
-        result.spectrogram.power,
-        result.velocity,
-        method=fcfg["method"],
-        threshold_db=fcfg["threshold_db"],
-        floor_db=fcfg["floor_db"],
-        percentiles=tuple(fcfg["percentiles"]),
-        torso_method=fcfg["torso"],
-    )
+    extra: dict[str, Any] = {}
+    if spec.histogram is not None:
+        cloud = _simulated_cloud(result, spec.record_id)
+        arrays = _histogram_arrays(cloud, spec.histogram["histogram"], fcfg, spec.record_id)
+        feats = arrays["features"]
+        extra = {"histograms": arrays["histograms"]}
+        spectrogram = {k: arrays[k] for k in ("spectrogram_db", "velocity_mps", "time_s")}
+    else:
+        feats = spectrogram_features(
+            result.spectrogram.power, result.velocity, **_feature_options(fcfg)
+        )
+        spectrogram = {
+            "spectrogram_db": result.spectrogram_db.astype(np.float32),
+            "velocity_mps": result.velocity,
+            "time_s": result.spectrogram.time,
+        }
     cfg: Any = config
     meta = {
         "id": spec.record_id,
@@ -308,8 +601,9 @@ def build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         "duration_s": cfg.motion.duration,
         "aspect_deg": cfg.scene.person.aspect_deg,
         "radar_position_m": list(cfg.scene.radar_position),
-        "height_m": spec.run_config["motion"].get("height"),
+        "height_m": run_config["motion"].get("height"),
         "seed": cfg.seed,
+        "draws": spec.draws,
         "prf_hz": result.metadata["prf_hz"],
         "carrier_frequency_hz": result.metadata["carrier_frequency_hz"],
         "units": {
@@ -322,17 +616,49 @@ def build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     }
     _atomic_savez(
         Path(out_dir) / RECORDS / f"{spec.record_id}.npz",
-        spectrogram_db=result.spectrogram_db.astype(np.float32),
-        velocity_mps=result.velocity,
-        time_s=result.spectrogram.time,
+        **spectrogram,
         features=feats,
+        **extra,
         meta=np.array(json.dumps(meta)),
     )
     return _row(meta, feats)
 
 
+def _simulated_cloud(result: Any, record: str) -> PointCloud:
+    """The point cloud a simulated radar produced (``products["points"]``, columns frame, t,
+    x, y, z [m], v [m/s] positive approaching, intensity [dB])."""
+    products = getattr(result, "products", None) or {}
+    points = products.get("points")
+    if points is None:
+        raise SceneError(
+            f"record {record}: representation = 'histogram' needs a radar that outputs point "
+            "clouds (e.g. an FMCW sensor with detection); this one outputs none"
+        )
+    pts = np.asarray(points, dtype=np.float64)
+    frame = pts[:, 0].astype(np.int64)
+    n_frames = int(result.metadata.get("n_frames", int(frame.max()) + 1 if frame.size else 1))
+    period = float(result.metadata["frame_period_s"])
+    return PointCloud(frame, pts[:, 2:5], pts[:, 5], pts[:, 6], period, n_frames)
+
+
+def _blank(value: Any) -> Any:
+    return "" if value is None else value
+
+
+def _draw_columns(draws: dict[str, Any] | None) -> dict[str, Any]:
+    """Table columns ``draw.<name>`` of a record's drawn values (lists spread over
+    ``draw.<name>.<i>``, booleans as 0/1)."""
+    out: dict[str, Any] = {}
+    for name, value in (draws or {}).items():
+        if isinstance(value, list):
+            out.update({f"draw.{name}.{i}": v for i, v in enumerate(value, start=1)})
+        else:
+            out[f"draw.{name}"] = int(value) if isinstance(value, bool) else value
+    return out
+
+
 def _row(meta: dict[str, Any], feats: NDArray[np.float64]) -> dict[str, Any]:
-    radar = meta["radar_position_m"]
+    radar = meta["radar_position_m"] or (None, None, None)
     row = {
         "id": meta["id"],
         "label": meta["label"],
@@ -341,14 +667,15 @@ def _row(meta: dict[str, Any], feats: NDArray[np.float64]) -> dict[str, Any]:
         "file": meta["file"],
         "start_s": meta["start_s"],
         "duration_s": meta["duration_s"],
-        "aspect_deg": meta["aspect_deg"],
-        "radar_x_m": radar[0],
-        "radar_y_m": radar[1],
-        "radar_z_m": radar[2],
-        "height_m": "" if meta["height_m"] is None else meta["height_m"],
-        "seed": meta["seed"],
+        "aspect_deg": _blank(meta["aspect_deg"]),
+        "radar_x_m": _blank(radar[0]),
+        "radar_y_m": _blank(radar[1]),
+        "radar_z_m": _blank(radar[2]),
+        "height_m": _blank(meta["height_m"]),
+        "seed": _blank(meta["seed"]),
     }
     row.update({name: float(f) for name, f in zip(FEATURE_NAMES, feats, strict=True)})
+    row.update(_draw_columns(meta.get("draws")))
     return row
 
 
@@ -376,6 +703,8 @@ def read_record(path: Path) -> tuple[dict[str, NDArray[Any]], dict[str, Any]]:
     """Arrays and metadata of one record file; raises if it is incomplete or corrupt."""
     with np.load(path) as data:
         arrays = {k: data[k] for k in ("spectrogram_db", "velocity_mps", "time_s", "features")}
+        if "histograms" in data.files:
+            arrays["histograms"] = data["histograms"]
         meta = json.loads(str(data["meta"]))
     return arrays, meta
 
@@ -477,7 +806,8 @@ def build_dataset(
 
 def _write_index(out: Path, rows: list[dict[str, Any]], config: DatasetConfig) -> None:
     buf = io.StringIO()
-    writer = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
+    fields = list(dict.fromkeys(k for row in rows for k in row))  # draws vary by source
+    writer = csv.DictWriter(buf, fieldnames=fields, lineterminator="\n", restval="")
     writer.writeheader()
     writer.writerows(rows)
     _atomic_write_text(out / INDEX, buf.getvalue())
@@ -499,7 +829,8 @@ class Dataset:
     (n_records,) str; ``table``: column name -> (n_records,) array (all of index.csv, ready for
     ``pandas.DataFrame(table)``); ``spectrograms``: (n_records, n_doppler, n_frames) float32
     [dB] when all records have the same shape, else a list; ``velocity`` (n_doppler,) [m/s] of
-    the first record.
+    the first record; ``histograms`` (when asked for): per record its per-frame Doppler
+    histograms (n_frames, n_bins) float32, or None for a spectrogram record.
     """
 
     features: NDArray[np.float64]
@@ -508,9 +839,12 @@ class Dataset:
     table: dict[str, NDArray[Any]]
     spectrograms: NDArray[np.float32] | list[NDArray[np.float32]] | None
     velocity: NDArray[np.float64] | None
+    histograms: list[NDArray[np.float32] | None] | None = None
 
 
-def load_dataset(path: str | Path, *, spectrograms: bool = True) -> Dataset:
+def load_dataset(
+    path: str | Path, *, spectrograms: bool = True, histograms: bool = False
+) -> Dataset:
     """Load a built dataset in one call (arrays plus the index table)."""
     root = Path(path)
     index = root / INDEX
@@ -523,21 +857,32 @@ def load_dataset(path: str | Path, *, spectrograms: bool = True) -> Dataset:
     table: dict[str, NDArray[Any]] = {}
     for key in rows[0]:
         col = [r[key] for r in rows]
-        if key in TEXT_COLUMNS:
-            table[key] = np.array(col, dtype=str)
-        else:
-            table[key] = np.array([float(c) if c != "" else np.nan for c in col])
+        try:
+            numbers = None if key in TEXT_COLUMNS else [float(c) if c else np.nan for c in col]
+        except ValueError:  # a drawn choice of strings
+            numbers = None
+        table[key] = np.array(col, dtype=str) if numbers is None else np.array(numbers)
     feats = np.stack([table[n].astype(np.float64) for n in FEATURE_NAMES], axis=1)
     specs: NDArray[np.float32] | list[NDArray[np.float32]] | None = None
     velocity = None
-    if spectrograms:
+    hists: list[NDArray[np.float32] | None] | None = [] if histograms else None
+    if spectrograms or histograms:
         maps = []
         for rid in table["id"]:
             arrays, _ = read_record(root / RECORDS / f"{rid}.npz")
             maps.append(arrays["spectrogram_db"])
             velocity = arrays["velocity_mps"] if velocity is None else velocity
-        same = len({m.shape for m in maps}) == 1
-        specs = np.stack(maps) if same else maps
+            if hists is not None:
+                hists.append(arrays.get("histograms"))
+        if spectrograms:
+            same = len({m.shape for m in maps}) == 1
+            specs = np.stack(maps) if same else maps
     return Dataset(
-        feats, table["label"].astype(str), table["group"].astype(str), table, specs, velocity
+        feats,
+        table["label"].astype(str),
+        table["group"].astype(str),
+        table,
+        specs,
+        velocity,
+        hists,
     )

@@ -23,6 +23,7 @@ SECTIONS = {
     "radar": "`[radar]`: the radar waveform",
     "effect": "`[[effects]]`: scene effects (only those listed are simulated)",
     "classifier": "`[classifier]`: classifiers",
+    "recording": "`recording` of a dataset source: readers of real radar recordings",
 }
 
 

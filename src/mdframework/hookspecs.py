@@ -25,7 +25,14 @@ from typing import Any
 
 import pluggy
 
-from .interfaces import Classifier, Effect, MotionSource, RadarWaveform, ScattererModel
+from .interfaces import (
+    Classifier,
+    Effect,
+    MotionSource,
+    RadarRecordingSource,
+    RadarWaveform,
+    ScattererModel,
+)
 
 PROJECT = "mdframework"
 hookspec = pluggy.HookspecMarker(PROJECT)
@@ -55,6 +62,12 @@ def mdframework_register_classifiers() -> list[type[Classifier]]:  # type: ignor
 @hookspec
 def mdframework_register_effects() -> list[type[Effect]]:  # type: ignore[empty-body]
     """Return the :class:`~mdframework.interfaces.Effect` classes this plugin provides."""
+
+
+@hookspec
+def mdframework_register_recordings() -> list[type[RadarRecordingSource]]:  # type: ignore[empty-body]
+    """Return the :class:`~mdframework.interfaces.RadarRecordingSource` classes (readers of
+    real radar recordings) this plugin provides."""
 
 
 # --------------------------------------------------------------------------- command line

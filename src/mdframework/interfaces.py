@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict
 
+from .pointcloud import PointCloud
 from .skeleton import Skeleton, to_canonical
 
 FloatArray = NDArray[np.float64]
@@ -179,6 +180,32 @@ class RadarWaveform(Plugin):
         ``ranges`` and ``rcs``: (n_pulses, n_scatterers) float64 [m], [m^2].
         ``gate_range``: (n_pulses,) float64 [m], the range gate to report in ``signal``.
         """
+
+
+# --------------------------------------------------------------------------- recorded radar output
+
+
+@dataclass(frozen=True)
+class Recording:
+    """One recording of a real radar's output.
+
+    ``name`` identifies the recording (e.g. its original file name; records cut from it share
+    it, so experiments can hold whole recordings out); ``cloud`` holds its detected points in the
+    conventions of :mod:`mdframework.pointcloud` (radial velocity positive approaching);
+    ``metadata``: source, file, sensor, licence and anything worth recording (JSON values).
+    """
+
+    name: str
+    cloud: PointCloud
+    metadata: Mapping[str, Any] = field(default_factory=dict)
+
+
+class RadarRecordingSource(Plugin):
+    """Reads recordings of a real radar (point clouds), for datasets and experiments."""
+
+    @abstractmethod
+    def load(self) -> list[Recording]:
+        """The recordings the config names, in a fixed order. Errors name the file and line."""
 
 
 # --------------------------------------------------------------------------- classifiers

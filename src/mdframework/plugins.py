@@ -25,6 +25,7 @@ from .interfaces import (
     Effect,
     MotionSource,
     Plugin,
+    RadarRecordingSource,
     RadarWaveform,
     ScattererModel,
 )
@@ -38,6 +39,7 @@ INTERFACES: dict[str, tuple[str, type[Plugin]]] = {
     "radar": ("mdframework_register_waveforms", RadarWaveform),
     "classifier": ("mdframework_register_classifiers", Classifier),
     "effect": ("mdframework_register_effects", Effect),
+    "recording": ("mdframework_register_recordings", RadarRecordingSource),
 }
 
 

@@ -23,7 +23,9 @@ from .interfaces import (
     Motion,
     MotionSource,
     Plugin,
+    RadarRecordingSource,
     RadarWaveform,
+    Recording,
     ScattererModel,
     Scatterers,
 )
@@ -105,3 +107,21 @@ def check_effect_class(cls: type[Effect]) -> None:
     assert getattr(cls, "stage", None) in ("scatterers", "received"), (
         f"{cls.__name__}.stage must be 'scatterers' or 'received'"
     )
+
+
+def check_recording_source(source: RadarRecordingSource) -> list[Recording]:
+    """``load()`` gives named recordings with consistent point clouds: unique names, frame
+    indices within the recording, finite positions and velocities, a positive frame period and
+    JSON metadata."""
+    recordings = source.load()
+    assert recordings, "load() must return at least one recording"
+    names = [r.name for r in recordings]
+    assert len(set(names)) == len(names), "recording names must be unique"
+    for rec in recordings:
+        assert isinstance(rec, Recording), "load() must return Recording objects"
+        cloud = rec.cloud
+        assert cloud.n_frames >= 1 and cloud.frame_period > 0
+        assert np.all(np.isfinite(cloud.positions)) and np.all(np.isfinite(cloud.velocity))
+        assert np.all(np.diff(cloud.frame) >= 0), "points must be in frame order"
+        json.dumps(dict(rec.metadata))
+    return recordings

@@ -1,0 +1,1 @@
+"""Static scene reflectors for mdframework (effect kind ``static_scene``)."""

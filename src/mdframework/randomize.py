@@ -1,0 +1,153 @@
+"""Domain randomisation: scene and motion parameters drawn per record from distributions.
+
+A dataset config's ``[randomize]`` section names distributions; every record draws its own
+values from a generator seeded by the dataset seed and the record's index, so a dataset is the
+same whatever the number of workers, and every drawn value is written to the dataset table
+(``index.csv`` columns ``draw.<name>``).
+
+Distributions (one key each)::
+
+    radar_height = { uniform = [0.8, 1.6] }        # low, high
+    aspect_deg   = { normal = [0.0, 30.0] }        # mean, standard deviation
+    snr          = { choice = [10, 20, 30] }       # one of the values, equally likely
+    speed        = { loguniform = [0.7, 1.4] }     # log-uniform between low and high
+
+Named scene parameters: ``aspect_deg``, ``radar_range``, ``radar_height`` (as the grid
+variations), ``height`` (the person's height, for sources that have one). Any other run-config
+field is drawn through ``params`` with its dotted path, list items by position::
+
+    [randomize.params]
+    "effects.0.snr_db" = { uniform = [5.0, 25.0] }
+    "radar.beamwidth_elevation_deg" = { uniform = [20.0, 60.0] }
+
+Motion augmentation (:mod:`mdframework.augment`), per record: ``speed`` (speed factor),
+``body_scale`` (height factor), ``mirror`` (probability of the mirror image) and ``time_warp``
+(strength ``s`` < 1: three warp coefficients drawn uniformly from ``[-s/3, s/3]``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from pydantic import Field, model_validator
+
+from .settings import StrictModel
+
+Scalar = float | int | str | bool
+
+
+class Distribution(StrictModel):
+    """One distribution: give exactly one of the fields."""
+
+    uniform: tuple[float, float] | None = Field(None, description="[low, high].")
+    loguniform: tuple[float, float] | None = Field(
+        None, description="[low, high], both > 0: uniform in log."
+    )
+    normal: tuple[float, float] | None = Field(None, description="[mean, std].")
+    choice: list[Scalar] | None = Field(None, min_length=1, description="Equally likely values.")
+
+    @model_validator(mode="after")
+    def _one(self) -> Distribution:
+        given = [k for k in ("uniform", "loguniform", "normal", "choice") if getattr(self, k)]
+        if len(given) != 1:
+            raise ValueError("give exactly one of uniform, loguniform, normal, choice")
+        lo_hi = self.uniform or self.loguniform
+        if lo_hi is not None and not lo_hi[0] <= lo_hi[1]:
+            raise ValueError("low must not exceed high")
+        if self.loguniform is not None and self.loguniform[0] <= 0:
+            raise ValueError("loguniform bounds must be positive")
+        if self.normal is not None and self.normal[1] < 0:
+            raise ValueError("the standard deviation must be >= 0")
+        return self
+
+    def draw(self, rng: np.random.Generator) -> Scalar:
+        """One value."""
+        if self.uniform is not None:
+            return float(rng.uniform(*self.uniform))
+        if self.loguniform is not None:
+            lo, hi = np.log(self.loguniform[0]), np.log(self.loguniform[1])
+            return float(np.exp(rng.uniform(lo, hi)))
+        if self.normal is not None:
+            return float(rng.normal(*self.normal))
+        assert self.choice is not None
+        value = self.choice[int(rng.integers(len(self.choice)))]
+        return value
+
+
+class Randomization(StrictModel):
+    """Per-record draws (see the module docstring); every field is optional."""
+
+    draws: int = Field(1, ge=1, description="Records drawn per window and grid point.")
+    aspect_deg: Distribution | None = Field(None, description="Facing [deg].")
+    radar_range: Distribution | None = Field(None, description="Horizontal distance [m].")
+    radar_height: Distribution | None = Field(None, description="Radar height [m].")
+    height: Distribution | None = Field(None, description="Person's height [m].")
+    params: dict[str, Distribution] = Field(
+        default_factory=dict, description="Dotted run-config path -> distribution."
+    )
+    speed: Distribution | None = Field(None, description="Motion speed factor.")
+    body_scale: Distribution | None = Field(None, description="Body size factor.")
+    mirror: float = Field(0.0, ge=0, le=1, description="Probability of the mirror image.")
+    time_warp: float = Field(0.0, ge=0, lt=1, description="Time-warp strength s (< 1).")
+
+    def active(self) -> bool:
+        """Whether anything is drawn."""
+        return bool(
+            self.aspect_deg
+            or self.radar_range
+            or self.radar_height
+            or self.height
+            or self.params
+            or self.speed
+            or self.body_scale
+            or self.mirror
+            or self.time_warp
+        )
+
+    def sample(self, rng: np.random.Generator) -> dict[str, Any]:
+        """One record's draws, ``{name: value}`` in a fixed order (``params`` by path,
+        ``time_warp`` as a list of three coefficients)."""
+        out: dict[str, Any] = {}
+        for name in ("aspect_deg", "radar_range", "radar_height", "height"):
+            dist = getattr(self, name)
+            if dist is not None:
+                out[name] = dist.draw(rng)
+        for path in sorted(self.params):
+            out[path] = self.params[path].draw(rng)
+        if self.speed is not None:
+            out["speed"] = self.speed.draw(rng)
+        if self.body_scale is not None:
+            out["body_scale"] = self.body_scale.draw(rng)
+        if self.mirror:
+            out["mirror"] = bool(rng.uniform() < self.mirror)
+        if self.time_warp:
+            s = self.time_warp / 3.0
+            out["time_warp"] = [float(c) for c in rng.uniform(-s, s, 3)]
+        return out
+
+
+def set_path(config: dict[str, Any], path: str, value: Any) -> None:
+    """Set ``config[a][b][0][c] = value`` for ``path = "a.b.0.c"`` in place. Missing tables
+    are created; a list index must exist. ``KeyError`` names the part that does not fit."""
+    parts = path.split(".")
+    node: Any = config
+    for i, part in enumerate(parts[:-1]):
+        where = ".".join(parts[: i + 1])
+        if isinstance(node, list):
+            if not part.isdigit() or int(part) >= len(node):
+                raise KeyError(f"{where}: no item {part} in a list of {len(node)}")
+            node = node[int(part)]
+        elif isinstance(node, dict):
+            node = node.setdefault(part, {})
+        else:
+            raise KeyError(f"{where}: not a table or list")
+    last = parts[-1]
+    if isinstance(node, list):
+        if not last.isdigit() or int(last) >= len(node):
+            raise KeyError(f"{path}: no item {last} in a list of {len(node)}")
+        node[int(last)] = value
+    elif isinstance(node, dict):
+        node[last] = value
+    else:
+        raise KeyError(f"{path}: not a table or list")

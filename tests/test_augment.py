@@ -1,0 +1,151 @@
+"""Motion augmentation (mdframework.augment) and per-record random draws (randomize)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from pydantic import ValidationError
+from synthetic import standing
+
+from mdframework import CANONICAL_JOINTS, Motion, Skeleton
+from mdframework.augment import (
+    augment_motion,
+    mirror_motion,
+    scale_height,
+    scale_speed,
+    time_warp,
+    warp_function,
+)
+from mdframework.randomize import Distribution, Randomization, set_path
+
+
+def walker(n: int = 61, speed: float = 1.3) -> Skeleton:
+    """The standing body translated along +x at ``speed`` m/s, 30 frames/s."""
+    t = 2.0 + np.arange(n) / 30.0
+    pos = standing()[None, :, :] + (speed * (t - t[0]))[:, None, None] * np.array([1.0, 0, 0])
+    return Skeleton(t, pos, CANONICAL_JOINTS)
+
+
+def velocity(s: Skeleton, joint: str = "base") -> np.ndarray:
+    track = s.joint(joint)
+    return np.asarray(np.diff(track, axis=0) / np.diff(s.time)[:, None])
+
+
+def test_speed_scaling_multiplies_every_velocity() -> None:
+    s = walker()
+    fast = scale_speed(s, 1.5)
+    np.testing.assert_allclose(velocity(fast), 1.5 * velocity(s), rtol=1e-12)
+    assert fast.time[0] == s.time[0]
+    assert fast.duration == pytest.approx(s.duration / 1.5)
+    np.testing.assert_array_equal(fast.positions, s.positions)
+    with pytest.raises(ValueError, match="positive"):
+        scale_speed(s, 0.0)
+
+
+def test_height_scaling_is_a_similarity_about_the_floor() -> None:
+    s = walker()
+    tall = scale_height(s, 1.1)
+    seg = lambda k, a, b: np.linalg.norm(k.joint(a) - k.joint(b), axis=1)  # noqa: E731
+    np.testing.assert_allclose(seg(tall, "neck", "head"), 1.1 * seg(s, "neck", "head"))
+    np.testing.assert_allclose(tall.joint("head")[:, 2], 1.1 * s.joint("head")[:, 2])
+    assert tall.positions[..., 2].min() == pytest.approx(0.0, abs=1e-12)  # feet stay down
+    np.testing.assert_allclose(velocity(tall), 1.1 * velocity(s), rtol=1e-12)
+
+
+def test_mirror_swaps_sides_and_is_an_involution() -> None:
+    s = walker()
+    motion = Motion(s, {"source": "test"}, {j: j for j in CANONICAL_JOINTS})
+    m = mirror_motion(motion)
+    np.testing.assert_array_equal(m.skeleton.positions[..., 1], -s.positions[..., 1])
+    body = m.canonical()
+    # the joint now called the left hand is the old right hand, mirrored onto the left (+y)
+    np.testing.assert_allclose(body.joint("l_hand")[:, 1], -s.joint("r_hand")[:, 1])
+    assert np.all(body.joint("l_hand")[:, 1] > 0)
+    twice = mirror_motion(m)
+    np.testing.assert_array_equal(twice.skeleton.positions, s.positions)
+    assert dict(twice.canonical_map or {}) == {j: j for j in CANONICAL_JOINTS}
+
+
+def test_time_warp_keeps_ends_and_order() -> None:
+    u = np.linspace(0.0, 1.0, 1001)
+    c = np.array([0.4, -0.3, 0.2])
+    g = warp_function(u, c)
+    assert g[0] == 0.0 and g[-1] == pytest.approx(1.0, abs=1e-15)
+    assert np.all(np.diff(g) > 0)
+    # g' = 1 + sum c_k cos(pi k u): compare with the finite difference
+    gprime = 1 + sum(ck * np.cos(np.pi * (k + 1) * u) for k, ck in enumerate(c))
+    np.testing.assert_allclose(np.gradient(g, u)[1:-1], gprime[1:-1], atol=2e-4)
+    s = walker()
+    w = time_warp(s, c)
+    assert w.time[0] == s.time[0] and w.time[-1] == pytest.approx(s.time[-1])
+    np.testing.assert_array_equal(w.positions, s.positions)
+    with pytest.raises(ValueError, match="sum"):
+        warp_function(u, np.array([0.6, 0.5]))
+
+
+def test_augment_motion_order_and_identity() -> None:
+    s = walker()
+    motion = Motion(s, {}, {j: j for j in CANONICAL_JOINTS})
+    same = augment_motion(motion)
+    np.testing.assert_array_equal(same.skeleton.positions, s.positions)
+    both = augment_motion(motion, speed=2.0, height=0.9)
+    np.testing.assert_allclose(velocity(both.skeleton), 1.8 * velocity(s), rtol=1e-12)
+
+
+def test_distributions_draw_within_their_support(rng: np.random.Generator) -> None:
+    uni = Distribution(uniform=(0.8, 1.6))
+    draws = np.array([uni.draw(rng) for _ in range(2000)])
+    assert draws.min() >= 0.8 and draws.max() <= 1.6
+    assert draws.mean() == pytest.approx(1.2, abs=0.02)
+    logu = Distribution(loguniform=(0.5, 2.0))
+    logs = np.log([logu.draw(rng) for _ in range(4000)])
+    assert np.mean(logs) == pytest.approx(0.0, abs=0.03)  # symmetric in log about 1
+    norm = Distribution(normal=(3.0, 0.5))
+    assert np.std([norm.draw(rng) for _ in range(4000)]) == pytest.approx(0.5, rel=0.05)
+    ch = Distribution(choice=["a", "b"])
+    assert {ch.draw(rng) for _ in range(50)} == {"a", "b"}
+    with pytest.raises(ValidationError, match="exactly one"):
+        Distribution(uniform=(0, 1), normal=(0, 1))
+    with pytest.raises(ValidationError, match="low"):
+        Distribution(uniform=(2, 1))
+
+
+def test_randomization_sample_is_seeded_and_complete() -> None:
+    rz = Randomization.model_validate(
+        {
+            "radar_height": {"uniform": [0.8, 1.6]},
+            "params": {"effects.0.snr_db": {"choice": [10, 20]}},
+            "speed": {"uniform": [0.8, 1.2]},
+            "mirror": 0.5,
+            "time_warp": 0.6,
+        }
+    )
+    a = rz.sample(np.random.default_rng(3))
+    b = rz.sample(np.random.default_rng(3))
+    assert a == b
+    assert set(a) == {"radar_height", "effects.0.snr_db", "speed", "mirror", "time_warp"}
+    assert sum(abs(c) for c in a["time_warp"]) < 0.6 + 1e-12
+
+
+def test_set_path_tables_and_lists() -> None:
+    cfg: dict = {"effects": [{"kind": "noise", "snr_db": 20}], "radar": {"kind": "lfm"}}
+    set_path(cfg, "effects.0.snr_db", 5.0)
+    set_path(cfg, "radar.carrier_frequency", 77e9)
+    set_path(cfg, "scene.person.aspect_deg", 30.0)
+    assert cfg["effects"][0]["snr_db"] == 5.0 and cfg["radar"]["carrier_frequency"] == 77e9
+    assert cfg["scene"] == {"person": {"aspect_deg": 30.0}}
+    with pytest.raises(KeyError, match=r"effects\.1: no item 1"):
+        set_path(cfg, "effects.1.snr_db", 1.0)
+
+
+def test_the_documented_randomize_section_is_valid() -> None:
+    import re
+    import tomllib
+
+    from conftest import ROOT
+
+    text = (ROOT / "docs" / "datasets.md").read_text()
+    block = next(b for b in re.findall(r"```toml\n(.*?)```", text, re.S) if "[randomize]" in b)
+    rz = Randomization.model_validate(tomllib.loads(block)["randomize"])
+    draws = rz.sample(np.random.default_rng(0))
+    assert {"radar_height", "speed", "effects.0.snr_db", "time_warp"} <= set(draws)
