@@ -19,6 +19,7 @@ from mdf_cmu import (
     CMU_UNIT_M,
     CmuConfig,
     CmuSource,
+    FrameRateWarning,
     bvh_forward_kinematics,
     read_asf,
     read_bvh,
@@ -253,9 +254,15 @@ def test_bvh_tpose_dropped_and_rates() -> None:
         drop = sk.positions[0, idx["l_hand"], 2] - sk.positions[0, idx["l_shoulder"], 2]
         assert lo < drop < hi
 
-    m80 = load(BVH / "80_10.bvh")
+    assert dropped.metadata["frame_rate_hz"] == 120.0  # the header's .0083333, rounded
+    assert dropped.metadata["frame_rate_from"] == "header"
+    # cgspeed's header says 120 Hz for subject 80 too; CMU's index says 60 Hz
+    with pytest.warns(FrameRateWarning, match=r"Frame Time 0.0083333 s \(120 Hz\).* 60 Hz"):
+        m80 = load(BVH / "80_10.bvh")
     assert m80.metadata["frame_rate_hz"] == 60.0
-    assert m80.metadata["frame_rate_from"] == "subject table"
+    assert m80.metadata["frame_rate_from"] == "CMU index (header corrected)"
+    kept_header = load(BVH / "80_10.bvh", cmu_rate_correction=False)
+    assert kept_header.metadata["frame_rate_hz"] == 120.0
     assert m80.metadata["bvh_frame_time_s"] == pytest.approx(1 / 120, rel=1e-3)
     assert np.allclose(np.diff(m80.skeleton.time), 1 / 60)
     assert m80.skeleton.duration == pytest.approx((m80.skeleton.n_frames - 1) / 60)

@@ -28,6 +28,7 @@ ALL = [(i, n) for i in INTERFACES for n in REGISTRY.names(i)]
 #: an example config that uses each motion source (every source must have one)
 SOURCE_EXAMPLES = {
     "boulic": "boulic_walk.toml",
+    "bvh": "bvh_mixamo.toml",
     "cmu": "cmu_walk.toml",
     "kinect": "kinect_utkinect_walk.toml",
     "point_targets": "point_target.toml",

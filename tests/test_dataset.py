@@ -15,6 +15,7 @@ from conftest import EXAMPLES
 
 from mdframework.dataset import (
     RECORDS,
+    DatasetWarning,
     build_dataset,
     load_dataset,
     load_dataset_config,
@@ -169,7 +170,10 @@ def test_bad_dataset_configs(tmp_path: Path) -> None:
         f'motion = {{ kind = "cmu", file = "{CMU / "asf-amc" / "09_06.amc"}" }}\n'
     )
     cfg, base = load_dataset_config(long)
-    with pytest.raises(ConfigError, match=r"sources\[0\]: record length 3 s exceeds"):
+    with (
+        pytest.warns(DatasetWarning, match=r"sources\[0\] \(.*09_06\.amc\): the 1\.167 s "),
+        pytest.raises(ConfigError, match=r"no records: every source is shorter .*09_06\.amc"),
+    ):
         plan_records(cfg, base)
 
 
@@ -266,5 +270,6 @@ def test_cli_dataset_error_names_the_config_and_leaves_nothing(
     out = tmp_path / "ds"
     assert cli.main(["dataset", "build", str(p), "--out", str(out), "--no-progress"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith(f"mdf: error: {p}: sources[0]: record length")
+    assert err[0].startswith("mdf: warning: sources[0] (") and "shorter than" in err[0]
+    assert len(err) == 2 and err[1].startswith(f"mdf: error: {p}: no records: every source")
     assert not out.exists()

@@ -84,7 +84,10 @@ def _cmd_dataset_build(args: argparse.Namespace) -> int:
             scheduler=args.scheduler,
             progress=not args.no_progress,
         )
-    print(f"{len(rows)} records in {args.out}")
+    manifest = json.loads((Path(args.out) / "dataset.json").read_text())
+    skipped = manifest.get("n_skipped", 0)
+    note = f"; {skipped} skipped, see {Path(args.out) / 'skipped.csv'}" if skipped else ""
+    print(f"{len(rows)} records in {args.out}{note}")
     return 0
 
 

@@ -36,6 +36,7 @@ import itertools
 import json
 import os
 import tempfile
+import warnings
 from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
@@ -65,9 +66,16 @@ from .pointcloud import (
 from .randomize import Randomization, set_path
 from .settings import StrictModel
 
+
+class DatasetWarning(UserWarning):
+    """A source or record of a dataset was left out (too short, or failed with on_error =
+    'skip')."""
+
+
 RECORDS = "records"
+SKIPPED = "skipped.csv"
 #: index.csv columns that hold text (all others are numbers)
-TEXT_COLUMNS = ("id", "label", "group", "source", "file")
+TEXT_COLUMNS = ("id", "label", "group", "source", "file", "subject", "recording", "dataset")
 INDEX = "index.csv"
 MANIFEST = "dataset.json"
 
@@ -121,6 +129,16 @@ class SourceEntry(StrictModel):
     )
     group: str | None = Field(
         None, description="Source group for cross-source experiments; default: the kind."
+    )
+    subject: str | None = Field(
+        None,
+        description="Subject recorded with every record; default: the motion's own (CMU: the "
+        "subject number; UTKinect and MSR: s01 ...), else empty.",
+    )
+    dataset: str | None = Field(
+        None,
+        description="Dataset name recorded with every record; default: the motion's format "
+        "(e.g. asf/amc, bvh, utkinect, msr-action3d) or its source.",
     )
     record_length: float | None = Field(
         None, gt=0, description="Record length [s]; default: record_lengths[label], else all."
@@ -197,6 +215,17 @@ class DatasetConfig(StrictModel):
     scheduler: str | None = Field(
         None, description="Dask scheduler address, or 'local' for a local Dask cluster."
     )
+    on_error: Literal["stop", "skip"] = Field(
+        "stop",
+        description="A record that fails: stop the build (naming the record, its source file, "
+        "window and cause), or skip it and list it in skipped.csv and dataset.json.",
+    )
+    place: Literal["recording", "record"] = Field(
+        "recording",
+        description="What scene.person.position places: the recording's start (every record "
+        "is a window of the one placed recording), or each record's start (a long walk's "
+        "late records start where its first one does, at the same heading).",
+    )
 
 
 @dataclass(frozen=True)
@@ -214,6 +243,11 @@ class RecordSpec:
     draws: dict[str, Any] | None = None
     #: ``{"histogram": settings}`` for histogram records, else None
     histogram: dict[str, Any] | None = None
+    #: record metadata for the table
+    subject: str = ""
+    recording: str = ""
+    dataset: str = ""
+    on_error: str = "stop"
 
 
 def load_dataset_config(path: str | Path) -> tuple[DatasetConfig, Path]:
@@ -343,8 +377,10 @@ def _spec(
     base_dir: Path,
     draws: dict[str, Any] | None,
     hist: dict[str, Any] | None,
+    meta: tuple[str, str, str] = ("", "", ""),
 ) -> RecordSpec:
-    """A record's spec; its id ends with a digest of everything that makes the record."""
+    """A record's spec; its id ends with a digest of everything that makes the record.
+    ``meta``: the record's subject, recording and dataset."""
     features = config.features.model_dump()
     payload = [run, features] + [x for x in (draws, hist) if x is not None]
     digest = hashlib.sha1(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:10]
@@ -358,6 +394,8 @@ def _spec(
         features,
         draws,
         None if hist is None else {"histogram": hist},
+        *meta,
+        config.on_error,
     )
 
 
@@ -400,6 +438,7 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
     )
     hist = config.histogram.model_dump() if config.representation == "histogram" else None
     specs: list[RecordSpec] = []
+    short: list[str] = []
     for entry_no, entry in enumerate(config.sources):
         if entry.recording is not None:
             specs += _plan_recordings(config, entry_no, entry, base_dir, len(specs))
@@ -416,11 +455,23 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
             span_end = min(span_end, span_start + float(motion["duration"]))
         duration = span_end - span_start
         length = entry.record_length or config.record_lengths.get(entry.label) or duration
+        where = motion.get("file", motion["kind"])
         if length > duration + 1e-9:
-            raise ConfigError(
-                f"sources[{entry_no}]: record length {length:g} s exceeds the "
-                f"{duration:.3f} s recording ({motion.get('file', motion['kind'])})"
+            warnings.warn(
+                f"sources[{entry_no}] ({where}): the {duration:.3f} s recording is shorter "
+                f"than the {length:g} s record length; skipped",
+                DatasetWarning,
+                stacklevel=2,
             )
+            short.append(str(where))
+            continue
+        md = loaded.metadata
+        subject = entry.subject if entry.subject is not None else md.get("subject")
+        meta = (
+            "" if subject is None else str(subject),
+            str(md.get("file") or where),
+            entry.dataset or str(md.get("format") or md.get("source") or motion["kind"]),
+        )
         hop = entry.hop or length
         rz = entry.randomize or config.randomize
         starts = float(motion.get("start", 0.0)) + np.arange(0.0, duration - length + 1e-9, hop)
@@ -443,6 +494,8 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
                         "radar_position": rpos,
                     },
                 )
+                if config.place == "record":
+                    run["scene"] = _place_record(run, loaded, base_dir)
                 index = len(specs)
                 draws = None
                 if rz.active():
@@ -451,9 +504,53 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
                     _apply_draws(run, section, draws, f"sources[{entry_no}]")
                 run["seed"] = _record_seed(config.seed, index)
                 specs.append(
-                    _spec(config, index, entry, motion["kind"], run, base_dir, draws, hist)
+                    _spec(config, index, entry, motion["kind"], run, base_dir, draws, hist, meta)
                 )
+    if not specs:
+        raise ConfigError(
+            f"no records: every source is shorter than its record length ({', '.join(short)})"
+        )
     return specs
+
+
+def _place_record(run: dict[str, Any], motion: Motion, base_dir: Path) -> dict[str, Any]:
+    """The scene of a record placed at ``person.position`` (``place = "record"``): the position
+    moved back by the placed recording's travel up to the record's start, and the heading the
+    recording's placement gives fixed, so that the record starts at the configured position."""
+    from .conditioning import condition
+    from .pipeline import place_body
+
+    config = validate_run_config(run, source="record placement", base_dir=base_dir)
+    scene: dict[str, Any] = json.loads(json.dumps(run.get("scene", {})))
+    if motion.canonical_map is None:
+        return scene
+    body = motion.canonical()
+    if config.conditioning.enabled:
+        body, _ = condition(body, config.conditioning)
+    person = config.scene.person
+    placed = place_body(body, person, np.asarray(config.scene.radar_position, dtype=np.float64))
+    base = placed.joint("base")
+    start = body.time[0] + float(run["motion"].get("start", 0.0))
+    at = np.array([np.interp(start, body.time, base[:, k]) for k in (0, 1)])
+    shift = at - np.asarray(person.position)
+    heading = _heading_deg(body, person, config.scene.radar_position)
+    new_person = dict(scene.get("person", {}))
+    new_person.pop("aspect_deg", None)
+    new_person["heading_deg"] = heading
+    new_person["position"] = [
+        float(person.position[0] - shift[0]),
+        float(person.position[1] - shift[1]),
+    ]
+    scene["person"] = new_person
+    return scene
+
+
+def _heading_deg(body: Any, person: Any, radar_position: Any) -> float:
+    """The heading [deg] the pipeline's placement gives a person config (aspect or heading)."""
+    if person.heading_deg is not None:
+        return float(person.heading_deg)
+    to_radar = np.asarray(radar_position[:2]) - np.asarray(person.position)
+    return float(np.degrees(np.arctan2(to_radar[1], to_radar[0])) + (person.aspect_deg or 0.0))
 
 
 def _feature_options(fcfg: dict[str, Any]) -> dict[str, Any]:
@@ -553,7 +650,39 @@ def _augmented(motion: Motion, draws: dict[str, Any], start: float, duration: fl
 
 
 def build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
-    """Simulate (or read) one record and write it atomically; returns its index row."""
+    """Simulate one record and write it atomically; returns its index row.
+
+    A record that fails raises :class:`MdfError` naming the record, its source file, window
+    and cause; with ``on_error = "skip"`` it returns a row with a ``skipped`` cause instead
+    (and writes no file)."""
+    try:
+        return _build_record(spec, out_dir)
+    except (MdfError, ValueError) as exc:
+        motion = spec.run_config.get("motion", {})
+        start = float(motion.get("start", 0.0))
+        end = start + float(motion.get("duration") or 0.0)
+        where = (
+            f"record {spec.record_id} ({spec.label}; source file "
+            f"{motion.get('file', motion.get('kind', '?'))}, window {start:.3f}-{end:.3f} s)"
+        )
+        cause = " ".join(str(exc).split())
+        if spec.on_error != "skip":
+            raise MdfError(f"{where}: {cause}") from None
+        return {
+            "id": spec.record_id,
+            "label": spec.label,
+            "group": spec.group,
+            "file": str(motion.get("file", motion.get("kind", ""))),
+            "start_s": start,
+            "duration_s": end - start,
+            "skipped": cause,
+        }
+    except Exception as exc:
+        exc.add_note(f"while building record {spec.record_id} of {spec.recording}")
+        raise
+
+
+def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     if "recording" in spec.run_config:
         return _build_recorded(spec, out_dir)
     run_config = spec.run_config
@@ -597,6 +726,9 @@ def build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         "group": spec.group,
         "source": result.metadata["motion"].get("source", cfg.motion.kind),
         "file": result.metadata["motion"].get("file", ""),
+        "subject": spec.subject,
+        "recording": spec.recording,
+        "dataset": spec.dataset,
         "start_s": cfg.motion.start,
         "duration_s": cfg.motion.duration,
         "aspect_deg": cfg.scene.person.aspect_deg,
@@ -665,6 +797,11 @@ def _row(meta: dict[str, Any], feats: NDArray[np.float64]) -> dict[str, Any]:
         "group": meta["group"],
         "source": meta["source"],
         "file": meta["file"],
+        "subject": meta.get("subject", ""),
+        "recording": meta.get("recording", meta["file"])
+        if isinstance(meta.get("recording", ""), str)
+        else meta["file"],
+        "dataset": meta.get("dataset", meta["source"]),
         "start_s": meta["start_s"],
         "duration_s": meta["duration_s"],
         "aspect_deg": _blank(meta["aspect_deg"]),
@@ -794,25 +931,54 @@ def build_dataset(
     bar = tqdm(
         total=len(specs), initial=len(rows), desc="records", unit="rec", disable=not progress
     )
+    skipped: dict[str, dict[str, Any]] = {}
     for run in _executor(config, workers, scheduler):
         for row in run(todo, str(out)):
-            rows[row["id"]] = row
+            if "skipped" in row:
+                skipped[row["id"]] = row
+                warnings.warn(
+                    f"record {row['id']} ({row['file']}, window {row['start_s']:.3f} s + "
+                    f"{row['duration_s']:g} s) skipped: {row['skipped']}",
+                    DatasetWarning,
+                    stacklevel=2,
+                )
+            else:
+                rows[row["id"]] = row
             bar.update(1)
     bar.close()
-    ordered = [rows[s.record_id] for s in specs]
-    _write_index(out, ordered, config)
+    ordered = [rows[s.record_id] for s in specs if s.record_id in rows]
+    if not ordered:
+        raise MdfError(f"every record failed; the first: {next(iter(skipped.values()))['skipped']}")
+    dropped = [skipped[s.record_id] for s in specs if s.record_id in skipped]
+    _write_index(out, ordered, config, dropped)
     return ordered
 
 
-def _write_index(out: Path, rows: list[dict[str, Any]], config: DatasetConfig) -> None:
+def _write_index(
+    out: Path,
+    rows: list[dict[str, Any]],
+    config: DatasetConfig,
+    skipped: list[dict[str, Any]] | None = None,
+) -> None:
     buf = io.StringIO()
     fields = list(dict.fromkeys(k for row in rows for k in row))  # draws vary by source
     writer = csv.DictWriter(buf, fieldnames=fields, lineterminator="\n", restval="")
     writer.writeheader()
     writer.writerows(rows)
     _atomic_write_text(out / INDEX, buf.getvalue())
+    skipped = skipped or []
+    if skipped:
+        sbuf = io.StringIO()
+        swriter = csv.DictWriter(sbuf, fieldnames=list(skipped[0]), lineterminator="\n")
+        swriter.writeheader()
+        swriter.writerows(skipped)
+        _atomic_write_text(out / SKIPPED, sbuf.getvalue())
+    else:
+        (out / SKIPPED).unlink(missing_ok=True)
     manifest = {
         "n_records": len(rows),
+        "n_skipped": len(skipped),
+        "skipped": skipped,
         "feature_names": list(FEATURE_NAMES),
         "feature_units": "m/s",
         "labels": sorted({r["label"] for r in rows}),

@@ -15,7 +15,7 @@ from pydantic.fields import FieldInfo
 from pydantic_core import PydanticUndefined
 
 from .plugins import INTERFACES, Registry, default_registry
-from .settings import PersonConfig, ProcessingConfig, SceneConfig
+from .settings import PersonConfig, ProcessingConfig, SanityConfig, SceneConfig
 
 SECTIONS = {
     "motion": "`[motion]`: the motion source",
@@ -98,6 +98,13 @@ def render(registry: Registry | None = None) -> str:
         "## `[processing]`",
         "",
         model_table(ProcessingConfig),
+        "",
+        "## `[motion.sanity]` (every motion source)",
+        "",
+        "Motion sanity checks, run on every human motion after loading; see "
+        "[motion formats and sanity checks](motion-formats.md).",
+        "",
+        model_table(SanityConfig),
         "",
     ]
     for interface in INTERFACES:

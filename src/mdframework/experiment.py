@@ -84,11 +84,21 @@ class EvaluationConfig(StrictModel):
 
     repeats: int = Field(10, ge=1, description="Number of random splits.")
     test_fraction: float = Field(0.4, gt=0, lt=1, description="Test share (the paper: 40 %).")
-    split: Literal["record", "recording"] = Field(
+    split: Literal["record", "recording", "groups"] = Field(
         "record",
         description="record: records are split at random (windows of one recording can land "
         "on both sides, which flatters the score); recording: whole recordings (source files) "
-        "are held out, per class.",
+        "are held out, per class; groups: cross-validation that holds out whole values of the "
+        "column `by` (e.g. leave-subjects-out).",
+    )
+    by: Literal["subject", "recording", "source", "dataset", "group", "file"] = Field(
+        "subject", description="split = 'groups': the record column whose values are held out."
+    )
+    folds: int | None = Field(
+        None,
+        ge=2,
+        description="split = 'groups': number of folds (GroupKFold); default: one fold per "
+        "value (leave-one-out).",
     )
 
 
@@ -97,6 +107,23 @@ class CrossSourceConfig(StrictModel):
 
     train: str = Field(description="Group used for training (e.g. 'kinect').")
     test: str = Field(description="Group used for testing (e.g. 'cmu').")
+    label_map: dict[str, str] = Field(
+        default_factory=dict, description="Rename labels before matching (e.g. jog = 'run')."
+    )
+
+
+Selector = dict[str, str | list[str]]
+
+
+class TrainTestConfig(StrictModel):
+    """Train on one selection of records and test on another, selected by any record column
+    (subject, recording, source, dataset, group, file, label)."""
+
+    train: Selector = Field(
+        description="Column -> value or list of values, e.g. {source = 'kinect'}; a record is "
+        "selected when it matches every column."
+    )
+    test: Selector = Field(description="The same for the test records, e.g. {source = 'cmu'}.")
     label_map: dict[str, str] = Field(
         default_factory=dict, description="Rename labels before matching (e.g. jog = 'run')."
     )
@@ -127,6 +154,9 @@ class ExperimentConfig(StrictModel):
     selection: SelectionConfig = Field(default_factory=SelectionConfig)
     evaluation: EvaluationConfig = Field(default_factory=EvaluationConfig)
     cross_source: CrossSourceConfig | None = None
+    train_test: TrainTestConfig | None = Field(
+        None, description="Train on one selection of records, test on another."
+    )
     report: ReportConfig = Field(default_factory=ReportConfig)
     workers: int | None = Field(None, ge=1, description="Processes for building the dataset.")
 
@@ -221,6 +251,84 @@ def recording_splits(
     return splits
 
 
+def group_splits(
+    groups: NDArray[Any], folds: int | None
+) -> list[tuple[NDArray[np.intp], NDArray[np.intp]]]:
+    """Cross-validation splits that hold out whole groups (e.g. subjects): one fold per group
+    (leave-one-group-out) or ``folds`` folds of whole groups (GroupKFold)."""
+    from sklearn.model_selection import GroupKFold, LeaveOneGroupOut
+
+    values = sorted(set(groups.tolist()))
+    if len(values) < 2:
+        raise MdfError(f"split = 'groups' needs two or more groups, have {values}")
+    if folds is not None and folds > len(values):
+        raise MdfError(f"evaluation.folds = {folds} exceeds the {len(values)} groups {values}")
+    splitter = LeaveOneGroupOut() if folds is None else GroupKFold(n_splits=folds)
+    x = np.zeros((groups.shape[0], 1))
+    return [(tr, te) for tr, te in splitter.split(x, groups=groups)]
+
+
+def select(table: dict[str, NDArray[Any]], selector: Selector, name: str) -> NDArray[np.bool_]:
+    """Records matching every column of a selector (value or list of values)."""
+    n = len(next(iter(table.values())))
+    mask = np.ones(n, dtype=bool)
+    for column, wanted in selector.items():
+        if column not in table:
+            raise MdfError(
+                f"{name}: the dataset has no column {column!r} (have {', '.join(table)}); "
+                "rebuild it to get subject, recording and dataset columns"
+            )
+        values = [wanted] if isinstance(wanted, str) else list(wanted)
+        col = np.array([_text(v) for v in table[column]])
+        mask &= np.isin(col, [str(v) for v in values])
+    return mask
+
+
+def _text(value: Any) -> str:
+    """A table cell as text (numbers that are whole print without '.0')."""
+    if isinstance(value, float | np.floating) and float(value).is_integer():
+        return str(int(value))
+    return str(value)
+
+
+def train_test(
+    cfg: ExperimentConfig,
+    factory: Callable[[], Classifier],
+    data: Dataset,
+    x: NDArray[np.float64] | None = None,
+    names: Sequence[str] = FEATURE_NAMES,
+) -> dict[str, Any]:
+    """Train on one selection of records and test on another, over the shared (mapped)
+    classes; records in both selections are an error. ``x``: the classifier input
+    (n_records, n_columns) named by ``names``; default: the seven features."""
+    tt = cfg.train_test
+    assert tt is not None
+    labels = np.array([tt.label_map.get(lab, lab) for lab in data.labels])
+    train = select(data.table, tt.train, "train_test.train")
+    test = select(data.table, tt.test, "train_test.test")
+    for name, mask in (("train", train), ("test", test)):
+        if not np.any(mask):
+            raise MdfError(f"train_test.{name}: no record matches {getattr(tt, name)}")
+    if np.any(train & test):
+        raise MdfError(f"train_test: {int(np.sum(train & test))} records are in both selections")
+    shared = sorted(set(labels[train].tolist()) & set(labels[test].tolist()))
+    if len(shared) < 2:
+        raise MdfError(f"train_test: the selections share fewer than two classes ({shared})")
+    train &= np.isin(labels, shared)
+    test &= np.isin(labels, shared)
+    x, y = (data.features if x is None else x), labels
+    sel = _select(cfg, factory, x[train], y[train], cfg.seed)
+    pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
+    return {
+        "classes": shared,
+        "confusion": confusion_matrix(y[test], pred, shared),
+        "balanced_accuracy": balanced_accuracy(y[test], pred),
+        "subset": [names[i] for i in sel.subset],
+        "train_counts": {c: int(np.sum(y[train] == c)) for c in shared},
+        "test_counts": {c: int(np.sum(y[test] == c)) for c in shared},
+    }
+
+
 def within_source(
     cfg: ExperimentConfig,
     factory: Callable[[], Classifier],
@@ -234,7 +342,11 @@ def within_source(
     ``names`` the columns of ``x``."""
     classes = sorted(set(y.tolist()))
     ev = cfg.evaluation
-    if ev.split == "recording":
+    if ev.split == "groups":
+        if recordings is None:
+            raise MdfError(f"evaluation.split = 'groups' needs each record's {ev.by}")
+        splits = group_splits(recordings, ev.folds)
+    elif ev.split == "recording":
         if recordings is None:
             raise MdfError("evaluation.split = 'recording' needs each record's recording")
         splits = recording_splits(y, recordings, ev.repeats, ev.test_fraction, cfg.seed)
@@ -417,9 +529,19 @@ def run_experiment(
         mask = data.groups == group
         if len(set(data.labels[mask].tolist())) < 2:
             continue
+        column = cfg.evaluation.by if cfg.evaluation.split == "groups" else "file"
+        if column not in data.table:
+            raise MdfError(
+                f"evaluation.by = {column!r}: the dataset has no such column; rebuild it"
+            )
         try:
             res = within_source(
-                cfg, factory, x_all[mask], data.labels[mask], data.table["file"][mask], names
+                cfg,
+                factory,
+                x_all[mask],
+                data.labels[mask],
+                np.array([_text(v) for v in data.table[column][mask]]),
+                names,
             )
         except MdfError as exc:  # e.g. a class with a single recording cannot be held out
             report += [f"## Within-source: {group}", "", f"Not evaluated: {exc}.", ""]
@@ -501,6 +623,30 @@ def run_experiment(
             _markdown_matrix(res["classes"], res["confusion"], None),
             "",
             "![cross](cross_confusion.png)",
+            "",
+        ]
+    if cfg.train_test is not None:
+        res = train_test(cfg, factory, data, x_all, names)
+        (out / "train_test_confusion.csv").write_text(
+            _csv(_matrix_rows(res["classes"], res["confusion"]))
+        )
+        plot_confusion(
+            out / "train_test_confusion.png",
+            res["classes"],
+            res["confusion"],
+            None,
+            title=f"train {cfg.train_test.train} -> test {cfg.train_test.test}",
+        )
+        summary["train_test"] = {**res, "confusion": res["confusion"].tolist()}
+        report += [
+            f"## Train on {cfg.train_test.train}, test on {cfg.train_test.test}",
+            "",
+            f"Balanced accuracy {res['balanced_accuracy']:.3f}; features {res['subset']}; "
+            f"training {res['train_counts']}, test {res['test_counts']}.",
+            "",
+            _markdown_matrix(res["classes"], res["confusion"], None),
+            "",
+            "![train/test](train_test_confusion.png)",
             "",
         ]
     stats = feature_statistics(data)

@@ -12,9 +12,16 @@
 - raw path only: ``range_time_db`` (n_slow, n_range) float32, |compressed output| in dB re peak,
   decimated in slow time to at most 2000 rows; ``range_time_time_s`` (n_slow,);
   ``range_m`` (n_range,)
+- ``envelope_upper_mps``, ``envelope_lower_mps``, ``torso_velocity_mps`` (n_frames,): the
+  spectrogram's upper and lower envelopes and torso track [m/s] (NaN in silent frames), and
+  ``features_mps`` (7,): the seven features of Erol & Gurbuz in
+  :data:`mdframework.features.FEATURE_NAMES` order (NaN if the spectrogram is silent); both
+  with the default feature settings (threshold method, -20 dB below each column's peak, floor
+  -40 dB, median torso), as datasets use them
 
-plus ``spectrogram.png``, ``range_time.png`` (raw path), ``config.resolved.json`` and
-``metadata.json``.
+plus ``spectrogram.png``, ``range_time.png`` (raw path), ``features.json`` (the seven
+features by name and the three tracks, ``null`` in silent frames), ``config.resolved.json``
+and ``metadata.json``.
 """
 
 from __future__ import annotations
@@ -28,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from .features import FEATURE_NAMES, envelopes, features_from_envelopes
 from .figures import plot_range_time, plot_spectrogram
 from .physics.spectrogram import power_to_db
 from .pipeline import RunResult
@@ -38,9 +46,62 @@ OUTPUTS = (
     "result.npz",
     "spectrogram.png",
     "range_time.png",
+    "features.json",
     "config.resolved.json",
     "metadata.json",
 )
+
+#: Envelope and feature settings of ``mdf run`` (the defaults of datasets' ``features``).
+FEATURE_SETTINGS: dict[str, Any] = {
+    "method": "threshold",
+    "threshold_db": -20.0,
+    "floor_db": -40.0,
+    "torso": "median",
+}
+
+
+def feature_arrays(result: RunResult) -> dict[str, np.ndarray]:
+    """Envelope tracks (n_frames,) and the seven features (7,) [m/s] of a run's spectrogram
+    (:data:`FEATURE_SETTINGS`); NaN where a frame, or the whole spectrogram, is silent."""
+    env = envelopes(
+        result.spectrogram.power,
+        result.velocity,
+        method="threshold",
+        threshold_db=FEATURE_SETTINGS["threshold_db"],
+        floor_db=FEATURE_SETTINGS["floor_db"],
+        torso_method="median",
+    )
+    try:
+        feats = features_from_envelopes(env)
+    except ValueError:  # silent spectrogram
+        feats = np.full(len(FEATURE_NAMES), np.nan)
+    return {
+        "envelope_upper_mps": env.upper,
+        "envelope_lower_mps": env.lower,
+        "torso_velocity_mps": env.torso,
+        "features_mps": feats,
+    }
+
+
+def features_document(arrays: dict[str, np.ndarray]) -> dict[str, Any]:
+    """The contents of ``features.json`` from :func:`result_arrays`' output."""
+
+    def listed(a: np.ndarray) -> list[float | None]:
+        return [None if not np.isfinite(v) else float(v) for v in a]
+
+    feats = arrays["features_mps"]
+    return {
+        "units": "m/s (positive = approaching)",
+        "settings": FEATURE_SETTINGS,
+        "features": {
+            n: (None if not np.isfinite(v) else float(v))
+            for n, v in zip(FEATURE_NAMES, feats, strict=True)
+        },
+        "time_s": listed(arrays["time_s"]),
+        "envelope_upper_mps": listed(arrays["envelope_upper_mps"]),
+        "envelope_lower_mps": listed(arrays["envelope_lower_mps"]),
+        "torso_velocity_mps": listed(arrays["torso_velocity_mps"]),
+    }
 
 
 def result_arrays(result: RunResult) -> dict[str, np.ndarray]:
@@ -57,6 +118,7 @@ def result_arrays(result: RunResult) -> dict[str, np.ndarray]:
         "scatterer_range_m": ranges,
         "scatterer_rcs_m2": result.scatterers.rcs.astype(np.float32),
     }
+    arrays.update(feature_arrays(result))
     rt = result.received.range_time
     if rt is not None and result.received.range_axis is not None:
         step = max(1, int(np.ceil(rt.shape[0] / MAX_RANGE_TIME_ROWS)))
@@ -93,6 +155,7 @@ def write_run(result: RunResult, resolved_config: dict[str, Any], out_dir: Path)
                 arrays["range_m"],
                 title=title,
             )
+        (stage / "features.json").write_text(json.dumps(features_document(arrays), indent=2) + "\n")
         (stage / "config.resolved.json").write_text(json.dumps(resolved_config, indent=2) + "\n")
         (stage / "metadata.json").write_text(
             json.dumps(result.metadata, indent=2, default=_jsonable) + "\n"

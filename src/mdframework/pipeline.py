@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from . import conditioning
+from . import conditioning, sanity
 from .errors import SceneError
 from .interfaces import (
     Effect,
@@ -30,7 +30,7 @@ from .interfaces import (
 from .physics import interpolation, radar, scene
 from .physics.spectrogram import RecordTooShortError, Spectrogram, power_to_db, spectrogram
 from .plugins import Registry, default_registry
-from .settings import ConditioningConfig, PersonConfig, RunConfigBase
+from .settings import ConditioningConfig, PersonConfig, RunConfigBase, SanityConfig
 from .skeleton import Skeleton
 
 FloatArray = NDArray[np.float64]
@@ -142,11 +142,13 @@ def simulate(config: RunConfigBase, registry: Registry | None = None) -> RunResu
 
 def load_motion(source: MotionSource) -> Motion:
     """``source.load()``, with a plugin's own check of its input (``ValueError``) reported as
-    a one-line user error naming the source."""
+    a one-line user error naming the source, followed by the motion sanity checks
+    (:func:`mdframework.sanity.check_motion`, with the source config's ``sanity`` section)."""
     try:
-        return source.load()
+        motion = source.load()
     except ValueError as exc:
         raise SceneError(f"motion {source.name!r}: {exc}") from None
+    return sanity.check_motion(motion, getattr(source.config, "sanity", SanityConfig()))
 
 
 def simulate_motion(

@@ -44,12 +44,79 @@ def _resolve_path(value: Path, info: ValidationInfo) -> Path:
 DataPath = Annotated[Path, AfterValidator(_resolve_path)]
 
 
+class StrictModel(BaseModel):
+    """Base of every config model that is not a plugin's: unknown fields are errors."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class SanityConfig(StrictModel):
+    """Motion sanity checks (:mod:`mdframework.sanity`), run on every human motion right after
+    its source reads it. Thresholds and their basis are documented in ``docs/motion-formats.md``.
+    """
+
+    enabled: bool = Field(True, description="Run the checks at all.")
+    glitches: Literal["warn", "repair", "ignore", "error"] = Field(
+        "warn",
+        description="Single-frame glitches: flag them in the metadata and warn (default), "
+        "repair them (the frame is replaced by interpolation from its neighbours), flag "
+        "silently, or stop.",
+    )
+    glitch_min_m: float = Field(
+        0.02,
+        gt=0,
+        description="Smallest glitch [m]: a frame's distance from the line between its two "
+        "neighbours must reach this.",
+    )
+    glitch_ratio: float = Field(
+        1.6,
+        gt=1,
+        description="A glitch stands out from its neighbours: its deviation is at least this "
+        "many times theirs (a pure one-frame spike gives 2).",
+    )
+    glitch_local_ratio: float = Field(
+        5.0,
+        gt=1,
+        description="... and at least this many times the median deviation of the 13 frames "
+        "around it (fast but smooth motion has no such outlier).",
+    )
+    limits: Literal["warn", "ignore", "error"] = Field(
+        "warn",
+        description="A joint faster or more accelerated than the human limits "
+        "(speed_limits_mps, accel_limits_mps2): warn, flag silently, or stop.",
+    )
+    speed_scale: float = Field(
+        1.0, gt=0, description="Multiplies every speed and acceleration limit."
+    )
+    bone_tolerance: float = Field(
+        0.1,
+        gt=0,
+        description="Largest coefficient of variation (std / mean) of a limb bone's length "
+        "before the motion is flagged (optical and depth-camera tracks; a rigid rig gives 0).",
+    )
+    cadence: bool = Field(
+        True, description="Check the step rate of motions labelled walk or run/jog."
+    )
+    walk_cadence: tuple[float, float] = Field(
+        (70.0, 150.0), description="Plausible walking cadence [steps/min]."
+    )
+    run_cadence: tuple[float, float] = Field(
+        (130.0, 230.0), description="Plausible running or jogging cadence [steps/min]."
+    )
+
+
 class MotionConfig(PluginConfig):
-    """Base of motion-source configs: every source can be cut to a time window."""
+    """Base of motion-source configs: every source can be cut to a time window, and its
+    motion is checked for sanity after loading."""
 
     start: float = Field(0.0, ge=0, description="Start of the window, s from the first frame.")
     duration: float | None = Field(
         None, gt=0, description="Length of the window [s]; default: to the end."
+    )
+    sanity: SanityConfig = Field(
+        default_factory=SanityConfig,
+        description="Motion sanity checks (speed and acceleration limits, single-frame "
+        "glitches, bone lengths, cadence).",
     )
 
 
@@ -78,12 +145,6 @@ class RadarPowerConfig(PluginConfig):
             system_loss=10.0 ** (self.system_loss_db / 10.0),
             atmospheric_loss=10.0 ** (self.atmospheric_loss_db / 10.0),
         )
-
-
-class StrictModel(BaseModel):
-    """Base of every config model that is not a plugin's: unknown fields are errors."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
 
 class PersonConfig(StrictModel):

@@ -40,13 +40,19 @@ facing direction given by the feet.
 
 Frame rate
 ----------
-The files do not hold a trustworthy rate (ASF/AMC has none; every cgspeed BVH says
-``Frame Time: .0083333`` even for subjects captured at 60 Hz). The rate comes from the subject and
-trial numbers in the file name (``80_10.bvh``: subject 80, trial 10) through :data:`SUBJECT_60HZ`
-and :data:`TRIAL_RATES` (from CMU's index, ``cmu-index.csv``), or from the config's ``frame_rate``.
+ASF/AMC holds no rate: it comes from the subject and trial numbers in the file name
+(``80_10.amc``: subject 80, trial 10) through :data:`SUBJECT_60HZ` and :data:`TRIAL_RATES`
+(from CMU's index, ``cmu-index.csv``), or from the config's ``frame_rate``. BVH: the header's
+``Frame Time``, except that cgspeed wrote ``.0083333`` (120 Hz) into every file, also for the
+subjects captured at 60 Hz: for those the index's rate is used, with a warning naming both
+rates (:func:`mdf_cmu.anybvh.choose_rate`); ``frame_rate`` in the config wins over both.
 
-BVH frame 0 of the cgspeed files is an added T-pose, not capture; it is dropped unless
-``keep_first_frame`` is set.
+BVH files of other rigs of the CMU database (cgspeed's 3ds Max-friendly conversion) are
+recognised by their joint names (:mod:`mdf_cmu.rigs`). BVH frame 0 of the cgspeed files is an
+added pose, not capture; it is dropped unless ``keep_first_frame`` is set.
+
+An AMC file read with another subject's ASF (``80_10.amc`` with ``02.asf``) is an error: the
+bone lengths would be the other subject's.
 """
 
 from __future__ import annotations
@@ -60,7 +66,6 @@ from pydantic import Field, model_validator
 
 from mdframework import (
     ConfigError,
-    DataFileError,
     DataPath,
     Motion,
     MotionConfig,
@@ -68,9 +73,9 @@ from mdframework import (
     Skeleton,
 )
 
+from .anybvh import choose_rate, load_any_bvh
 from .asfamc import asf_forward_kinematics, read_amc, read_asf
-from .bvh import bvh_forward_kinematics, read_bvh
-from .kinematics import CMU_UNIT_M, to_project_frame
+from .kinematics import to_project_frame
 
 #: CMU's requested acknowledgement, recorded in every motion's metadata.
 ACKNOWLEDGEMENT = (
@@ -183,8 +188,19 @@ class CmuConfig(MotionConfig):
     frame_rate: float | None = Field(
         None,
         gt=0,
-        description="Capture rate [Hz]. Default: from the subject number (120 Hz, or 60 Hz for "
-        "the subjects CMU's index lists at 60 Hz); the BVH 'Frame Time' is not used.",
+        description="Capture rate [Hz]. Default: AMC from the subject number (120 Hz, or 60 Hz "
+        "for the subjects CMU's index lists at 60 Hz); BVH from the header's Frame Time, "
+        "corrected from CMU's index where the header is known to be wrong.",
+    )
+    cmu_rate_correction: bool = Field(
+        True,
+        description="BVH: use CMU's index rate where the header is known to be wrong (with a "
+        "warning naming both rates).",
+    )
+    allow_other_subject_asf: bool = Field(
+        False,
+        description="AMC: accept an ASF whose subject number differs from the AMC's (the "
+        "bones would be another person's).",
     )
     activity: str | None = Field(
         None,
@@ -249,29 +265,33 @@ class CmuSource(MotionSource):
             subject = int(c.subject)
         meta: dict[str, Any] = {"source": "cmu", "file": path.name}
         if path.suffix.lower() == ".bvh":
-            names, pos_m, n_dropped, extra = self._load_bvh(path)
-            canonical = BVH_CANONICAL_MAP
+            names, pos_m, canonical, extra, rig, frame_time = load_any_bvh(
+                path, keep_first_frame=c.keep_first_frame
+            )
+            n_dropped = int(extra.pop("frames_dropped_at_start"))
             meta["format"] = "bvh"
+            rate, rate_from = choose_rate(
+                path,
+                frame_time,
+                rig,
+                config_rate=c.frame_rate,
+                cmu_correction=c.cmu_rate_correction,
+                subject=subject,
+                trial=trial,
+            )
         else:
-            names, pos_m, extra = self._load_asf_amc(path)
+            names, pos_m, extra = self._load_asf_amc(path, subject)
             n_dropped = 0
-            canonical = ASF_CANONICAL_MAP
+            canonical = dict(ASF_CANONICAL_MAP)
             meta["format"] = "asf/amc"
-        if c.frame_rate is not None:
-            rate, rate_from = float(c.frame_rate), "config"
-        elif subject is not None:
-            rate, rate_from = subject_frame_rate(subject, trial), "subject table"
-        else:
-            rate, rate_from = DEFAULT_RATE_HZ, "default (subject unknown)"
+            if c.frame_rate is not None:
+                rate, rate_from = float(c.frame_rate), "config"
+            elif subject is not None:
+                rate, rate_from = subject_frame_rate(subject, trial), "subject table"
+            else:
+                rate, rate_from = DEFAULT_RATE_HZ, "default (subject unknown)"
         n = pos_m.shape[0]
         time = np.arange(n, dtype=np.float64) / rate
-        missing = [j for j in canonical.values() if j not in names]
-        if missing:
-            raise DataFileError(
-                path,
-                "not a CMU skeleton: joint(s) "
-                f"{', '.join(missing)} needed for the canonical body are missing",
-            )
         activity = c.activity
         if activity is None:
             key = (subject, trial) if subject is not None and trial is not None else None
@@ -291,25 +311,22 @@ class CmuSource(MotionSource):
         )
         return Motion(Skeleton(time, pos_m, names), meta, dict(canonical))
 
-    def _load_bvh(self, path: Path) -> tuple[tuple[str, ...], np.ndarray, int, dict[str, Any]]:
-        bvh = read_bvh(path)
-        drop = 0 if self.config.keep_first_frame else 1
-        if bvh.n_frames - drop < 1:
-            raise DataFileError(
-                path,
-                f"no frames left after dropping the T-pose frame 0 ({bvh.n_frames} in the file); "
-                "set keep_first_frame = true to keep it",
-            )
-        pos = bvh_forward_kinematics(bvh, slice(drop, None))
-        extra = {
-            "bvh_frame_time_s": bvh.frame_time,
-            "bvh_frames_in_file": bvh.n_frames,
-            "unit_m": CMU_UNIT_M,
-        }
-        return bvh.joint_names, to_project_frame(pos, CMU_UNIT_M), drop, extra
-
-    def _load_asf_amc(self, path: Path) -> tuple[tuple[str, ...], np.ndarray, dict[str, Any]]:
+    def _load_asf_amc(
+        self, path: Path, subject: int | None
+    ) -> tuple[tuple[str, ...], np.ndarray, dict[str, Any]]:
         asf_path = self.config.asf
+        if asf_path is not None and subject is not None:
+            m = re.match(r"^0*(\d+)$", Path(asf_path).stem)
+            if (
+                m is not None
+                and int(m.group(1)) != subject
+                and not (self.config.allow_other_subject_asf)
+            ):
+                raise ConfigError(
+                    f"{path}: motion.asf {Path(asf_path).name} is subject {int(m.group(1))}'s "
+                    f"skeleton, but the motion is subject {subject}'s; give {subject:02d}.asf "
+                    "(or set allow_other_subject_asf = true to use another body on purpose)"
+                )
         if asf_path is None:
             prefix = path.stem.split("_")[0]
             asf_path = path.with_name(f"{prefix}.asf")

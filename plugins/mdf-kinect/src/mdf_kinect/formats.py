@@ -9,10 +9,15 @@ line (or frame / record).
 Formats
 -------
 ``utkinect``
-    UTKinect-Action3D ``joints_sXX_eYY.txt``: one frame per line, a video frame number then
-    20 joints x (x, y, z) in Kinect SDK v1 order; time = frame number / 30 Hz (the numbers step
-    by 2-4 and repeat: repeated frames are dropped, the first kept). ``actionLabel.txt`` gives
-    each sequence's segments as ``action: first_frame last_frame``.
+    UTKinect-Action3D ``joints_sXX_eYY.txt``: one frame per line, a frame number then
+    20 joints x (x, y, z) in Kinect SDK v1 order; time = frame number / 60 (repeated frames
+    are dropped, the first kept). The dataset says it was captured at 30 frames per second,
+    that only frames with a tracked skeleton were kept, and that the final rate is about
+    15 frames per second. The numbers in the files are all even and step by 2-10 (mostly 4):
+    read as 30 per second they give about 8 kept frames per second and walks of 50 steps a
+    minute; read as 60 per second (two numbers per 30 Hz frame) they give 16 kept frames per
+    second and about 100 steps a minute, as the dataset's note and a normal walk require.
+    ``actionLabel.txt`` gives each sequence's segments as ``action: first_frame last_frame``.
 ``msr-action3d``
     MSR Action3D ``aAA_sSS_eEE_skeleton3D.txt``: 20 lines of ``x y z c`` per frame in MSR's own
     joint order (:data:`MSR_JOINTS`); 15 frames per second. The 4th column is not a tracking
@@ -147,8 +152,9 @@ KINECT_V1_CANONICAL: dict[str, str] = _limb_map("HipCenter", "ShoulderCenter")
 #: Canonical joint -> Kinect v2 joint (SpineShoulder is v1's ShoulderCenter).
 KINECT_V2_CANONICAL: dict[str, str] = _limb_map("SpineBase", "SpineShoulder")
 
-#: Rates [Hz] where the files hold no time stamps.
-UTKINECT_RATE_HZ = 30.0
+#: Rates [Hz] where the files hold no time stamps. UTKinect: frame numbers per second (two
+#: per 30 Hz Kinect frame; see the module docstring).
+UTKINECT_RATE_HZ = 60.0
 MSR_RATE_HZ = 15.0
 PRECOG_RATE_HZ = 25.0
 NTU_RATE_HZ = 30.0
@@ -269,7 +275,11 @@ def read_utkinect(path: Path, rate_hz: float = UTKINECT_RATE_HZ) -> Recording:
         rows.append(vals[1:])
     fr = np.asarray(frames, dtype=np.int64)
     pos = np.asarray(rows, dtype=np.float64).reshape(-1, 20, 3)
-    meta = {"format": "utkinect", "frame_rate_hz": rate_hz, "time_from": "frame numbers"}
+    meta = {
+        "format": "utkinect",
+        "frame_rate_hz": rate_hz,
+        "time_from": f"frame numbers / {rate_hz:g} (frame numbers per second)",
+    }
     return _finish(path, KINECT_V1_JOINTS, fr / rate_hz, pos, fr, None, KINECT_V1_CANONICAL, meta)
 
 

@@ -82,8 +82,9 @@ class KinectConfig(MotionConfig):
     frame_rate: float | None = Field(
         None,
         gt=0,
-        description="Rate [Hz] for formats without time stamps (UTKinect 30, MSR 15, PRECOG 25, "
-        "NTU 30 by default); NiTE files carry their own time stamps.",
+        description="Rate [Hz] for formats without time stamps (MSR 15, PRECOG 25, NTU 30 by "
+        "default); for UTKinect, frame numbers per second (60 by default: two per 30 Hz "
+        "frame); NiTE files carry their own time stamps.",
     )
     floor: Literal["auto"] | float = Field(
         "auto",
@@ -182,8 +183,11 @@ class KinectSource(MotionSource):
         pos = pos.copy()
         pos[..., 2] -= floor
         pos[~valid] = np.nan
+        who = re.search(r"_s(\d+)_e(\d+)", path.stem)  # UTKinect and MSR: ..._s01_e02
         meta.update(
             activity=c.activity or self._activity(path),
+            subject=f"s{who.group(1)}" if who else None,
+            episode=int(who.group(2)) if who else None,
             n_frames=int(t.shape[0]),
             time_offset_s=float(t[0]),
             floor_kinect_y_m=floor,

@@ -1,0 +1,291 @@
+"""BVH files from any rig: the ``bvh`` motion source and the loading shared with ``cmu``.
+
+The rig is detected from the joint names (:mod:`mdf_cmu.rigs`) or named in the config
+(``rig``), and a ``joint_map`` (canonical joint = file joint) overrides or completes it; a rig
+that is neither known nor mapped stops with the file's joints and the nearest known rig.
+
+Units: the rig's (CMU conversions: 1/0.45 inch; Mixamo and Biovision: centimetres) or the
+config's ``unit_m`` (metres per file unit). Axes: BVH is y up; positions map as
+(X, Y, Z)_file -> (Z, X, Y) metres, which puts a rig that faces +Z with its left at +X (all
+four shipped rigs) facing +x with its left at +y.
+
+Frame rate, in order:
+
+1. the config's ``frame_rate``;
+2. for a CMU conversion whose file name gives a subject (``80_10.bvh``) whose header rate
+   differs from CMU's index (cgspeed wrote ``Frame Time: .0083333``, 120 Hz, into every file,
+   also for the subjects captured at 60 Hz): the index's rate, with a
+   :class:`FrameRateWarning` naming both (``cmu_rate_correction = false`` turns this off);
+3. the header's ``Frame Time``: its inverse, rounded to a whole number of hertz when within
+   0.05 % of one (headers write ``1 / rate`` to about six digits).
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import Field, model_validator
+
+from mdframework import (
+    CANONICAL_JOINTS,
+    DataFileError,
+    DataPath,
+    Motion,
+    MotionConfig,
+    MotionSource,
+    Skeleton,
+)
+
+from .bvh import bvh_forward_kinematics, read_bvh
+from .kinematics import to_project_frame
+from .rigs import RIGS, Rig, RigMismatch, detect_rig, resolve
+
+
+class FrameRateWarning(UserWarning):
+    """A file's own frame rate was replaced by a documented correction."""
+
+
+RigName = Literal["auto", "cmu-cgspeed", "cmu-3dsmax", "mixamo", "biovision"]
+
+
+def header_rate(frame_time: float) -> float:
+    """``1 / frame_time`` [Hz], rounded to a whole number when within 0.05 % of one."""
+    rate = 1.0 / frame_time
+    whole = round(rate)
+    return float(whole) if whole > 0 and abs(rate - whole) <= 5e-4 * rate else rate
+
+
+def choose_rate(
+    path: Path,
+    frame_time: float,
+    rig: Rig | None,
+    *,
+    config_rate: float | None,
+    cmu_correction: bool,
+    subject: int | None,
+    trial: int | None,
+) -> tuple[float, str]:
+    """The frame rate [Hz] of a BVH file and where it came from (see the module docstring);
+    warns (:class:`FrameRateWarning`) when CMU's index corrects the header."""
+    from .source import subject_frame_rate
+
+    if config_rate is not None:
+        return float(config_rate), "config"
+    rate = header_rate(frame_time)
+    if rig is not None and rig.cmu and cmu_correction and subject is not None:
+        index = subject_frame_rate(subject, trial)
+        if abs(index - rate) > 1e-3 * index:
+            warnings.warn(
+                f"{path}: its header says Frame Time {frame_time:g} s ({rate:.4g} Hz), known "
+                f"to be wrong for CMU subject {subject}, captured at {index:g} Hz per CMU's "
+                f"index; using {index:g} Hz (set motion.frame_rate to override, or "
+                "motion.cmu_rate_correction = false to keep the header)",
+                FrameRateWarning,
+                stacklevel=4,
+            )
+            return index, "CMU index (header corrected)"
+    return rate, "header"
+
+
+def load_any_bvh(
+    path: Path,
+    *,
+    rig_name: str = "auto",
+    joint_map: dict[str, str] | None = None,
+    unit_m: float | None = None,
+    keep_first_frame: bool | None = None,
+) -> tuple[tuple[str, ...], np.ndarray, dict[str, str], dict[str, Any], Rig | None, float]:
+    """Read a BVH file of any rig.
+
+    Returns the joint names, positions (n_frames, n_joints, 3) float64 [m] in the project
+    frame, the canonical map, metadata, the rig (None when ``joint_map`` alone maps it) and
+    the header's frame time [s].
+
+    Raises
+    ------
+    mdframework.DataFileError
+        Malformed file; no rig fits and no complete joint map is given (the message lists
+        the file's joints and the nearest rig); a mapped joint is not in the file.
+    """
+    bvh = read_bvh(path)
+    names = bvh.joint_names
+    rig: Rig | None = None
+    mapping: dict[str, str] = {}
+    if rig_name != "auto":
+        rig = RIGS[rig_name]
+        mapping, missing = resolve(rig, names)
+        if missing and not set(m.split(" ")[0] for m in missing) <= set(joint_map or {}):
+            raise DataFileError(
+                path,
+                f"motion.rig = {rig_name!r}, but the file lacks {', '.join(missing)}; "
+                f"its joints are {', '.join(names)}",
+            )
+    elif not joint_map or set(joint_map) != set(CANONICAL_JOINTS):
+        try:
+            rig, mapping = detect_rig(names)
+        except RigMismatch as exc:
+            if not joint_map:
+                raise DataFileError(path, str(exc)) from None
+            # a partial user map: complete it from the nearest rig that it makes fit
+            for candidate in RIGS.values():
+                cmap, missing = resolve(candidate, names)
+                if {m.split(" ")[0] for m in missing} <= set(joint_map):
+                    rig, mapping = candidate, cmap
+                    break
+            else:
+                raise DataFileError(path, str(exc)) from None
+    if joint_map:
+        for canon, joint in joint_map.items():
+            if joint not in names:
+                raise DataFileError(
+                    path,
+                    f"motion.joint_map: {canon} = {joint!r} is not a joint of this file; its "
+                    f"joints are {', '.join(names)}",
+                )
+        mapping = {**mapping, **joint_map}
+    drop_first = rig is not None and rig.added_first_frame
+    if keep_first_frame is not None:
+        drop_first = not keep_first_frame
+    drop = 1 if drop_first else 0
+    if bvh.n_frames - drop < 1:
+        raise DataFileError(
+            path,
+            f"no frames left after dropping the added pose frame 0 ({bvh.n_frames} in the "
+            "file); set keep_first_frame = true to keep it",
+        )
+    scale = unit_m if unit_m is not None else (rig.unit_m if rig is not None else None)
+    if scale is None:
+        raise DataFileError(path, "the file's unit is unknown: give motion.unit_m [m per unit]")
+    pos = to_project_frame(bvh_forward_kinematics(bvh, slice(drop, None)), scale)
+    meta = {
+        "rig": rig.name if rig is not None else "joint_map",
+        "unit_m": scale,
+        "unit_from": "config" if unit_m is not None else "rig",
+        "bvh_frame_time_s": bvh.frame_time,
+        "bvh_frames_in_file": bvh.n_frames,
+        "frames_dropped_at_start": drop,
+    }
+    return names, pos, mapping, meta, rig, bvh.frame_time
+
+
+class BvhConfig(MotionConfig):
+    """A BVH file of any rig (CMU conversions, Mixamo, Biovision-named studio captures, or
+    any rig with a joint map)."""
+
+    kind: Literal["bvh"] = Field("bvh", description="Selects this source: 'bvh'.")
+    file: DataPath = Field(description="The .bvh file; relative to the config file's folder.")
+    rig: RigName = Field(
+        "auto",
+        description="Joint naming: auto (detected from the joint names), cmu-cgspeed, "
+        "cmu-3dsmax, mixamo or biovision.",
+    )
+    joint_map: dict[str, str] | None = Field(
+        None,
+        description="Canonical joint -> file joint (e.g. {l_hand = 'LeftWrist'}): overrides "
+        "the rig's, or maps a rig that is not known (then all 17 canonical joints).",
+    )
+    unit_m: float | None = Field(
+        None, gt=0, description="Metres per file unit; default: the rig's."
+    )
+    frame_rate: float | None = Field(
+        None,
+        gt=0,
+        description="Capture rate [Hz]; default: the header's Frame Time (CMU conversions: "
+        "corrected from CMU's index for subjects whose header is known to be wrong).",
+    )
+    cmu_rate_correction: bool = Field(
+        True,
+        description="CMU conversions: use CMU's index rate where the header is known to be "
+        "wrong (with a warning naming both).",
+    )
+    keep_first_frame: bool | None = Field(
+        None,
+        description="Keep frame 0; default: dropped for the CMU conversions (an added pose), "
+        "kept otherwise.",
+    )
+    activity: str = Field("unknown", description="Activity label recorded in the metadata.")
+    subject: str | None = Field(
+        None,
+        description="Subject id for the metadata; CMU conversions: default from the file "
+        "name '<subject>_<trial>' (it selects CMU's index rate).",
+    )
+
+    @model_validator(mode="after")
+    def _check(self) -> BvhConfig:
+        if Path(self.file).suffix.lower() != ".bvh":
+            raise ValueError(f"file must be a .bvh file, got {Path(self.file).name!r}")
+        bad = sorted(set(self.joint_map or {}) - set(CANONICAL_JOINTS))
+        if bad:
+            raise ValueError(
+                f"joint_map: {', '.join(bad)} are not canonical joints "
+                f"({', '.join(CANONICAL_JOINTS)})"
+            )
+        return self
+
+
+class BvhSource(MotionSource):
+    """A BVH file of any rig, in metres, z up, with the canonical 17-joint mapping."""
+
+    name = "bvh"
+    Config = BvhConfig
+    config: BvhConfig
+
+    def load(self) -> Motion:
+        """Read the file, map its rig and run forward kinematics.
+
+        Returns
+        -------
+        Motion
+            ``skeleton``: time (n_frames,) [s] from 0; positions (n_frames, n_joints, 3) [m],
+            z up; every joint and End Site (``<joint>_end``). ``metadata``: source, format,
+            file, rig, unit_m, frame_rate_hz and frame_rate_from, subject, activity, the
+            header's frame time.
+        """
+        from .source import ACKNOWLEDGEMENT, parse_trial_name
+
+        c = self.config
+        path = Path(c.file)
+        names, pos, mapping, meta, rig, frame_time = load_any_bvh(
+            path,
+            rig_name=c.rig,
+            joint_map=c.joint_map,
+            unit_m=c.unit_m,
+            keep_first_frame=c.keep_first_frame,
+        )
+        subject: Any = c.subject
+        trial = None
+        if rig is not None and rig.cmu:
+            s, trial = parse_trial_name(path)
+            if subject is None:
+                subject = s
+            elif str(subject).isdigit():
+                subject = int(subject)
+        rate, rate_from = choose_rate(
+            path,
+            frame_time,
+            rig,
+            config_rate=c.frame_rate,
+            cmu_correction=c.cmu_rate_correction,
+            subject=subject if isinstance(subject, int) else None,
+            trial=trial,
+        )
+        time = np.arange(pos.shape[0], dtype=np.float64) / rate
+        meta.update(
+            source="bvh",
+            format="bvh",
+            file=path.name,
+            subject=subject,
+            trial=trial,
+            activity=c.activity,
+            frame_rate_hz=rate,
+            frame_rate_from=rate_from,
+            n_frames=int(pos.shape[0]),
+            units="m",
+            axes="x = file Z, y = file X, z = file Y (up)",
+        )
+        if rig is not None and rig.cmu:
+            meta["acknowledgement"] = ACKNOWLEDGEMENT
+        return Motion(Skeleton(time, pos, names), meta, mapping)

@@ -1,0 +1,202 @@
+"""Motion sanity checks (``mdframework.sanity``) on real recordings.
+
+Named hard cases: CMU 80_10 (boxing, cgspeed BVH) has one-frame spikes in its arm channels (a
+44-degree jump of RightArm.Xrotation at one frame, confirmed here from the raw file); CMU 02_01
+and 16_21 (walks) and 09_03/09_06 (runs) are clean; the UTKinect walk's shin length varies
+(a depth camera does not track rigid bones) and its cadence exposes a wrong time base.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from mdf_cmu import read_bvh
+from scipy.signal import find_peaks
+
+from mdframework import DataFileError
+from mdframework.config import validate_run_config
+from mdframework.interfaces import Motion
+from mdframework.pipeline import build_stages, load_motion
+from mdframework.sanity import (
+    MotionSanityWarning,
+    cadence_spm,
+    check_motion,
+    deviations,
+    find_glitches,
+)
+from mdframework.settings import SanityConfig
+
+EXAMPLES = Path(__file__).parents[1] / "examples"
+CMU = {
+    "80_10": {"kind": "cmu", "file": "data/cmu/bvh/80_10.bvh"},
+    "02_01": {"kind": "cmu", "file": "data/cmu/asf-amc/02_01.amc"},
+    "16_21": {"kind": "cmu", "file": "data/cmu/bvh/16_21.bvh"},
+    "09_03": {"kind": "cmu", "file": "data/cmu/bvh/09_03.bvh"},
+    "09_06": {"kind": "cmu", "file": "data/cmu/asf-amc/09_06.amc"},
+}
+UT_WALK = {
+    "kind": "kinect",
+    "format": "utkinect",
+    "file": "data/kinect/utkinect/joints_s01_e01.txt",
+    "segment": "walk",
+}
+
+
+def load(section: dict[str, Any], **sanity: Any) -> tuple[Motion, list[str]]:
+    """Load through the motion-loading helper; returns the motion and the sanity warnings."""
+    cfg = validate_run_config(
+        {"motion": {**section, "sanity": sanity}}, source="test", base_dir=EXAMPLES
+    )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        motion = load_motion(build_stages(cfg).source)
+    return motion, [str(w.message) for w in caught if w.category is MotionSanityWarning]
+
+
+def test_80_10_one_frame_arm_glitch_is_flagged_and_confirmed_in_the_raw_channels() -> None:
+    motion, msgs = load(CMU["80_10"])
+    items = motion.metadata["sanity"]["glitches"]["items"]
+    hit = [it for it in items if it["joint"] == "r_elbow"]
+    assert hit and hit[0]["frame"] == 148
+    assert any("single-frame glitch" in m and "80_10.bvh" in m for m in msgs)
+    # independent confirmation in the file: frame 148 after the dropped T-pose is file frame
+    # 149, where RightArm's X rotation jumps ~44 degrees off its neighbours for one frame
+    bvh = read_bvh(EXAMPLES / "data/cmu/bvh/80_10.bvh")
+    arm = next(j for j in bvh.joints if j.name == "RightArm")
+    col = arm.first_channel + arm.channels.index("Xrotation")
+    x = bvh.values[148:151, col]
+    assert abs(x[1] - (x[0] + x[2]) / 2) > 40.0
+    assert abs(x[0] - x[2]) < 30.0
+    assert [(it["joint"], it["time_s"]) for it in items] == [
+        ("r_elbow", 2.466667),
+        ("l_hand", 4.033333),
+        ("r_elbow", 8.666667),
+    ]
+    # the left-hand channels jump too (moving only the fingers): LThumb Z at file frame 213
+    thumb = next(j for j in bvh.joints if j.name == "LThumb")
+    z = bvh.values[212:215, thumb.first_channel + thumb.channels.index("Zrotation")]
+    assert abs(z[1] - (z[0] + z[2]) / 2) > 70.0
+
+
+def test_repair_removes_the_glitch_and_leaves_every_other_frame_alone() -> None:
+    raw, _ = load(CMU["80_10"], glitches="ignore")
+    fixed, msgs = load(CMU["80_10"], glitches="repair")
+    assert fixed.metadata["sanity"]["glitches"]["repaired"] is True
+    assert any("repaired" in m for m in msgs)
+    body_raw, body_fixed = raw.canonical(), fixed.canonical()
+    j = body_raw.index("r_elbow")
+    e_raw, _ = deviations(body_raw.time, body_raw.positions)
+    e_fixed, _ = deviations(body_fixed.time, body_fixed.positions)
+    assert e_raw[148, j] > 0.02 and e_fixed[148, j] < 0.005
+    changed = np.any(raw.skeleton.positions != fixed.skeleton.positions, axis=2)
+    flagged = {(it["frame"]) for it in raw.metadata["sanity"]["glitches"]["items"]}
+    assert set(np.nonzero(changed)[0].tolist()) <= flagged
+
+
+def test_injected_spike_in_a_clean_walk_is_found_exactly_and_repaired_to_the_original() -> None:
+    motion, msgs = load(CMU["02_01"])
+    assert motion.metadata["sanity"]["glitches"]["count"] == 0 and not msgs
+    sk = motion.skeleton
+    pos = np.array(sk.positions)
+    toe = sk.index(motion.canonical_map["l_toe"])  # type: ignore[index]
+    pos[200, toe] += [0.0, 0.04, 0.03]  # a 5 cm one-frame spike
+    spiked = Motion(sk.with_positions(pos), motion.metadata, motion.canonical_map)
+    mask = find_glitches(sk.time, spiked.canonical().positions)
+    assert np.argwhere(mask).tolist() == [[200, 15]]  # frame 200, l_toe (canonical index 15)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fixed = check_motion(spiked, SanityConfig(glitches="repair"))
+    # linear interpolation of a smooth 120 Hz track: within a millimetre of the original
+    assert np.linalg.norm(fixed.skeleton.positions[200, toe] - sk.positions[200, toe]) < 1e-3
+
+
+@pytest.mark.parametrize("name", ["02_01", "16_21", "09_03", "09_06"])
+def test_clean_walks_and_runs_pass_every_check(name: str) -> None:
+    motion, msgs = load(CMU[name])
+    report = motion.metadata["sanity"]
+    assert msgs == []
+    assert report["glitches"]["count"] == 0 and report["limits"] == []
+    assert report["bones"]["cv_max"] < 1e-6  # a rigid rig
+    assert report["cadence"]["ok"] and report["cadence"]["steps_per_min"] is not None
+
+
+def test_cadence_of_real_walks_and_runs_against_counted_steps() -> None:
+    for name, lo, hi in (("02_01", 100, 125), ("16_21", 110, 135), ("09_06", 150, 180)):
+        motion, _ = load(CMU[name])
+        spm = motion.metadata["sanity"]["cadence"]["steps_per_min"]
+        assert lo < spm < hi
+        # independent count: peaks of the ankle distance (one per step)
+        body = motion.canonical()
+        dist = np.linalg.norm(body.joint("l_ankle") - body.joint("r_ankle"), axis=1)
+        peaks, _ = find_peaks(dist, prominence=0.1 * np.ptp(dist))
+        counted = 60.0 / np.median(np.diff(body.time[peaks]))
+        assert spm == pytest.approx(counted, rel=0.1)
+
+
+def test_utkinect_cadence_flags_the_old_30_hz_time_base() -> None:
+    ok, msgs = load(UT_WALK)  # frame numbers / 60 (the dataset's ~15 kept frames per second)
+    spm = ok.metadata["sanity"]["cadence"]["steps_per_min"]
+    assert 95 < spm < 115
+    assert not any("steps" in m for m in msgs)
+    slow, msgs = load({**UT_WALK, "frame_rate": 30.0})
+    assert slow.metadata["sanity"]["cadence"]["steps_per_min"] == pytest.approx(spm / 2, rel=0.02)
+    assert any("labelled 'walk' but steps 5" in m and "time base" in m for m in msgs)
+
+
+def test_bone_lengths_rigid_rig_versus_depth_camera() -> None:
+    ut, msgs = load(UT_WALK)
+    bones = ut.metadata["sanity"]["bones"]
+    assert bones["cv_max"] > 0.1  # the Kinect's shin stretches by well over 10 %
+    assert any("varies in length" in m for m in msgs)
+    msr, _ = load(
+        {
+            "kind": "kinect",
+            "format": "msr-action3d",
+            "file": "data/kinect/msr-action3d/a12_s01_e01_skeleton3D.txt",
+        }
+    )
+    assert 0.005 < msr.metadata["sanity"]["bones"]["cv_max"] < 0.1
+    _, quiet = load(UT_WALK, bone_tolerance=0.5)
+    assert not any("varies in length" in m for m in quiet)
+
+
+def test_limits_scale_and_error_mode_name_the_file() -> None:
+    motion, msgs = load(CMU["09_03"], speed_scale=0.3)
+    over = motion.metadata["sanity"]["limits"]
+    feet = {o["joint"] for o in over if o["quantity"] == "speed"}
+    assert {"l_toe", "r_toe"} <= feet  # 9-10 m/s toes of a run over 0.3 x 25 m/s
+    assert any("limit(s) exceeded" in m for m in msgs)
+    with pytest.raises(DataFileError, match=r"09_03\.bvh: motion sanity: .*limit"):
+        load(CMU["09_03"], speed_scale=0.3, limits="error")
+    with pytest.raises(DataFileError, match=r"80_10\.bvh: motion sanity: 3 single-frame"):
+        load(CMU["80_10"], glitches="error")
+
+
+def test_ignore_and_disabled() -> None:
+    motion, msgs = load(CMU["80_10"], glitches="ignore")
+    assert motion.metadata["sanity"]["glitches"]["count"] == 3 and msgs == []
+    off, msgs = load(CMU["80_10"], enabled=False)
+    assert "sanity" not in off.metadata and msgs == []
+
+
+def test_cadence_needs_a_period() -> None:
+    t = np.arange(50) / 30.0
+    still = np.zeros((50, 3))
+    assert cadence_spm(t, still, still + np.array([0.0, 0.2, 0.0])) is None
+
+
+def test_short_clip_cadence_takes_the_first_period_not_the_highest() -> None:
+    # Mixamo walk cycle, 69 frames at 30 Hz, forward then back: the ankle distance peaks every
+    # ~17 frames (0.53 s per step), while its autocorrelation is highest at 3 steps (1.67 s)
+    motion, msgs = load({"kind": "bvh", "file": "data/bvh/test_freebvh.bvh", "activity": "walk"})
+    spm = motion.metadata["sanity"]["cadence"]["steps_per_min"]
+    body = motion.canonical()
+    dist = np.linalg.norm(body.joint("l_ankle") - body.joint("r_ankle"), axis=1)
+    peaks, _ = find_peaks(dist, prominence=0.05)
+    counted = 60.0 / np.median(np.diff(body.time[peaks]))
+    assert spm == pytest.approx(counted, rel=0.1) and 100 < spm < 125
+    assert msgs == []
