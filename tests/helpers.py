@@ -22,9 +22,9 @@ def point_run(
     cfg = {
         "motion": {"kind": "point_targets", "length": duration, "targets": targets},
         "scatterers": {"kind": "points"},
-        "radar": {"kind": "lfm", **(radar or {})},
+        "radar": {"kind": "lfm", "precision": "float64", **(radar or {})},
         "scene": {"radar_position": [0.0, 0.0, 0.0], **(scene or {})},
-        "processing": processing or {},
+        "processing": {"keep_scatterers": True, **(processing or {})},
     }
     return simulate(validate_run_config(cfg))
 

@@ -264,6 +264,7 @@ def run(registry: Registry, **sections: Any) -> RunResult:
         "scatterers": {"kind": "mujoco_body"},
         "radar": {"kind": "lfm"},
         "scene": {"radar_position": list(RADAR)},
+        "processing": {"keep_scatterers": True},
     }
     cfg.update(sections)
     return simulate(validate_run_config(cfg, registry=registry), registry)

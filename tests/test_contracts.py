@@ -14,6 +14,7 @@ from mdframework.pipeline import build_stages, place_body
 from mdframework.plugins import INTERFACES, default_registry
 from mdframework.skeleton import Skeleton
 from mdframework.testing import (
+    check_block_invariance,
     check_effect_class,
     check_motion_source,
     check_plugin_class,
@@ -97,8 +98,8 @@ def test_the_contracts_catch_broken_plugins() -> None:
     class Flipped(LfmPulseDoppler):
         """Conjugates its output: approaching targets come out negative."""
 
-        def receive(self, ranges: Any, rcs: Any, gate_range: Any) -> Received:
-            return Received(np.conj(super().receive(ranges, rcs, gate_range).signal))
+        def receive(self, block: Any) -> Received:
+            return Received(np.conj(super().receive(block).signal))
 
     with pytest.raises(AssertionError, match="approaching target must show"):
         check_waveform(Flipped(Flipped.Config()))
@@ -110,3 +111,64 @@ def test_the_contracts_catch_broken_plugins() -> None:
 
     with pytest.raises(AssertionError, match=r"Config\.kind must be Literal\['lfm2'\]"):
         check_plugin_class(Misnamed, "radar")
+
+
+def _model(name: str) -> Any:
+    cls: Any = REGISTRY.get("scatterers", name)
+    return cls(cls.Config(body=True) if name == "points" else cls.Config())
+
+
+@pytest.mark.parametrize("name", REGISTRY.names("scatterers"))
+def test_scatterer_model_is_block_invariant(name: str, placed_body: tuple[Any, Skeleton]) -> None:
+    """One block or blocks of 37 pulses give the same RCS and signal (streaming contract)."""
+    motion, skeleton = placed_body
+    lfm: Any = REGISTRY.get("radar", "lfm")
+    check_block_invariance(_model(name), lfm(lfm.Config()), skeleton, motion)
+
+
+@pytest.mark.parametrize("path", ["analytic", "raw"])
+def test_waveform_paths_are_block_invariant(path: str, placed_body: tuple[Any, Skeleton]) -> None:
+    motion, skeleton = placed_body
+    short = skeleton.select_frames(slice(0, 300))
+    lfm: Any = REGISTRY.get("radar", "lfm")
+    check_block_invariance(_model("ellipsoid"), lfm(lfm.Config(path=path)), short, motion)
+
+
+SCATTERER_EFFECTS = [
+    n for n in REGISTRY.names("effect") if REGISTRY.get("effect", n).stage == "scatterers"
+]
+
+
+@pytest.mark.parametrize("name", SCATTERER_EFFECTS)
+def test_scatterer_effects_are_block_invariant(
+    name: str, placed_body: tuple[Any, Skeleton]
+) -> None:
+    motion, skeleton = placed_body
+    cls: Any = REGISTRY.get("effect", name)
+    effect = cls(cls.Config())
+    effect.start_record(skeleton, np.array([10.0, 0.0, 1.0]))
+    lfm: Any = REGISTRY.get("radar", "lfm")
+    check_block_invariance(_model("ellipsoid"), lfm(lfm.Config()), skeleton, motion, (effect,))
+
+
+def test_block_invariance_check_catches_a_per_block_model(
+    placed_body: tuple[Any, Skeleton],
+) -> None:
+    """A model that estimates the body height from each block (not the record) is caught."""
+    from mdf_ellipsoid.model import EllipsoidBody
+
+    from mdframework.physics import body as bodymodel
+
+    class PerBlock(EllipsoidBody):
+        """Re-estimates the height from every block."""
+
+        def scatterers(self, motion: Any, skeleton: Skeleton, *args: Any) -> Any:
+            self._a, self._semi_c = bodymodel.part_semi_axes(
+                self._parts, bodymodel.estimate_height(skeleton.positions)
+            )
+            return super().scatterers(motion, skeleton, *args)
+
+    motion, skeleton = placed_body
+    lfm: Any = REGISTRY.get("radar", "lfm")
+    with pytest.raises(AssertionError, match="not block-invariant"):
+        check_block_invariance(PerBlock(PerBlock.Config()), lfm(lfm.Config()), skeleton, motion)

@@ -48,9 +48,9 @@ def run(
     cfg = {
         "motion": {"kind": "point_targets", "length": duration, "targets": targets},
         "scatterers": {"kind": "points"},
-        "radar": {"kind": "lfm", **(radar_cfg or {})},
+        "radar": {"kind": "lfm", "precision": "float64", **(radar_cfg or {})},
         "scene": {"radar_position": list(radar_position), "gate": gate},
-        "processing": processing or {},
+        "processing": {"keep_scatterers": True, **(processing or {})},
         "effects": effects,
         "seed": seed,
     }

@@ -21,7 +21,10 @@ def registry() -> Registry:
 
 
 def walk(registry: Registry, **sections: Any) -> RunResult:
-    cfg: dict[str, Any] = {"motion": {"kind": "synthetic_walker"}}
+    cfg: dict[str, Any] = {
+        "motion": {"kind": "synthetic_walker"},
+        "processing": {"keep_scatterers": True},
+    }
     for key, value in sections.items():
         cfg[key] = value
     return simulate(validate_run_config(cfg, registry=registry), registry)

@@ -108,6 +108,7 @@ def run(registry: Registry, effects: list[dict[str, Any]], **scatterers: Any) ->
             "person": {"position": [0.0, -1.0], "aspect_deg": 90.0},
         },
         "effects": effects,
+        "processing": {"keep_scatterers": True},
     }
     return simulate(validate_run_config(cfg, registry=registry), registry)
 

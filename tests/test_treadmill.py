@@ -31,7 +31,7 @@ def walk(source: str, motion: str) -> RunResult:
             "radar_position": [10.0, 0.0, 1.0],
             "person": {"motion": motion, "position": [0.0, 0.0], "aspect_deg": 0.0},
         },
-        "processing": {"hop": 32},
+        "processing": {"hop": 32, "keep_scatterers": True},
     }
     return simulate(validate_run_config(cfg, base_dir=EXAMPLES))
 

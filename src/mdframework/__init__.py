@@ -17,6 +17,7 @@ from .interfaces import (
     Motion,
     MotionSource,
     PluginConfig,
+    PulseBlock,
     RadarRecordingSource,
     RadarWaveform,
     Received,
@@ -24,6 +25,7 @@ from .interfaces import (
     ScattererModel,
     Scatterers,
     SceneContext,
+    receive_points,
 )
 from .settings import DataPath, MotionConfig
 from .skeleton import CANONICAL_JOINTS, CANONICAL_SEGMENTS, Skeleton, to_canonical
@@ -43,6 +45,7 @@ __all__ = [
     "MotionConfig",
     "MotionSource",
     "PluginConfig",
+    "PulseBlock",
     "RadarRecordingSource",
     "RadarWaveform",
     "Received",
@@ -53,5 +56,6 @@ __all__ = [
     "SceneError",
     "Skeleton",
     "hookimpl",
+    "receive_points",
     "to_canonical",
 ]

@@ -31,7 +31,7 @@ Columns with no bin above the floor (silence) are left out of every statistic.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -63,7 +63,7 @@ class Envelopes:
 
 
 def envelopes(
-    power: FloatArray,
+    power: NDArray[np.floating[Any]],
     velocity: FloatArray,
     *,
     method: EnvelopeMethod = "threshold",
@@ -147,7 +147,7 @@ def features_from_envelopes(env: Envelopes) -> FloatArray:
 
 
 def spectrogram_features(
-    power: FloatArray,
+    power: NDArray[np.floating[Any]],
     velocity: FloatArray,
     *,
     method: EnvelopeMethod = "threshold",

@@ -9,9 +9,16 @@ Data passed between stages (shapes, dtypes, units):
 - :class:`Motion`: a :class:`~mdframework.skeleton.Skeleton` plus metadata.
 - :class:`Scatterers`: ``positions`` ``(n_pulses, n_scatterers, 3)`` float64 [m] in the scene
   frame and ``rcs`` ``(n_pulses, n_scatterers)`` float64 [m^2].
+- :class:`PulseBlock`: the streaming unit. The pipeline cuts a record's pulses into blocks of
+  consecutive pulses (a few thousand) and runs scatterers, scatterer-stage effects, ranges and the
+  radar's receive chain block by block, so memory is set by the block size, not the record.
 - :class:`Received`: ``signal`` ``(n_pulses,)`` complex128, the pulse-compressed slow-time return
   at the range gate, normalised so that a lone scatterer at the gate gives its range-equation
-  amplitude [sqrt(W)]; optional range-time data.
+  amplitude [sqrt(W)]; optional range-time data and waveform-specific ``products``.
+
+Block invariance: every per-block stage (scatterer models, scatterer-stage effects, waveforms)
+must give the same output whether a record is processed as one block or as many
+(:func:`mdframework.testing.check_block_invariance`).
 """
 
 from __future__ import annotations
@@ -20,7 +27,7 @@ import dataclasses
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, Literal
+from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -28,6 +35,10 @@ from pydantic import BaseModel, ConfigDict
 
 from .pointcloud import PointCloud
 from .skeleton import Skeleton, to_canonical
+
+if TYPE_CHECKING:
+    from .physics.spectrogram import Spectrogram
+    from .settings import ProcessingConfig
 
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
@@ -104,6 +115,12 @@ class Scatterers:
     #: c-axis (not necessarily unit length). ``None`` for point scatterers.
     semi_axes: FloatArray | None = None
     axes: FloatArray | None = None
+    #: Optional ranges already computed by the model: ``(radar_position, ranges)`` with ranges
+    #: (n_pulses, n_scatterers) [m]; :meth:`ranges` returns them for that radar position. It
+    #: survives :meth:`replace` only when the positions are not replaced.
+    range_cache: tuple[tuple[float, float, float], FloatArray] | None = field(
+        default=None, repr=False, compare=False
+    )
 
     def __post_init__(self) -> None:
         if self.positions.ndim != 3 or self.positions.shape[2] != 3:
@@ -117,12 +134,20 @@ class Scatterers:
 
     def replace(self, **changes: Any) -> Scatterers:
         """A copy with some fields replaced (e.g. ``rcs``)."""
+        if "positions" in changes:
+            changes.setdefault("range_cache", None)
         return dataclasses.replace(self, **changes)
 
     def ranges(self, radar_position: FloatArray) -> FloatArray:
         """Distance of every scatterer to the radar, (n_pulses, n_scatterers) float64 [m]."""
+        key = tuple(float(v) for v in np.asarray(radar_position, dtype=np.float64))
+        if self.range_cache is not None and self.range_cache[0] == key:
+            return self.range_cache[1]
         d = self.positions - np.asarray(radar_position, dtype=np.float64)
-        return np.asarray(np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2 + d[..., 2] ** 2), np.float64)
+        r = d[..., 0] ** 2
+        r += d[..., 1] ** 2
+        r += d[..., 2] ** 2
+        return np.asarray(np.sqrt(r, out=r), dtype=np.float64)
 
 
 class ScattererModel(Plugin):
@@ -131,15 +156,23 @@ class ScattererModel(Plugin):
     #: Whether this model needs the canonical 17-joint body (a model may decide per config).
     needs_canonical: bool = True
 
+    def start_record(self, body: Skeleton) -> None:
+        """Called once per record before its blocks, with the whole placed body at the source's
+        own frame times (``n_frames``, not pulses). A model that needs record-wide quantities
+        (the body's height, an orientation to hold over untracked frames) takes them from here,
+        so that :meth:`scatterers` gives the same result for any cut of the record into blocks.
+        Default: nothing."""
+
     @abstractmethod
     def scatterers(
         self, motion: Motion, skeleton: Skeleton, radar_position: FloatArray, wavelength: float
     ) -> Scatterers:
-        """Scatterers for every pulse.
+        """Scatterers for every pulse of one block.
 
-        ``skeleton`` is already resampled to the pulse times and placed in the scene frame
-        (canonical joints if ``needs_canonical``). ``radar_position`` is (3,) [m];
-        ``wavelength`` [m] is the radar's, for frequency-dependent RCS.
+        ``skeleton`` is already resampled to the block's pulse times and placed in the scene
+        frame (canonical joints if ``needs_canonical``). ``radar_position`` is (3,) [m];
+        ``wavelength`` [m] is the radar's, for frequency-dependent RCS. Blocks arrive in time
+        order, after :meth:`start_record`.
         """
 
 
@@ -147,21 +180,55 @@ class ScattererModel(Plugin):
 
 
 @dataclass(frozen=True)
+class PulseBlock:
+    """Consecutive pulses of a record, the unit a waveform receives.
+
+    ``start``: index of the block's first pulse in the record. ``times`` (n,) float64 [s] on the
+    scene clock. ``scatterers``: positions (n, K, 3) float64 [m] in the scene frame and RCS
+    (n, K) float64 [m^2]. ``ranges`` (n, K) float64 [m]: scatterer to radar, computed once by the
+    pipeline. ``gate_range`` (n,) float64 [m]. ``radar_position`` (3,) float64 [m].
+    """
+
+    start: int
+    times: FloatArray
+    scatterers: Scatterers
+    ranges: FloatArray
+    gate_range: FloatArray
+    radar_position: FloatArray
+
+    @property
+    def n_pulses(self) -> int:
+        """Number of pulses in the block."""
+        return int(self.times.shape[0])
+
+
+@dataclass(frozen=True)
 class Received:
     """Radar data after pulse compression.
 
     ``signal`` (n_pulses,) complex128: slow-time return at the range gate [sqrt(W)].
-    ``range_time`` (n_pulses, n_bins) complex128 and ``range_axis`` (n_bins,) float64 [m]: the
-    compressed output over a window of ranges, when the waveform computes it (else ``None``).
+    ``range_time`` (n_rows, n_bins) complex128 and ``range_axis`` (n_bins,) float64 [m]: the
+    compressed output over a window of ranges, when the waveform computes it (else ``None``); a
+    waveform returns one row per pulse of a block, and the pipeline keeps every pulse's row of a
+    record up to ``processing.max_range_time_rows`` and evenly spaced rows beyond
+    (``range_time_pulses`` (n_rows,) int64 then gives the pulse index of each row).
+    ``products``: further arrays a waveform produces (e.g. range-Doppler maps or point clouds),
+    each stacked along axis 0 over a record's blocks and saved under its name.
     """
 
     signal: ComplexArray
     range_time: ComplexArray | None = None
     range_axis: FloatArray | None = None
+    products: Mapping[str, NDArray[Any]] = field(default_factory=dict)
+    range_time_pulses: NDArray[np.int64] | None = None
 
 
 class RadarWaveform(Plugin):
-    """A radar: its carrier, pulse rate, range equation and receive chain."""
+    """A radar: its carrier, pulse timing, range equation and receive chain."""
+
+    #: Blocks hold a multiple of this many pulses (e.g. the pulses of one FMCW frame, so that no
+    #: frame straddles two blocks).
+    block_multiple: ClassVar[int] = 1
 
     @property
     @abstractmethod
@@ -171,15 +238,63 @@ class RadarWaveform(Plugin):
     @property
     @abstractmethod
     def prf(self) -> float:
-        """Pulse repetition frequency, i.e. the slow-time sample rate [Hz]."""
+        """Pulse repetition frequency, i.e. the (mean) slow-time sample rate [Hz]."""
+
+    @property
+    def max_unambiguous_velocity(self) -> float:
+        """Largest |radial velocity| [m/s] the slow-time sampling represents without aliasing.
+        Default: ``lambda * prf / 4`` (complex samples at ``prf``)."""
+        from .physics.radar import max_unambiguous_velocity
+
+        return max_unambiguous_velocity(self.carrier_frequency, self.prf)
+
+    def start_record(self, times: FloatArray, range_span: tuple[float, float]) -> None:
+        """Called once per record before its blocks: ``times`` (n_pulses,) [s] of the whole
+        record and the smallest and largest distance [m] of the body's joints to the radar over
+        it (e.g. to fix a range-time window for every block). Default: nothing."""
+
+    def pulse_times(self, start: float, end: float) -> FloatArray:
+        """Slow-time instants (n_pulses,) float64 [s] of a record from ``start`` to ``end``
+        (scene clock, inclusive). Default: uniform at :attr:`prf` from ``start``."""
+        from .physics.interpolation import pulse_times
+
+        return pulse_times(start, end, self.prf)
 
     @abstractmethod
-    def receive(self, ranges: FloatArray, rcs: FloatArray, gate_range: FloatArray) -> Received:
-        """Received, pulse-compressed data.
+    def receive(self, block: PulseBlock) -> Received:
+        """Received, pulse-compressed data of one block: ``signal`` (block.n_pulses,)."""
 
-        ``ranges`` and ``rcs``: (n_pulses, n_scatterers) float64 [m], [m^2].
-        ``gate_range``: (n_pulses,) float64 [m], the range gate to report in ``signal``.
-        """
+    def spectrogram(
+        self, signal: ComplexArray, times: FloatArray, processing: ProcessingConfig
+    ) -> Spectrogram | None:
+        """The record's micro-Doppler spectrogram when this radar's slow time is not uniform
+        (e.g. FMCW frames with gaps): ``signal`` (n_pulses,), ``times`` (n_pulses,) [s].
+        Default ``None``: the pipeline takes the STFT of ``signal`` at :attr:`prf`."""
+        return None
+
+
+def receive_points(
+    waveform: RadarWaveform,
+    ranges: FloatArray,
+    rcs: FloatArray,
+    gate_range: FloatArray,
+    radar_position: FloatArray | None = None,
+    times: FloatArray | None = None,
+) -> Received:
+    """One-off receive of point scatterers given by their ranges, e.g. clutter patches or
+    contract checks: ``ranges``, ``rcs`` (n_pulses, K) [m], [m^2]; ``gate_range`` (n_pulses,)
+    [m]. The scatterers are put on the +x axis of the radar; ``times`` default to ``n / prf``."""
+    r = np.asarray(ranges, dtype=np.float64)
+    origin = np.zeros(3) if radar_position is None else np.asarray(radar_position, np.float64)
+    positions = np.zeros((*r.shape, 3))
+    positions[..., 0] = r
+    positions += origin
+    t = np.arange(r.shape[0]) / waveform.prf if times is None else np.asarray(times, np.float64)
+    scat = Scatterers(
+        positions, np.asarray(rcs, dtype=np.float64), tuple(map(str, range(r.shape[1])))
+    )
+    block = PulseBlock(0, t, scat, r, np.asarray(gate_range, dtype=np.float64), origin)
+    return waveform.receive(block)
 
 
 # --------------------------------------------------------------------------- recorded radar output
@@ -231,10 +346,14 @@ class SceneContext:
     """What an effect may need to know about the scene.
 
     ``radar_position`` (3,) [m]; ``prf`` and ``carrier_frequency`` [Hz]; ``pulse_times``
-    (n_pulses,) [s]; ``gate_range`` (n_pulses,) [m]; ``skeleton``: the body at the pulse times in
-    the scene frame (canonical joints when the scatterer model uses them); ``waveform``: the radar
-    plugin (for its bandwidth, pulse width, range equation); ``rng``: the run's seeded generator
-    (each effect gets its own stream, derived from the run's seed and the effect's position).
+    (n_pulses,) [s] and ``gate_range`` (n_pulses,) [m]: of the block for scatterer-stage effects,
+    of the whole record for received-stage effects; ``skeleton``: the body at the block's pulse
+    times in the scene frame (canonical joints when the scatterer model uses them), ``None`` for
+    received-stage effects; ``waveform``: the radar plugin (for its bandwidth, pulse width, range
+    equation); ``rng``: the effect's own seeded generator (derived from the run's seed and the
+    effect's position; received-stage effects only: a scatterer-stage effect must not draw
+    random numbers, so that it is block-invariant); ``block_start``: index of the block's first
+    pulse in the record (0 for received-stage effects).
     """
 
     radar_position: FloatArray
@@ -242,26 +361,35 @@ class SceneContext:
     carrier_frequency: float
     pulse_times: FloatArray
     gate_range: FloatArray
-    skeleton: Skeleton
+    skeleton: Skeleton | None
     waveform: RadarWaveform
     rng: np.random.Generator
+    block_start: int = 0
 
 
 class Effect(Plugin):
     """A scene effect (noise, clutter, multipath, antenna pattern, shadowing, ...).
 
     ``stage`` says where it acts: on the scatterers before the radar (``"scatterers"``: it gets
-    and returns :class:`Scatterers`, e.g. attenuating RCS or adding image scatterers) or on the
-    received data (``"received"``: it gets and returns :class:`Received`, e.g. adding noise).
+    and returns :class:`Scatterers` of one block, e.g. attenuating RCS or adding image
+    scatterers; it must be deterministic and block-invariant) or on the received data
+    (``"received"``: it gets and returns the whole record's :class:`Received`, e.g. adding
+    noise).
     The pipeline instantiates and runs only the effects a scene's ``effects`` list names, in
     that order within each stage; an effect not named is never constructed.
     """
 
     stage: ClassVar[Literal["scatterers", "received"]]
 
+    def start_record(self, body: Skeleton, radar_position: FloatArray) -> None:
+        """Called once per record before its blocks, with the whole placed body at the source's
+        own frame times and the radar position (3,) [m]: a scatterer-stage effect takes
+        record-wide quantities (e.g. a fixed beam's aim) from here and resets what it
+        accumulates over blocks. Default: nothing."""
+
     @abstractmethod
     def apply(self, data: Any, context: SceneContext) -> Any:
-        """Return the modified ``Scatterers`` or ``Received``."""
+        """Return the modified ``Scatterers`` (of one block) or ``Received`` (of the record)."""
 
     def describe(self) -> dict[str, Any]:
         """What this effect did, for the run's metadata (default: its config)."""

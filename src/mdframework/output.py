@@ -8,7 +8,11 @@
 - ``spectrogram_db`` (n_doppler, n_frames) float32: power in dB re its peak, floored
 - ``doppler_hz`` (n_doppler,), ``velocity_mps`` (n_doppler,): axes (+ approaching)
 - ``time_s`` (n_frames,): STFT window centres [s from the first pulse]
-- ``scatterer_range_m`` (n_pulses, n_scatterers), ``scatterer_rcs_m2`` (same) float32
+- ``body_time_s`` (n_frames,), ``body_positions_m`` (n_frames, n_joints, 3) float32: the placed
+  body at the source's frame times within the record [s from the first pulse, m]; ``body_joints``
+  (n_joints,) str
+- with ``processing.keep_scatterers`` only: ``scatterer_range_m`` (n_pulses, n_scatterers),
+  ``scatterer_rcs_m2`` (same) float32
 - raw path only: ``range_time_db`` (n_slow, n_range) float32, |compressed output| in dB re peak,
   decimated in slow time to at most 2000 rows; ``range_time_time_s`` (n_slow,);
   ``range_m`` (n_range,)
@@ -18,6 +22,7 @@
   :data:`mdframework.features.FEATURE_NAMES` order (NaN if the spectrogram is silent); both
   with the default feature settings (threshold method, -20 dB below each column's peak, floor
   -40 dB, median torso), as datasets use them
+- waveform products (e.g. range-Doppler maps, point clouds), under their own names
 
 plus ``spectrogram.png``, ``range_time.png`` (raw path), ``features.json`` (the seven
 features by name and the three tracks, ``null`` in silent frames), ``config.resolved.json``
@@ -106,7 +111,6 @@ def features_document(arrays: dict[str, np.ndarray]) -> dict[str, Any]:
 
 def result_arrays(result: RunResult) -> dict[str, np.ndarray]:
     """The arrays stored in ``result.npz``."""
-    ranges = result.scatterers.ranges(np.asarray(result.metadata["radar_position_m"]))
     arrays: dict[str, np.ndarray] = {
         "signal": result.received.signal,
         "pulse_time_s": result.pulse_times,
@@ -115,17 +119,27 @@ def result_arrays(result: RunResult) -> dict[str, np.ndarray]:
         "doppler_hz": result.spectrogram.doppler,
         "velocity_mps": result.velocity,
         "time_s": result.spectrogram.time,
-        "scatterer_range_m": ranges,
-        "scatterer_rcs_m2": result.scatterers.rcs.astype(np.float32),
+        "body_time_s": result.body.time,
+        "body_positions_m": result.body.positions.astype(np.float32),
+        "body_joints": np.array(result.body.joint_names),
     }
     arrays.update(feature_arrays(result))
-    rt = result.received.range_time
-    if rt is not None and result.received.range_axis is not None:
-        step = max(1, int(np.ceil(rt.shape[0] / MAX_RANGE_TIME_ROWS)))
-        power = np.abs(rt[::step]) ** 2
+    if result.scatterers is not None:
+        radar_position = np.asarray(result.metadata["radar_position_m"])
+        arrays["scatterer_range_m"] = result.scatterers.ranges(radar_position)
+        arrays["scatterer_rcs_m2"] = result.scatterers.rcs.astype(np.float32)
+    rec = result.received
+    if rec.range_time is not None and rec.range_axis is not None:
+        rows = rec.range_time_pulses
+        if rows is None:
+            rows = np.arange(rec.range_time.shape[0])
+        step = max(1, int(np.ceil(rec.range_time.shape[0] / MAX_RANGE_TIME_ROWS)))
+        power = np.abs(rec.range_time[::step]) ** 2
         arrays["range_time_db"] = power_to_db(power, -80.0).astype(np.float32)
-        arrays["range_time_time_s"] = result.pulse_times[::step]
-        arrays["range_m"] = result.received.range_axis
+        arrays["range_time_time_s"] = result.pulse_times[rows[::step]]
+        arrays["range_m"] = rec.range_axis
+    for name, value in rec.products.items():
+        arrays.setdefault(name, value)
     return arrays
 
 

@@ -1,8 +1,13 @@
 """The run pipeline: wires the stages, computes nothing itself.
 
-motion source -> canonical body -> conditioning -> scene placement -> window -> resampling to
-pulse times -> scatterers and RCS -> effects (scatterers) -> ranges (checked) -> radar receive
-and pulse compression -> effects (received) -> spectrogram.
+motion source -> canonical body -> conditioning -> scene placement (whole recording) -> record
+window -> then, block by block of pulses: resampling to the pulse times -> scatterers and RCS ->
+effects (scatterers) -> ranges (checked) -> radar receive and pulse compression; then, on the
+record's slow-time signal: effects (received) -> spectrogram.
+
+Memory: the per-scatterer arrays (n_pulses, n_scatterers, ...) exist one block at a time
+(``processing.block_pulses``); only per-pulse arrays (signal, gate) and the spectrogram span the
+record.
 """
 
 from __future__ import annotations
@@ -21,6 +26,7 @@ from .interfaces import (
     Effect,
     Motion,
     MotionSource,
+    PulseBlock,
     RadarWaveform,
     Received,
     ScattererModel,
@@ -40,19 +46,29 @@ class AliasingWarning(UserWarning):
     """A scatterer moves faster than the PRF can represent without Doppler aliasing."""
 
 
+#: Range-time rows a record keeps: every pulse's row up to this many pulses, evenly spaced rows
+#: beyond (the map is for display; the slow-time ``signal`` keeps every pulse).
+MAX_RANGE_TIME_ROWS = 16384
+
+
 @dataclass(frozen=True)
 class RunResult:
     """Everything a run produces. Arrays: ``pulse_times`` (n_pulses,) [s from the first pulse];
     ``gate_range`` (n_pulses,) [m]; ``received.signal`` (n_pulses,) complex [sqrt(W)];
-    ``spectrogram_db`` (n_doppler, n_frames) [dB re peak]; ``velocity`` (n_doppler,) [m/s]."""
+    ``spectrogram_db`` (n_doppler, n_frames) float32 [dB re peak]; ``velocity`` (n_doppler,)
+    [m/s]; ``body``: the placed body at the source's own frame times within the record, times
+    [s from the first pulse]; ``scatterers``: every pulse's scatterers, only when
+    ``processing.keep_scatterers`` (else ``None``: the pipeline streams them block by block)."""
 
     pulse_times: FloatArray
     gate_range: FloatArray
-    scatterers: Scatterers
     received: Received
     spectrogram: Spectrogram
-    spectrogram_db: FloatArray
+    spectrogram_db: NDArray[np.float32]
     velocity: FloatArray
+    scatterer_names: tuple[str, ...]
+    body: Skeleton
+    scatterers: Scatterers | None = None
     metadata: dict[str, Any] = field(default_factory=dict)
 
 
@@ -85,14 +101,18 @@ def build_stages(config: RunConfigBase, registry: Registry | None = None) -> Sta
     )
 
 
-def _apply_effects(
-    stages: Stages, stage: str, data: Any, context: SceneContext, ran: list[dict[str, Any]]
-) -> Any:
+def _apply_effects(stages: Stages, stage: str, data: Any, context: SceneContext) -> Any:
     for effect in stages.effects:
         if effect.stage == stage:
             data = effect.apply(data, context)
-            ran.append({"kind": effect.name, "stage": stage, **effect.describe()})
     return data
+
+
+def _describe(stages: Stages, stage: str) -> list[dict[str, Any]]:
+    """What the effects of one stage did, for the metadata (after the record)."""
+    return [
+        {"kind": e.name, "stage": stage, **e.describe()} for e in stages.effects if e.stage == stage
+    ]
 
 
 def place_body(body: Skeleton, person: PersonConfig, radar_position: FloatArray) -> Skeleton:
@@ -154,92 +174,83 @@ def load_motion(source: MotionSource) -> Motion:
 def simulate_motion(
     config: RunConfigBase, stages: Stages, motion: Motion, timings: dict[str, float] | None = None
 ) -> RunResult:
-    """Run the stages after the motion source on an already loaded motion."""
-    cfg: Any = config
+    """Run the stages after the motion source on an already loaded motion.
+
+    The body is conditioned and placed over the whole recording (facing, drift and outlier
+    statistics need it); only the record's window (plus a margin of frames) is resampled; then
+    pulses stream through scatterers, effects, ranges and the receive chain in blocks of
+    ``processing.block_pulses``, and the slow-time signal goes to the spectrogram.
+    """
     timings = {} if timings is None else timings
-    sc = config.scene
-    proc = config.processing
+    cfg: Any = config
+    sc, proc, wf, model = config.scene, config.processing, stages.radar, stages.model
     radar_pos = np.asarray(sc.radar_position, dtype=np.float64)
-    wf = stages.radar
     lam = radar.wavelength(wf.carrier_frequency)
 
     clock = time.perf_counter()
-    if stages.model.needs_canonical and motion.canonical_map is None:
-        raise SceneError(
-            f"scatterers.kind: the {stages.model.name!r} model needs a human body, but this "
-            f"motion ({motion.metadata.get('source', 'unknown')}) has no canonical joints"
-        )
-    # conditioning and placement see the whole recording (facing, drift, outlier statistics);
-    # the record is then a window of the placed recording
-    body = motion.canonical() if stages.model.needs_canonical else motion.skeleton
-    body, conditioning_report = _condition(body, config.conditioning)
-    if stages.model.needs_canonical:
-        body = place_body(body, sc.person, radar_pos)
-        placement = sc.person.model_dump()
-    elif not _is_default_placement(sc.person):
-        raise SceneError(
-            "scene.person: placement applies to human bodies only; this motion "
-            f"({motion.metadata.get('source', 'unknown')}) is used as recorded"
-        )
-    else:
-        placement = {"motion": "as given"}
+    body, conditioning_report, placement = _place(config, stages, motion, radar_pos)
     t_start, t_end = _window(body, cfg.motion.start, cfg.motion.duration)
-
-    # the spline sees the whole recording, so a record has no end effects of its own
-    t = interpolation.pulse_times(t_start, t_end, wf.prf)
-    joints = interpolation.resample_tracks(
-        body.time, body.positions, body.valid, t, proc.interpolation
+    t = wf.pulse_times(t_start, t_end)
+    frames = interpolation.window_frames(body.time, float(t[0]), float(t[-1]))
+    near = body.select_frames(frames)
+    resample = interpolation.TrackResampler(
+        near.time, near.positions, near.valid, proc.interpolation
     )
-    at_pulses = Skeleton(t, joints, body.joint_names)
-    timings["resample"] = time.perf_counter() - clock
+    record_body = near.select_frames(_inside(near.time, t_start, t_end))
+    model.start_record(record_body)
+    wf.start_record(t, _range_span(record_body, radar_pos))
+    for effect in stages.effects:
+        effect.start_record(record_body, radar_pos)
+    timings["prepare"] = time.perf_counter() - clock
 
-    clock = time.perf_counter()
-    scat = stages.model.scatterers(motion, at_pulses, radar_pos, lam)
-    gate = _gate(sc.gate, at_pulses, radar_pos)
-    effects_ran: list[dict[str, Any]] = []
+    n = t.shape[0]
     seeds = np.random.SeedSequence(config.seed).spawn(len(stages.effects) + 1)
-    context = SceneContext(
-        radar_pos,
-        wf.prf,
-        wf.carrier_frequency,
-        t,
-        gate,
-        at_pulses,
-        wf,
-        np.random.default_rng(seeds[0]),
-    )
-    scat = _apply_effects(stages, "scatterers", scat, context, effects_ran)
-    ranges = scat.ranges(radar_pos)
-    _check_ranges(ranges, scat, t, sc.min_range)
-    v_max = radar.max_unambiguous_velocity(wf.carrier_frequency, wf.prf)
-    speed = _max_radial_speed(ranges, wf.prf)
-    if speed > v_max:
-        msg = (
-            f"the fastest scatterer moves at {speed:.2f} m/s radially, beyond the unambiguous "
-            f"{v_max:.2f} m/s of PRF {wf.prf:g} Hz: its Doppler aliases"
+    rng = np.random.default_rng(seeds[0])
+    stream = _Stream(n, proc.keep_scatterers, proc.aliasing, wf, sc.min_range, t)
+    for lo, hi in _blocks(n, proc.block_pulses, wf.block_multiple):
+        clock = time.perf_counter()
+        tb = t[lo:hi]
+        at_pulses = Skeleton(tb, resample(tb), body.joint_names)
+        timings["resample"] = timings.get("resample", 0.0) + time.perf_counter() - clock
+
+        clock = time.perf_counter()
+        scat = model.scatterers(motion, at_pulses, radar_pos, lam)
+        gate = _gate(sc.gate, at_pulses, radar_pos)
+        context = SceneContext(
+            radar_pos, wf.prf, wf.carrier_frequency, tb, gate, at_pulses, wf, rng, lo
         )
-        if proc.aliasing == "error":
-            raise SceneError(msg)
-        warnings.warn(msg, AliasingWarning, stacklevel=2)
-    timings["scatterers"] = time.perf_counter() - clock
+        scat = _apply_effects(stages, "scatterers", scat, context)
+        ranges = scat.ranges(radar_pos)
+        stream.check(lo, scat, ranges)
+        timings["scatterers"] = timings.get("scatterers", 0.0) + time.perf_counter() - clock
+
+        clock = time.perf_counter()
+        stream.add(lo, gate, scat, wf.receive(PulseBlock(lo, tb, scat, ranges, gate, radar_pos)))
+        timings["receive"] = timings.get("receive", 0.0) + time.perf_counter() - clock
 
     clock = time.perf_counter()
-    received = wf.receive(ranges, scat.rcs, gate)
-    received = _apply_effects(stages, "received", received, context, effects_ran)
-    timings["receive"] = time.perf_counter() - clock
+    stream.warn_aliasing()
+    received = stream.received()
+    context = SceneContext(radar_pos, wf.prf, wf.carrier_frequency, t, stream.gate, None, wf, rng)
+    received = _apply_effects(stages, "received", received, context)
+    effects_ran = _describe(stages, "scatterers") + _describe(stages, "received")
+    timings["received_effects"] = time.perf_counter() - clock
 
     clock = time.perf_counter()
-    try:
-        spec = spectrogram(
-            received.signal,
-            wf.prf,
-            window=proc.window,
-            window_length=proc.window_length,
-            hop=proc.hop,
-            nfft=proc.nfft,
-        )
-    except RecordTooShortError as exc:
-        raise SceneError(f"processing.window_length: {exc}") from None
+    spec = wf.spectrogram(received.signal, t, proc)
+    if spec is None:
+        try:
+            spec = spectrogram(
+                received.signal,
+                wf.prf,
+                window=proc.window,
+                window_length=proc.window_length,
+                hop=proc.hop,
+                nfft=proc.nfft,
+                precision=proc.precision,
+            )
+        except RecordTooShortError as exc:
+            raise SceneError(f"processing.window_length: {exc}") from None
     spec_db = power_to_db(spec.power, proc.floor_db)
     velocity = radar.doppler_to_velocity(spec.doppler, wf.carrier_frequency)
     timings["spectrogram"] = time.perf_counter() - clock
@@ -248,20 +259,183 @@ def simulate_motion(
         "motion": dict(motion.metadata),
         "placement": placement,
         "conditioning": conditioning_report,
-        "scatterers": list(scat.names),
-        "n_pulses": int(t.shape[0]),
+        "scatterers": list(stream.names),
+        "n_pulses": int(n),
         "prf_hz": wf.prf,
         "carrier_frequency_hz": wf.carrier_frequency,
         "wavelength_m": lam,
-        "max_unambiguous_velocity_mps": v_max,
-        "max_radial_speed_mps": speed,
+        "max_unambiguous_velocity_mps": stream.v_max,
+        "max_radial_speed_mps": stream.speed,
         "radar_position_m": list(sc.radar_position),
         "record_start_s": t_start,
         "effects": effects_ran,
         "seed": config.seed,
         "timings_s": timings,
     }
-    return RunResult(t - t[0], gate, scat, received, spec, spec_db, velocity, metadata)
+    shifted = Skeleton(
+        record_body.time - t[0], record_body.positions, record_body.joint_names, record_body.valid
+    )
+    return RunResult(
+        t - t[0],
+        stream.gate,
+        received,
+        spec,
+        spec_db,
+        velocity,
+        stream.names,
+        shifted,
+        stream.scatterers(),
+        metadata,
+    )
+
+
+def _place(
+    config: RunConfigBase, stages: Stages, motion: Motion, radar_pos: FloatArray
+) -> tuple[Skeleton, dict[str, Any], dict[str, Any]]:
+    """The conditioned body placed in the scene (whole recording), the conditioning report and
+    the placement recorded in the metadata."""
+    sc = config.scene
+    if stages.model.needs_canonical and motion.canonical_map is None:
+        raise SceneError(
+            f"scatterers.kind: the {stages.model.name!r} model needs a human body, but this "
+            f"motion ({motion.metadata.get('source', 'unknown')}) has no canonical joints"
+        )
+    body = motion.canonical() if stages.model.needs_canonical else motion.skeleton
+    body, conditioning_report = _condition(body, config.conditioning)
+    if stages.model.needs_canonical:
+        return place_body(body, sc.person, radar_pos), conditioning_report, sc.person.model_dump()
+    if not _is_default_placement(sc.person):
+        raise SceneError(
+            "scene.person: placement applies to human bodies only; this motion "
+            f"({motion.metadata.get('source', 'unknown')}) is used as recorded"
+        )
+    return body, conditioning_report, {"motion": "as given"}
+
+
+def _blocks(n: int, size: int, multiple: int) -> list[tuple[int, int]]:
+    """Consecutive ``(lo, hi)`` pulse ranges of about ``size`` pulses, multiples of
+    ``multiple`` (the last block may be shorter)."""
+    step = max(multiple, (size // multiple) * multiple)
+    return [(lo, min(lo + step, n)) for lo in range(0, n, step)]
+
+
+def _inside(time_s: FloatArray, t_first: float, t_last: float) -> slice:
+    """The frames with ``t_first <= time <= t_last`` (at least the nearest one)."""
+    lo = int(np.searchsorted(time_s, t_first - 1e-12, side="left"))
+    hi = int(np.searchsorted(time_s, t_last + 1e-12, side="right"))
+    return slice(min(lo, time_s.shape[0] - 1), max(hi, lo + 1))
+
+
+def _range_span(body: Skeleton, radar_pos: FloatArray) -> tuple[float, float]:
+    """Smallest and largest distance [m] of the record's valid joints to the radar."""
+    d = np.linalg.norm(body.positions - radar_pos, axis=-1)[body.valid]
+    if d.size == 0 or not np.all(np.isfinite(d)):
+        raise SceneError("the record has no valid, finite joint positions")
+    return float(d.min()), float(d.max())
+
+
+class _Stream:
+    """Collects a record's blocks: the slow-time signal, gate, range-time rows and products
+    (arrays of n_pulses or fewer rows), and checks ranges and radial speeds as blocks pass."""
+
+    def __init__(
+        self,
+        n: int,
+        keep: bool,
+        aliasing: str,
+        wf: RadarWaveform,
+        min_range: float,
+        t: FloatArray,
+    ) -> None:
+        self.n, self.keep, self.aliasing, self.min_range, self.t = n, keep, aliasing, min_range, t
+        self.signal = np.empty(n, dtype=np.complex128)
+        self.gate = np.empty(n, dtype=np.float64)
+        self.v_max = wf.max_unambiguous_velocity
+        self.prf = wf.prf
+        self.speed = 0.0
+        self.names: tuple[str, ...] = ()
+        self._last: tuple[float, FloatArray] | None = None
+        self._blocks: list[Scatterers] = []
+        self._rt_step = max(1, -(-n // MAX_RANGE_TIME_ROWS))
+        self._rt: list[NDArray[np.complex128]] = []
+        self._rt_axis: FloatArray | None = None
+        self._products: dict[str, list[NDArray[Any]]] = {}
+
+    def check(self, lo: int, scat: Scatterers, ranges: FloatArray) -> None:
+        """Finite ranges above ``scene.min_range``; the fastest radial speed so far."""
+        nearest = float(ranges.min())
+        if not (np.isfinite(nearest) and np.isfinite(ranges.max())):
+            raise SceneError("a scatterer position is not finite")
+        if nearest < self.min_range:
+            p, s = np.unravel_index(int(np.argmin(ranges)), ranges.shape)
+            raise SceneError(
+                f"scatterer {scat.names[s]!r} comes within {ranges[p, s]:.3g} m of the radar "
+                f"at t = {self.t[lo + p] - self.t[0]:.3f} s (scene.min_range = "
+                f"{self.min_range:g} m): the range equation and far-field RCS do not hold there"
+            )
+        tb = self.t[lo : lo + ranges.shape[0]]
+        if ranges.shape[0] > 1:
+            step = np.diff(ranges, axis=0)
+            fastest = np.maximum(step.max(axis=1), -step.min(axis=1))
+            self.speed = max(self.speed, float(np.max(fastest / np.diff(tb))))
+        if self._last is not None and self._last[1].shape == ranges[0].shape:
+            jump = float(np.max(np.abs(ranges[0] - self._last[1])))
+            self.speed = max(self.speed, jump / (float(tb[0]) - self._last[0]))
+        self._last = (float(tb[-1]), ranges[-1].copy())
+        if self.speed > self.v_max and self.aliasing == "error":
+            raise SceneError(self._aliasing_message())
+
+    def _aliasing_message(self) -> str:
+        return (
+            f"the fastest scatterer moves at {self.speed:.2f} m/s radially, beyond the "
+            f"unambiguous {self.v_max:.2f} m/s of PRF {self.prf:g} Hz: its Doppler aliases"
+        )
+
+    def warn_aliasing(self) -> None:
+        """Warn once when the record's fastest scatterer aliases."""
+        if self.speed > self.v_max:
+            warnings.warn(self._aliasing_message(), AliasingWarning, stacklevel=3)
+
+    def add(self, lo: int, gate: FloatArray, scat: Scatterers, rec: Received) -> None:
+        """Store one block's received data."""
+        hi = lo + gate.shape[0]
+        self.signal[lo:hi] = rec.signal
+        self.gate[lo:hi] = gate
+        self.names = scat.names
+        if self.keep:
+            self._blocks.append(scat)
+        if rec.range_time is not None:
+            first = (-lo) % self._rt_step
+            self._rt.append(np.asarray(rec.range_time[first :: self._rt_step]))
+            self._rt_axis = rec.range_axis
+        for key, value in rec.products.items():
+            self._products.setdefault(key, []).append(np.asarray(value))
+
+    def received(self) -> Received:
+        """The whole record's received data."""
+        if not self._rt:
+            return Received(
+                self.signal, products={k: np.concatenate(v) for k, v in self._products.items()}
+            )
+        rows = np.arange(0, self.n, self._rt_step, dtype=np.int64)
+        return Received(
+            self.signal,
+            np.concatenate(self._rt),
+            self._rt_axis,
+            {k: np.concatenate(v) for k, v in self._products.items()},
+            rows if self._rt_step > 1 else None,
+        )
+
+    def scatterers(self) -> Scatterers | None:
+        """Every pulse's scatterers (``processing.keep_scatterers``), else ``None``."""
+        if not self._blocks:
+            return None
+        first = self._blocks[0]
+        cat = [np.concatenate([getattr(b, f) for b in self._blocks]) for f in ("positions", "rcs")]
+        axes = None
+        if first.axes is not None:
+            axes = np.concatenate([b.axes for b in self._blocks if b.axes is not None])
+        return Scatterers(cat[0], cat[1], first.names, first.semi_axes, axes)
 
 
 def _gate(gate: str | float, at_pulses: Skeleton, radar_pos: FloatArray) -> FloatArray:
@@ -297,21 +471,3 @@ def _condition(body: Skeleton, cfg: ConditioningConfig) -> tuple[Skeleton, dict[
         return conditioning.condition(body, cfg)
     except ValueError as exc:
         raise SceneError(f"conditioning: {exc}") from None
-
-
-def _check_ranges(ranges: FloatArray, scat: Scatterers, t: FloatArray, min_range: float) -> None:
-    if not np.all(np.isfinite(ranges)):
-        raise SceneError("a scatterer position is not finite")
-    p, s = np.unravel_index(int(np.argmin(ranges)), ranges.shape)
-    if ranges[p, s] < min_range:
-        raise SceneError(
-            f"scatterer {scat.names[s]!r} comes within {ranges[p, s]:.3g} m of the radar at "
-            f"t = {t[p] - t[0]:.3f} s (scene.min_range = {min_range:g} m): the range equation "
-            "and far-field RCS do not hold there"
-        )
-
-
-def _max_radial_speed(ranges: FloatArray, prf: float) -> float:
-    if ranges.shape[0] < 2:
-        return 0.0
-    return float(np.max(np.abs(np.diff(ranges, axis=0))) * prf)

@@ -226,6 +226,23 @@ class ProcessingConfig(StrictModel):
     hop: int = Field(32, ge=1, description="STFT hop [pulses].")
     nfft: int = Field(1024, ge=2, description="FFT size (>= window_length).")
     floor_db: float = Field(-60.0, lt=0, description="Spectrogram floor, dB below its peak.")
+    precision: Literal["float32", "float64"] = Field(
+        "float32",
+        description="STFT arithmetic: float32 (complex64 FFTs and float32 power, the default: "
+        "the accuracy ladder measures its cost at under 0.001 dB) or float64.",
+    )
+    block_pulses: int = Field(
+        4096,
+        ge=16,
+        le=1_000_000,
+        description="Pulses per block of the streaming pipeline: the per-scatterer arrays exist "
+        "one block at a time, so memory is set by this, not by the record length.",
+    )
+    keep_scatterers: bool = Field(
+        False,
+        description="Keep every pulse's scatterer positions and RCS in the result (and write "
+        "their ranges and RCS to result.npz); memory then grows with the record.",
+    )
     aliasing: Literal["warn", "error"] = Field(
         "warn",
         description="When a scatterer's radial speed exceeds lambda*PRF/4: warn, or stop.",

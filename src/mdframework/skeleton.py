@@ -114,7 +114,7 @@ class Skeleton:
             )
         finite = np.isfinite(pos)
         if self.valid is None:
-            valid = np.all(finite, axis=2)
+            valid = finite[:, :, 0] & finite[:, :, 1] & finite[:, :, 2]
         else:
             valid = np.asarray(self.valid, dtype=bool)
             if valid.shape != pos.shape[:2]:
@@ -172,6 +172,12 @@ class Skeleton:
                 f"of a {self.duration:.3f} s recording"
             )
         return Skeleton(self.time[keep], self.positions[keep], self.joint_names, self.valid[keep])
+
+    def select_frames(self, frames: slice) -> Skeleton:
+        """The frames ``frames`` (a slice of frame indices)."""
+        return Skeleton(
+            self.time[frames], self.positions[frames], self.joint_names, self.valid[frames]
+        )
 
     def renamed(self, names: Sequence[str]) -> Skeleton:
         """Same data with new joint names (same count and order)."""

@@ -23,11 +23,14 @@ from .interfaces import (
     Motion,
     MotionSource,
     Plugin,
+    PulseBlock,
     RadarRecordingSource,
     RadarWaveform,
     Recording,
     ScattererModel,
     Scatterers,
+    SceneContext,
+    receive_points,
 )
 from .physics import radar
 from .plugins import INTERFACES
@@ -90,7 +93,7 @@ def check_waveform(waveform: RadarWaveform) -> None:
     t = np.arange(n) / prf
     v = 0.25 * radar.max_unambiguous_velocity(fc, prf)  # approaching, well inside the limit
     ranges = (50.0 - v * t)[:, None]
-    received = waveform.receive(ranges, np.ones_like(ranges), ranges[:, 0])
+    received = receive_points(waveform, ranges, np.ones_like(ranges), ranges[:, 0], times=t)
     y = received.signal
     assert y.shape == (n,) and np.iscomplexobj(y), "signal must be (n_pulses,) complex"
     assert np.all(np.isfinite(y))
@@ -106,6 +109,67 @@ def check_effect_class(cls: type[Effect]) -> None:
     check_plugin_class(cls, "effect")
     assert getattr(cls, "stage", None) in ("scatterers", "received"), (
         f"{cls.__name__}.stage must be 'scatterers' or 'received'"
+    )
+
+
+def check_block_invariance(
+    model: ScattererModel,
+    waveform: RadarWaveform,
+    skeleton: Skeleton,
+    motion: Motion,
+    effects: tuple[Effect, ...] = (),
+    block: int = 37,
+) -> None:
+    """The streaming contract: scatterers, scatterer-stage ``effects`` and ``receive`` give the
+    same result for a record processed as one block and as blocks of ``block`` pulses
+    (``skeleton``: the body at the pulse times, in the scene frame)."""
+    radar_position = np.array([10.0, 0.0, 1.0])
+    lam = float(radar.wavelength(waveform.carrier_frequency))
+    t = skeleton.time
+    span = np.linalg.norm(skeleton.positions - radar_position, axis=-1)
+
+    def run(size: int) -> tuple[np.ndarray, np.ndarray]:
+        model.start_record(skeleton)
+        waveform.start_record(t, (float(span.min()), float(span.max())))
+        rcs_parts, signal_parts = [], []
+        step = max(waveform.block_multiple, size - size % waveform.block_multiple)
+        for lo in range(0, t.shape[0], step):
+            sk = skeleton.select_frames(slice(lo, lo + step))
+            scat = model.scatterers(motion, sk, radar_position, lam)
+            gate = np.linalg.norm(sk.positions[:, 0, :] - radar_position, axis=-1)
+            rng = np.random.default_rng(0)
+            ctx = SceneContext(
+                radar_position,
+                waveform.prf,
+                waveform.carrier_frequency,
+                sk.time,
+                gate,
+                sk,
+                waveform,
+                rng,
+                lo,
+            )
+            for effect in effects:
+                if effect.stage == "scatterers":
+                    scat = effect.apply(scat, ctx)
+                    assert isinstance(scat, Scatterers), (
+                        f"effect {effect.name!r}: apply must return Scatterers"
+                    )
+            ranges = scat.ranges(radar_position)
+            rec = waveform.receive(PulseBlock(lo, sk.time, scat, ranges, gate, radar_position))
+            rcs_parts.append(scat.rcs)
+            signal_parts.append(rec.signal)
+        return np.concatenate(rcs_parts), np.concatenate(signal_parts)
+
+    rcs_one, sig_one = run(t.shape[0])
+    rcs_many, sig_many = run(block)
+    assert np.allclose(rcs_one, rcs_many, rtol=1e-12, atol=0), (
+        "scatterer RCS differs between one block and many: the model or an effect is not "
+        "block-invariant (take record-wide quantities in start_record)"
+    )
+    scale = float(np.max(np.abs(sig_one))) or 1.0
+    assert np.max(np.abs(sig_one - sig_many)) <= 1e-9 * scale, (
+        "received signal differs between one block and many: the waveform is not block-invariant"
     )
 
 

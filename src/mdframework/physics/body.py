@@ -14,6 +14,7 @@ In both, the head can be a sphere of radius 0.1 m (the paper) or Chen's spheroid
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Literal
 
@@ -181,27 +182,43 @@ def part_semi_axes(parts: tuple[BodyPart, ...], height: float) -> tuple[FloatArr
     return a, c
 
 
-def part_geometry(parts: tuple[BodyPart, ...], joints: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Positions and axis vectors of the parts from canonical joints.
-
-    ``joints`` (n_pulses, 17, 3) [m]. Returns ``positions`` and ``axes``, both
-    (n_pulses, n_parts, 3) [m]; axes are not normalised and may be zero for coincident joints.
-    """
+@functools.cache
+def _part_index(
+    parts: tuple[BodyPart, ...],
+) -> tuple[NDArray[np.intp], FloatArray, list[int], list[int], bool]:
+    """Joint indices and weights of the parts' positions, their axes' tail and tip joints, and
+    whether the positions are exactly the 17 joints in order."""
     n_terms = max(len(p.position) for p in parts)
     index = np.zeros((n_terms, len(parts)), dtype=np.intp)
     weight = np.zeros((n_terms, len(parts)))
     for i, p in enumerate(parts):
         for k, (joint, w) in enumerate(p.position):
             index[k, i], weight[k, i] = _J[joint], w
+    identity = n_terms == 1 and bool(np.all(weight[0] == 1.0))
+    identity = identity and index[0].tolist() == list(range(len(CANONICAL_JOINTS)))
+    tail = [_J[p.axis[0]] for p in parts]
+    tip = [_J[p.axis[1]] for p in parts]
+    return index, weight, tail, tip, identity
+
+
+def part_geometry(parts: tuple[BodyPart, ...], joints: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Positions and axis vectors of the parts from canonical joints.
+
+    ``joints`` (n_pulses, 17, 3) [m]. Returns ``positions`` and ``axes``, both
+    (n_pulses, n_parts, 3) [m]; axes are not normalised and may be zero for coincident joints.
+    Positions may share memory with ``joints`` (when the parts are the joints themselves).
+    """
+    index, weight, tail, tip, identity = _part_index(parts)
+    axes = np.take(joints, tip, axis=1)
+    axes -= np.take(joints, tail, axis=1)
+    if identity:
+        return joints, axes
+    n_terms = index.shape[0]
     positions = np.take(joints, index[0], axis=1)
     if not np.all(weight[0] == 1.0):
         positions *= weight[0][None, :, None]
     for k in range(1, n_terms):
         positions += weight[k][None, :, None] * np.take(joints, index[k], axis=1)
-    tail = [_J[p.axis[0]] for p in parts]
-    tip = [_J[p.axis[1]] for p in parts]
-    axes = np.take(joints, tip, axis=1)
-    axes -= np.take(joints, tail, axis=1)
     return positions, axes
 
 

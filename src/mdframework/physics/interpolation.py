@@ -7,7 +7,7 @@ are dropped per joint and the spline bridges the gap.
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -26,6 +26,92 @@ def pulse_times(t_first: float, t_last: float, prf: float) -> FloatArray:
     return t_first + np.arange(n, dtype=np.float64) / prf
 
 
+#: Frames kept beyond each end of a record window when only the window is resampled. A cubic
+#: spline's end condition decays by a factor 2 - sqrt(3) ~ 0.27 per knot, so 16 knots put the
+#: recording's own window edges ~1e-9 of their effect away from the record.
+WINDOW_MARGIN_FRAMES = 16
+
+
+def window_frames(
+    time: FloatArray, t_first: float, t_last: float, margin: int = WINDOW_MARGIN_FRAMES
+) -> slice:
+    """The frames of a recording (``time`` (n_frames,) [s]) that resampling a record from
+    ``t_first`` to ``t_last`` [s] needs: those inside, plus ``margin`` frames on either side."""
+    lo = int(np.searchsorted(time, t_first, side="right")) - 1 - margin
+    hi = int(np.searchsorted(time, t_last, side="left")) + 1 + margin
+    return slice(max(lo, 0), min(hi, time.shape[0]))
+
+
+class TrackResampler:
+    """Joint tracks of a recording, interpolated at any times within it; the interpolants are
+    built once, so a record can be evaluated block by block.
+
+    ``time`` (n_frames,) [s] strictly increasing; ``positions`` (n_frames, n_joints, 3) [m];
+    ``valid`` (n_frames, n_joints) bool: untracked frames are dropped per joint and the
+    interpolant bridges the gap. ``method``: cubic (C2 spline; natural ends below 4 frames),
+    pchip, akima (modified Akima) or linear.
+    """
+
+    def __init__(
+        self, time: FloatArray, positions: FloatArray, valid: BoolArray, method: Method = "cubic"
+    ) -> None:
+        if method not in ("cubic", "pchip", "akima", "linear"):
+            raise ValueError(f"unknown interpolation method {method!r}")
+        self.n_joints = int(positions.shape[1])
+        self.method = method
+        #: (joints, time, values (n_frames, n_sel * 3)), one group when every frame is valid
+        self._groups: list[tuple[NDArray[np.intp], FloatArray, Any]] = []
+        if np.all(valid):
+            self._add(np.arange(self.n_joints), time, positions)
+            return
+        for j in range(self.n_joints):
+            ok = valid[:, j]
+            if ok.sum() < 2:
+                raise ValueError(f"joint {j} has fewer than two valid frames")
+            self._add(np.array([j]), time[ok], positions[ok][:, [j], :])
+
+    def _add(self, joints: NDArray[np.intp], t: FloatArray, y: FloatArray) -> None:
+        flat = np.ascontiguousarray(y.reshape(y.shape[0], -1), dtype=np.float64)
+        if self.method == "linear":
+            self._groups.append((joints, t, flat))
+            return
+        from scipy.interpolate import Akima1DInterpolator, CubicSpline, PchipInterpolator
+
+        if self.method == "cubic":
+            bc = "natural" if t.shape[0] < 4 else "not-a-knot"
+            f: Any = CubicSpline(t, flat, axis=0, bc_type=bc)
+        elif self.method == "pchip":
+            f = PchipInterpolator(t, flat, axis=0)
+        else:
+            f = Akima1DInterpolator(t, flat, axis=0, method="makima")
+        self._groups.append((joints, t, f))
+
+    def __call__(self, t_out: FloatArray) -> FloatArray:
+        """Positions (n_out, n_joints, 3) float64 [m] at ``t_out`` (n_out,) [s], which must lie
+        within every joint's first and last valid frame (never extrapolated)."""
+        t_out = np.asarray(t_out, dtype=np.float64)
+        n = t_out.shape[0]
+        out = np.empty((n, self.n_joints, 3), dtype=np.float64)
+        for joints, t, f in self._groups:
+            if t_out.size and (t_out[0] < t[0] - 1e-12 or t_out[-1] > t[-1] + 1e-12):
+                who = "" if joints.size > 1 else f"joint {int(joints[0])} is valid only "
+                raise ValueError(
+                    f"output times {t_out[0]:.4f}..{t_out[-1]:.4f} s leave the recording; "
+                    f"{who}from {t[0]:.4f} to {t[-1]:.4f} s; interpolation never extrapolates"
+                )
+            tq = t_out
+            if n and (t_out[0] < t[0] or t_out[-1] > t[-1]):  # within the 1e-12 s tolerance
+                tq = np.clip(t_out, t[0], t[-1])
+            if self.method == "linear":
+                vals = np.stack([np.interp(tq, t, f[:, k]) for k in range(f.shape[1])], axis=1)
+            else:
+                vals = f(tq)
+            if len(self._groups) == 1:
+                return np.asarray(vals, dtype=np.float64).reshape(n, self.n_joints, 3)
+            out[:, joints, :] = vals.reshape(n, joints.size, 3)
+        return out
+
+
 def resample_tracks(
     time: FloatArray,
     positions: FloatArray,
@@ -33,48 +119,10 @@ def resample_tracks(
     t_out: FloatArray,
     method: Method = "cubic",
 ) -> FloatArray:
-    """Interpolate joint tracks to new times.
+    """Interpolate joint tracks to new times (a one-off :class:`TrackResampler`).
 
     ``time`` (n_frames,) [s] strictly increasing; ``positions`` (n_frames, n_joints, 3) [m];
     ``valid`` (n_frames, n_joints); ``t_out`` (n_out,) [s] within every joint's first and last
     valid frame. Returns (n_out, n_joints, 3) float64 [m].
     """
-    if method not in ("cubic", "pchip", "akima", "linear"):
-        raise ValueError(f"unknown interpolation method {method!r}")
-    out = np.empty((t_out.shape[0], positions.shape[1], 3), dtype=np.float64)
-    if np.all(valid):
-        return _interp(time, positions, t_out, method)
-    for j in range(positions.shape[1]):
-        ok = valid[:, j]
-        if ok.sum() < 2:
-            raise ValueError(f"joint {j} has fewer than two valid frames")
-        tj = time[ok]
-        if t_out[0] < tj[0] - 1e-12 or t_out[-1] > tj[-1] + 1e-12:
-            raise ValueError(
-                f"joint {j} is valid only from {tj[0]:.4f} to {tj[-1]:.4f} s; "
-                "interpolation never extrapolates"
-            )
-        out[:, j, :] = _interp(tj, positions[ok, j, :], t_out, method)
-    return out
-
-
-def _interp(t: FloatArray, y: FloatArray, t_out: FloatArray, method: Method) -> FloatArray:
-    if t_out[0] < t[0] - 1e-12 or t_out[-1] > t[-1] + 1e-12:
-        raise ValueError(
-            f"output times {t_out[0]:.4f}..{t_out[-1]:.4f} s leave the recording "
-            f"{t[0]:.4f}..{t[-1]:.4f} s; interpolation never extrapolates"
-        )
-    tq = np.clip(t_out, t[0], t[-1])
-    from scipy.interpolate import Akima1DInterpolator, CubicSpline, PchipInterpolator
-
-    if method == "linear":
-        flat = y.reshape(y.shape[0], -1)
-        res = np.stack([np.interp(tq, t, flat[:, k]) for k in range(flat.shape[1])], axis=1)
-        return res.reshape((tq.shape[0], *y.shape[1:]))
-    if method == "cubic":
-        if t.shape[0] < 4:
-            return np.asarray(CubicSpline(t, y, axis=0, bc_type="natural")(tq), np.float64)
-        return np.asarray(CubicSpline(t, y, axis=0)(tq), dtype=np.float64)
-    if method == "pchip":
-        return np.asarray(PchipInterpolator(t, y, axis=0)(tq), dtype=np.float64)
-    return np.asarray(Akima1DInterpolator(t, y, axis=0, method="makima")(tq), np.float64)
+    return TrackResampler(time, positions, valid, method)(t_out)

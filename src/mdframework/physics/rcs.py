@@ -70,21 +70,33 @@ def ellipsoid_rcs_angles(
 
 
 def spheroid_rcs(
-    a: ArrayLike, c: ArrayLike, axis: FloatArray, line_of_sight: FloatArray
+    a: ArrayLike,
+    c: ArrayLike,
+    axis: FloatArray,
+    line_of_sight: FloatArray,
+    axis_norm2: FloatArray | None = None,
+    los_norm2: FloatArray | None = None,
 ) -> FloatArray:
     """RCS of a prolate/oblate spheroid (``a = b``) whose symmetry axis is ``axis`` (..., 3),
     seen along ``line_of_sight`` (..., 3) (part -> radar). Neither vector needs unit length but
     the aspect uses ``cos^2 theta = (A.B)^2/(|A|^2 |B|^2)`` and ``sin^2 = 1 - cos^2`` (no
     arccos, no azimuth: it does not matter when ``a = b``). Where either vector is zero the aspect
     is undefined and broadside is used, so the result is always finite; callers that can have
-    zero axes should hold the last valid orientation instead."""
-    dot = _dot(axis, line_of_sight)
-    n2 = _dot(axis, axis) * _dot(line_of_sight, line_of_sight)
-    cos2 = np.clip(np.divide(dot * dot, n2, out=np.zeros_like(n2), where=n2 > 0), 0.0, 1.0)
+    zero axes should hold the last valid orientation instead. ``axis_norm2`` and ``los_norm2``:
+    ``|axis|^2`` and ``|line_of_sight|^2`` when the caller has them already."""
+    dot = np.asarray(_dot(axis, line_of_sight), dtype=np.float64)
+    dot *= dot
+    n2 = np.asarray(_dot(axis, axis) if axis_norm2 is None else axis_norm2.copy(), np.float64)
+    n2 *= _dot(line_of_sight, line_of_sight) if los_norm2 is None else los_norm2
+    cos2 = np.divide(dot, n2, out=dot, where=n2 > 0)
+    cos2[~(n2 > 0)] = 0.0
+    np.clip(cos2, 0.0, 1.0, out=cos2)
     a2 = np.asarray(a, dtype=np.float64) ** 2
     c2 = np.asarray(c, dtype=np.float64) ** 2
-    h2 = a2 * (1.0 - cos2) + c2 * cos2
-    return np.asarray(np.pi * a2 * a2 * c2 / (h2 * h2), dtype=np.float64)
+    h2 = np.asarray(cos2 * (c2 - a2), dtype=np.float64)  # a^2 sin^2 + c^2 cos^2, less a^2
+    h2 += a2
+    h2 *= h2
+    return np.asarray(np.divide(np.pi * a2 * a2 * c2, h2, out=h2), dtype=np.float64)
 
 
 def _dot(x: FloatArray, y: FloatArray) -> FloatArray:

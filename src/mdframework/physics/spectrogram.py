@@ -7,8 +7,10 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any, Literal
 
 import numpy as np
+import scipy.fft as sfft
 from numpy.typing import NDArray
 from scipy.signal import get_window
 
@@ -22,11 +24,12 @@ class RecordTooShortError(ValueError):
 
 @dataclass(frozen=True)
 class Spectrogram:
-    """``power`` (n_doppler, n_frames) float64 [W-like, |signal|^2 units];
+    """``power`` (n_doppler, n_frames) float32 (float64 with ``precision = "float64"``)
+    [W-like, |signal|^2 units];
     ``doppler`` (n_doppler,) [Hz], ascending; ``time`` (n_frames,) [s], window centres relative
     to the first sample."""
 
-    power: FloatArray
+    power: NDArray[np.floating[Any]]
     doppler: FloatArray
     time: FloatArray
 
@@ -39,6 +42,7 @@ def spectrogram(
     window_length: int = 256,
     hop: int = 32,
     nfft: int | None = None,
+    precision: Literal["float32", "float64"] = "float32",
 ) -> Spectrogram:
     """STFT power of a complex signal (n_samples,).
 
@@ -46,6 +50,9 @@ def spectrogram(
     ``window_length`` (default: the window length). Frame ``m`` covers samples
     ``mH .. mH + L - 1`` and its time is their midpoint ``(mH + (L - 1)/2) / fs``. A record shorter
     than one window raises :class:`RecordTooShortError`; the resolution never changes silently.
+    ``precision``: ``float32`` (complex64 FFTs, float32 power; the accuracy ladder in
+    ``docs/accuracy.md`` measures its cost) or ``float64``. Frames are transformed a few
+    thousand at a time, so the only record-sized array is the power itself.
     """
     y = np.asarray(signal)
     n = y.shape[0]
@@ -59,28 +66,54 @@ def spectrogram(
             f"the record has {n} samples ({n / sample_rate:.4f} s) but the STFT window needs "
             f"{window_length}: use a longer record or a shorter window"
         )
+    n_frames = 1 + (n - window_length) // hop
+    real, cplx = (
+        (np.float32, np.complex64) if precision == "float32" else (np.float64, np.complex128)
+    )
     w = get_window(window, window_length, fftbins=True).astype(np.float64)
-    frames = np.lib.stride_tricks.sliding_window_view(y, window_length)[::hop]
-    spec = np.fft.fftshift(np.fft.fft(frames * w, n=nfft, axis=1), axes=1)
-    power = (spec.real**2 + spec.imag**2).T
+    if nfft % 2 == 0:
+        # (-1)^m moves bin k to frequency (k - N/2) PRF/N: ascending bins without fftshift
+        w = w * np.where(np.arange(window_length) % 2 == 0, 1.0, -1.0)
+    weights = w.astype(real)
+    frames = np.lib.stride_tricks.sliding_window_view(y.astype(cplx, copy=False), window_length)
+    frames = frames[::hop]
+    # (n_frames, nfft) C-ordered; returned transposed: (n_doppler, n_frames) without a copy
+    power = np.empty((n_frames, nfft), dtype=real)
+    chunk = min(n_frames, max(1, (1 << 20) // nfft))  # frames per FFT call: a few MiB
+    buf = np.zeros((chunk, nfft), dtype=cplx)  # zero-padded beyond the window
+    for lo in range(0, n_frames, chunk):
+        hi = min(lo + chunk, n_frames)
+        m = hi - lo
+        np.multiply(frames[lo:hi], weights, out=buf[:m, :window_length])
+        spec = sfft.fft(buf[:m], axis=1)
+        if nfft % 2:
+            spec = sfft.fftshift(spec, axes=1)
+        np.square(spec.real, out=power[lo:hi])
+        power[lo:hi] += np.square(spec.imag)
     doppler = np.arange(-(nfft // 2), nfft - nfft // 2, dtype=np.float64) * sample_rate / nfft
     time = np.asarray(
-        (np.arange(frames.shape[0]) * hop + (window_length - 1) / 2.0) / sample_rate, np.float64
+        (np.arange(n_frames) * hop + (window_length - 1) / 2.0) / sample_rate, np.float64
     )
-    return Spectrogram(np.ascontiguousarray(power), doppler, time)
+    return Spectrogram(power.T, doppler, time)
 
 
-def power_to_db(power: FloatArray, floor_db: float = -60.0) -> FloatArray:
-    """``10 log10(P / P_max)`` clipped below at ``floor_db`` (< 0): never -inf or NaN.
+def power_to_db(power: NDArray[np.floating[Any]], floor_db: float = -60.0) -> NDArray[Any]:
+    """``10 log10(P / P_max)`` clipped below at ``floor_db`` (< 0): never -inf or NaN. The
+    result has the input's precision (float32 or float64; other types become float64).
 
     An all-zero input gives ``floor_db`` everywhere (there is no peak to refer to)."""
     if floor_db >= 0:
         raise ValueError("floor_db must be negative")
-    p = np.asarray(power, dtype=np.float64)
+    p = np.asarray(power)
+    if p.dtype not in (np.float32, np.float64):
+        p = p.astype(np.float64)
     p_max = float(np.max(p)) if p.size else 0.0
     if not np.isfinite(p_max):
         raise ValueError("the power has non-finite values")
     if p_max <= 0.0:
-        return np.full(p.shape, float(floor_db))
-    floor = p_max * 10.0 ** (floor_db / 10.0)
-    return np.asarray(10.0 * np.log10(np.maximum(p, floor) / p_max), dtype=np.float64)
+        return np.full(p.shape, float(floor_db), dtype=p.dtype)
+    out = np.maximum(p, p.dtype.type(p_max * 10.0 ** (floor_db / 10.0)))
+    out *= p.dtype.type(1.0 / p_max)
+    np.log10(out, out=out)
+    out *= p.dtype.type(10.0)
+    return np.asarray(out)

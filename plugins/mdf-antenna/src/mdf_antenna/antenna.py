@@ -38,7 +38,7 @@ from numpy.typing import NDArray
 from pydantic import Field, model_validator
 from scipy.optimize import brentq
 
-from mdframework import Effect, PluginConfig, Scatterers, SceneContext
+from mdframework import Effect, PluginConfig, Scatterers, SceneContext, Skeleton
 
 FloatArray = NDArray[np.float64]
 
@@ -147,6 +147,15 @@ class AntennaPattern(Effect):
     def __init__(self, config: PluginConfig) -> None:
         super().__init__(config)
         self._stats: dict[str, Any] = {}
+        self._mean: FloatArray | None = None
+        self._min_gain = 1.0
+
+    def start_record(self, body: Skeleton, radar_position: FloatArray) -> None:
+        """The fixed boresight's aim: the record's mean reference point (``base`` or joint 0)."""
+        ref = body.index("base") if "base" in body.joint_names else 0
+        track = body.positions[:, ref, :][body.valid[:, ref]]
+        self._mean = np.asarray(np.mean(track, axis=0), dtype=np.float64) if track.size else None
+        self._min_gain = 1.0
 
     def boresight(self, context: SceneContext) -> FloatArray:
         """Boresight vector(s): (3,) or (n_pulses, 1, 3) when tracking."""
@@ -155,10 +164,10 @@ class AntennaPattern(Effect):
         if c.pointing == "angles":
             az, el = np.deg2rad(c.azimuth_deg), np.deg2rad(c.elevation_deg)
             return np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
-        track = reference_track(context) - radar
         if c.steering == "track":
-            return track[:, None, :]
-        return np.asarray(np.mean(track, axis=0), dtype=np.float64)
+            return (reference_track(context) - radar)[:, None, :]
+        mean = self._mean if self._mean is not None else np.mean(reference_track(context), axis=0)
+        return np.asarray(mean - radar, dtype=np.float64)
 
     def apply(self, data: Scatterers, context: SceneContext) -> Scatterers:
         """Scatterers with RCS times the two-way gain."""
@@ -169,11 +178,14 @@ class AntennaPattern(Effect):
         d = data.positions - np.asarray(context.radar_position, dtype=np.float64)
         g = one_way_gain(d, boresight, pattern=c.pattern, beamwidth_az=bw_az, beamwidth_el=bw_el)
         b = np.asarray(boresight).reshape(-1, 3)[0]
-        self._stats = {
-            "boresight_azimuth_deg": float(np.degrees(np.arctan2(b[1], b[0]))),
-            "boresight_elevation_deg": float(np.degrees(np.arcsin(b[2] / np.linalg.norm(b)))),
-            "min_two_way_gain_db": float(10 * np.log10(max(float(np.min(g)) ** 2, 1e-300))),
-        }
+        if context.block_start == 0 or not self._stats:
+            self._min_gain = 1.0
+            self._stats = {
+                "boresight_azimuth_deg": float(np.degrees(np.arctan2(b[1], b[0]))),
+                "boresight_elevation_deg": float(np.degrees(np.arcsin(b[2] / np.linalg.norm(b)))),
+            }
+        self._min_gain = min(self._min_gain, float(np.min(g)) if g.size else 1.0)
+        self._stats["min_two_way_gain_db"] = float(10 * np.log10(max(self._min_gain**2, 1e-300)))
         return data.replace(rcs=data.rcs * g * g)
 
     def describe(self) -> dict[str, Any]:

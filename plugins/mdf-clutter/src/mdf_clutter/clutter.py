@@ -35,13 +35,14 @@ The clutter is added to ``Received.signal``; a range-time map, if any, is passed
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field
 
-from mdframework import Effect, PluginConfig, Received, SceneContext, SceneError
+from mdframework import Effect, PluginConfig, Received, SceneContext, SceneError, receive_points
 from mdframework.constants import SPEED_OF_LIGHT
 from mdframework.physics import radar
 
@@ -138,7 +139,14 @@ class GroundClutter(Effect):
         n_p = gate.shape[0]
         resp = np.empty((n_patch, n_p), dtype=np.complex128)
         for k, r_k in enumerate(ranges):
-            out = context.waveform.receive(np.full((n_p, 1), r_k), np.ones((n_p, 1)), gate)
+            out = receive_points(
+                context.waveform,
+                np.full((n_p, 1), r_k),
+                np.ones((n_p, 1)),
+                gate,
+                context.radar_position,
+                context.pulse_times,
+            )
             resp[k] = out.signal
         return ranges, resp
 
@@ -171,7 +179,7 @@ class GroundClutter(Effect):
             "clutter_power_w": p_c,
             "spread_hz": spread_hz,
         }
-        return Received(data.signal + clutter, data.range_time, data.range_axis)
+        return dataclasses.replace(data, signal=data.signal + clutter)
 
     def describe(self) -> dict[str, Any]:
         """The config plus the patches' extent and the clutter power [W]."""

@@ -27,7 +27,8 @@ import numpy as np
 from pydantic import Field
 
 from mdframework import Motion, PluginConfig, ScattererModel, Scatterers, Skeleton
-from mdframework.physics import body, rcs
+from mdframework.physics import body as bodymodel
+from mdframework.physics import rcs
 
 #: Segments shorter than this fraction of their nominal length have no usable orientation
 #: (coincident joints, and the spline's small ringing around such a collapse).
@@ -64,6 +65,12 @@ class EllipsoidConfig(PluginConfig):
     )
 
 
+def _usable(axes: np.ndarray, semi_c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(n, n_parts) bool: segments long enough to give an orientation; and their |axis|^2."""
+    length2 = axes[..., 0] ** 2 + axes[..., 1] ** 2 + axes[..., 2] ** 2
+    return np.asarray(length2 > (MIN_SEGMENT_FRACTION * 2.0 * semi_c) ** 2), length2
+
+
 def hold_last_valid(axes: np.ndarray, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Replace invalid rows of ``axes`` (n_pulses, n_parts, 3) by the last valid one (or the
     first valid one before any). Returns the filled axes and a (n_parts,) mask of parts that are
@@ -86,15 +93,27 @@ def fibonacci_sphere(n: int) -> np.ndarray:
     return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
 
 
-def segment_frames(axes: np.ndarray) -> np.ndarray:
+def _unit_axes(axes: np.ndarray) -> np.ndarray:
+    n = np.linalg.norm(axes, axis=-1, keepdims=True)
+    return np.where(n > 0, axes / np.where(n > 0, n, 1.0), np.array([0.0, 0.0, 1.0]))
+
+
+def helper_directions(axes: np.ndarray) -> np.ndarray:
+    """(n_parts, 3): per part, the world axis least aligned with its segment at any frame of
+    ``axes`` (n_frames, n_parts, 3); it fixes the roll of :func:`segment_frames`."""
+    worst = np.max(np.abs(_unit_axes(axes)), axis=0)
+    return np.asarray(np.eye(3)[np.argmin(worst, axis=-1)])
+
+
+def segment_frames(axes: np.ndarray, helper: np.ndarray | None = None) -> np.ndarray:
     """Rotations (n_pulses, n_parts, 3, 3) whose third column is the unit ``axes`` (n_pulses,
     n_parts, 3). The roll about the axis is fixed by one helper direction per part over the
-    whole record (the world axis least aligned with the segment at any pulse), so the frame
-    turns smoothly with the segment and surface points do not jump between pulses."""
-    n = np.linalg.norm(axes, axis=-1, keepdims=True)
-    z = np.where(n > 0, axes / np.where(n > 0, n, 1.0), np.array([0.0, 0.0, 1.0]))
-    worst = np.max(np.abs(z), axis=0)
-    helper = np.eye(3)[np.argmin(worst, axis=-1)][None, :, :]
+    whole record (``helper`` (n_parts, 3), default :func:`helper_directions` of ``axes``), so
+    the frame turns smoothly with the segment and surface points do not jump between pulses."""
+    z = _unit_axes(axes)
+    if helper is None:
+        helper = helper_directions(axes)
+    helper = helper[None, :, :]
     x = helper - np.sum(helper * z, -1, keepdims=True) * z
     x /= np.linalg.norm(x, axis=-1, keepdims=True)
     return np.stack([x, np.cross(z, x), z], axis=-1)
@@ -108,11 +127,12 @@ def surface_scatterers(
     sigma: np.ndarray,
     radar_position: np.ndarray,
     n_points: int,
+    helper: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Surface points (n_pulses, n_parts * n_points, 3) [m] and their RCS (n_pulses,
     n_parts * n_points) [m^2] (see the module docstring), part-major order."""
     s = fibonacci_sphere(n_points)
-    rot = segment_frames(axes)
+    rot = segment_frames(axes, helper)
     scale = np.stack([a, a, semi_c], axis=1)
     local = s[None, :, :] * scale[:, None, :]
     pts = pos[:, :, None, :] + np.einsum("psij,sqj->psqi", rot, local)
@@ -133,23 +153,43 @@ class EllipsoidBody(ScattererModel):
     Config = EllipsoidConfig
     config: EllipsoidConfig
 
+    def start_record(self, body: Skeleton) -> None:
+        """Record-wide quantities, so that any cut into blocks gives the same scatterers: the
+        body height (unless configured) from the record's joints (n_frames, 17, 3), and each
+        part's first usable orientation (held over untracked pulses before it)."""
+        c = self.config
+        self._parts = bodymodel.body_parts(c.placement, c.head)
+        height = c.height if c.height is not None else bodymodel.estimate_height(body.positions)
+        self._a, self._semi_c = bodymodel.part_semi_axes(self._parts, height)
+        _, axes = bodymodel.part_geometry(self._parts, body.positions)
+        ok, _ = _usable(axes, self._semi_c)
+        self._carry = axes[np.argmax(ok, axis=0), np.arange(axes.shape[1])]
+        self._never = ~np.any(ok, axis=0)
+        self._helper = helper_directions(axes)
+
     def scatterers(
         self, motion: Motion, skeleton: Skeleton, radar_position: np.ndarray, wavelength: float
     ) -> Scatterers:
-        """Positions and RCS of every body part at every pulse."""
+        """Positions and RCS of every body part at every pulse of a block."""
         c = self.config
-        parts = body.body_parts(c.placement, c.head)
-        joints = skeleton.positions
-        height = c.height if c.height is not None else body.estimate_height(joints)
-        a, semi_c = body.part_semi_axes(parts, height)
-        pos, axes = body.part_geometry(parts, joints)
-        length2 = axes[..., 0] ** 2 + axes[..., 1] ** 2 + axes[..., 2] ** 2
-        ok = length2 > (MIN_SEGMENT_FRACTION * 2.0 * semi_c) ** 2
+        if not hasattr(self, "_carry"):  # used without a record (a one-off block)
+            self.start_record(skeleton)
+        parts, a, semi_c = self._parts, self._a, self._semi_c
+        pos, axes = bodymodel.part_geometry(parts, skeleton.positions)
+        ok, norm2 = _usable(axes, semi_c)
         if not np.all(ok):
-            axes, never = hold_last_valid(axes, ok)
-            semi_c = np.where(never, a, semi_c)
+            ext = np.concatenate((self._carry[None], axes))
+            ok_ext = np.concatenate((~self._never[None], ok))
+            filled, _ = hold_last_valid(ext, ok_ext)
+            axes = filled[1:]
+            semi_c = np.where(self._never, a, semi_c)
+            _, norm2 = _usable(axes, semi_c)
+        self._carry = axes[-1].copy()
         los = np.asarray(radar_position, dtype=np.float64) - pos
-        sigma = rcs.spheroid_rcs(a, semi_c, axes, los)
+        los2 = los[..., 0] ** 2
+        los2 += los[..., 1] ** 2
+        los2 += los[..., 2] ** 2
+        sigma = rcs.spheroid_rcs(a, semi_c, axes, los, norm2, los2)
         spheres = np.array([p.sphere for p in parts])
         if np.any(spheres):
             if c.sphere_rcs == "mie":
@@ -160,7 +200,11 @@ class EllipsoidBody(ScattererModel):
         names = tuple(p.name for p in parts)
         if c.surface_points > 0:
             n = c.surface_points
-            pts, sig = surface_scatterers(pos, axes, a, semi_c, sigma, radar_position, n)
+            pts, sig = surface_scatterers(
+                pos, axes, a, semi_c, sigma, radar_position, n, self._helper
+            )
             return Scatterers(pts, sig, tuple(f"{m}#{j}" for m in names for j in range(n)))
         semi_axes = np.stack([a, a, semi_c], axis=1)
-        return Scatterers(pos, sigma, tuple(p.name for p in parts), semi_axes, axes)
+        key = tuple(float(v) for v in radar_position)
+        cache = (key, np.sqrt(los2, out=los2))
+        return Scatterers(pos, sigma, names, semi_axes, axes, cache)  # type: ignore[arg-type]

@@ -10,11 +10,12 @@ Two receive paths:
 Both are normalised by the pulse width, so a lone scatterer at the gate gives its range-equation
 amplitude.
 
-``precision = "float32"`` (analytic path only; for the accuracy ladder, ``benchmarks/
-bench_accuracy.py``): the carrier phase is still reduced to a fraction of a cycle in float64 from
-float64 ranges (``physics.md`` section 6.1), then the phasor, the gate weights, the amplitudes and
-the sum over scatterers are float32 / complex64; the result is returned as complex128. The
-default ``float64`` is the reference.
+``precision`` (analytic path; the raw path always computes in float64): the carrier phase is
+always reduced to a fraction of a cycle in float64 from float64 ranges (large ranges keep their
+Doppler), then the phasor, the gate weights, the range-equation amplitudes and the sum over
+scatterers are computed in ``float32`` (the default: the accuracy ladder in ``docs/accuracy.md``
+measures its cost in the spectrogram at under 0.001 dB) or ``float64`` (the reference); the
+result is returned as complex128.
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from mdframework import RadarWaveform, Received
+from mdframework import PulseBlock, RadarWaveform, Received
 from mdframework.constants import SPEED_OF_LIGHT
 from mdframework.physics import radar
 from mdframework.settings import RadarPowerConfig
@@ -50,9 +51,10 @@ class LfmConfig(RadarPowerConfig):
         "response, its sinc limit, or none).",
     )
     precision: Literal["float64", "float32"] = Field(
-        "float64",
+        "float32",
         description="Analytic path: arithmetic after the float64 phase reduction (float32: "
-        "complex64 phasors and sums).",
+        "float32 amplitudes, weights and phasors; float64: the reference). The raw path is "
+        "float64.",
     )
     sample_rate: float | None = Field(
         None, gt=0, description="Raw path: fast-time sample rate [Hz]; default 2 x bandwidth."
@@ -65,8 +67,6 @@ class LfmConfig(RadarPowerConfig):
     def _check(self) -> LfmConfig:
         if self.bandwidth * self.pulse_width < 1.0:
             raise ValueError("bandwidth x pulse_width must be >= 1 for a pulse-compression radar")
-        if self.precision == "float32" and self.path == "raw":
-            raise ValueError("precision 'float32' is implemented for the analytic path only")
         if self.sample_rate is not None and self.sample_rate < self.bandwidth:
             raise ValueError("sample_rate must be >= bandwidth (complex sampling)")
         return self
@@ -94,65 +94,100 @@ class LfmPulseDoppler(RadarWaveform):
         shape as ``ranges``."""
         return self.config.amplitudes(rcs, ranges, radar.wavelength(self.config.carrier_frequency))
 
-    def receive(self, ranges: np.ndarray, rcs: np.ndarray, gate_range: np.ndarray) -> Received:
+    def start_record(self, times: np.ndarray, range_span: tuple[float, float]) -> None:
+        """Fix the raw path's range-time window for the record: the joints' range span plus
+        ``range_margin`` on either side."""
+        self._span = range_span
+
+    def receive(self, block: PulseBlock) -> Received:
         """Compressed slow-time return at the gate (and a range-time map on the raw path)."""
-        amp = self.amplitudes(ranges, rcs)
         c = self.config
-        if c.path == "analytic" and c.precision == "float32":
-            return Received(self._receive_float32(ranges, amp, gate_range))
         if c.path == "analytic":
-            signal = radar.compressed_return_at_gate(
-                ranges,
-                amp,
-                gate_range,
-                carrier_frequency=c.carrier_frequency,
-                pulse_width=c.pulse_width,
-                bandwidth=c.bandwidth,
-                response=c.gate_response,
+            return Received(
+                self._receive_analytic(block.ranges, block.scatterers.rcs, block.gate_range)
             )
-            return Received(signal)
-        return self._receive_raw(ranges, amp, gate_range)
+        amp = self.amplitudes(block.ranges, block.scatterers.rcs)
+        return self._receive_raw(block.ranges, amp, block.gate_range)
 
-    def _receive_float32(
-        self, ranges: np.ndarray, amp: np.ndarray, gate_range: np.ndarray
+    def _receive_analytic(
+        self, ranges: np.ndarray, rcs: np.ndarray, gate_range: np.ndarray
     ) -> np.ndarray:
-        """The analytic return with complex64 arithmetic after a float64 phase reduction."""
+        """Eq. (4) in one pass: ``y(n) = sum_i a_i w_i exp(-j 4 pi f_c R_i / c)``, with the
+        carrier phase reduced to a fraction of a cycle in float64 from float64 ranges and the
+        rest (amplitude by the ``amplitude`` model, gate weight, phasor, sum) in ``precision``."""
         c = self.config
-        w = radar.gate_weights(
-            ranges,
-            gate_range,
-            pulse_width=c.pulse_width,
-            bandwidth=c.bandwidth,
-            response=c.gate_response,
-        ).astype(np.float32)
-        frac = radar.carrier_cycles_fraction(ranges, c.carrier_frequency)
-        phase = ((-2.0 * np.pi) * frac).astype(np.float32)
-        phasor = np.empty(phase.shape, dtype=np.complex64)
-        phasor.real = np.cos(phase)
-        phasor.imag = np.sin(phase)
-        total = np.sum((amp.astype(np.float32) * w) * phasor, axis=1, dtype=np.complex64)
-        return np.asarray(total, dtype=np.complex128)
+        real = np.float32 if c.precision == "float32" else np.float64
+        if not np.all(ranges > 0):
+            raise ValueError("ranges must be positive and finite for the range equation")
+        cycles = ranges * (2.0 * c.carrier_frequency / SPEED_OF_LIGHT)
+        cycles -= np.floor(cycles)  # the fraction of a cycle, in float64
+        phase = cycles.astype(real, copy=False)
+        phase *= real(-2.0 * np.pi)
+        amp = rcs.astype(real)  # a copy: amplitudes are built in place
+        if c.amplitude == "range_equation":
+            lam = radar.wavelength(c.carrier_frequency)
+            gain = 10.0 ** (c.gain_dbi / 10.0)
+            loss = 10.0 ** ((c.system_loss_db + c.atmospheric_loss_db) / 10.0)
+            amp *= real(c.transmit_power * gain**2 * lam**2 / ((4.0 * np.pi) ** 3 * loss))
+        np.sqrt(amp, out=amp)
+        r = ranges.astype(real, copy=False)
+        if c.amplitude == "range_equation":
+            amp /= r * r
+        if c.gate_response != "phase_only":
+            amp *= self._gate_weights(r, gate_range.astype(real, copy=False), real)
+        out = np.empty(ranges.shape[0], dtype=np.complex128)
+        out.real = np.einsum("ps,ps->p", amp, np.cos(phase))
+        out.imag = np.einsum("ps,ps->p", amp, np.sin(phase))
+        return out
 
-    def fast_time_grid(self, ranges: np.ndarray) -> np.ndarray:
-        """Fast-time samples [s] covering every echo of the record plus the range margin."""
+    def _gate_weights(self, r: np.ndarray, gate: np.ndarray, real: type) -> np.ndarray:
+        """The gate response (``radar.gate_weights``) in the given float type."""
+        c = self.config
+        d = gate[:, None] - r
+        np.abs(d, out=d)
+        d *= real(2.0 / SPEED_OF_LIGHT)
+        if c.gate_response == "sinc":
+            x = d * real(np.pi * c.bandwidth)
+        else:  # exact: chi(D) / tau = (1 - |D|/tau) sinc(gamma |D| (tau - |D|))
+            rem = real(c.pulse_width) - d
+            np.maximum(rem, 0, out=rem)
+            x = d * rem
+            x *= real(np.pi * c.bandwidth / c.pulse_width)
+            rem *= real(1.0 / c.pulse_width)
+        x += real(1e-30)  # x >= 0; sin(x)/x is then exactly 1 at x = 0, unchanged elsewhere
+        w = np.sin(x)
+        w /= x
+        if c.gate_response != "sinc":
+            w *= rem
+        return w
+
+    def fast_time_grid(self, lo_range: float, hi_range: float) -> np.ndarray:
+        """Fast-time samples [s] on the record's sample grid (multiples of ``1/fs``) covering
+        echoes from ``lo_range`` to ``hi_range`` [m] plus the range margin and half a pulse."""
         c = self.config
         fs = c.sample_rate or 2.0 * c.bandwidth
-        lo = 2.0 * (float(np.min(ranges)) - c.range_margin) / SPEED_OF_LIGHT - c.pulse_width / 2
-        hi = 2.0 * (float(np.max(ranges)) + c.range_margin) / SPEED_OF_LIGHT + c.pulse_width / 2
+        lo = 2.0 * (lo_range - c.range_margin) / SPEED_OF_LIGHT - c.pulse_width / 2
+        hi = 2.0 * (hi_range + c.range_margin) / SPEED_OF_LIGHT + c.pulse_width / 2
         k0 = np.floor(lo * fs)
         return (k0 + np.arange(int(np.ceil(hi * fs) - k0) + 1)) / fs
 
     def _receive_raw(self, ranges: np.ndarray, amp: np.ndarray, gate: np.ndarray) -> Received:
+        """Sampled echoes of the block on a fast-time grid covering its scatterers; the
+        range-time rows are cut to the record's fixed window (``start_record``)."""
         c = self.config
         fs = c.sample_rate or 2.0 * c.bandwidth
-        fast = self.fast_time_grid(ranges)
-        rng_axis = fast * SPEED_OF_LIGHT / 2.0
-        keep = (rng_axis >= np.min(ranges) - c.range_margin) & (
-            rng_axis <= np.max(ranges) + c.range_margin
-        )
+        fast = self.fast_time_grid(float(np.min(ranges)), float(np.max(ranges)))
+        lo_r, hi_r = getattr(self, "_span", (float(np.min(ranges)), float(np.max(ranges))))
+        grid = self.fast_time_grid(lo_r, hi_r) * SPEED_OF_LIGHT / 2.0
+        window = grid[(grid >= lo_r - c.range_margin) & (grid <= hi_r + c.range_margin)]
+        # the record window's columns (same 1/fs grid) that this block's grid covers
+        k_block = np.rint(fast * fs).astype(np.int64)
+        k_window = np.rint(window * 2.0 / SPEED_OF_LIGHT * fs).astype(np.int64)
         n = ranges.shape[0]
         signal = np.empty(n, dtype=np.complex128)
-        range_time = np.empty((n, int(keep.sum())), dtype=np.complex128)
+        range_time = np.zeros((n, k_window.size), dtype=np.complex128)
+        src = np.searchsorted(k_block, k_window)
+        inside = (src < k_block.size) & (k_block[np.minimum(src, k_block.size - 1)] == k_window)
         kw = dict(pulse_width=c.pulse_width, bandwidth=c.bandwidth)
         for lo in range(0, n, RAW_BLOCK):
             sl = slice(lo, min(lo + RAW_BLOCK, n))
@@ -162,5 +197,5 @@ class LfmPulseDoppler(RadarWaveform):
             delay = 2.0 * gate[sl] / SPEED_OF_LIGHT
             signal[sl] = radar.compress_at_delay(echoes, fast, delay, **kw) / c.pulse_width
             compressed = radar.matched_filter(echoes, fs, **kw) / c.pulse_width
-            range_time[sl] = compressed[:, keep]
-        return Received(signal, range_time, rng_axis[keep])
+            range_time[sl, inside] = compressed[:, src[inside]]
+        return Received(signal, range_time, window)

@@ -111,10 +111,15 @@ class MujocoBody(ScattererModel):
     Config = MujocoBodyConfig
     config: MujocoBodyConfig
 
+    def start_record(self, body_: Skeleton) -> None:
+        """The body height for the segment sizes, from the whole record (block-invariant)."""
+        self._height = self.config.height or body.estimate_height(body_.positions)
+
     def scatterers(
         self, motion: Motion, skeleton: Skeleton, radar_position: FloatArray, wavelength: float
     ) -> Scatterers:
-        """Scatterers of the 16 parts at every pulse (names as the ``chen16`` placement)."""
+        """Scatterers of the 16 parts at every pulse of a block (names as the ``chen16``
+        placement)."""
         if isinstance(motion, BoulicMotion) and motion.gait is not None:
             joints, centres, rot, semi = self._boulic_frames(motion, skeleton)
         else:
@@ -157,7 +162,8 @@ class MujocoBody(ScattererModel):
         self, skeleton: Skeleton
     ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         joints = skeleton.positions
-        height = self.config.height or body.estimate_height(joints)
+        height = getattr(self, "_height", None) or self.config.height
+        height = height or body.estimate_height(joints)
         ab = {k: (r, r) for k, r in PART_RADII.items()} | dict(self.config.radii or {})
         semi = np.array(
             [

@@ -121,7 +121,13 @@ class Shadowing(Effect):
 
     def __init__(self, config: PluginConfig) -> None:
         super().__init__(config)
+        self.start_record()
+
+    def start_record(self, *args: Any) -> None:
+        """Reset the ray row carried between blocks and the record's blocked fractions."""
         self._stats: dict[str, Any] = {}
+        self._carry: BoolArray | None = None
+        self._totals: tuple[int, Any, int] = (0, None, 0)
 
     # ---------------------------------------------------------------- occluder geometry
 
@@ -194,7 +200,11 @@ class Shadowing(Effect):
         else:
             types, sizes, centres, rot, own = self._capsules(scat, context)
         n_p, n_s = scat.positions.shape[:2]
-        idx = np.arange(0, n_p, c.decimation)
+        if context.block_start == 0:  # a record's first block
+            self.start_record()
+        # rays at the record's pulses 0, d, 2d, ...: the same pulses for any cut into blocks
+        first = (-context.block_start) % c.decimation
+        idx = np.arange(first, n_p, c.decimation)
         x = scat.positions[idx]
         centres, rot = centres[idx], rot[idx]
         allowed = self._contains(types, sizes, centres, rot, x) | own[None]
@@ -218,12 +228,19 @@ class Shadowing(Effect):
             hit = geomid >= 0
             g = np.where(hit, geomid, 0)
             blocked[k] = hit & (dist < rng[k] - c.tolerance) & ~allowed[k, cols, g]
-        full = blocked[np.minimum(np.arange(n_p) // c.decimation, len(idx) - 1)]
+        row = (np.arange(n_p) - first) // c.decimation  # -1: before this block's first ray
+        carried = self._carry if self._carry is not None else np.zeros(n_s, dtype=bool)
+        full = np.concatenate((carried[None], blocked))[row + 1]
+        if len(idx):
+            self._carry = blocked[-1].copy()
+        rays, counts, pulses = self._totals
+        counts = counts + full.sum(axis=0) if counts is not None else full.sum(axis=0)
+        self._totals = (rays + int(len(idx) * n_s), counts, pulses + n_p)
         self._stats = {
             "occluders": "ellipsoids" if use_ellipsoids else "capsules",
-            "rays_cast": int(len(idx) * n_s),
+            "rays_cast": self._totals[0],
             "blocked_fraction": {
-                name: float(f) for name, f in zip(scat.names, full.mean(axis=0), strict=True)
+                name: float(f) / self._totals[2] for name, f in zip(scat.names, counts, strict=True)
             },
         }
         return np.asarray(full, dtype=bool)

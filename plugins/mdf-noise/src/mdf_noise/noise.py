@@ -33,6 +33,7 @@ neighbouring cells' noise is in fact correlated over ``1/B``, which this does no
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any, Literal
 
 import numpy as np
@@ -161,7 +162,7 @@ class ReceiverNoise(Effect):
         range_time = data.range_time
         if range_time is not None:
             range_time = range_time + complex_noise(context.rng, range_time.shape, power)
-        return Received(signal, range_time, data.range_axis)
+        return dataclasses.replace(data, signal=signal, range_time=range_time)
 
     def describe(self) -> dict[str, Any]:
         """The config plus the noise power per compressed sample [W]."""

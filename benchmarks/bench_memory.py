@@ -1,0 +1,79 @@
+"""Benchmark: peak memory and time against record length (the streaming pipeline).
+
+Each measurement runs in a fresh process (so its peak resident set is its own): a body walking on
+a treadmill 12 m from the radar (17 ellipsoid scatterers, PRF 2400 Hz), simulated end to end for
+a record of the given length on the analytic or the raw LFM path. Reports the wall time, the peak
+RSS [MiB] and the time exponent between the shortest and the longest record
+(``log(t_long / t_short) / log(len_long / len_short)``).
+
+    .venv/bin/python benchmarks/bench_memory.py [--lengths 6 600] [--paths analytic raw]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+CHILD = r"""
+import json, resource, sys, time
+sys.path.insert(0, {bench!r})
+from bench_pipeline import walking_motion
+from mdframework.config import validate_run_config
+from mdframework.pipeline import build_stages, simulate_motion
+
+length, path = float(sys.argv[1]), sys.argv[2]
+motion = walking_motion(duration=length + 0.5)
+cfg = validate_run_config({{
+    "motion": {{"kind": "point_targets", "length": 1.0, "targets": [{{"position": [1, 0, 0]}}],
+               "duration": length}},
+    "scatterers": {{"kind": "ellipsoid", "placement": "joints17", "height": 1.8}},
+    "radar": {{"kind": "lfm", "path": path}},
+    "scene": {{"radar_position": [12.0, 0.0, 1.5], "person": {{"motion": "treadmill"}}}},
+}})
+stages = build_stages(cfg)
+t0 = time.perf_counter()
+res = simulate_motion(cfg, stages, motion)
+wall = time.perf_counter() - t0
+rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+print(json.dumps({{"wall_s": wall, "peak_rss_mib": rss, "n_pulses": int(res.pulse_times.size)}}))
+"""
+
+
+def measure(length: float, path: str) -> dict[str, float]:
+    """Wall time and peak RSS of one record in a fresh process."""
+    bench = str(Path(__file__).resolve().parent)
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+    out = subprocess.run(
+        [sys.executable, "-c", CHILD.format(bench=bench), str(length), path],
+        check=True,
+        capture_output=True,
+        text=True,
+        env=env,
+    )
+    return dict(json.loads(out.stdout.strip().splitlines()[-1]))
+
+
+def main() -> None:
+    """Measure every (path, length) and print a JSON summary."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--lengths", type=float, nargs="+", default=[6.0, 600.0])
+    parser.add_argument("--paths", nargs="+", default=["analytic", "raw"])
+    args = parser.parse_args()
+    report: dict[str, object] = {}
+    for path in args.paths:
+        rows = {f"{length:g}s": measure(length, path) for length in args.lengths}
+        first, last = rows[f"{args.lengths[0]:g}s"], rows[f"{args.lengths[-1]:g}s"]
+        ratio = args.lengths[-1] / args.lengths[0]
+        exponent = math.log(last["wall_s"] / first["wall_s"]) / math.log(ratio)
+        report[path] = {"records": rows, "time_exponent": round(exponent, 3)}
+        print(json.dumps({path: report[path]}), flush=True)
+    print(json.dumps(report, indent=2))
+
+
+if __name__ == "__main__":
+    main()
