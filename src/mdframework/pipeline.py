@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -231,6 +231,8 @@ def simulate_motion(
     clock = time.perf_counter()
     stream.warn_aliasing()
     received = stream.received()
+    if received.products:
+        received = replace(received, products={**received.products, **wf.product_axes()})
     context = SceneContext(radar_pos, wf.prf, wf.carrier_frequency, t, stream.gate, None, wf, rng)
     received = _apply_effects(stages, "received", received, context)
     effects_ran = _describe(stages, "scatterers") + _describe(stages, "received")
