@@ -247,3 +247,19 @@ def test_outputs_hold_maps_points_and_their_figures(tmp_path: Any) -> None:
     table = np.loadtxt(tmp_path / "run" / "points.csv", delimiter=",", skiprows=1, ndmin=2)
     np.testing.assert_allclose(table, pts, rtol=1e-5, atol=1e-6)
     assert len(lines) - 1 == len(pts) > 0
+
+
+def test_a_radar_section_without_kind_is_still_the_lfm_radar() -> None:
+    """With several radars installed, a ``[radar]`` section that names no kind keeps meaning
+    the default radar (as it did when ``lfm`` was the only one)."""
+    cfg = validate_run_config(
+        {
+            "motion": {
+                "kind": "point_targets",
+                "length": 1.0,
+                "targets": [{"position": [5, 0, 0]}],
+            },
+            "radar": {"carrier_frequency": 10e9},
+        }
+    )
+    assert cfg.radar.kind == "lfm" and cfg.radar.carrier_frequency == 10e9  # type: ignore[attr-defined]

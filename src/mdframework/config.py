@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Annotated, Any, Union
 
 import yaml
-from pydantic import Field, ValidationError, create_model
+from pydantic import Field, ValidationError, create_model, model_validator
 
 from .errors import ConfigError
 from .interfaces import PluginConfig
@@ -43,10 +43,31 @@ def run_config_model(registry: Registry | None = None) -> type[RunConfigBase]:
             return Field(default={"kind": name}, validate_default=True)
         return ...
 
+    # a section without ``kind`` means its default plugin, whatever else is installed
+    kinds = {
+        section: name
+        for section, interface, name in (
+            ("scatterers", "scatterers", "ellipsoid"),
+            ("radar", "radar", "lfm"),
+        )
+        if name in reg.plugins[interface]
+    }
+
+    class Base(RunConfigBase):
+        @model_validator(mode="before")
+        @classmethod
+        def _default_kinds(cls, data: Any) -> Any:
+            if isinstance(data, dict):
+                for section, name in kinds.items():
+                    value = data.get(section)
+                    if isinstance(value, dict) and "kind" not in value:
+                        data = {**data, section: {"kind": name, **value}}
+            return data
+
     effect_list: Any = list[_union(reg, "effect")]  # type: ignore[misc]
     model = create_model(
         "RunConfig",
-        __base__=RunConfigBase,
+        __base__=Base,
         effects=(
             effect_list,
             Field(
