@@ -11,18 +11,22 @@ venv: $(STAMP)
 
 $(STAMP): pyproject.toml $(PLUGINS)
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e ".[dev]" $(foreach p,$(PLUGINS),-e $(dir $(p)))
+	@echo "Installing mdframework and $(words $(PLUGINS)) plugins into $(VENV): pip reports every distribution"
+	$(BIN)/python -m pip install --progress-bar on --upgrade pip "setuptools>=70.1"
+	@# one pip call for every editable distribution; they all build with the setuptools just
+	@# installed, instead of one isolated build environment each
+	$(BIN)/python -m pip install --progress-bar on --no-build-isolation \
+		-e ".[dev]" $(foreach p,$(PLUGINS),-e $(dir $(p)))
 	touch $(STAMP)
+
+# the example runs go $(JOBS) at a time (one per core), then the CMU experiment
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 
 demo: $(STAMP)
 	@mkdir -p out/demo
-	@for cfg in examples/*.toml; do \
-		name=$$(basename $$cfg .toml); \
-		case $$name in experiment_*) continue;; esac; \
-		echo "mdf run $$cfg --out out/demo/$$name"; \
-		$(BIN)/mdf run $$cfg --out out/demo/$$name || exit 1; \
-	done
+	@ls examples/*.toml | grep -v '/experiment_' | xargs -P $(JOBS) -I{} sh -c \
+		'name=$$(basename {} .toml); echo "mdf run {} --out out/demo/$$name"; \
+		$(BIN)/mdf run {} --out out/demo/$$name || exit 255'
 	$(BIN)/python examples/side_by_side.py out/demo
 	$(BIN)/mdf experiment examples/experiment_cmu.toml --out out/demo/experiment_cmu
 	@echo "spectrograms: out/demo/*/spectrogram.png; FMCW points: out/demo/fmcw_walk/points.csv; experiment report: out/demo/experiment_cmu/report.md"

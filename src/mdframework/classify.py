@@ -9,10 +9,10 @@ from __future__ import annotations
 import itertools
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from sklearn.model_selection import StratifiedKFold
 
 from .interfaces import Classifier
 
@@ -89,6 +89,41 @@ def _best(scores: dict[tuple[int, ...], float]) -> tuple[tuple[int, ...], float]
     return subset, scores[subset]
 
 
+def _checked(features: FloatArray, labels: NDArray[np.str_]) -> tuple[FloatArray, NDArray[Any]]:
+    """Features as a finite (n_samples, n_features) float64 array with one label each: checked
+    once, so that the selection loops can tell scikit-learn to skip its own repeated checks."""
+    x = np.asarray(features, dtype=np.float64)
+    y = np.asarray(labels)
+    if x.ndim != 2 or x.shape[0] != y.shape[0]:
+        raise ValueError("features must be (n_samples, n_features) with one label each")
+    if not np.all(np.isfinite(x)):
+        raise ValueError("features contain NaN or infinite values")
+    return x, y
+
+
+def _score_subsets(
+    folds: Sequence[tuple[FloatArray, NDArray[Any], FloatArray, NDArray[Any]]],
+    make_classifier: ClassifierFactory,
+    subsets: Sequence[tuple[int, ...]],
+) -> dict[tuple[int, ...], float]:
+    """Mean balanced accuracy over ``folds`` (train x, train y, test x, test y) of every subset,
+    with scikit-learn's per-call finiteness checks off (the inputs were checked once)."""
+    from sklearn import config_context
+
+    scores: dict[tuple[int, ...], float] = {}
+    with config_context(assume_finite=True):
+        for subset in subsets:
+            cols = list(subset)
+            accs = [
+                balanced_accuracy(
+                    y_te, make_classifier().fit(x_tr[:, cols], y_tr).predict(x_te[:, cols])
+                )
+                for x_tr, y_tr, x_te, y_te in folds
+            ]
+            scores[subset] = float(np.mean(accs))
+    return scores
+
+
 def wrapper_select(
     features: FloatArray,
     labels: NDArray[np.str_],
@@ -101,20 +136,15 @@ def wrapper_select(
     """Wrapper feature selection by stratified k-fold cross-validation on the given (training)
     data only: every subset of the given sizes is scored by its mean balanced accuracy over the
     folds. The caller passes only training data, so the test split is never seen."""
-    x = np.asarray(features, dtype=np.float64)
-    y = np.asarray(labels)
+    from sklearn.model_selection import StratifiedKFold
+
+    x, y = _checked(features, labels)
     n_folds = min(int(folds), int(np.unique(y, return_counts=True)[1].min()))
     if n_folds < 2:
         raise ValueError("wrapper selection needs at least two training samples per class")
-    splits = list(StratifiedKFold(n_folds, shuffle=True, random_state=seed).split(x, y))
-    scores: dict[tuple[int, ...], float] = {}
-    for subset in _subsets(x.shape[1], sizes):
-        cols = list(subset)
-        accs = []
-        for train, test in splits:
-            clf = make_classifier().fit(x[train][:, cols], y[train])
-            accs.append(balanced_accuracy(y[test], clf.predict(x[test][:, cols])))
-        scores[subset] = float(np.mean(accs))
+    splits = StratifiedKFold(n_folds, shuffle=True, random_state=seed).split(x, y)
+    data = [(x[train], y[train], x[test], y[test]) for train, test in splits]
+    scores = _score_subsets(data, make_classifier, _subsets(x.shape[1], sizes))
     subset, score = _best(scores)
     return Selection(subset, score, scores)
 
@@ -130,10 +160,10 @@ def optimistic_select(
 ) -> Selection:
     """The paper's variant: the subset scoring best **on the test data**. Its accuracy is an
     optimistic upper bound and is reported separately, clearly labelled."""
-    scores: dict[tuple[int, ...], float] = {}
-    for subset in _subsets(train_features.shape[1], sizes):
-        cols = list(subset)
-        clf = make_classifier().fit(train_features[:, cols], train_labels)
-        scores[subset] = balanced_accuracy(test_labels, clf.predict(test_features[:, cols]))
+    x_tr, y_tr = _checked(train_features, train_labels)
+    x_te, y_te = _checked(test_features, test_labels)
+    scores = _score_subsets(
+        [(x_tr, y_tr, x_te, y_te)], make_classifier, _subsets(x_tr.shape[1], sizes)
+    )
     subset, score = _best(scores)
     return Selection(subset, score, scores)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import tomllib
+from functools import lru_cache
 from pathlib import Path
 from typing import Annotated, Any, Union
 
@@ -24,9 +25,11 @@ from .interfaces import PluginConfig
 from .plugins import Registry, default_registry
 from .settings import RunConfigBase
 
+#: (interface, ((plugin name, its Config model), ...)) for every interface, sorted by name
+_ConfigModels = tuple[tuple[str, tuple[tuple[str, type[PluginConfig]], ...]], ...]
 
-def _union(registry: Registry, interface: str) -> Any:
-    models = [registry.plugins[interface][n].cls.Config for n in registry.names(interface)]
+
+def _union(models: list[type[PluginConfig]]) -> Any:
     if not models:
         return PluginConfig
     if len(models) == 1:
@@ -35,11 +38,25 @@ def _union(registry: Registry, interface: str) -> Any:
 
 
 def run_config_model(registry: Registry | None = None) -> type[RunConfigBase]:
-    """The run-config model for the plugins in ``registry`` (default: the installed ones)."""
+    """The run-config model for the plugins in ``registry`` (default: the installed ones). It
+    is built once per set of plugin config models (datasets validate one config per record)."""
     reg = registry or default_registry()
+    key = tuple(
+        (interface, tuple((n, reg.plugins[interface][n].cls.Config) for n in reg.names(interface)))
+        for interface in sorted(reg.plugins)
+    )
+    return _run_config_model(key)
+
+
+@lru_cache(maxsize=16)
+def _run_config_model(key: _ConfigModels) -> type[RunConfigBase]:
+    configs = {interface: dict(models) for interface, models in key}
+
+    def union(interface: str) -> Any:
+        return _union(list(configs.get(interface, {}).values()))
 
     def default(interface: str, name: str) -> Any:
-        if name in reg.plugins[interface]:
+        if name in configs.get(interface, {}):
             return Field(default={"kind": name}, validate_default=True)
         return ...
 
@@ -50,7 +67,7 @@ def run_config_model(registry: Registry | None = None) -> type[RunConfigBase]:
             ("scatterers", "scatterers", "ellipsoid"),
             ("radar", "radar", "lfm"),
         )
-        if name in reg.plugins[interface]
+        if name in configs.get(interface, {})
     }
 
     class Base(RunConfigBase):
@@ -64,7 +81,7 @@ def run_config_model(registry: Registry | None = None) -> type[RunConfigBase]:
                         data = {**data, section: {"kind": name, **value}}
             return data
 
-    effect_list: Any = list[_union(reg, "effect")]  # type: ignore[misc]
+    effect_list: Any = list[union("effect")]  # type: ignore[misc]
     model = create_model(
         "RunConfig",
         __base__=Base,
@@ -75,9 +92,9 @@ def run_config_model(registry: Registry | None = None) -> type[RunConfigBase]:
                 description="Scene effects to simulate, in order; nothing else is computed.",
             ),
         ),
-        motion=(_union(reg, "motion"), ...),
-        scatterers=(_union(reg, "scatterers"), default("scatterers", "ellipsoid")),
-        radar=(_union(reg, "radar"), default("radar", "lfm")),
+        motion=(union("motion"), ...),
+        scatterers=(union("scatterers"), default("scatterers", "ellipsoid")),
+        radar=(union("radar"), default("radar", "lfm")),
     )
     return model
 

@@ -260,9 +260,12 @@ def load_dataset_config(path: str | Path) -> tuple[DatasetConfig, Path]:
         raise ConfigError(format_validation_error(exc, str(p), data)) from None
 
 
-@lru_cache(maxsize=8)
+@lru_cache(maxsize=64)
 def _load_motion(motion_json: str, base_dir: str) -> Motion:
-    """Load a motion once per process (records of one recording share it)."""
+    """Load a motion once per process (records of one recording share it). Local worker
+    processes are forked after planning and inherit the motions the planner loaded; a Dask
+    worker loads each motion it meets once (the cache holds far more recordings than a dataset
+    config lists, so records scheduled in any order never evict one)."""
     section = json.loads(motion_json)
     config = validate_run_config(
         {"motion": section}, source="dataset motion", base_dir=Path(base_dir)
@@ -883,11 +886,16 @@ def _executor(
         from distributed import as_completed as dask_completed
     except ImportError:
         raise MdfError("a Dask scheduler needs `pip install mdframework[dask]`") from None
-    cluster = (
-        LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None)
-        if address == "local"
-        else None
-    )
+    import dask
+
+    # the statistical profiler samples every worker thread every 10 ms and nothing reads its
+    # profiles; the workers started here inherit the setting
+    with dask.config.set({"distributed.worker.profile.enabled": False}):
+        cluster = (
+            LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None)
+            if address == "local"
+            else None
+        )
     client = Client(cluster if cluster is not None else address)
     try:
 

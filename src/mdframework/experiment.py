@@ -26,6 +26,7 @@ import csv
 import io
 import json
 from collections.abc import Callable, Sequence
+from functools import partial
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -493,7 +494,8 @@ def run_experiment(
     progress: bool = True,
     registry: Registry | None = None,
 ) -> dict[str, Any]:
-    """Build or load the dataset, run the experiments, write the report."""
+    """Build or load the dataset, run the experiments, write the report. The figures are drawn
+    together at the end, once every number is computed (matplotlib loads only then)."""
     from .figures import plot_confusion, plot_feature_scatter
 
     out = Path(out_dir)
@@ -507,6 +509,7 @@ def run_experiment(
         assert cfg.dataset.path is not None
         data_dir = cfg.dataset.path
     data, x_all, names = classifier_inputs(cfg, data_dir)
+    figures: list[Callable[[], None]] = []  # drawn at the end
 
     summary: dict[str, Any] = {
         "dataset": str(data_dir),
@@ -568,12 +571,15 @@ def run_experiment(
                 ]
             )
         )
-        plot_confusion(
-            out / f"{stem}_confusion.png",
-            classes,
-            res["confusion_mean"],
-            res["confusion_std"],
-            title=f"{group}: within-source",
+        figures.append(
+            partial(
+                plot_confusion,
+                out / f"{stem}_confusion.png",
+                classes,
+                res["confusion_mean"],
+                res["confusion_std"],
+                title=f"{group}: within-source",
+            )
         )
         summary["within"][group] = {
             k: v for k, v in res.items() if k not in ("confusion_mean", "confusion_std")
@@ -602,12 +608,15 @@ def run_experiment(
         (out / "cross_confusion.csv").write_text(
             _csv(_matrix_rows(res["classes"], res["confusion"]))
         )
-        plot_confusion(
-            out / "cross_confusion.png",
-            res["classes"],
-            res["confusion"],
-            None,
-            title=f"train {cfg.cross_source.train} -> test {cfg.cross_source.test}",
+        figures.append(
+            partial(
+                plot_confusion,
+                out / "cross_confusion.png",
+                res["classes"],
+                res["confusion"],
+                None,
+                title=f"train {cfg.cross_source.train} -> test {cfg.cross_source.test}",
+            )
         )
         summary["cross"] = {**res, "confusion": res["confusion"].tolist()}
         report += [
@@ -656,16 +665,21 @@ def run_experiment(
     report += ["## Feature statistics", "", md, ""]
     for f1, f2 in cfg.report.scatter_pairs:
         name = f"scatter_{f1}_{f2}.png"
-        plot_feature_scatter(
-            out / name,
-            data.features[:, FEATURE_NAMES.index(f1)],
-            data.features[:, FEATURE_NAMES.index(f2)],
-            data.labels,
-            data.groups,
-            f1,
-            f2,
+        figures.append(
+            partial(
+                plot_feature_scatter,
+                out / name,
+                data.features[:, FEATURE_NAMES.index(f1)],
+                data.features[:, FEATURE_NAMES.index(f2)],
+                data.labels,
+                data.groups,
+                f1,
+                f2,
+            )
         )
         report += [f"![{f1} vs {f2}]({name})", ""]
+    for draw in figures:
+        draw()
     (out / "report.md").write_text("\n".join(report))
     (out / "summary.json").write_text(json.dumps(summary, indent=2, default=str) + "\n")
     return summary

@@ -22,6 +22,7 @@ Every problem raises :class:`mdframework.DataFileError` with the file and 1-base
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -135,17 +136,21 @@ class _BoneDraft:
     dof: tuple[str, ...] = ()
 
 
-def _floats(path: Path, tokens: list[str], count: int, what: str, line: int) -> FloatArray:
+def _float_list(path: Path, tokens: list[str], count: int, what: str, line: int) -> list[float]:
     if len(tokens) != count:
         raise DataFileError(path, f"{what} needs {count} numbers, found {len(tokens)}", line)
     try:
-        out = np.array([float(t) for t in tokens], dtype=np.float64)
+        out = [float(t) for t in tokens]
     except ValueError:
         bad = next(t for t in tokens if not _is_float(t))
         raise DataFileError(path, f"bad number {bad!r} in {what}", line) from None
-    if not np.all(np.isfinite(out)):
+    if not all(map(math.isfinite, out)):
         raise DataFileError(path, f"non-finite number in {what}", line)
     return out
+
+
+def _floats(path: Path, tokens: list[str], count: int, what: str, line: int) -> FloatArray:
+    return np.array(_float_list(path, tokens, count, what, line), dtype=np.float64)
 
 
 def _is_float(text: str) -> bool:
@@ -445,9 +450,9 @@ def read_amc(path: str | Path, asf: AsfSkeleton) -> AmcMotion:
             raise DataFileError(p, f"bone {key!r} is not in the skeleton {asf.path.name}", ln)
         if key in in_frame:
             raise DataFileError(p, f"bone {key!r} appears twice in frame {numbers[-1]}", ln)
-        vals = _floats(p, toks[1:], counts[key], f"the values of bone {key!r}", ln)
+        vals = _float_list(p, toks[1:], counts[key], f"the values of bone {key!r}", ln)
         in_frame.add(key)
-        rows.setdefault(key, []).append(vals.tolist())
+        rows.setdefault(key, []).append(vals)
     if not numbers:
         raise DataFileError(p, "the file holds zero frames", max(len(lines), 1))
     close_frame(len(lines))

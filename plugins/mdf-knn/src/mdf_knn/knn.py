@@ -2,9 +2,11 @@
 
 - **Standardisation**: z-scores with the training data's mean and standard deviation only; a
   zero-variance feature is only centred (``mdframework.classify.Standardizer``).
-- **Neighbours**: scikit-learn's ``NearestNeighbors`` (tree or brute search, Euclidean by
-  default). Candidates are ranked by distance with a stable sort, so **distance ties** are
-  broken by training order (the earlier sample wins), documented and repeatable.
+- **Neighbours**: an exact brute-force search over all training samples, vectorised over the
+  queries. Euclidean distances are summed feature by feature in column order and square-rooted,
+  as a k-d tree does; other metrics go through scikit-learn's ``pairwise_distances``. Candidates
+  are ranked by distance with a stable sort, so **distance ties** are broken by training order
+  (the earlier sample wins), documented and repeatable.
 - **Vote ties**: among the classes with the most votes, the one whose closest member among the
   k neighbours is nearest wins (``tie_rule = "nearest"``, the default); ``"lowest"`` picks the
   alphabetically first class, as ``argmax`` over sorted labels would.
@@ -17,10 +19,13 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field
-from sklearn.neighbors import NearestNeighbors
 
 from mdframework import Classifier, PluginConfig
 from mdframework.classify import Standardizer
+
+#: Queries per block: a block's (queries, training samples, features) difference array stays
+#: near this many float64 elements (32 MiB).
+_BLOCK_ELEMENTS = 1 << 22
 
 
 class KnnConfig(PluginConfig):
@@ -49,40 +54,51 @@ class Knn(Classifier):
             raise ValueError("features must be (n_samples, n_features) with one label each")
         self.scaler_ = Standardizer.fit(x)
         self.labels_ = np.asarray(labels)
-        self.nn_ = NearestNeighbors(algorithm="auto", metric=self.config.metric)
-        self.nn_.fit(self.scaler_.transform(x))
+        # classes in sorted order; codes_ (n_samples,) indexes them
+        self.classes_, self.codes_ = np.unique(self.labels_, return_inverse=True)
+        self.train_ = self.scaler_.transform(x)
         return self
+
+    def _distances(self, z: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Distances (n_queries, n_samples) of standardised queries to the training set."""
+        train = self.train_
+        if self.config.metric != "euclidean":
+            from sklearn.metrics import pairwise_distances
+
+            return np.asarray(pairwise_distances(z, train, metric=self.config.metric))
+        sq = np.zeros((z.shape[0], train.shape[0]))
+        for j in range(train.shape[1]):  # column by column, in order (as a k-d tree sums)
+            diff = z[:, j, None] - train[None, :, j]
+            sq += diff * diff
+        return np.sqrt(sq)
 
     def neighbours(self, features: NDArray[np.float64]) -> tuple[NDArray[Any], NDArray[Any]]:
         """Distances and training indices of the k nearest neighbours, (n_queries, k) each,
         ordered by distance, ties by training order."""
-        n_train = self.labels_.shape[0]
+        n_train, n_feat = self.train_.shape
         k = min(self.config.k, n_train)
-        z = self.scaler_.transform(features)
-        # a few spare neighbours reveal distance ties at the k-th place; rows whose ties reach
-        # past the spares are searched again over the whole training set
-        n_ask = min(n_train, k + 8)
-        dist, idx = self.nn_.kneighbors(z, n_neighbors=n_ask, return_distance=True)
-        if n_ask < n_train:
-            redo = np.flatnonzero(dist[:, k - 1] >= dist[:, -1])
-            if redo.size:
-                d_all, i_all = self.nn_.kneighbors(z[redo], n_neighbors=n_train)
-                order = np.lexsort((i_all, d_all), axis=1)[:, :n_ask]
-                dist[redo] = np.take_along_axis(d_all, order, 1)
-                idx[redo] = np.take_along_axis(i_all, order, 1)
-        order = np.lexsort((idx, dist), axis=1)[:, :k]
-        return np.take_along_axis(dist, order, 1), np.take_along_axis(idx, order, 1)
+        z = self.scaler_.transform(np.asarray(features, dtype=np.float64))
+        step = max(1, _BLOCK_ELEMENTS // max(1, n_train * n_feat))
+        dist = np.empty((z.shape[0], k))
+        idx = np.empty((z.shape[0], k), dtype=np.intp)
+        for lo in range(0, z.shape[0], step):
+            d = self._distances(z[lo : lo + step])
+            order = np.argsort(d, axis=1, kind="stable")[:, :k]
+            idx[lo : lo + step] = order
+            dist[lo : lo + step] = np.take_along_axis(d, order, 1)
+        return dist, idx
 
     def predict(self, features: NDArray[np.float64]) -> NDArray[Any]:
         """Majority vote of the k nearest neighbours with the documented tie rule."""
-        _, idx = self.neighbours(np.asarray(features, dtype=np.float64))
-        out = []
-        for row in idx:
-            votes = self.labels_[row]
-            classes, counts = np.unique(votes, return_counts=True)
-            tied = classes[counts == counts.max()]
-            if tied.size == 1 or self.config.tie_rule == "lowest":
-                out.append(tied[0])
-            else:  # the first neighbour (nearest) whose class is among the tied
-                out.append(next(v for v in votes if v in set(tied)))
-        return np.asarray(out)
+        _, idx = self.neighbours(features)
+        votes = self.codes_[idx]  # (n_queries, k) class codes, nearest first
+        n_q, n_classes = votes.shape[0], self.classes_.shape[0]
+        counts = np.zeros((n_q, n_classes), dtype=np.intp)
+        np.add.at(counts, (np.arange(n_q)[:, None], votes), 1)
+        tied = counts == counts.max(axis=1, keepdims=True)  # (n_queries, n_classes)
+        if self.config.tie_rule == "lowest":
+            winner = np.argmax(tied, axis=1)  # the first tied class in sorted order
+        else:  # the class of the first (nearest) neighbour whose class is among the tied
+            first = np.argmax(np.take_along_axis(tied, votes, 1), axis=1)
+            winner = votes[np.arange(n_q), first]
+        return np.asarray(self.classes_[winner])

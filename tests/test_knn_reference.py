@@ -1,0 +1,99 @@
+"""The vectorised kNN against the per-query implementation it replaced, on real feature data.
+
+The reference below is the plugin's previous algorithm, kept verbatim in spirit: scikit-learn's
+``NearestNeighbors`` (a k-d tree here), a stable ranking by (distance, training index) and a
+per-query vote with ``np.unique``. The features are those of the CMU example dataset
+(``tests/data/cmu_features.csv``, see PROVENANCE.md there): envelope features sit on the
+velocity-bin grid, so exact distance ties and vote ties occur often, and single features or
+pairs of them tie more still.
+"""
+
+from __future__ import annotations
+
+import csv
+import itertools
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from mdf_knn import Knn
+from numpy.typing import NDArray
+from sklearn.model_selection import StratifiedKFold
+from sklearn.neighbors import NearestNeighbors
+
+from mdframework.classify import Standardizer
+from mdframework.features import FEATURE_NAMES
+
+DATA = Path(__file__).parent / "data" / "cmu_features.csv"
+
+
+def reference_predict(
+    x_train: NDArray[np.float64],
+    y_train: NDArray[Any],
+    x_test: NDArray[np.float64],
+    k: int,
+    tie_rule: str,
+) -> NDArray[Any]:
+    """The previous per-query kNN (scikit-learn neighbours, np.unique votes)."""
+    scaler = Standardizer.fit(x_train)
+    nn = NearestNeighbors(algorithm="auto").fit(scaler.transform(x_train))
+    n_train = len(y_train)
+    k = min(k, n_train)
+    z = scaler.transform(x_test)
+    dist, idx = nn.kneighbors(z, n_neighbors=n_train)  # every candidate, then a stable rank
+    order = np.lexsort((idx, dist), axis=1)[:, :k]
+    idx = np.take_along_axis(idx, order, 1)
+    out = []
+    for row in idx:
+        votes = y_train[row]
+        classes, counts = np.unique(votes, return_counts=True)
+        tied = classes[counts == counts.max()]
+        if tied.size == 1 or tie_rule == "lowest":
+            out.append(tied[0])
+        else:
+            out.append(next(v for v in votes if v in set(tied)))
+    return np.asarray(out)
+
+
+@pytest.fixture(scope="module")
+def cmu() -> tuple[NDArray[np.float64], NDArray[np.str_]]:
+    with DATA.open(newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    x = np.array([[float(r[n]) for n in FEATURE_NAMES] for r in rows])
+    return x, np.array([r["label"] for r in rows])
+
+
+@pytest.mark.parametrize("tie_rule", ["nearest", "lowest"])
+@pytest.mark.parametrize("k", [1, 4, 5, 8])
+def test_identical_predictions_on_real_features(
+    cmu: tuple[NDArray[np.float64], NDArray[np.str_]], k: int, tie_rule: str
+) -> None:
+    x, y = cmu
+    assert len(y) == 280
+    subsets = [
+        *itertools.combinations(range(7), 1),
+        *itertools.combinations(range(7), 2),
+        *list(itertools.combinations(range(7), 4))[::5],
+        tuple(range(7)),
+    ]
+    folds = list(StratifiedKFold(3, shuffle=True, random_state=k).split(x, y))
+    n_vote_ties = n_distance_ties = 0
+    for cols in subsets:
+        for train, test in folds:
+            xt, xs = x[train][:, list(cols)], x[test][:, list(cols)]
+            model = Knn(Knn.Config(k=k, tie_rule=tie_rule)).fit(xt, y[train])  # type: ignore[arg-type]
+            got = model.predict(xs)
+            want = reference_predict(xt, y[train], xs, k, tie_rule)
+            np.testing.assert_array_equal(got, want)
+            # ties at the cut (k-th and (k+1)-th neighbour equidistant): training order decides
+            wider = Knn(Knn.Config(k=k + 1)).fit(xt, y[train])  # type: ignore[arg-type]
+            dist, idx = wider.neighbours(xs)
+            n_distance_ties += int(np.sum(dist[:, k - 1] == dist[:, k]))
+            votes = y[train][idx[:, :k]]
+            counts = np.sort(np.stack([np.sum(votes == c, axis=1) for c in np.unique(y)]), 0)
+            n_vote_ties += int(np.sum(counts[-1] == counts[-2]))
+    # the hard cases were exercised, not only clear majorities
+    assert n_distance_ties > 100
+    if k > 1:
+        assert n_vote_ties > 100
