@@ -32,8 +32,8 @@ demo: $(STAMP)
 	@echo "spectrograms: out/demo/*/spectrogram.png; FMCW points: out/demo/fmcw_walk/points.csv; experiment report: out/demo/experiment_cmu/report.md"
 
 lint: $(STAMP)
-	$(BIN)/ruff check src plugins tests benchmarks docs examples/plugin-example
-	$(BIN)/ruff format --check src plugins tests benchmarks docs examples/plugin-example
+	$(BIN)/ruff check src plugins tests benchmarks docs examples/plugin-example examples/plugin-template
+	$(BIN)/ruff format --check src plugins tests benchmarks docs examples/plugin-example examples/plugin-template
 
 typecheck: $(STAMP)
 	$(BIN)/mypy src

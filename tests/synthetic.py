@@ -13,27 +13,14 @@ import numpy as np
 from pydantic import Field
 
 from mdframework import CANONICAL_JOINTS, Motion, MotionConfig, MotionSource, Skeleton, hookimpl
-from mdframework.physics import body
+from mdframework.testing import standing_body, walking_positions
 
 J = {n: i for i, n in enumerate(CANONICAL_JOINTS)}
 
 
 def standing(height: float = 1.8) -> np.ndarray:
     """Canonical joints (17, 3) [m] of a person standing at the origin facing +x."""
-    f = body.SEGMENT_FRACTIONS
-    z_hip = (f["upper_leg"] + f["lower_leg"]) * height
-    top = z_hip + f["torso"] * height
-    p = {"base": (0, 0, z_hip), "neck": (0, 0, top), "head": (0, 0, top + f["head"] * height)}
-    for s, y in (("l", 1.0), ("r", -1.0)):
-        sh, hp = y * f["shoulder"] * height, y * f["hip"] * height
-        p[f"{s}_shoulder"] = (0, sh, top)
-        p[f"{s}_elbow"] = (0, sh, top - f["upper_arm"] * height)
-        p[f"{s}_hand"] = (0, sh, top - (f["upper_arm"] + f["lower_arm"]) * height)
-        p[f"{s}_hip"] = (0, hp, z_hip)
-        p[f"{s}_knee"] = (0, hp, z_hip - f["upper_leg"] * height)
-        p[f"{s}_ankle"] = (0, hp, 0.0)
-        p[f"{s}_toe"] = (f["foot"] * height, hp, 0.0)
-    return np.array([p[j] for j in CANONICAL_JOINTS], dtype=float)
+    return standing_body(height)
 
 
 class SyntheticConfig(MotionConfig):
@@ -58,19 +45,7 @@ class SyntheticWalker(MotionSource):
     def load(self) -> Motion:
         c = self.config
         t = np.arange(0, c.length + 1e-9, 1 / c.frame_rate)
-        base = standing()
-        pos = np.repeat(base[None], t.size, axis=0)
-        ang = np.deg2rad(c.swing_deg) * np.sin(2 * np.pi * c.cadence_hz * t)
-        for s, sign in (("l", 1.0), ("r", -1.0)):
-            for pivot, limb in (("hip", ("knee", "ankle", "toe")), ("shoulder", ("elbow", "hand"))):
-                a = sign * ang * (1 if pivot == "hip" else -1)
-                piv = base[J[f"{s}_{pivot}"]]
-                for name in limb:
-                    d = base[J[f"{s}_{name}"]] - piv
-                    x = d[0] * np.cos(a) - d[2] * np.sin(a)
-                    z = d[0] * np.sin(a) + d[2] * np.cos(a)
-                    pos[:, J[f"{s}_{name}"]] = piv + np.stack([x, np.full_like(x, d[1]), z], 1)
-        pos[:, :, 0] += c.speed * t[:, None]
+        pos = walking_positions(t, c.speed, c.swing_deg, c.cadence_hz)
         if c.collapse == "l_forearm":
             pos[t.size // 3 :, J["l_hand"]] = pos[t.size // 3 :, J["l_elbow"]]
         elif c.collapse == "all":  # every joint but the hips onto the base

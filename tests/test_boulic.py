@@ -197,7 +197,7 @@ def test_out_of_range_rv_refused(bad: dict[str, float]) -> None:
 
 
 def test_config_errors_are_clear(registry: Registry) -> None:
-    with pytest.raises(ConfigError, match=r"motion\.rv.*less than or equal to 3"):
+    with pytest.raises(ConfigError, match=r"motion\.rv: must be at most 3 \(got 3\.5\)"):
         validate_run_config({"motion": {"kind": "boulic", "rv": 3.5}}, registry=registry)
     with pytest.raises(ConfigError, match="rv or speed, not both"):
         validate_run_config(

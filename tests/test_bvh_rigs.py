@@ -186,3 +186,18 @@ def test_amc_with_another_subjects_asf_is_an_error() -> None:
         CmuSource(CmuConfig(file=amc, asf=other)).load()
     ok = CmuSource(CmuConfig(file=amc, asf=other, allow_other_subject_asf=True)).load()
     assert ok.metadata["asf_file"] == "09.asf"
+
+
+def test_cli_unknown_rig_is_one_line_and_exit_2(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from mdframework import cli
+
+    odd = renamed_copy(MOCAPBANK, tmp_path / "odd.bvh", {"LeftWrist": "L_Wrist"})
+    cfg = tmp_path / "run.toml"
+    cfg.write_text(f'[motion]\nkind = "bvh"\nfile = "{odd}"\n')
+    out = tmp_path / "out"
+    assert cli.main(["run", str(cfg), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"mdf: error: {odd}: no known BVH rig fits")
+    assert not out.exists()

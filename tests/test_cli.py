@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -83,14 +85,14 @@ BAD_CONFIGS = {
     "field.toml": (
         '[motion]\nkind = "point_targets"\nlength = 1.0\n'
         "targets = [{ position = [10, 0, 0] }]\n[radar]\nkind = 'lfm'\nprf = -5\n",
-        "radar.prf: Input should be greater than 0",
+        "radar.prf: must be greater than 0 (got -5)",
     ),
     "extra.toml": (
         '[motion]\nkind = "point_targets"\nlength = 1.0\nspeed = 3\n'
         "targets = [{ position = [10, 0, 0] }]\n",
-        "motion.speed: Extra inputs are not permitted",
+        "motion.speed: unknown field 'speed'",
     ),
-    "kind.toml": ('[motion]\nkind = "nope"\n', "motion: unknown kind 'nope'"),
+    "kind.toml": ('[motion]\nkind = "nope"\n', "motion.kind: no motion plugin named 'nope'"),
     "nofile.toml": ('[motion]\nkind = "cmu"\nfile = "missing.bvh"\n', "motion.file:"),
     "yaml.yaml": ("motion: [1, 2\n", "invalid YAML: line"),
     "short.toml": (
@@ -182,7 +184,7 @@ def test_yaml_and_json_configs_run(tmp_path: Path, capsys: pytest.CaptureFixture
         ("gate = -5.0\n", "scene.gate"),
         (
             '[processing]\nwindow = "nosuchwindow"\n',
-            "processing.window: Value error, unknown window",
+            "processing.window: unknown window",
         ),
     ],
 )
@@ -193,3 +195,162 @@ def test_more_config_field_errors(
     cfg.write_text((EXAMPLES / "point_target.toml").read_text() + extra)  # ends in [scene]
     code, _, err = run_cli(["run", str(cfg), "--out", str(tmp_path / "o")], capsys)
     assert code == 2 and expected in err and len(err.strip().splitlines()) == 1
+
+
+FIX_HINTS = {
+    "nearest field": (
+        '[motion]\nkind = "point_targets"\nlength = 1.0\n'
+        "targets = [{ position = [10, 0, 0] }]\n[scatterers]\nkind = 'points'\n"
+        "[radar]\nkind = 'lfm'\nfrequency = 24e9\n",
+        "radar.frequency: unknown field 'frequency' (did you mean 'carrier_frequency'?)",
+    ),
+    "nearest kind": (
+        '[motion]\nkind = "point_target"\n',
+        "motion.kind: no motion plugin named 'point_target' (did you mean 'point_targets'?); "
+        "installed: ",
+    ),
+    "nearest effect": (
+        '[motion]\nkind = "point_targets"\nlength = 1.0\n'
+        "targets = [{ position = [10, 0, 0] }]\n[scatterers]\nkind = 'points'\n"
+        '[[effects]]\nkind = "nose"\n',
+        "effects.0.kind: no effects plugin named 'nose' (did you mean 'noise'?); installed: "
+        "antenna, attenuation, clutter, multipath, noise, shadowing",
+    ),
+    "toml table order": (
+        '[motion]\nkind = "point_targets"\nlength = 1.0\n'
+        "targets = [{ position = [10, 0, 0] }]\n[scatterers]\nkind = 'points'\n"
+        '[scene]\nradar_position = [0, 0, 0]\neffects = [{ kind = "noise" }]\n',
+        "scene.effects: unknown field 'effects' (allowed: gate, min_range, person, "
+        "radar_position); in TOML a key belongs to the last [table] header above it, so "
+        "'effects = ...' written after [scene] landed inside it: move it above the first "
+        "[table] header or write each effect as an [[effects]] table",
+    ),
+    "literal": (
+        '[motion]\nkind = "point_targets"\nlength = 1.0\n'
+        "targets = [{ position = [10, 0, 0] }]\n[scatterers]\nkind = 'points'\n"
+        '[processing]\naliasing = "warning"\n',
+        "processing.aliasing: must be one of 'warn', 'error' (got 'warning') "
+        "(did you mean 'warn'?)",
+    ),
+    "missing kind": (
+        "[motion]\nlength = 1.0\n",
+        "motion.kind: missing: say which motion plugin (installed kinds: boulic, ",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(FIX_HINTS))
+def test_errors_say_how_to_fix(
+    case: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    text, expected = FIX_HINTS[case]
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(text)
+    code, _, err = run_cli(["run", str(cfg), "--out", str(tmp_path / "o")], capsys)
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert f"mdf: error: {cfg}: {expected}" in err
+    assert "Extra inputs" not in err and "Input should" not in err and "Value error" not in err
+
+
+def _subparsers(parser: argparse.ArgumentParser, path: str = "mdf") -> list[tuple[str, Any]]:
+    found = []
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for name, sub in action.choices.items():
+                found.append((f"{path} {name}", sub))
+                found += _subparsers(sub, f"{path} {name}")
+    return found
+
+
+def test_every_command_has_a_description_and_examples() -> None:
+    """Including the commands plugins add (mdf kinect info, mdf capture)."""
+    commands = _subparsers(cli.build_parser())
+    names = [n for n, _ in commands]
+    assert {"mdf run", "mdf check", "mdf dataset build", "mdf kinect info", "mdf capture"} <= set(
+        names
+    )
+    for name, sub in commands:
+        assert sub.description and len(sub.description) > 20, f"{name} has no description"
+        assert sub.epilog and sub.epilog.startswith("examples:"), f"{name} has no examples"
+        for line in sub.epilog.splitlines()[1:]:
+            assert line.strip().startswith("mdf "), f"{name}: example {line!r}"
+
+
+def test_version(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as info:
+        cli.main(["--version"])
+    assert info.value.code == 0
+    assert capsys.readouterr().out.startswith("mdf (mdframework) 0.1.0, Python 3.")
+
+
+@pytest.mark.parametrize("where", ["first", "after the command", "last"])
+def test_debug_is_accepted_anywhere(where: str, tmp_path: Path) -> None:
+    cfg = tmp_path / "kind.toml"
+    cfg.write_text('[motion]\nkind = "nope"\n')
+    args = ["run", str(cfg), "--out", str(tmp_path / "o")]
+    position = {"first": 0, "after the command": 1, "last": len(args)}[where]
+    args.insert(position, "--debug")
+    proc = subprocess.run(
+        [sys.executable, "-m", "mdframework.cli", *args], capture_output=True, text=True
+    )
+    assert proc.returncode == 2
+    assert "Traceback" in proc.stderr and "mdf: error:" in proc.stderr
+
+
+def test_split_global_options_stops_at_double_dash() -> None:
+    rest, debug, off = cli.split_global_options(
+        ["run", "--disable-plugin", "mdf_cmu", "x.toml", "--disable-plugin=mdf_kinect", "--debug"]
+    )
+    assert rest == ["run", "x.toml"] and debug and off == ["mdf_cmu", "mdf_kinect"]
+    rest, debug, off = cli.split_global_options(["run", "--", "--debug"])
+    assert rest == ["run", "--", "--debug"] and not debug and off == []
+
+
+def test_check_output_in_the_docs_is_current(capsys: pytest.CaptureFixture[str]) -> None:
+    guide = (EXAMPLES.parent / "docs" / "getting-started.md").read_text()
+    code, out, _ = run_cli(["check", "examples/point_target.toml"], capsys)
+    assert code == 0
+    assert f"```text\n{out}```" in guide
+
+
+@pytest.mark.parametrize("name", ["cmu_walk.toml", "point_target.toml", "boulic_walk.toml"])
+def test_check_predicts_what_the_run_does(
+    name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The pulses, frames, axes and aliasing verdict of `mdf check` are those of the run; the
+    fastest joint's radial speed bounds the run's fastest scatterer within the frame-rate
+    differencing (10 %)."""
+    code, out, err = run_cli(["check", str(EXAMPLES / name), "--json"], capsys)
+    assert code == 0, err
+    plan = json.loads(out)
+    assert run_cli(["run", str(EXAMPLES / name), "--out", str(tmp_path / "o")], capsys)[0] == 0
+    meta = json.loads((tmp_path / "o" / "metadata.json").read_text())
+    with np.load(tmp_path / "o" / "result.npz") as d:
+        assert d["signal"].shape == (plan["n_pulses"],)
+        assert d["spectrogram_db"].shape == (plan["nfft"], plan["n_frames"])
+        dv = float(np.diff(d["velocity_mps"][:2])[0])
+    assert plan["velocity_bin_mps"] == pytest.approx(dv, rel=1e-12)
+    assert plan["max_unambiguous_velocity_mps"] == meta["max_unambiguous_velocity_mps"]
+    assert plan["max_joint_radial_speed_mps"] >= 0.9 * meta["max_radial_speed_mps"]
+    assert plan["aliasing"] is False
+
+
+def test_check_warns_of_aliasing_and_names_the_prf(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """3 m/s at 24 GHz needs PRF >= 4 * 3 / 0.012491 = 960.7 Hz; 500 Hz aliases."""
+    cfg = tmp_path / "fast.toml"
+    cfg.write_text(
+        '[motion]\nkind = "point_targets"\nlength = 2.0\n'
+        "targets = [{ position = [100.0, 0.0, 0.0], velocity = [3.0, 0.0, 0.0] }]\n"
+        '[scatterers]\nkind = "points"\n[radar]\ncarrier_frequency = 24e9\nprf = 500.0\n'
+        "[scene]\nradar_position = [0.0, 0.0, 0.0]\n"
+        "[processing]\nwindow_length = 128\nhop = 16\nnfft = 256\n"
+    )
+    code, out, _ = run_cli(["check", str(cfg)], capsys)
+    assert code == 0
+    assert (
+        "aliasing    LIKELY: fastest joint 3 m/s radially; raise radar.prf to at least 961 Hz"
+        in out
+    )
+    assert not (tmp_path / "o").exists()

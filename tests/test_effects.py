@@ -316,6 +316,15 @@ def test_antenna_gain_is_minus_3db_at_beamwidth_edge(pattern: str, bw_deg: float
     assert one_way_gain(-bore, bore, pattern=pattern, beamwidth_az=bw, beamwidth_el=bw) == 0.0
 
 
+def test_sinc2_half_power_constant_is_the_root() -> None:
+    """The written-out half-power point is the root of sinc(x)^2 = 1/2 in (0, 1)."""
+    from scipy.optimize import brentq
+
+    root = brentq(lambda x: np.sinc(x) ** 2 - 0.5, 0.1, 0.9, xtol=1e-15)
+    assert SINC2_HALF_POWER == pytest.approx(root, abs=2e-15)
+    assert np.sinc(SINC2_HALF_POWER) ** 2 == pytest.approx(0.5, abs=1e-15)
+
+
 def test_uniform_aperture_first_sidelobe_and_null() -> None:
     bw = np.deg2rad(10.0)
     d_over_lam = SINC2_HALF_POWER / np.sin(bw / 2)

@@ -35,10 +35,10 @@ def test_bad_experiment_config(tmp_path: Path) -> None:
     p = tmp_path / "e.toml"
     p.write_text('[dataset]\npath = "x"\n[classifier]\nkind = "knn"\nk = 0\n')
     cfg = exp.load_experiment_config(p)
-    with pytest.raises(ConfigError, match=r"e\.toml: classifier\.k: Input should be greater"):
+    with pytest.raises(ConfigError, match=r"e\.toml: classifier\.k: must be at least 1 \(got 0\)"):
         exp.classifier_factory(cfg.classifier, str(p))
     p.write_text('[dataset]\npath = "x"\n[selection]\nsizes = [9]\n')
-    with pytest.raises(ConfigError, match=r"selection\.sizes\.0: Input should be less than"):
+    with pytest.raises(ConfigError, match=r"selection\.sizes\.0: must be at most 7 \(got 9\)"):
         exp.load_experiment_config(p)
     p.write_text('[dataset]\npath = "x"\nconfig = "y"\n')
     with pytest.raises(ConfigError, match=r"exactly one of dataset\.config and dataset\.path"):
@@ -107,6 +107,21 @@ def test_experiment_on_shipped_cmu_data(tmp_path: Path) -> None:
     for name in ("report.md", "within_cmu_confusion.png", "scatter_torso_mean_upper_max.png"):
         assert (out / name).stat().st_size > 100
     assert json.loads((out / "summary.json").read_text())["n_records"] == 280
+    # the report says which features the selection chose in each split
+    subsets = summary["within"]["cmu"]["subsets"]
+    report = (out / "report.md").read_text()
+    assert "\n".join(exp.selected_features_markdown(subsets, "wrapper")) in report
+    assert "Selected features (times chosen in 2 splits): " in report
+
+
+def test_selected_features_are_counted_over_splits() -> None:
+    subsets = [["a", "b"], ["a", "c"], ["a", "b"]]
+    line = exp.selected_features_markdown(subsets, "wrapper")[0]
+    assert line == (
+        "Selected features (times chosen in 3 splits): a 3, b 2, c 1; most frequent subset: "
+        "a, b (2 of 3)."
+    )
+    assert exp.selected_features_markdown([], "none")[0] == "Inputs: all (no feature selection)."
 
 
 def test_recording_split_holds_out_whole_recordings(rng: np.random.Generator) -> None:

@@ -151,7 +151,7 @@ def test_receive_is_block_invariant() -> None:
         ranges = scat.ranges(radar_pos)
         return PulseBlock(lo, t[lo:hi], scat, ranges, ranges[:, 0], radar_pos)
 
-    wf = FmcwRadar(FmcwConfig(boresight_azimuth_deg=0.0))
+    wf = FmcwRadar(FmcwConfig(boresight_azimuth_deg=0.0, receiver_noise=True))
     whole = wf.receive(block(0, 192))
     halves = [wf.receive(block(0, 96)), wf.receive(block(96, 192))]
     np.testing.assert_array_equal(whole.signal, np.concatenate([h.signal for h in halves]))

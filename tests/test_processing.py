@@ -93,3 +93,21 @@ def test_db_floor_never_inf_or_nan() -> None:
     assert np.all(zero == -50.0)
     with pytest.raises(ValueError):
         spectrogram.power_to_db(np.array([np.inf]), -60.0)
+
+
+@pytest.mark.parametrize("name", sorted(spectrogram.COSINE_WINDOWS))
+@pytest.mark.parametrize("length", [2, 7, 64, 256, 1000])
+def test_numpy_windows_equal_scipys_periodic_windows(name: str, length: int) -> None:
+    from scipy.signal import get_window
+
+    expected = get_window(name, length, fftbins=True)
+    assert np.allclose(spectrogram.stft_window(name, length), expected, rtol=0, atol=1e-14)
+
+
+def test_other_windows_come_from_scipy_and_unknown_names_fail() -> None:
+    from scipy.signal import get_window
+
+    w = spectrogram.stft_window("flattop", 128)
+    assert np.array_equal(w, get_window("flattop", 128, fftbins=True))
+    with pytest.raises(ValueError):
+        spectrogram.stft_window("nosuchwindow", 8)

@@ -13,6 +13,24 @@ FC = 15e9
 PRF = 2400.0
 
 
+def test_written_out_constants_are_scipys_exact_values() -> None:
+    import scipy.constants
+
+    from mdframework.constants import BOLTZMANN
+
+    assert SPEED_OF_LIGHT == scipy.constants.speed_of_light
+    assert BOLTZMANN == scipy.constants.Boltzmann
+
+
+def test_prf_needed_inverts_the_unambiguous_velocity() -> None:
+    """lambda PRF / 4 at the PRF min_prf_for_velocity gives back the speed (15 GHz: 3 m/s
+    needs 4 * 3 / 0.019986 = 600.4 Hz)."""
+    prf = radar.min_prf_for_velocity(3.0, FC)
+    assert prf == pytest.approx(4 * 3.0 / (SPEED_OF_LIGHT / FC), rel=1e-12)
+    assert prf == pytest.approx(600.415, abs=1e-3)
+    assert radar.max_unambiguous_velocity(FC, prf) == pytest.approx(3.0, rel=1e-12)
+
+
 def test_wavelength_and_velocity_scale() -> None:
     assert radar.wavelength(FC) == pytest.approx(0.019986163867, rel=1e-11)
     assert float(radar.velocity_to_doppler(1.0, FC)) == pytest.approx(100.069228559, rel=1e-11)

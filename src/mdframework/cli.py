@@ -1,14 +1,18 @@
 """The ``mdf`` command line.
 
 Errors caused by input (config, data files, the scene) print one line and exit with code 2; add
-``--debug`` for the traceback.
+``--debug`` (anywhere on the command line) for the traceback. ``--disable-plugin NAME`` (also
+anywhere, repeatable) switches one plugin off. This module imports nothing heavy: each command
+imports what it needs when it runs, so ``mdf --help`` and ``mdf plugins`` start fast.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
+import textwrap
 import traceback
 import warnings
 from collections.abc import Iterator, Sequence
@@ -17,9 +21,22 @@ from pathlib import Path
 from typing import Any
 
 from .errors import DataFileError, MdfError
-from .plugins import INTERFACES, PluginError, default_registry, make_plugin_manager
+from .plugins import (
+    DISABLE_ENV,
+    DISABLE_PLUGINS_ENV,
+    INTERFACES,
+    PluginError,
+    add_cli_commands,
+    autoload_enabled,
+    default_registry,
+    disabled_by_user,
+    reset_default_registry,
+)
 
 EXIT_USAGE = 2
+#: options accepted anywhere on the command line (before a lone ``--``)
+GLOBAL_FLAGS = ("--debug",)
+DISABLE_OPTION = "--disable-plugin"
 
 
 @contextmanager
@@ -49,6 +66,20 @@ def _cmd_run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_check(args: argparse.Namespace) -> int:
+    from .check import format_plan, plan_run
+    from .config import load_run_config
+
+    config = load_run_config(args.config)
+    with _naming(args.config):
+        plan = plan_run(config)
+    if args.json:
+        print(json.dumps(plan.as_dict(), indent=2))
+    else:
+        print(format_plan(plan, args.config))
+    return 0
+
+
 def _cmd_plugins(args: argparse.Namespace) -> int:
     registry = default_registry()
     for interface in INTERFACES:
@@ -61,6 +92,10 @@ def _cmd_plugins(args: argparse.Namespace) -> int:
             doc = (info.cls.__doc__ or "").strip().splitlines()
             summary = doc[0] if doc else ""
             print(f"  {name:<16} {info.provider:<28} {summary}")
+    if registry.disabled:
+        print("disabled:")
+        for name, why in sorted(registry.disabled.items()):
+            print(f"  {name:<16} {why}")
     return 0
 
 
@@ -94,6 +129,7 @@ def _cmd_dataset_build(args: argparse.Namespace) -> int:
 def _cmd_experiment(args: argparse.Namespace) -> int:
     from .experiment import load_experiment_config, run_experiment
 
+    _status(args, "reading the experiment config and the installed plugins")
     config = load_experiment_config(args.config)
     with _naming(args.config):
         run_experiment(config, Path(args.out), source=args.config, progress=not args.no_progress)
@@ -101,22 +137,130 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
     return 0
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of ``mdf``."""
-    parser = argparse.ArgumentParser(
-        prog="mdf", description="Radar micro-Doppler simulation of people in motion."
-    )
-    parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
-    sub = parser.add_subparsers(dest="command", required=True)
+def _status(args: argparse.Namespace, message: str) -> None:
+    """One progress line on stderr (unless ``--no-progress``)."""
+    if not getattr(args, "no_progress", False):
+        print(f"mdf: {message} ...", file=sys.stderr, flush=True)
 
-    run = sub.add_parser("run", help="run a config: motion -> radar -> spectrogram")
+
+def _examples(*lines: str) -> str:
+    return "examples:\n" + "\n".join(f"  {line}" for line in lines)
+
+
+def add_command(
+    sub: argparse._SubParsersAction[Any],
+    name: str,
+    summary: str,
+    description: str,
+    examples: Sequence[str],
+) -> argparse.ArgumentParser:
+    """A sub-command with a one-line summary (``mdf --help``), a description and examples
+    (``mdf NAME --help``). Plugins adding commands may use it too."""
+    return sub.add_parser(  # type: ignore[no-any-return]
+        name,
+        help=summary,
+        description=textwrap.fill(description, 79),
+        epilog=_examples(*examples),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        v = version("mdframework")
+    except PackageNotFoundError:  # pragma: no cover - running from a source tree
+        from . import __version__ as v
+    return f"mdf (mdframework) {v}, Python {sys.version.split()[0]}"
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of ``mdf`` (with the commands installed plugins add)."""
+    parser = argparse.ArgumentParser(
+        prog="mdf",
+        description=textwrap.fill(
+            "Radar micro-Doppler signatures of people in motion, simulated from motion capture: "
+            "runs, labelled datasets and classification experiments from config files.",
+            79,
+        ),
+        epilog=_examples(
+            "mdf check examples/cmu_walk.toml            # what a run would do",
+            "mdf run examples/cmu_walk.toml --out out/walk",
+            "mdf dataset build examples/datasets/cmu.toml --out out/ds",
+            "mdf experiment examples/experiment_cmu.toml --out out/exp",
+            "mdf plugins                                  # installed and disabled plugins",
+            "mdf COMMAND --help                           # options and examples of a command",
+        )
+        + "\n\n--debug and --disable-plugin may be given anywhere on the command line.",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--version", action="version", version=_version())
+    parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
+    parser.add_argument(
+        DISABLE_OPTION,
+        metavar="NAME",
+        action="append",
+        default=[],
+        help=f"do not load the plugin NAME (entry point or distribution name, e.g. mdf_kinect "
+        f"or mdf-kinect); repeatable; adds to ${DISABLE_PLUGINS_ENV}",
+    )
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    run = add_command(
+        sub,
+        "run",
+        "run a config: motion -> radar -> spectrogram",
+        "Simulate one record from a run config (TOML, YAML or JSON) and write result.npz, "
+        "spectrogram.png, config.resolved.json and metadata.json into the output folder (all "
+        "or nothing). See docs/config-reference.md for every field.",
+        [
+            "mdf run examples/point_target.toml --out out/pt",
+            "mdf run examples/cmu_walk.toml --out out/walk --debug",
+        ],
+    )
     run.add_argument("config", help="run config file (.toml, .yaml or .json)")
     run.add_argument("--out", required=True, help="output folder")
     run.set_defaults(func=_cmd_run)
 
-    dataset = sub.add_parser("dataset", help="labelled datasets of simulated records")
-    dataset_sub = dataset.add_subparsers(dest="dataset_command", required=True)
-    build = dataset_sub.add_parser("build", help="build (or resume building) a dataset")
+    check = add_command(
+        sub,
+        "check",
+        "validate a run config and report what a run would do, without running it",
+        "Validate a run config, load its motion and report the plugins chosen, the record "
+        "(length, pulses), the spectrogram geometry, the Doppler and velocity resolution, the "
+        "unambiguous velocity, the aliasing risk (with the PRF that avoids it) and the memory "
+        "the run needs. Simulates nothing and writes nothing.",
+        [
+            "mdf check examples/cmu_walk.toml",
+            "mdf check examples/point_target.toml --json",
+        ],
+    )
+    check.add_argument("config", help="run config file (.toml, .yaml or .json)")
+    check.add_argument("--json", action="store_true", help="print the report as JSON")
+    check.set_defaults(func=_cmd_check)
+
+    dataset = add_command(
+        sub,
+        "dataset",
+        "labelled datasets of simulated records",
+        "Build labelled datasets of simulated records (see docs/datasets.md).",
+        ["mdf dataset build examples/datasets/cmu.toml --out out/ds"],
+    )
+    dataset_sub = dataset.add_subparsers(
+        dest="dataset_command", required=True, metavar="SUBCOMMAND"
+    )
+    build = add_command(
+        dataset_sub,
+        "build",
+        "build (or resume building) a dataset",
+        "Simulate every record a dataset config describes, in parallel, into a dataset folder "
+        "(features, spectrograms, labels). An interrupted build resumes where it stopped.",
+        [
+            "mdf dataset build examples/datasets/cmu.toml --out out/ds",
+            "mdf dataset build examples/datasets/cmu.toml --out out/ds --workers 2",
+        ],
+    )
     build.add_argument("config", help="dataset config file")
     build.add_argument("--out", required=True, help="dataset folder")
     build.add_argument("--workers", type=int, default=None, help="local processes")
@@ -128,21 +272,50 @@ def build_parser() -> argparse.ArgumentParser:
     build.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     build.set_defaults(func=_cmd_dataset_build)
 
-    experiment = sub.add_parser("experiment", help="run a classification experiment")
+    experiment = add_command(
+        sub,
+        "experiment",
+        "run a classification experiment",
+        "Build (or load) a dataset, select features, train and test a classifier over repeated "
+        "splits, and write report.md with confusion matrices, the selected features and "
+        "feature statistics (see docs/experiments.md).",
+        ["mdf experiment examples/experiment_cmu.toml --out out/exp"],
+    )
     experiment.add_argument("config", help="experiment config file")
     experiment.add_argument("--out", required=True, help="report folder")
     experiment.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     experiment.set_defaults(func=_cmd_experiment)
 
-    plugins = sub.add_parser("plugins", help="list installed plugins by interface")
+    plugins = add_command(
+        sub,
+        "plugins",
+        "list installed plugins by interface, and the disabled ones with the reason",
+        "List the installed plugins of every interface (the kind a config uses, the "
+        "distribution that provides it, a summary), then the plugins that are disabled and "
+        f"why. Disable one with --disable-plugin NAME or ${DISABLE_PLUGINS_ENV}=NAME,...",
+        ["mdf plugins", "mdf plugins --disable-plugin mdf_kinect"],
+    )
     plugins.set_defaults(func=_cmd_plugins)
 
-    config = sub.add_parser("config", help="config utilities")
-    config_sub = config.add_subparsers(dest="config_command", required=True)
-    schema = config_sub.add_parser("schema", help="print the JSON schema of run configs")
+    config = add_command(
+        sub,
+        "config",
+        "config utilities",
+        "Config utilities: the JSON schema of run configs for the installed plugins.",
+        ["mdf config schema > run-config.schema.json"],
+    )
+    config_sub = config.add_subparsers(dest="config_command", required=True, metavar="SUBCOMMAND")
+    schema = add_command(
+        config_sub,
+        "schema",
+        "print the JSON schema of run configs",
+        "Print the JSON schema of run configs for the installed plugins (for editors and "
+        "validators).",
+        ["mdf config schema > run-config.schema.json"],
+    )
     schema.set_defaults(func=_cmd_schema)
 
-    make_plugin_manager().hook.mdframework_add_cli_commands(subparsers=sub)
+    add_cli_commands(sub)
     return parser
 
 
@@ -150,9 +323,79 @@ def _one_line(message: str) -> str:
     return " ".join(str(message).split())
 
 
+def split_global_options(argv: Sequence[str]) -> tuple[list[str], bool, list[str]]:
+    """``argv`` without the options accepted anywhere (``--debug``, ``--disable-plugin NAME``),
+    whether ``--debug`` was given, and the plugins to disable. A lone ``--`` ends the scan."""
+    rest: list[str] = []
+    debug = False
+    disabled: list[str] = []
+    items = list(argv)
+    i = 0
+    while i < len(items):
+        arg = items[i]
+        if arg == "--":
+            rest += items[i:]
+            break
+        if arg in GLOBAL_FLAGS:
+            debug = True
+        elif arg == DISABLE_OPTION and i + 1 < len(items):
+            disabled.append(items[i + 1])
+            i += 1
+        elif arg.startswith(DISABLE_OPTION + "="):
+            disabled.append(arg.split("=", 1)[1])
+        else:
+            rest.append(arg)
+        i += 1
+    return rest, debug, disabled
+
+
+def _show_warning(message: Any, category: Any, *rest: Any, **kw: Any) -> None:
+    print(f"mdf: warning: {_one_line(str(message))}", file=sys.stderr)
+
+
+def _plugins_off_note() -> str:
+    if not autoload_enabled():
+        return f" (plugin loading is off: {DISABLE_ENV} is set)"
+    off = disabled_by_user()
+    return f" (disabled plugins: {', '.join(sorted(off))})" if off else ""
+
+
+def _quiet_broken_pipe() -> int:
+    """The reader of our output went away (``mdf plugins | head -1``): stop quietly."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):  # pragma: no cover - stdout without a file descriptor
+        pass
+    return 0
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point; returns the exit code."""
-    debug = "--debug" in (sys.argv[1:] if argv is None else argv)
+    raw = sys.argv[1:] if argv is None else argv
+    args_list, debug, disable = split_global_options(raw)
+    old_env = os.environ.get(DISABLE_PLUGINS_ENV)
+    if disable:  # in the environment, so that worker processes see it too
+        off = sorted(disabled_by_user() | set(disable))
+        os.environ[DISABLE_PLUGINS_ENV] = ",".join(off)
+        reset_default_registry()
+    old_showwarning = warnings.showwarning
+    warnings.showwarning = _show_warning
+    try:
+        return _main(args_list, debug)
+    except BrokenPipeError:
+        return _quiet_broken_pipe()
+    finally:
+        warnings.showwarning = old_showwarning
+        if disable:  # main() may be called again in this process (tests, embedding)
+            if old_env is None:
+                os.environ.pop(DISABLE_PLUGINS_ENV, None)
+            else:
+                os.environ[DISABLE_PLUGINS_ENV] = old_env
+            reset_default_registry()
+
+
+def _main(argv: list[str], debug: bool) -> int:
     try:
         parser = build_parser()
     except PluginError as exc:
@@ -161,17 +404,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"mdf: error: {_one_line(str(exc))}", file=sys.stderr)
         return EXIT_USAGE
     args = parser.parse_args(argv)
-
-    def show_warning(message: Any, category: Any, *rest: Any, **kw: Any) -> None:
-        print(f"mdf: warning: {_one_line(str(message))}", file=sys.stderr)
-
-    warnings.showwarning = show_warning
+    args.debug = debug or args.debug
     try:
         return int(args.func(args))
+    except BrokenPipeError:
+        raise
     except (MdfError, PluginError) as exc:
         if args.debug:
             traceback.print_exc()
-        print(f"mdf: error: {_one_line(str(exc))}", file=sys.stderr)
+        message = _one_line(str(exc))
+        if "disabled" not in message:
+            message += _plugins_off_note()
+        print(f"mdf: error: {message}", file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt:
         print("mdf: interrupted", file=sys.stderr)

@@ -36,7 +36,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.interpolate import CubicSpline
 
 from .settings import ConditioningConfig
 from .skeleton import Skeleton
@@ -151,6 +150,8 @@ def bridge_gaps(time: FloatArray, positions: FloatArray, valid: BoolArray) -> Fl
     Returns positions (n_frames, n_joints, 3) float64 [m]; valid samples are returned unchanged.
     Raises ``ValueError`` for a joint with no valid sample.
     """
+    from scipy.interpolate import CubicSpline
+
     out = np.array(positions, dtype=np.float64, copy=True)
     for j in range(positions.shape[1]):
         ok = valid[:, j]

@@ -15,14 +15,14 @@ import json
 import tomllib
 from functools import lru_cache
 from pathlib import Path
-from typing import Annotated, Any, Union
+from typing import Annotated, Any, Union, get_args
 
 import yaml
-from pydantic import Field, ValidationError, create_model, model_validator
+from pydantic import BaseModel, Field, ValidationError, create_model, model_validator
 
 from .errors import ConfigError
 from .interfaces import PluginConfig
-from .plugins import Registry, default_registry
+from .plugins import Registry, default_registry, suggest
 from .settings import RunConfigBase
 
 #: (interface, ((plugin name, its Config model), ...)) for every interface, sorted by name
@@ -81,7 +81,7 @@ def _run_config_model(key: _ConfigModels) -> type[RunConfigBase]:
                         data = {**data, section: {"kind": name, **value}}
             return data
 
-    effect_list: Any = list[union("effect")]  # type: ignore[misc]
+    effect_list: Any = list[union("effects")]  # type: ignore[misc]
     model = create_model(
         "RunConfig",
         __base__=Base,
@@ -130,22 +130,200 @@ def read_config_file(path: str | Path) -> dict[str, Any]:
     return data
 
 
-def format_validation_error(exc: ValidationError, source: str, data: Any = None) -> str:
-    """One line naming the file and the first invalid field (``section.field``)."""
+#: top-level fields of run configs (a TOML key written after a [table] header lands in it)
+TOP_LEVEL = ("seed", "motion", "scatterers", "radar", "effects", "scene", "processing",
+             "conditioning")  # fmt: skip
+#: sections that choose a plugin by ``kind``, and their interface
+PLUGIN_SECTIONS = {"motion": "motion", "scatterers": "scatterers", "radar": "radar"}
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _model_candidates(annotation: Any) -> list[type[BaseModel]]:
+    """The pydantic models an annotation may hold (through Optional, unions, lists, dicts)."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return [annotation]
+    found: list[type[BaseModel]] = []
+    for arg in get_args(annotation):
+        found += _model_candidates(arg)
+    return found
+
+
+def _model_at(
+    model: type[BaseModel] | None, loc: tuple[Any, ...], data: Any
+) -> type[BaseModel] | None:
+    """The model that validates the object at ``loc`` (choosing plugin models by ``kind``)."""
+    node = data
+    for part in loc:
+        if model is None:
+            return None
+        if isinstance(part, int):
+            node = node[part] if isinstance(node, list) and part < len(node) else None
+            continue
+        field = model.model_fields.get(str(part))
+        node = node.get(part) if isinstance(node, dict) else None
+        if field is None:
+            return None
+        candidates = _model_candidates(field.annotation)
+        kind = None
+        if isinstance(node, dict):
+            kind = node.get("kind")
+        elif isinstance(node, list) and node and isinstance(node[0], dict):
+            kind = None  # resolved at the list index below
+        model = _pick(candidates, kind)
+        if isinstance(node, list):
+            return _model_in_list(candidates, loc[loc.index(part) + 1 :], node)
+    return model
+
+
+def _model_in_list(
+    candidates: list[type[BaseModel]], rest: tuple[Any, ...], node: list[Any]
+) -> type[BaseModel] | None:
+    if not rest or not isinstance(rest[0], int) or rest[0] >= len(node):
+        return None
+    item = node[rest[0]]
+    kind = item.get("kind") if isinstance(item, dict) else None
+    return _model_at(_pick(candidates, kind), tuple(rest[1:]), item)
+
+
+def _pick(candidates: list[type[BaseModel]], kind: Any) -> type[BaseModel] | None:
+    if len(candidates) == 1:
+        return candidates[0]
+    for cand in candidates:
+        field = cand.model_fields.get("kind")
+        if field is not None and kind in get_args(field.annotation):
+            return cand
+    return None
+
+
+#: pydantic comparison errors -> (words, ctx key)
+_BOUNDS = {
+    "greater_than": ("greater than", "gt"),
+    "greater_than_equal": ("at least", "ge"),
+    "less_than": ("less than", "lt"),
+    "less_than_equal": ("at most", "le"),
+}
+
+
+def _plain(error: Any, allowed: list[str] | None) -> str:
+    """A pydantic error in plain words, with the nearest valid name for unknown fields."""
+    kind, msg, ctx = error["type"], error["msg"], error.get("ctx") or {}
+    got = f" (got {_short(error.get('input'))})"
+    if kind == "extra_forbidden":
+        name = str(error["loc"][-1])
+        text = f"unknown field {name!r}"
+        if allowed:
+            hint = suggest(name, allowed)
+            text += hint or f" (allowed: {', '.join(allowed)})"
+        return text
+    if kind == "missing":
+        return "required field is missing"
+    if kind in _BOUNDS:
+        words, key = _BOUNDS[kind]
+        bound = ctx.get(key)
+        shown = f"{bound:g}" if isinstance(bound, float) else str(bound)
+        return f"must be {words} {shown}{got}"
+    if kind == "literal_error":
+        expected = str(ctx.get("expected", "")).replace(" or ", ", ")
+        options = [o.strip().strip("'\"") for o in expected.split(",")]
+        return f"must be one of {expected}{got}{suggest(str(error.get('input')), options)}"
+    if kind in ("value_error", "assertion_error"):
+        return str(msg.split(", ", 1)[1] if ", " in msg else msg)
+    plain = str(msg).replace("Input should be", "must be").replace("Value error, ", "")
+    return plain + (got if kind.endswith(("_type", "_parsing")) else "")
+
+
+def _toml_hint(parts: list[str], source: str) -> str:
+    """The table-order trap: a top-level key written after a [table] header belongs to it."""
+    if len(parts) < 2 or parts[-1] not in TOP_LEVEL or parts[0] not in TOP_LEVEL:
+        return ""
+    where = "[" + ".".join(parts[:-1]) + "]"
+    if source.endswith(".toml"):
+        return (
+            f"; in TOML a key belongs to the last [table] header above it, so "
+            f"'{parts[-1]} = ...' written after {where} landed inside it: move it above the "
+            "first [table] header"
+            + (" or write each effect as an [[effects]] table" if parts[-1] == "effects" else "")
+        )
+    return f"; {parts[-1]!r} is a top-level field: move it out of {where}"
+
+
+def format_validation_error(
+    exc: ValidationError,
+    source: str,
+    data: Any = None,
+    model: type[BaseModel] | None = None,
+) -> str:
+    """One line naming the file and the first invalid field (``section.field``) in plain words,
+    with the nearest valid name for an unknown field and the TOML table-order hint. ``model``
+    (the model validated) lets it list the valid field names."""
     errors = exc.errors(include_url=False)
     first = errors[0]
     parts: list[str] = []
+    loc: list[Any] = []
     node = data
     for part in first["loc"]:
         if isinstance(node, dict) and part not in node and node.get("kind") == part:
             continue  # the discriminator tag pydantic inserts for plugin sections
         parts.append(str(part))
-        node = node.get(part) if isinstance(node, dict) else None
+        loc.append(part)
+        if isinstance(node, dict):
+            node = node.get(part)
+        elif isinstance(node, list) and isinstance(part, int) and part < len(node):
+            node = node[part]
+        else:
+            node = None
+    allowed = None
+    if first["type"] == "extra_forbidden":
+        parent = _model_at(model, tuple(loc[:-1]), data)
+        if parent is not None:
+            allowed = sorted(parent.model_fields)
     more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
-    msg = first["msg"]
     if first["type"] == "union_tag_invalid":
-        msg = f"unknown kind {first['input'].get('kind')!r}; " + msg.split(";")[-1].strip()
-    return f"{source}: {'.'.join(parts) or '(top level)'}: {msg}{more}"
+        msg = f"unknown kind {first['input'].get('kind')!r}; " + first["msg"].split(";")[-1].strip()
+    else:
+        msg = _plain(first, allowed)
+    hint = _toml_hint(parts, source) if first["type"] == "extra_forbidden" else ""
+    return f"{source}: {'.'.join(parts) or '(top level)'}: {msg}{hint}{more}"
+
+
+def check_plugin_kinds(data: dict[str, Any], source: str, registry: Registry) -> None:
+    """Every plugin section names an installed kind; else a :class:`ConfigError` that lists the
+    installed kinds, suggests the nearest and says which plugins are disabled."""
+    sections: list[tuple[str, str, Any]] = [
+        (key, interface, data.get(key)) for key, interface in PLUGIN_SECTIONS.items()
+    ]
+    effects = data.get("effects")
+    if isinstance(effects, list):
+        sections += [(f"effects.{i}", "effects", e) for i, e in enumerate(effects)]
+    for where, interface, section in sections:
+        if section is None and where != "motion":
+            continue  # a default applies
+        if not isinstance(section, dict):
+            if section is None:
+                problem = "missing: add a [motion] section with a kind"
+            else:
+                problem = f"must be a table with a kind (got {_short(section)})"
+            raise ConfigError(f"{source}: {where}: {problem}{_kinds(registry, interface)}")
+        kind = section.get("kind")
+        if kind is None:
+            if len(registry.names(interface)) == 1:
+                continue  # the only plugin's config has its kind as default
+            raise ConfigError(
+                f"{source}: {where}.kind: missing: say which {interface} plugin"
+                f"{_kinds(registry, interface)}"
+            )
+        if str(kind) not in registry.plugins[interface]:
+            message = registry.unknown_kind_message(interface, str(kind))
+            raise ConfigError(f"{source}: {where}.kind: {message}")
+
+
+def _kinds(registry: Registry, interface: str) -> str:
+    names = ", ".join(registry.names(interface)) or "none"
+    return f" (installed kinds: {names}{registry.disabled_note()})"
 
 
 def load_run_config(path: str | Path, registry: Registry | None = None) -> RunConfigBase:
@@ -163,8 +341,10 @@ def validate_run_config(
     registry: Registry | None = None,
 ) -> RunConfigBase:
     """Validate a config dict; errors are :class:`ConfigError` naming ``source`` and the field."""
-    model = run_config_model(registry)
+    reg = registry or default_registry()
+    check_plugin_kinds(data, source, reg)
+    model = run_config_model(reg)
     try:
         return model.model_validate(data, context={"base_dir": base_dir})
     except ValidationError as exc:
-        raise ConfigError(format_validation_error(exc, source, data)) from None
+        raise ConfigError(format_validation_error(exc, source, data, model)) from None

@@ -257,7 +257,7 @@ def load_dataset_config(path: str | Path) -> tuple[DatasetConfig, Path]:
     try:
         return DatasetConfig.model_validate(data), p.parent
     except ValidationError as exc:
-        raise ConfigError(format_validation_error(exc, str(p), data)) from None
+        raise ConfigError(format_validation_error(exc, str(p), data, DatasetConfig)) from None
 
 
 @lru_cache(maxsize=64)

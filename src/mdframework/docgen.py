@@ -21,7 +21,7 @@ SECTIONS = {
     "motion": "`[motion]`: the motion source",
     "scatterers": "`[scatterers]`: the scatterer (RCS) model",
     "radar": "`[radar]`: the radar waveform",
-    "effect": "`[[effects]]`: scene effects (only those listed are simulated)",
+    "effects": "`[[effects]]`: scene effects (only those listed are simulated)",
     "classifier": "`[classifier]`: classifiers",
     "recording": "`recording` of a dataset source: readers of real radar recordings",
 }
@@ -120,5 +120,22 @@ def render(registry: Registry | None = None) -> str:
     return "\n".join(out)
 
 
+def project_registry() -> Registry:
+    """The installed plugins whose code lives in this source tree's ``plugins/`` folder (the
+    reference documents those, whatever else is installed)."""
+    import inspect
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2] / "plugins"
+    reg = default_registry()
+    own = {
+        info.provider.split()[0]
+        for infos in reg.plugins.values()
+        for info in infos.values()
+        if root in Path(inspect.getfile(info.cls)).resolve().parents
+    }
+    return reg.provided_by(own)
+
+
 if __name__ == "__main__":
-    sys.stdout.write(render())
+    sys.stdout.write(render(project_registry()))

@@ -25,6 +25,8 @@ from __future__ import annotations
 import csv
 import io
 import json
+import sys
+from collections import Counter
 from collections.abc import Callable, Sequence
 from functools import partial
 from pathlib import Path
@@ -33,7 +35,6 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field, ValidationError, model_validator
-from sklearn.model_selection import StratifiedShuffleSplit
 
 from .classify import (
     Selection,
@@ -175,7 +176,7 @@ def load_experiment_config(path: str | Path) -> ExperimentConfig:
     try:
         cfg = ExperimentConfig.model_validate(data)
     except ValidationError as exc:
-        raise ConfigError(format_validation_error(exc, str(p), data)) from None
+        raise ConfigError(format_validation_error(exc, str(p), data, ExperimentConfig)) from None
     if cfg.input == "histogram" and cfg.selection.method != "none":
         raise ConfigError(f"{p}: input = 'histogram' needs selection.method = 'none'")
     for pair in cfg.report.scatter_pairs:
@@ -199,7 +200,7 @@ def classifier_factory(
         cfg = cls.Config.model_validate(section)
     except ValidationError as exc:
         raise ConfigError(
-            format_validation_error(exc, source, section).replace(
+            format_validation_error(exc, source, section, cls.Config).replace(
                 f"{source}: ", f"{source}: classifier.", 1
             )
         ) from None
@@ -337,10 +338,12 @@ def within_source(
     y: NDArray[Any],
     recordings: NDArray[Any] | None = None,
     names: Sequence[str] = FEATURE_NAMES,
+    progress: str | None = None,
 ) -> dict[str, Any]:
     """Repeated stratified splits of one group's records; returns matrices and scores.
     ``recordings`` (n_records,) names each record's source file (for ``split = 'recording'``);
-    ``names`` the columns of ``x``."""
+    ``names`` the columns of ``x``; ``progress``: a progress bar with this label over the
+    splits (on stderr), or none."""
     classes = sorted(set(y.tolist()))
     ev = cfg.evaluation
     if ev.split == "groups":
@@ -352,12 +355,17 @@ def within_source(
             raise MdfError("evaluation.split = 'recording' needs each record's recording")
         splits = recording_splits(y, recordings, ev.repeats, ev.test_fraction, cfg.seed)
     else:
+        from sklearn.model_selection import StratifiedShuffleSplit
+
         splitter = StratifiedShuffleSplit(
             n_splits=ev.repeats, test_size=ev.test_fraction, random_state=cfg.seed
         )
         splits = list(splitter.split(x, y))
     mats, accs, optimistic, subsets = [], [], [], []
-    for rep, (train, test) in enumerate(splits):
+    from tqdm import tqdm
+
+    bar = tqdm(splits, desc=progress, unit="split", disable=progress is None, leave=False)
+    for rep, (train, test) in enumerate(bar):
         sel = _select(cfg, factory, x[train], y[train], cfg.seed + rep)
         pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
         mats.append(confusion_matrix(y[test], pred, classes))
@@ -486,6 +494,26 @@ def classifier_inputs(
     return data, x, list(histogram_vector_names(centres))
 
 
+def _status(progress: bool, message: str) -> None:
+    if progress:
+        print(f"mdf: {message} ...", file=sys.stderr, flush=True)
+
+
+def selected_features_markdown(subsets: Sequence[Sequence[str]], method: str) -> list[str]:
+    """Report lines saying which inputs feature selection chose: how often each was chosen over
+    the splits, and the most frequent subset."""
+    if method == "none" or not subsets:
+        return ["Inputs: all (no feature selection).", ""]
+    counts = Counter(name for subset in subsets for name in subset)
+    per_feature = ", ".join(f"{name} {n}" for name, n in counts.most_common())
+    best, times = Counter(tuple(s) for s in subsets).most_common(1)[0]
+    return [
+        f"Selected features (times chosen in {len(subsets)} splits): {per_feature}; most "
+        f"frequent subset: {', '.join(best)} ({times} of {len(subsets)}).",
+        "",
+    ]
+
+
 def run_experiment(
     cfg: ExperimentConfig,
     out_dir: Path,
@@ -508,6 +536,7 @@ def run_experiment(
     else:
         assert cfg.dataset.path is not None
         data_dir = cfg.dataset.path
+    _status(progress, f"loading the dataset {data_dir}")
     data, x_all, names = classifier_inputs(cfg, data_dir)
     figures: list[Callable[[], None]] = []  # drawn at the end
 
@@ -545,6 +574,7 @@ def run_experiment(
                 data.labels[mask],
                 np.array([_text(v) for v in data.table[column][mask]]),
                 names,
+                progress=f"within {group}" if progress else None,
             )
         except MdfError as exc:  # e.g. a class with a single recording cannot be held out
             report += [f"## Within-source: {group}", "", f"Not evaluated: {exc}.", ""]
@@ -595,6 +625,7 @@ def run_experiment(
             "",
             _markdown_matrix(classes, res["confusion_mean"], res["confusion_std"]),
             "",
+            *selected_features_markdown(res["subsets"], cfg.selection.method),
         ]
         if opt is not None:
             report += [
@@ -658,6 +689,7 @@ def run_experiment(
             "![train/test](train_test_confusion.png)",
             "",
         ]
+    _status(progress, "feature statistics and figures")
     stats = feature_statistics(data)
     (out / "feature_stats.csv").write_text(_csv(stats))
     md = _stats_markdown(stats)

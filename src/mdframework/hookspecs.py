@@ -1,5 +1,8 @@
 """pluggy hook specifications: one registration hook per interface.
 
+The hook of each interface is named after its base class (``RadarWaveform`` ->
+``mdframework_register_radar_waveforms``); see :mod:`mdframework.plugins` for the table.
+
 A plugin distribution declares an entry point in the ``mdframework`` group whose object is a module
 (or class) implementing some of these hooks with ``@mdframework.hookimpl``. Each hook returns a list
 of plugin classes; their ``name`` is the ``kind`` used in config files.
@@ -50,8 +53,19 @@ def mdframework_register_scatterer_models() -> list[type[ScattererModel]]:  # ty
 
 
 @hookspec
+def mdframework_register_radar_waveforms() -> list[type[RadarWaveform]]:  # type: ignore[empty-body]
+    """Return the :class:`~mdframework.interfaces.RadarWaveform` classes this plugin provides
+    (the ``[radar]`` section)."""
+
+
+@hookspec(
+    warn_on_impl=DeprecationWarning(
+        "the hook mdframework_register_waveforms is deprecated: rename it to "
+        "mdframework_register_radar_waveforms"
+    )
+)
 def mdframework_register_waveforms() -> list[type[RadarWaveform]]:  # type: ignore[empty-body]
-    """Return the :class:`~mdframework.interfaces.RadarWaveform` classes this plugin provides."""
+    """Deprecated spelling of :func:`mdframework_register_radar_waveforms`."""
 
 
 @hookspec
@@ -61,7 +75,8 @@ def mdframework_register_classifiers() -> list[type[Classifier]]:  # type: ignor
 
 @hookspec
 def mdframework_register_effects() -> list[type[Effect]]:  # type: ignore[empty-body]
-    """Return the :class:`~mdframework.interfaces.Effect` classes this plugin provides."""
+    """Return the :class:`~mdframework.interfaces.Effect` classes this plugin provides (the
+    ``[[effects]]`` entries)."""
 
 
 @hookspec
@@ -77,8 +92,13 @@ def mdframework_register_recordings() -> list[type[RadarRecordingSource]]:  # ty
 def mdframework_add_cli_commands(subparsers: argparse._SubParsersAction[Any]) -> None:
     """Add ``mdf`` sub-commands (e.g. ``mdf capture``).
 
-    Call ``subparsers.add_parser(name, help=...)`` and ``set_defaults(func=handler)``; the handler
+    Call ``subparsers.add_parser(name, help=..., description=..., epilog=...,
+    formatter_class=argparse.RawDescriptionHelpFormatter)`` with a one-line ``help``, a
+    ``description`` and an ``epilog`` of examples, and ``set_defaults(func=handler)``; the handler
     takes the parsed ``argparse.Namespace`` and returns an exit code. Raise
     :class:`~mdframework.errors.MdfError` for bad input: the CLI prints it as one line and exits
     with code 2.
+
+    ``mdf --help`` calls this hook, so the module that implements it must import nothing heavy
+    (import inside the handler instead).
     """

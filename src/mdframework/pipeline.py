@@ -97,7 +97,7 @@ def build_stages(config: RunConfigBase, registry: Registry | None = None) -> Sta
         make("motion", cfg.motion),
         make("scatterers", cfg.scatterers),
         make("radar", cfg.radar),
-        tuple(make("effect", e) for e in cfg.effects),
+        tuple(make("effects", e) for e in cfg.effects),
     )
 
 
@@ -390,7 +390,9 @@ class _Stream:
     def _aliasing_message(self) -> str:
         return (
             f"the fastest scatterer moves at {self.speed:.2f} m/s radially, beyond the "
-            f"unambiguous {self.v_max:.2f} m/s of PRF {self.prf:g} Hz: its Doppler aliases"
+            f"unambiguous {self.v_max:.2f} m/s of PRF {self.prf:g} Hz: its Doppler aliases; "
+            f"raise the PRF to at least {np.ceil(self.prf * self.speed / self.v_max):.0f} Hz "
+            "(processing.aliasing = 'error' stops such runs)"
         )
 
     def warn_aliasing(self) -> None:

@@ -4,18 +4,45 @@ Built-in plugins are separate distributions that register through the ``mdframew
 group, exactly as a third party's would. The registry is derived from the hook results, never kept
 as a second hand-written table.
 
-Set the environment variable ``MDFRAMEWORK_DISABLE_PLUGIN_AUTOLOAD=1`` to skip entry points (tests
-then register plugins by hand with :func:`build_registry`).
+One name per interface, used everywhere: the config section (``[radar]``), the registry key, the
+base class, the registration hook and the contract check follow :data:`INTERFACES`:
+
+- ``motion``: ``MotionSource``, hook ``mdframework_register_motion_sources``,
+  check ``check_motion_source``;
+- ``scatterers``: ``ScattererModel``, ``mdframework_register_scatterer_models``,
+  ``check_scatterer_model``;
+- ``radar``: ``RadarWaveform``, ``mdframework_register_radar_waveforms``,
+  ``check_radar_waveform``;
+- ``classifier``: ``Classifier``, ``mdframework_register_classifiers``, ``check_classifier``;
+- ``effects``: ``Effect``, ``mdframework_register_effects``, ``check_effect``;
+- ``recording`` (dataset configs): ``RadarRecordingSource``, ``mdframework_register_recordings``,
+  ``check_recording_source``.
+
+Old spellings (the registry key ``effect``, the hook ``mdframework_register_waveforms``) keep
+working with a :class:`DeprecationWarning`.
+
+Switching plugins off (both read by every process, so dataset workers see them too):
+
+- ``MDFRAMEWORK_DISABLE_PLUGINS=name,name``: skip these entry points (by entry-point name, e.g.
+  ``mdf_kinect``, or distribution name, e.g. ``mdf-kinect``); ``mdf --disable-plugin NAME`` sets it.
+- ``MDFRAMEWORK_DISABLE_PLUGIN_AUTOLOAD=1``: skip every entry point (tests then register plugins by
+  hand with :func:`build_registry`).
+
+A plugin that fails to import, whose hook raises, or whose hook returns something that is not a
+plugin class, disables only itself with one :class:`PluginWarning`. Every disabled plugin and the
+reason are kept in :attr:`Registry.disabled` (``mdf plugins`` lists them).
 """
 
 from __future__ import annotations
 
+import difflib
 import importlib.metadata
 import os
+import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from functools import cache
-from typing import Any
+from typing import Any, NamedTuple
 
 import pluggy
 
@@ -31,20 +58,52 @@ from .interfaces import (
 )
 
 DISABLE_ENV = "MDFRAMEWORK_DISABLE_PLUGIN_AUTOLOAD"
+DISABLE_PLUGINS_ENV = "MDFRAMEWORK_DISABLE_PLUGINS"
 
-#: interface name -> (hook name, base class)
-INTERFACES: dict[str, tuple[str, type[Plugin]]] = {
-    "motion": ("mdframework_register_motion_sources", MotionSource),
-    "scatterers": ("mdframework_register_scatterer_models", ScattererModel),
-    "radar": ("mdframework_register_waveforms", RadarWaveform),
-    "classifier": ("mdframework_register_classifiers", Classifier),
-    "effect": ("mdframework_register_effects", Effect),
-    "recording": ("mdframework_register_recordings", RadarRecordingSource),
+
+class Interface(NamedTuple):
+    """One plugin interface: its registration hook and base class."""
+
+    hook: str
+    base: type[Plugin]
+
+
+#: interface (= config section) -> (hook name, base class)
+INTERFACES: dict[str, Interface] = {
+    "motion": Interface("mdframework_register_motion_sources", MotionSource),
+    "scatterers": Interface("mdframework_register_scatterer_models", ScattererModel),
+    "radar": Interface("mdframework_register_radar_waveforms", RadarWaveform),
+    "classifier": Interface("mdframework_register_classifiers", Classifier),
+    "effects": Interface("mdframework_register_effects", Effect),
+    "recording": Interface("mdframework_register_recordings", RadarRecordingSource),
 }
+
+#: old interface spelling -> current one
+OLD_INTERFACE_NAMES = {"effect": "effects"}
+#: old hook name -> the interface it registers for
+OLD_HOOKS = {"mdframework_register_waveforms": "radar"}
 
 
 class PluginError(RuntimeError):
-    """A plugin could not be loaded or registered (duplicate name, wrong type, ...)."""
+    """A plugin could not be registered (two plugins with one name, unknown interface, ...)."""
+
+
+class PluginWarning(UserWarning):
+    """A plugin was disabled because it failed to load or to register."""
+
+
+def interface_name(name: str) -> str:
+    """The current spelling of an interface name (old spellings warn); ``PluginError`` if
+    unknown."""
+    if name in INTERFACES:
+        return name
+    if name in OLD_INTERFACE_NAMES:
+        new = OLD_INTERFACE_NAMES[name]
+        warnings.warn(
+            f"the plugin interface {name!r} is now called {new!r}", DeprecationWarning, stacklevel=3
+        )
+        return new
+    raise PluginError(f"unknown plugin interface {name!r} (known: {', '.join(INTERFACES)})")
 
 
 @dataclass(frozen=True)
@@ -56,25 +115,78 @@ class PluginInfo:
     provider: str
 
 
+class _ByInterface(dict[str, dict[str, PluginInfo]]):
+    """Plugins by interface; old interface spellings still work (with a DeprecationWarning)."""
+
+    def __missing__(self, key: str) -> dict[str, PluginInfo]:
+        if key in OLD_INTERFACE_NAMES:
+            return self[interface_name(key)]
+        raise KeyError(key)
+
+
+def suggest(name: str, known: Iterable[str]) -> str:
+    """`` (did you mean 'x'?)`` for the closest of ``known`` to ``name``, or ``""``."""
+    close = difflib.get_close_matches(str(name), list(known), n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
 @dataclass
 class Registry:
-    """Registered plugins, by interface and name."""
+    """Registered plugins, by interface and name, and the disabled ones with the reason."""
 
     plugins: dict[str, dict[str, PluginInfo]] = field(
-        default_factory=lambda: {k: {} for k in INTERFACES}
+        default_factory=lambda: _ByInterface({k: {} for k in INTERFACES})
     )
+    #: entry-point name (or "<all entry points>") -> why it is not loaded
+    disabled: dict[str, str] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.plugins, _ByInterface):
+            self.plugins = _ByInterface(self.plugins)
 
     def get(self, interface: str, name: str) -> type[Plugin]:
-        """The plugin class ``name`` of ``interface``; ``KeyError`` lists the known names."""
+        """The plugin class ``name`` of ``interface``; ``KeyError`` with a one-line message that
+        lists the installed names, suggests the nearest and says which plugins are disabled."""
+        interface = interface_name(interface)
         known = self.plugins[interface]
         if name not in known:
-            names = ", ".join(sorted(known)) or "none installed"
-            raise KeyError(f"no {interface} plugin named {name!r} (known: {names})")
+            raise KeyError(self.unknown_kind_message(interface, name))
         return known[name].cls
+
+    def unknown_kind_message(self, interface: str, name: str) -> str:
+        """Why ``name`` is not a plugin of ``interface``, and what to do."""
+        interface = interface_name(interface)
+        known = sorted(self.plugins[interface])
+        installed = ", ".join(known) or "none"
+        msg = f"no {interface} plugin named {name!r}{suggest(name, known)}; installed: {installed}"
+        return msg + self.disabled_note()
+
+    def disabled_note(self) -> str:
+        """``"; disabled plugins: ..."`` naming each disabled plugin and why, or ``""``."""
+        if not self.disabled:
+            return ""
+        by_reason: dict[str, list[str]] = {}
+        for name, why in sorted(self.disabled.items()):
+            by_reason.setdefault(why, []).append(name)
+        items = [
+            f"{names[0]} ({why})" if len(names) == 1 else f"{len(names)} plugins ({why})"
+            for why, names in by_reason.items()
+        ]
+        return "; disabled: " + ", ".join(items)
 
     def names(self, interface: str) -> list[str]:
         """Sorted plugin names of one interface."""
-        return sorted(self.plugins[interface])
+        return sorted(self.plugins[interface_name(interface)])
+
+    def provided_by(self, distributions: Iterable[str]) -> Registry:
+        """The plugins of the named distributions only (e.g. the project's own, to document
+        them whatever else is installed)."""
+        keep = set(distributions)
+        plugins = {
+            interface: {n: i for n, i in infos.items() if i.provider.split()[0] in keep}
+            for interface, infos in self.plugins.items()
+        }
+        return Registry(plugins, dict(self.disabled))
 
 
 def _provider_name(pm: pluggy.PluginManager, plugin: object) -> str:
@@ -86,44 +198,129 @@ def _provider_name(pm: pluggy.PluginManager, plugin: object) -> str:
 _DISTRIBUTIONS: dict[str, str] = {}
 
 
+def _warn_disabled(pm: pluggy.PluginManager, name: str, reason: str) -> None:
+    """Record a plugin as disabled and warn once (per plugin manager, i.e. once per process for
+    the installed plugins)."""
+    disabled = _disabled(pm)
+    if name not in disabled:
+        warnings.warn(f"plugin {name!r} is disabled: {reason}", PluginWarning, stacklevel=2)
+    disabled[name] = reason
+
+
+def _disabled(pm: pluggy.PluginManager) -> dict[str, str]:
+    found: dict[str, str] | None = getattr(pm, "_mdf_disabled", None)
+    if found is None:
+        found = {}
+        pm._mdf_disabled = found  # type: ignore[attr-defined]
+    return found
+
+
+def disabled_by_user() -> set[str]:
+    """Plugin names listed in ``MDFRAMEWORK_DISABLE_PLUGINS`` (comma or space separated)."""
+    raw = os.environ.get(DISABLE_PLUGINS_ENV, "")
+    return {n.strip() for n in raw.replace(",", " ").split() if n.strip()}
+
+
+def autoload_enabled() -> bool:
+    """Whether entry points are loaded (``MDFRAMEWORK_DISABLE_PLUGIN_AUTOLOAD`` unset or 0)."""
+    return os.environ.get(DISABLE_ENV, "") in ("", "0")
+
+
+def _entry_points() -> list[importlib.metadata.EntryPoint]:
+    return sorted(importlib.metadata.entry_points(group=hookspecs.PROJECT), key=lambda e: e.name)
+
+
+def _unknown_hooks(plugin: object) -> list[str]:
+    """Names of hook implementations on ``plugin`` that match no hook specification."""
+    specs = {n for n in dir(hookspecs) if n.startswith("mdframework_")}
+    bad = []
+    for attr in dir(plugin):
+        if not attr.startswith("mdframework_") or attr in specs:
+            continue
+        if hasattr(getattr(plugin, attr, None), f"{hookspecs.PROJECT}_impl"):
+            bad.append(attr + suggest(attr, specs))
+    return bad
+
+
 def _load_entry_points(pm: pluggy.PluginManager) -> None:
-    for ep in importlib.metadata.entry_points(group=hookspecs.PROJECT):
+    off = disabled_by_user()
+    for ep in _entry_points():
         if pm.get_plugin(ep.name) is not None or pm.is_blocked(ep.name):
             continue
-        dist = f"{ep.dist.name} {ep.dist.version}" if ep.dist else ep.name
+        dist_name = ep.dist.name if ep.dist else ep.name
+        dist = f"{dist_name} {ep.dist.version}" if ep.dist else ep.name
+        if {ep.name, dist_name} & off:
+            _disabled(pm)[ep.name] = f"{dist}, disabled by {DISABLE_PLUGINS_ENV}"
+            continue
         try:
             plugin = ep.load()
         except Exception as exc:
-            raise PluginError(
-                f"plugin {ep.name!r} from {dist} failed to load: {type(exc).__name__}: {exc}"
-            ) from exc
-        pm.register(plugin, name=ep.name)
+            _warn_disabled(pm, ep.name, f"{dist} failed to load: {type(exc).__name__}: {exc}")
+            continue
+        bad = _unknown_hooks(plugin)
+        if bad:
+            _warn_disabled(pm, ep.name, f"{dist} implements unknown hooks: {', '.join(bad)}")
+            continue
+        with warnings.catch_warnings():
+            # the old hook names warn through pluggy; a plugin author sees it in their tests
+            warnings.simplefilter("ignore", DeprecationWarning)
+            pm.register(plugin, name=ep.name)
         _DISTRIBUTIONS[ep.name] = dist
 
 
+def _hook_classes(
+    pm: pluggy.PluginManager, hook_name: str
+) -> Iterable[tuple[object, str, list[Any] | None]]:
+    hook = getattr(pm.hook, hook_name)
+    for impl in hook.get_hookimpls():
+        provider = _provider_name(pm, impl.plugin)
+        try:
+            classes = impl.function()
+        except Exception as exc:
+            name = pm.get_name(impl.plugin) or provider
+            _warn_disabled(pm, name, f"{provider}: {hook_name} raised {type(exc).__name__}: {exc}")
+            yield impl.plugin, provider, None
+            continue
+        yield impl.plugin, provider, list(classes or [])
+
+
 def _collect(pm: pluggy.PluginManager) -> Registry:
-    registry = Registry()
-    for interface, (hook_name, base) in INTERFACES.items():
-        hook = getattr(pm.hook, hook_name)
-        for impl in hook.get_hookimpls():
-            provider = _provider_name(pm, impl.plugin)
-            classes = impl.function() or []
+    registry = Registry(disabled=_disabled(pm))
+    hooks = [(i, spec.hook) for i, spec in INTERFACES.items()]
+    hooks += [(i, old) for old, i in OLD_HOOKS.items()]
+    entries: list[tuple[str, str, object, str, type[Plugin]]] = []
+    broken: set[object] = set()
+    for interface, hook_name in hooks:
+        base = INTERFACES[interface].base
+        for plugin, provider, classes in _hook_classes(pm, hook_name):
+            if classes is None:
+                broken.add(plugin)
+                continue
             for cls in classes:
+                problem = ""
                 if not (isinstance(cls, type) and issubclass(cls, base)):
-                    raise PluginError(
-                        f"plugin {provider}: {hook_name} returned {cls!r}, "
-                        f"which is not a {base.__name__} subclass"
-                    )
-                name = getattr(cls, "name", None)
-                if not isinstance(name, str) or not name:
-                    raise PluginError(f"plugin {provider}: {cls.__name__} has no 'name'")
-                known = registry.plugins[interface]
-                if name in known:
-                    raise PluginError(
-                        f"two {interface} plugins are named {name!r}: "
-                        f"{known[name].provider} and {provider}"
-                    )
-                known[name] = PluginInfo(cls, interface, provider)
+                    problem = f"{hook_name} returned {cls!r}, which is not a {base.__name__}"
+                elif not isinstance(getattr(cls, "name", None), str) or not cls.name:
+                    problem = f"{cls.__name__} has no 'name'"
+                if problem:
+                    broken.add(plugin)
+                    _warn_disabled(pm, pm.get_name(plugin) or provider, f"{provider}: {problem}")
+                    continue
+                entries.append((interface, cls.name, plugin, provider, cls))
+    for plugin in broken:
+        if pm.is_registered(plugin):
+            pm.unregister(plugin)  # its other hooks (e.g. CLI commands) go with it
+    for interface, name, plugin, provider, cls in entries:
+        if plugin in broken:
+            continue
+        known = registry.plugins[interface]
+        if name in known:
+            raise PluginError(
+                f"two {interface} plugins are named {name!r}: {known[name].provider} and "
+                f"{provider}; disable one with {DISABLE_PLUGINS_ENV}=<entry point name> "
+                "or mdf --disable-plugin"
+            )
+        known[name] = PluginInfo(cls, interface, provider)
     return registry
 
 
@@ -131,15 +328,19 @@ def make_plugin_manager(
     modules: Iterable[Any] = (), *, autoload: bool | None = None
 ) -> pluggy.PluginManager:
     """A plugin manager with the hookspecs, the given plugin modules and (unless disabled) every
-    ``mdframework`` entry point. An import error in a plugin propagates to the caller."""
+    ``mdframework`` entry point. The given modules must be valid (an unknown hook raises);
+    an entry point that fails to load is disabled with one :class:`PluginWarning`."""
     pm = pluggy.PluginManager(hookspecs.PROJECT)
     pm.add_hookspecs(hookspecs)
     for module in modules:
         pm.register(module)
     if autoload is None:
-        autoload = os.environ.get(DISABLE_ENV, "") in ("", "0")
+        autoload = autoload_enabled()
     if autoload:
         _load_entry_points(pm)
+    else:
+        for ep in _entry_points():
+            _disabled(pm)[ep.name] = f"plugin autoloading is off: {DISABLE_ENV}=1"
     pm.check_pending()
     return pm
 
@@ -150,6 +351,36 @@ def build_registry(modules: Iterable[Any] = (), *, autoload: bool | None = None)
 
 
 @cache
+def default_plugin_manager() -> pluggy.PluginManager:
+    """The plugin manager of the installed plugins, built once per process."""
+    return make_plugin_manager()
+
+
+@cache
 def default_registry() -> Registry:
     """The registry of installed plugins, built once per process."""
-    return build_registry()
+    return _collect(default_plugin_manager())
+
+
+def add_cli_commands(subparsers: Any) -> None:
+    """Let the installed plugins add their ``mdf`` sub-commands; a plugin whose hook raises is
+    disabled with one :class:`PluginWarning` (the others still add theirs)."""
+    pm = default_plugin_manager()
+    default_registry()  # unregisters the plugins that fail to register their classes
+    for impl in pm.hook.mdframework_add_cli_commands.get_hookimpls():
+        try:
+            impl.function(subparsers=subparsers)
+        except Exception as exc:
+            provider = _provider_name(pm, impl.plugin)
+            name = pm.get_name(impl.plugin) or provider
+            _warn_disabled(
+                pm,
+                name,
+                f"{provider}: mdframework_add_cli_commands raised {type(exc).__name__}: {exc}",
+            )
+
+
+def reset_default_registry() -> None:
+    """Forget the cached plugin manager and registry (after changing the environment)."""
+    default_registry.cache_clear()
+    default_plugin_manager.cache_clear()

@@ -214,10 +214,10 @@ class ProcessingConfig(StrictModel):
     @field_validator("window")
     @classmethod
     def _known_window(cls, value: str) -> str:
-        from scipy.signal import get_window
+        from .physics.spectrogram import stft_window
 
         try:
-            get_window(value, 8)
+            stft_window(value, 8)
         except (ValueError, TypeError) as exc:
             raise ValueError(f"unknown window {value!r}: {exc}") from None
         return value
@@ -245,7 +245,9 @@ class ProcessingConfig(StrictModel):
     )
     aliasing: Literal["warn", "error"] = Field(
         "warn",
-        description="When a scatterer's radial speed exceeds lambda*PRF/4: warn, or stop.",
+        description="When a scatterer's radial speed exceeds the unambiguous lambda*PRF/4 its "
+        "Doppler folds over: 'warn' (the warning names the PRF that avoids it; the results are "
+        "still written) or 'error' (stop, write nothing). `mdf check` predicts it.",
     )
 
     @model_validator(mode="after")

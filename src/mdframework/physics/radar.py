@@ -46,6 +46,12 @@ def max_unambiguous_velocity(carrier_frequency: float, prf: float) -> float:
     return wavelength(carrier_frequency) * float(prf) / 4.0
 
 
+def min_prf_for_velocity(speed: float, carrier_frequency: float) -> float:
+    """The smallest PRF [Hz] whose unambiguous velocity ``lambda * PRF / 4`` reaches ``speed``
+    [m/s]: ``4 |v| / lambda`` (the inverse of :func:`max_unambiguous_velocity`)."""
+    return 4.0 * abs(float(speed)) / wavelength(carrier_frequency)
+
+
 def alias_frequency(doppler: ArrayLike, prf: float) -> FloatArray:
     """The frequency [Hz] at which a true Doppler [Hz] is observed after sampling at ``prf``:
     ``((f + PRF/2) mod PRF) - PRF/2``."""

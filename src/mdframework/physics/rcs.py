@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import special
 
 FloatArray = NDArray[np.float64]
 
@@ -25,6 +24,8 @@ def sphere_rcs_mie(radius: float, wavelength: float) -> float:
     ``a_n = j_n(ka)/h_n(ka)`` and
     ``b_n = (ka j_{n-1}(ka) - n j_n(ka)) / (ka h_{n-1}(ka) - n h_n(ka))``, summed to convergence.
     """
+    from scipy import special
+
     ka = 2.0 * np.pi * float(radius) / float(wavelength)
     if ka <= 0:
         raise ValueError("radius and wavelength must be positive")

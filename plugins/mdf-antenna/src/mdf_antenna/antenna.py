@@ -36,14 +36,15 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field, model_validator
-from scipy.optimize import brentq
 
 from mdframework import Effect, PluginConfig, Scatterers, SceneContext, Skeleton
 
 FloatArray = NDArray[np.float64]
 
-#: ``x_h`` with ``sinc(x_h)^2 = 1/2`` (normalised sinc): the half-power point of a uniform aperture.
-SINC2_HALF_POWER: float = float(brentq(lambda x: np.sinc(x) ** 2 - 0.5, 0.1, 0.9, xtol=1e-15))
+#: ``x_h`` with ``sinc(x_h)^2 = 1/2`` (normalised sinc): the half-power point of a uniform aperture
+#: (the root in (0, 1), found with scipy.optimize.brentq to 1e-15 and written out so that
+#: importing the plugin does not import scipy.optimize; a test checks it is the root).
+SINC2_HALF_POWER: float = 0.44294647068945237
 
 
 class AntennaConfig(PluginConfig):

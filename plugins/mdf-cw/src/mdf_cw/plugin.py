@@ -8,6 +8,6 @@ from .waveform import CwDoppler
 
 
 @hookimpl
-def mdframework_register_waveforms() -> list[type[RadarWaveform]]:
+def mdframework_register_radar_waveforms() -> list[type[RadarWaveform]]:
     """Register the CW Doppler radar."""
     return [CwDoppler]

@@ -40,6 +40,7 @@ PRESETS: dict[str, dict[str, Any]] = {
         "peak_grouping": ["doppler"],
         "multi_object_threshold": 0.5,
         "clutter_removal": False,
+        "receiver_noise": True,
     },
     # TI IWR6843ISK with `ISK_6m_default.cfg` of TI's 3D people counting lab (mmWave Industrial
     # Toolbox): profileCfg 0 60.75 30.00 25.00 59.10 ... 54.71 1 96 2950.00; chirpCfg TX masks
@@ -64,5 +65,6 @@ PRESETS: dict[str, dict[str, Any]] = {
         "peak_grouping": ["doppler", "range"],
         "multi_object_threshold": 0.5,
         "clutter_removal": True,
+        "receiver_noise": True,
     },
 }

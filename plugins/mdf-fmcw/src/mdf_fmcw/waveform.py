@@ -126,7 +126,9 @@ class FmcwConfig(RadarPowerConfig):
         None, ge=1, description="Doppler FFT size (>= n_loops); default n_loops."
     )
     receiver_noise: bool = Field(
-        True, description="Add the receiver's thermal noise to the IF samples (false: none)."
+        False,
+        description="Add the receiver's thermal noise to the IF samples (the presets do: CFAR "
+        "needs a noise floor).",
     )
     noise_figure_db: float = Field(
         15.0,

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from mdframework import DataFileError
+from mdframework.cli import add_command
 
 from .device import (
     DeviceError,
@@ -25,15 +26,40 @@ from .nitefile import nite_frames_to_arrays, write_nite
 
 def add_commands(subparsers: argparse._SubParsersAction[Any]) -> None:
     """Register ``kinect info`` and ``capture``."""
-    kinect = subparsers.add_parser("kinect", help="Kinect / OpenNI2 utilities")
-    ksub = kinect.add_subparsers(dest="kinect_command", required=True)
-    info = ksub.add_parser("info", help="streams, resolutions, frames and rate of an .oni file")
+    kinect = add_command(
+        subparsers,
+        "kinect",
+        "Kinect / OpenNI2 utilities",
+        "Kinect and OpenNI2 utilities (see docs/kinect.md).",
+        ["mdf kinect info examples/data/kinect/oni/test.oni"],
+    )
+    ksub = kinect.add_subparsers(dest="kinect_command", required=True, metavar="SUBCOMMAND")
+    info = add_command(
+        ksub,
+        "info",
+        "streams, resolutions, frames and rate of an .oni file",
+        "Print the device, and for every stream of an OpenNI recording (.oni) its resolution, "
+        "pixel format, number of frames and measured frame rate.",
+        [
+            "mdf kinect info examples/data/kinect/oni/test.oni",
+            "mdf kinect info examples/data/kinect/oni/test.oni --json",
+        ],
+    )
     info.add_argument("file", help="an OpenNI recording (.oni)")
     info.add_argument("--json", action="store_true", help="print JSON")
     info.set_defaults(func=cmd_info)
 
-    cap = subparsers.add_parser(
-        "capture", help="record NiTE2 skeletons from a Kinect (needs OpenNI2 and NiTE2)"
+    cap = add_command(
+        subparsers,
+        "capture",
+        "record NiTE2 skeletons from a Kinect (needs OpenNI2 and NiTE2)",
+        "Track skeletons with NiTE2 from a live Kinect (or an .oni recording) and write them "
+        "as a skeleton recording that the kinect motion source reads. Needs the OpenNI2 "
+        "library and NiTE2 (see docs/kinect.md).",
+        [
+            "mdf capture --out walk.nite.txt --duration 10",
+            "mdf capture --out walk.nite.txt --device examples/data/kinect/oni/test.oni",
+        ],
     )
     cap.add_argument("--out", required=True, help="skeleton recording to write (.nite.txt)")
     cap.add_argument(

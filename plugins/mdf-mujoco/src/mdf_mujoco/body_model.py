@@ -29,8 +29,8 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-import mujoco  # type: ignore[import-untyped]
 import numpy as np
 from numpy.typing import NDArray
 
@@ -38,6 +38,9 @@ from mdframework import CANONICAL_JOINTS
 from mdframework.physics.body import PART_RADII
 
 from .gait import Gait, base_translation, frozen_elbow_z
+
+if TYPE_CHECKING:
+    pass  # type: ignore[import-untyped]
 
 FloatArray = NDArray[np.float64]
 
@@ -233,6 +236,8 @@ class WalkerBody:
         radii: Mapping[str, tuple[float, float]] | None = None,
         chen_lower_leg: bool | None = None,
     ) -> None:
+        import mujoco  # type: ignore[import-untyped]  # heavy: imported when used
+
         self.gait = gait
         q5 = gait.chen_compatible if chen_lower_leg is None else chen_lower_leg
         self.xml = build_mjcf(gait, radii, q5)
@@ -274,6 +279,8 @@ class WalkerBody:
 
         In chen-compatible mode the elbow sites are moved to Chen's frozen-height position (Q4);
         the geoms stay rigid."""
+        import mujoco  # type: ignore[import-untyped]  # heavy: imported when used
+
         m, d = self.model, self.data
         n = qpos.shape[0]
         joints = np.empty((n, len(CANONICAL_JOINTS), 3))

@@ -37,7 +37,6 @@ from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.interpolate import PchipInterpolator
 
 from mdframework import CANONICAL_JOINTS
 from mdframework.physics.body import LEG_FRACTION, SEGMENT_FRACTIONS
@@ -86,6 +85,8 @@ def _periodic_pchip(xs: list[float], ys: list[float], phase: FloatArray) -> Floa
     kx, ky = kx[order], ky[order]
     keep = np.ones(kx.shape, dtype=bool)
     keep[1:] = np.diff(kx) > 1e-12
+    from scipy.interpolate import PchipInterpolator
+
     return np.asarray(PchipInterpolator(kx[keep], ky[keep])(phase), dtype=np.float64)
 
 

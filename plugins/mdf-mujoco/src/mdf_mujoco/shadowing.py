@@ -26,9 +26,8 @@ cycle, ~1 s, so k = 8 at 2400 Hz still resolves 3.3 ms). The effect runs only wh
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
-import mujoco  # type: ignore[import-untyped]
 import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field
@@ -42,6 +41,9 @@ from mdframework import (
     SceneError,
 )
 from mdframework.physics.body import PART_RADII
+
+if TYPE_CHECKING:
+    import mujoco  # type: ignore[import-untyped]
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
@@ -99,6 +101,8 @@ def _frames_from_axis(axis: FloatArray) -> FloatArray:
 
 
 def _build_model(types: list[int], sizes: FloatArray) -> tuple[mujoco.MjModel, mujoco.MjData]:
+    import mujoco  # type: ignore[import-untyped]  # heavy: imported when used
+
     names = {int(mujoco.mjtGeom.mjGEOM_ELLIPSOID): "ellipsoid",
              int(mujoco.mjtGeom.mjGEOM_CAPSULE): "capsule"}  # fmt: skip
     geoms = "\n".join(
@@ -134,6 +138,8 @@ class Shadowing(Effect):
     def _ellipsoids(
         self, scat: Scatterers
     ) -> tuple[list[int], FloatArray, FloatArray, FloatArray, BoolArray]:
+        import mujoco  # type: ignore[import-untyped]  # heavy: imported when used
+
         if scat.semi_axes is None or scat.axes is None:
             raise SceneError(
                 "effects.shadowing: bodies = 'ellipsoids' needs a scatterer model that gives "
@@ -151,6 +157,8 @@ class Shadowing(Effect):
     def _capsules(
         self, scat: Scatterers, context: SceneContext
     ) -> tuple[list[int], FloatArray, FloatArray, FloatArray, BoolArray]:
+        import mujoco  # type: ignore[import-untyped]  # heavy: imported when used
+
         skel = context.skeleton
         try:
             tail = skel.positions[:, [skel.index(a) for a, _ in CANONICAL_SEGMENTS]]
@@ -175,6 +183,8 @@ class Shadowing(Effect):
     ) -> BoolArray:
         """(n_p, n_s, n_g): whether each scatterer position ``x`` (n_p, n_s, 3) lies inside each
         geom (1 % margin)."""
+        import mujoco  # type: ignore[import-untyped]  # heavy: imported when used
+
         n_p, n_s = x.shape[:2]
         out = np.zeros((n_p, n_s, len(types)), dtype=bool)
         for g, (kind, size) in enumerate(zip(types, sizes, strict=True)):
@@ -191,6 +201,8 @@ class Shadowing(Effect):
 
     def visibility(self, scat: Scatterers, context: SceneContext) -> BoolArray:
         """Whether each scatterer is blocked, (n_pulses, n_scatterers) bool."""
+        import mujoco  # type: ignore[import-untyped]  # heavy: imported when used
+
         c = self.config
         use_ellipsoids = c.bodies == "ellipsoids" or (
             c.bodies == "auto" and scat.semi_axes is not None and scat.axes is not None

@@ -1,0 +1,210 @@
+"""What a run config would do, without running it (``mdf check CONFIG``).
+
+:func:`plan_run` validates the config, instantiates its plugins, loads the motion (reading the
+input is part of checking it) and places the body, then reports the record, the spectrogram
+geometry, the Doppler and velocity resolution, the unambiguous velocity, the aliasing risk and an
+estimate of the memory the run needs. No pulses are simulated.
+
+The aliasing risk is judged from the radial speed of the body's joints at the motion's own frame
+times (finite differences of each joint's range to the radar): body-part scatterers sit on the
+segments between joints, so they move no faster than the fastest joint (up to the accuracy of
+the frame-rate differences).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .errors import SceneError
+from .physics import radar
+from .pipeline import _place, _window, build_stages, load_motion
+from .plugins import Registry, default_registry
+from .settings import RunConfigBase
+
+MIB = 1024.0**2
+
+
+@dataclass(frozen=True)
+class RunPlan:
+    """What a run would do. Units are in the field names."""
+
+    plugins: dict[str, str]  # section -> "kind (provider)"
+    effects: list[str]
+    record_start_s: float
+    record_length_s: float
+    n_pulses: int
+    prf_hz: float
+    carrier_frequency_hz: float
+    wavelength_m: float
+    n_joints: int
+    window_pulses: int
+    hop_pulses: int
+    nfft: int
+    n_frames: int
+    doppler_bin_hz: float
+    velocity_bin_mps: float
+    window_resolution_hz: float
+    window_resolution_mps: float
+    max_unambiguous_velocity_mps: float
+    max_joint_radial_speed_mps: float
+    aliasing: bool
+    prf_needed_hz: float
+    memory_mib: float
+    memory_terms_mib: dict[str, float] = field(default_factory=dict)
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-serialisable view."""
+        return asdict(self)
+
+
+def _provider(reg: Registry, interface: str, kind: str) -> str:
+    info = reg.plugins[interface].get(kind)
+    return f"{kind} ({info.provider})" if info is not None else kind
+
+
+def max_joint_radial_speed(
+    time: np.ndarray, positions: np.ndarray, valid: np.ndarray, radar_position: np.ndarray
+) -> float:
+    """Largest |d range / dt| [m/s] of any joint between consecutive frames where it is valid in
+    both. ``time`` (n_frames,) [s], ``positions`` (n_frames, n_joints, 3) [m], ``valid``
+    (n_frames, n_joints) bool, ``radar_position`` (3,) [m]."""
+    if time.shape[0] < 2:
+        return 0.0
+    ranges = np.linalg.norm(positions - radar_position, axis=2)
+    rate = np.abs(np.diff(ranges, axis=0)) / np.diff(time)[:, None]
+    both = valid[1:] & valid[:-1]
+    return float(np.max(rate[both], initial=0.0))
+
+
+def memory_estimate(
+    n_pulses: int,
+    n_scatterers: int,
+    n_doppler: int,
+    n_frames: int,
+    block_pulses: int,
+    keep_scatterers: bool = False,
+    stft_bytes: int = 4,
+) -> dict[str, float]:
+    """The arrays a run holds at once [MiB]: per pulse the time, gate and complex signal
+    (8 + 8 + 16 bytes); the scatterer positions, ranges and RCS (5 float64 per scatterer) of one
+    block of ``block_pulses`` (of every pulse with ``keep_scatterers``); the spectrogram's power
+    (``stft_bytes`` per value) and its float64 dB map."""
+    rows = n_pulses if keep_scatterers else min(n_pulses, block_pulses)
+    return {
+        "signal": n_pulses * 32 / MIB,
+        "scatterers": rows * n_scatterers * 40 / MIB,
+        "spectrogram": n_doppler * n_frames * (stft_bytes + 8) / MIB,
+    }
+
+
+def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan:
+    """Resolve ``config`` into a :class:`RunPlan` (see the module docstring)."""
+    reg = registry or default_registry()
+    cfg: Any = config
+    stages = build_stages(config, reg)
+    wf = stages.radar
+    fc, prf = float(wf.carrier_frequency), float(wf.prf)
+    lam = radar.wavelength(fc)
+    radar_pos = np.asarray(config.scene.radar_position, dtype=np.float64)
+    proc = config.processing
+
+    motion = load_motion(stages.source)
+    body, _, _ = _place(config, stages, motion, radar_pos)
+    t_start, t_end = _window(body, cfg.motion.start, cfg.motion.duration)
+    n_pulses = int(wf.pulse_times(t_start, t_end).shape[0])
+    if n_pulses < proc.window_length:
+        raise SceneError(
+            f"processing.window_length: the record has {n_pulses} pulses "
+            f"({n_pulses / prf:.4f} s) but the STFT window needs {proc.window_length}: use a "
+            "longer record or a shorter window"
+        )
+
+    inside = (body.time >= t_start - 1e-9) & (body.time <= t_end + 1e-9)
+    speed = max_joint_radial_speed(
+        body.time[inside], body.positions[inside], body.valid[inside], radar_pos
+    )
+    v_max = float(wf.max_unambiguous_velocity)
+    n_frames = max(0, 1 + (n_pulses - proc.window_length) // proc.hop)
+    n_scatterers = body.n_joints  # the body models have about one scatterer per joint/segment
+    terms = memory_estimate(
+        n_pulses,
+        n_scatterers,
+        proc.nfft,
+        n_frames,
+        proc.block_pulses,
+        proc.keep_scatterers,
+        4 if proc.precision == "float32" else 8,
+    )
+    return RunPlan(
+        plugins={
+            "motion": _provider(reg, "motion", cfg.motion.kind),
+            "scatterers": _provider(reg, "scatterers", cfg.scatterers.kind),
+            "radar": _provider(reg, "radar", cfg.radar.kind),
+        },
+        effects=[_provider(reg, "effects", e.kind) for e in cfg.effects],
+        record_start_s=t_start - float(body.time[0]),
+        record_length_s=t_end - t_start,
+        n_pulses=n_pulses,
+        prf_hz=prf,
+        carrier_frequency_hz=fc,
+        wavelength_m=lam,
+        n_joints=body.n_joints,
+        window_pulses=proc.window_length,
+        hop_pulses=proc.hop,
+        nfft=proc.nfft,
+        n_frames=n_frames,
+        doppler_bin_hz=prf / proc.nfft,
+        velocity_bin_mps=float(radar.doppler_to_velocity(prf / proc.nfft, fc)),
+        window_resolution_hz=prf / proc.window_length,
+        window_resolution_mps=float(radar.doppler_to_velocity(prf / proc.window_length, fc)),
+        max_unambiguous_velocity_mps=v_max,
+        max_joint_radial_speed_mps=speed,
+        aliasing=speed > v_max,
+        prf_needed_hz=prf * speed / v_max,  # v_max grows in proportion to the PRF
+        memory_mib=sum(terms.values()),
+        memory_terms_mib=terms,
+    )
+
+
+def _hz(value: float) -> str:
+    for unit, scale in (("GHz", 1e9), ("MHz", 1e6), ("kHz", 1e3)):
+        if abs(value) >= scale:
+            return f"{value / scale:.4g} {unit}"
+    return f"{value:.4g} Hz"
+
+
+def format_plan(plan: RunPlan, source: str) -> str:
+    """The plan as the lines ``mdf check`` prints."""
+    p = plan
+    lines = [f"{source}: valid"]
+    for section, chosen in p.plugins.items():
+        lines.append(f"  {section:<12}{chosen}")
+    lines += [
+        f"  {'effects':<12}{', '.join(p.effects) or 'none'}",
+        f"  {'carrier':<12}{_hz(p.carrier_frequency_hz)} (wavelength "
+        f"{p.wavelength_m * 100:.3g} cm), PRF {_hz(p.prf_hz)}",
+        f"  {'record':<12}{p.record_length_s:.3f} s from {p.record_start_s:.3f} s: "
+        f"{p.n_pulses} pulses; joints: {p.n_joints}",
+        f"  {'spectrogram':<12}window {p.window_pulses} pulses "
+        f"({1e3 * p.window_pulses / p.prf_hz:.1f} ms), hop {p.hop_pulses} "
+        f"({1e3 * p.hop_pulses / p.prf_hz:.2f} ms), nfft {p.nfft}: {p.n_frames} frames",
+        f"  {'resolution':<12}Doppler bin {p.doppler_bin_hz:.3g} Hz = "
+        f"{p.velocity_bin_mps:.3g} m/s; window {p.window_resolution_hz:.3g} Hz = "
+        f"{p.window_resolution_mps:.3g} m/s",
+        f"  {'unambiguous':<12}+-{p.max_unambiguous_velocity_mps:.3g} m/s "
+        f"(+-{p.prf_hz / 2:.4g} Hz)",
+    ]
+    speed = f"fastest joint {p.max_joint_radial_speed_mps:.3g} m/s radially"
+    if p.aliasing:
+        lines.append(
+            f"  {'aliasing':<12}LIKELY: {speed}; raise radar.prf to at least "
+            f"{np.ceil(p.prf_needed_hz):.0f} Hz"
+        )
+    else:
+        lines.append(f"  {'aliasing':<12}none expected: {speed}")
+    terms = ", ".join(f"{k} {v:.3g}" for k, v in p.memory_terms_mib.items())
+    lines.append(f"  {'memory':<12}about {p.memory_mib:.3g} MiB of arrays ({terms} MiB)")
+    return "\n".join(lines)
