@@ -18,6 +18,8 @@ from mdframework.physics import radar
 from mdframework.pipeline import simulate
 
 QUIET = {"receiver_noise": False}
+#: the IWR1443 short-range 3-D preset
+IWR1443 = FmcwConfig(preset="iwr1443_short_range_3d")
 
 
 def point_run(targets: list[dict[str, Any]], *, duration: float, radar: dict[str, Any]) -> Any:
@@ -46,9 +48,12 @@ def fmcw_run(targets: list[dict[str, Any]], duration: float = 0.5, **radar_field
             (0.0436, 10.46, 79.20, 64.14, 4.92, 0.615, 3.08, 4.00),
         ),
         ("iwr6843isk_people_counting_6m", (0.0842, 8.08, 63.00, 89.1, 4.45, 0.0927, 25.66, 3.23)),
+        (None, (0.0976, 24.98, 77.94, 70.0, 4.58, 0.286, 6.72, 1.80)),
     ],
 )
-def test_preset_derived_values_as_documented(preset: str, expected: tuple[float, ...]) -> None:
+def test_preset_derived_values_as_documented(
+    preset: str | None, expected: tuple[float, ...]
+) -> None:
     seq = FmcwConfig(preset=preset).sequence()  # type: ignore[arg-type]
     got = (
         seq.range_resolution,
@@ -73,9 +78,9 @@ def test_explicit_fields_override_the_preset() -> None:
 @pytest.mark.parametrize(
     ("change", "field", "limit"),
     [
-        ({"frame_period": 2e-3}, "frame_period:", "3.0787 ms"),
+        ({"frame_period": 2e-3}, "frame_period:", "6.7200 ms"),
         ({"slope": 80e12}, "slope:", "4.0000 GHz"),
-        ({"n_samples": 256}, "ramp_end_time:", "57.140 us"),
+        ({"n_samples": 300}, "ramp_end_time:", "60.000 us"),
         ({"tdm_order": [1, 4]}, "tdm_order:", "TX 4"),
     ],
 )
@@ -103,7 +108,7 @@ def test_scatterer_beyond_max_range_is_an_error_or_aliases() -> None:
         fmcw_run(target, duration=0.2, **QUIET)
     res = fmcw_run(target, duration=0.2, beyond_max_range="alias")
     rd = res.received.products["range_doppler"]
-    axis = FmcwRadar(FmcwConfig()).axes()["range_m"]
+    axis = FmcwRadar(IWR1443).axes()["range_m"]
     peaks = axis[np.argmax(rd.max(axis=1), axis=1)]
     np.testing.assert_allclose(peaks, 12.0 - 10.4585, atol=0.0436)
     pts = res.received.products["points"]
@@ -137,7 +142,7 @@ def test_point_target_points_have_position_and_positive_approach_velocity() -> N
 def test_receive_is_block_invariant() -> None:
     """Four frames in one block or in two give the same signal, maps and points (the receiver
     noise is seeded per frame)."""
-    wf = FmcwRadar(FmcwConfig())
+    wf = FmcwRadar(IWR1443)
     t = wf.pulse_times(0.0, 4 * 33.333e-3)
     assert t.size == 4 * 48
     radar_pos = np.array([0.0, 0.0, 1.0])
@@ -151,7 +156,7 @@ def test_receive_is_block_invariant() -> None:
         ranges = scat.ranges(radar_pos)
         return PulseBlock(lo, t[lo:hi], scat, ranges, ranges[:, 0], radar_pos)
 
-    wf = FmcwRadar(FmcwConfig(boresight_azimuth_deg=0.0, receiver_noise=True))
+    wf = FmcwRadar(IWR1443.model_copy(update={"boresight_azimuth_deg": 0.0}))
     whole = wf.receive(block(0, 192))
     halves = [wf.receive(block(0, 96)), wf.receive(block(96, 192))]
     np.testing.assert_array_equal(whole.signal, np.concatenate([h.signal for h in halves]))
@@ -167,7 +172,7 @@ def test_spectrogram_follows_the_frame_timing() -> None:
     gaps, the STFT at the loop rate."""
     v = 1.0
     res = fmcw_run([{"position": [3.0, 0.0, 0.0], "velocity": [-v, 0.0, 0.0]}], **QUIET)
-    wf = FmcwRadar(FmcwConfig())
+    wf = FmcwRadar(IWR1443)
     seq = wf.sequence
     spec = res.spectrogram
     assert spec.time.shape == (15,)

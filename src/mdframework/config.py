@@ -63,11 +63,8 @@ def _run_config_model(key: _ConfigModels) -> type[RunConfigBase]:
     # a section without ``kind`` means its default plugin, whatever else is installed
     kinds = {
         section: name
-        for section, interface, name in (
-            ("scatterers", "scatterers", "ellipsoid"),
-            ("radar", "radar", "lfm"),
-        )
-        if name in configs.get(interface, {})
+        for section, name in DEFAULT_KINDS.items()
+        if name in configs.get(PLUGIN_SECTIONS[section], {})
     }
 
     class Base(RunConfigBase):
@@ -93,8 +90,8 @@ def _run_config_model(key: _ConfigModels) -> type[RunConfigBase]:
             ),
         ),
         motion=(union("motion"), ...),
-        scatterers=(union("scatterers"), default("scatterers", "ellipsoid")),
-        radar=(union("radar"), default("radar", "lfm")),
+        scatterers=(union("scatterers"), default("scatterers", DEFAULT_KINDS["scatterers"])),
+        radar=(union("radar"), default("radar", DEFAULT_KINDS["radar"])),
     )
     return model
 
@@ -135,6 +132,8 @@ TOP_LEVEL = ("seed", "motion", "scatterers", "radar", "effects", "scene", "proce
              "conditioning")  # fmt: skip
 #: sections that choose a plugin by ``kind``, and their interface
 PLUGIN_SECTIONS = {"motion": "motion", "scatterers": "scatterers", "radar": "radar"}
+#: the plugin a section without ``kind`` (or no section at all) means
+DEFAULT_KINDS = {"scatterers": "ellipsoid", "radar": "lfm"}
 
 
 def _short(value: Any) -> str:
@@ -312,6 +311,8 @@ def check_plugin_kinds(data: dict[str, Any], source: str, registry: Registry) ->
         if kind is None:
             if len(registry.names(interface)) == 1:
                 continue  # the only plugin's config has its kind as default
+            if DEFAULT_KINDS.get(where) in registry.plugins[interface]:
+                continue  # the section's default plugin (filled in by the run model)
             raise ConfigError(
                 f"{source}: {where}.kind: missing: say which {interface} plugin"
                 f"{_kinds(registry, interface)}"

@@ -62,24 +62,26 @@ class CfarConfig(BaseModel):
 
 class FmcwConfig(RadarPowerConfig):
     """Chirp-sequence FMCW radar with TDM-MIMO. ``preset`` fills every field it names unless the
-    config gives it; without a preset the defaults are the IWR1443 short-range 3-D demo."""
+    config gives it. Without a preset the defaults are a generic 77 GHz sensor with the
+    IWR1443's antennas and a 25 m range (30 MHz/us, 256 samples at 5 Msps, 32 loops of three
+    chirps every 50 ms); the presets are the vendors' demo configurations."""
 
     kind: Literal["fmcw"] = "fmcw"
     preset: Literal["iwr1443_short_range_3d", "iwr6843isk_people_counting_6m"] | None = Field(
         None, description="Sensor preset (see docs/fmcw.md); explicit fields override it."
     )
     start_frequency: float = Field(77e9, gt=0, description="Chirp start frequency f0 [Hz].")
-    slope: float = Field(70e12, gt=0, description="Chirp slope S [Hz/s].")
-    idle_time: float = Field(7e-6, ge=0, description="Idle time before each ramp [s].")
-    adc_start_time: float = Field(7e-6, ge=0, description="ADC start after the ramp start [s].")
-    ramp_end_time: float = Field(57.14e-6, gt=0, description="Ramp length [s].")
-    sample_rate: float = Field(4.884e6, gt=0, description="Complex ADC sample rate [Hz].")
-    n_samples: int = Field(240, ge=2, description="ADC samples per chirp.")
-    n_loops: int = Field(16, ge=1, description="Loops (chirps per TX) per frame.")
+    slope: float = Field(30e12, gt=0, description="Chirp slope S [Hz/s].")
+    idle_time: float = Field(10e-6, ge=0, description="Idle time before each ramp [s].")
+    adc_start_time: float = Field(6e-6, ge=0, description="ADC start after the ramp start [s].")
+    ramp_end_time: float = Field(60e-6, gt=0, description="Ramp length [s].")
+    sample_rate: float = Field(5e6, gt=0, description="Complex ADC sample rate [Hz].")
+    n_samples: int = Field(256, ge=2, description="ADC samples per chirp.")
+    n_loops: int = Field(32, ge=1, description="Loops (chirps per TX) per frame.")
     tdm_order: list[int] = Field(
         [1, 3, 2], min_length=1, description="TX (1-based) of each chirp of a loop, in order."
     )
-    frame_period: float = Field(33.333e-3, gt=0, description="Frame period [s].")
+    frame_period: float = Field(50e-3, gt=0, description="Frame period [s].")
     max_bandwidth: float = Field(
         4e9, gt=0, description="The sensor's largest sweep, slope x ramp_end_time [Hz]."
     )
