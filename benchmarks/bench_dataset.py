@@ -93,11 +93,12 @@ def _run_child(args: list[str]) -> tuple[dict[str, Any], float, float]:
     t0 = time.perf_counter()
     proc = subprocess.run(
         [sys.executable, __file__, "--child", *args],
-        check=True,
         capture_output=True,
         text=True,
         env={**os.environ, "PYTHONWARNINGS": "ignore"},
     )
+    if proc.returncode:
+        raise SystemExit(f"child {args} failed:\n{proc.stderr}")
     wall = time.perf_counter() - t0
     return json.loads(proc.stdout.strip().splitlines()[-1]), wall, _children_cpu() - cpu0
 

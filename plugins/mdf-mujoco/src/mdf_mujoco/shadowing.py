@@ -127,7 +127,7 @@ class Shadowing(Effect):
         super().__init__(config)
         self.start_record()
 
-    def start_record(self, *args: Any) -> None:
+    def start_record(self, body: Any = None, radar_position: Any = None) -> None:
         """Reset the ray row carried between blocks and the record's blocked fractions."""
         self._stats: dict[str, Any] = {}
         self._carry: BoolArray | None = None
