@@ -354,3 +354,20 @@ def test_check_warns_of_aliasing_and_names_the_prf(
         in out
     )
     assert not (tmp_path / "o").exists()
+
+
+def test_progress_notes_only_on_a_terminal(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Notes of slow steps reach an interactive user; a pipe keeps one line per error."""
+    import io
+
+    from mdframework import progress
+
+    class Tty(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    for stream, expected in ((Tty(), "mdf: planning ...\n"), (io.StringIO(), "")):
+        monkeypatch.setattr(sys, "stderr", stream)
+        progress.note("planning")
+        progress.note("hidden", enabled=False)
+        assert stream.getvalue() == expected

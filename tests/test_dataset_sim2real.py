@@ -24,6 +24,7 @@ from mdframework.features import FEATURE_NAMES
 
 RADHAR = EXAMPLES / "data" / "radhar"
 CMU_WALK = EXAMPLES / "data" / "cmu" / "asf-amc" / "02_01.amc"
+CMU_BOXING = EXAMPLES / "data" / "cmu" / "asf-amc" / "13_18.amc"
 
 
 def test_real_recordings_become_windows_of_histograms(tmp_path: Path) -> None:
@@ -205,7 +206,76 @@ def test_a_source_can_have_its_own_draws(tmp_path: Path) -> None:
     path.write_text(text)
     cfg, base = load_dataset_config(path)
     specs = plan_records(cfg, base)
-    assert [s.label for s in specs] == ["walk"] * 3 + ["slow walk"]
-    assert specs[3].draws is not None and set(specs[3].draws) == {"speed"}
-    assert 0.5 <= specs[3].draws["speed"] <= 0.6
+    assert [s.label for s in specs] == ["walk"] * 3 + ["slow walk"] * 3
+    # the source's speed range, and the dataset's scene draws (and number of draws)
+    own = [s.draws or {} for s in specs[3:]]
+    assert len(own) == 3 and all(0.5 <= d["speed"] <= 0.6 for d in own)
+    assert all({"radar_height", "aspect_deg"} <= set(d) for d in own)
     assert "speed" not in (specs[0].draws or {})
+
+
+def test_simulated_point_clouds_become_the_same_histograms(tmp_path: Path) -> None:
+    """A simulated FMCW record (IWR1443 preset) with representation = 'histogram': its stored
+    per-frame histograms equal an independent count of the run's own point cloud, frame by
+    frame, with the same bins and range gate as real records."""
+    pytest.importorskip("mdf_fmcw")
+    from mdframework.config import validate_run_config
+    from mdframework.pipeline import simulate
+
+    path = tmp_path / "sim.toml"
+    path.write_text(
+        f"""
+representation = "histogram"
+[[sources]]
+label = "boxing"
+motion = {{ kind = "cmu", file = "{CMU_BOXING}", start = 5.0 }}
+record_length = 0.5
+max_records = 1
+[base.radar]
+kind = "fmcw"
+preset = "iwr1443_short_range_3d"
+save_range_doppler = false
+[base.scene]
+radar_position = [1.6, 0.0, 1.0]
+min_range = 0.25
+"""
+    )
+    cfg, base = load_dataset_config(path)
+    [spec] = plan_records(cfg, base)
+    rows = build_dataset(cfg, base, tmp_path / "ds", workers=1, progress=False)
+    arrays, meta = read_record(tmp_path / "ds" / RECORDS / f"{rows[0]['id']}.npz")
+    result = simulate(validate_run_config(spec.run_config, base_dir=base))
+    points = result.received.products["points"]
+    r = np.linalg.norm(points[:, 2:5], axis=1)
+    gate = (r >= 0.5) & (r <= 3.0)
+    edges = (np.arange(18) - 8.5) * 0.61466867
+    h = arrays["histograms"]
+    assert h.shape == (15, 17)  # 0.5 s of 33.33 ms frames
+    for f in range(15):
+        sel = gate & (points[:, 0] == f)
+        ref, _ = np.histogram(points[sel, 5], bins=edges)
+        np.testing.assert_array_equal(h[f], ref)
+    assert h[:, 8].sum() > 0 and h.sum() > h[:, 8].sum()  # static body and moving fists
+    assert meta["label"] == "boxing"
+
+
+def test_the_sim_to_real_dataset_plan() -> None:
+    """docs/sim-to-real.md: 45 simulated records of 2 s (16 boxing, 15 jump, 14 walk) beside
+    360 real ones (120 per activity), every simulated one with its own draws."""
+    pytest.importorskip("mdf_fmcw")
+    from collections import Counter
+
+    cfg, base = load_dataset_config(EXAMPLES / "datasets" / "sim2real.toml")
+    specs = plan_records(cfg, base)
+    counts = Counter((s.group, s.label) for s in specs)
+    assert counts == {
+        ("sim", "boxing"): 16,
+        ("sim", "jump"): 15,
+        ("sim", "walk"): 14,
+        ("radhar", "boxing"): 120,
+        ("radhar", "jump"): 120,
+        ("radhar", "walk"): 120,
+    }
+    sim = [s for s in specs if s.group == "sim"]
+    assert all(s.draws and "radar_height" in s.draws for s in sim)
+    assert len({s.draws["radar_height"] for s in sim if s.draws}) == len(sim)

@@ -118,3 +118,23 @@ def test_bad_files_name_the_file_and_line(tmp_path: Path) -> None:
         npz_recordings(npz)
     with pytest.raises(DataFileError, match=r"no recording named 'nope\.txt'"):
         npz_recordings(DATA / "radhar_walk_subset.npz", names=["nope.txt"])
+
+
+def test_the_numbers_on_the_sim_to_real_page() -> None:
+    """docs/sim-to-real.md: within 0.5-3 m a frame holds about 8 static points and 3.1
+    (boxing), 2.2 (walk) or 0.24 (jump) moving points; the fastest 1 % of the boxing points
+    move at 3.1 m/s toward the sensor or faster."""
+    moving = {"boxing": 3.1, "walk": 2.2, "jump": 0.24}
+    for activity, expected in moving.items():
+        frames = n_static = n_moving = 0
+        fast: list[float] = []
+        for _, c in npz_recordings(DATA / f"radhar_{activity}_subset.npz"):
+            gate = (c.ranges >= 0.5) & (c.ranges <= 3.0)
+            frames += c.n_frames
+            n_static += int(np.sum(gate & (c.velocity == 0)))
+            n_moving += int(np.sum(gate & (c.velocity != 0)))
+            fast += c.velocity[gate & (c.velocity != 0)].tolist()
+        assert 7.0 <= n_static / frames <= 9.1, (activity, n_static / frames)
+        assert n_moving / frames == pytest.approx(expected, abs=0.05), activity
+        if activity == "boxing":
+            assert np.percentile(fast, 99) == pytest.approx(5 * IWR1443_BIN_WIDTH, abs=1e-6)

@@ -128,19 +128,14 @@ def _cmd_dataset_build(args: argparse.Namespace) -> int:
 
 def _cmd_experiment(args: argparse.Namespace) -> int:
     from .experiment import load_experiment_config, run_experiment
+    from .progress import note
 
-    _status(args, "reading the experiment config and the installed plugins")
+    note("reading the experiment config and the installed plugins", not args.no_progress)
     config = load_experiment_config(args.config)
     with _naming(args.config):
         run_experiment(config, Path(args.out), source=args.config, progress=not args.no_progress)
     print(Path(args.out) / "report.md")
     return 0
-
-
-def _status(args: argparse.Namespace, message: str) -> None:
-    """One progress line on stderr (unless ``--no-progress``)."""
-    if not getattr(args, "no_progress", False):
-        print(f"mdf: {message} ...", file=sys.stderr, flush=True)
 
 
 def _examples(*lines: str) -> str:

@@ -63,6 +63,7 @@ from .pointcloud import (
     histogram_features,
     velocity_bins,
 )
+from .progress import note
 from .randomize import Randomization, set_path
 from .settings import StrictModel
 
@@ -151,7 +152,9 @@ class SourceEntry(StrictModel):
         "conditioning for Kinect recordings, or its own scene).",
     )
     randomize: Randomization | None = Field(
-        None, description="Random draws for this source only, instead of the dataset's."
+        None,
+        description="Random draws for this source: the fields given here replace the "
+        "dataset's (e.g. its own speed range); the others stay as the dataset's.",
     )
 
     @model_validator(mode="after")
@@ -419,11 +422,19 @@ def _apply_draws(
                 raise ConfigError(f"{where}: randomize.params: {exc.args[0]}") from None
 
 
+def _randomize(config: DatasetConfig, entry: SourceEntry) -> Randomization:
+    """The draws of one source: the dataset's, with the fields the source gives replaced."""
+    if entry.randomize is None:
+        return config.randomize
+    own = {k: getattr(entry.randomize, k) for k in entry.randomize.model_fields_set}
+    return config.randomize.model_copy(update=own)
+
+
 def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
     """Expand sources x windows x variations x random draws into record specs, in a fixed
     order."""
     v = config.variations
-    for rz in [config.randomize] + [e.randomize for e in config.sources if e.randomize]:
+    for rz in [config.randomize] + [_randomize(config, e) for e in config.sources]:
         for name in ("aspect_deg", "radar_range", "radar_height", "height"):
             if getattr(v, name) is not None and getattr(rz, name) is not None:
                 raise ConfigError(f"{name}: give it as a variation or as a random draw, not both")
@@ -476,7 +487,7 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
             entry.dataset or str(md.get("format") or md.get("source") or motion["kind"]),
         )
         hop = entry.hop or length
-        rz = entry.randomize or config.randomize
+        rz = _randomize(config, entry)
         starts = float(motion.get("start", 0.0)) + np.arange(0.0, duration - length + 1e-9, hop)
         if entry.max_records is not None:
             starts = starts[: entry.max_records]
@@ -497,14 +508,14 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
                         "radar_position": rpos,
                     },
                 )
-                if config.place == "record":
-                    run["scene"] = _place_record(run, loaded, base_dir)
                 index = len(specs)
                 draws = None
                 if rz.active():
                     rng = np.random.default_rng(np.random.SeedSequence([config.seed, index, 1]))
                     draws = rz.sample(rng)
                     _apply_draws(run, section, draws, f"sources[{entry_no}]")
+                if config.place == "record":  # after the draws: it fixes the drawn aspect
+                    run["scene"] = _place_record(run, loaded, base_dir)
                 run["seed"] = _record_seed(config.seed, index)
                 specs.append(
                     _spec(config, index, entry, motion["kind"], run, base_dir, draws, hist, meta)
@@ -708,7 +719,7 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     fcfg = spec.features
     extra: dict[str, Any] = {}
     if spec.histogram is not None:
-        cloud = _simulated_cloud(result, spec.record_id)
+        cloud = _simulated_cloud(result, config, spec.record_id)
         arrays = _histogram_arrays(cloud, spec.histogram["histogram"], fcfg, spec.record_id)
         feats = arrays["features"]
         extra = {"histograms": arrays["histograms"]}
@@ -759,21 +770,24 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     return _row(meta, feats)
 
 
-def _simulated_cloud(result: Any, record: str) -> PointCloud:
-    """The point cloud a simulated radar produced (``products["points"]``, columns frame, t,
-    x, y, z [m], v [m/s] positive approaching, intensity [dB])."""
-    products = getattr(result, "products", None) or {}
+def _simulated_cloud(result: Any, config: Any, record: str) -> PointCloud:
+    """The point cloud a simulated radar produced: ``received.products["points"]``
+    (n_points, 7) with columns frame (from 0 in the record), t [s], x, y, z [m, sensor frame],
+    v [m/s, positive approaching], intensity [dB]; the frame period is the radar's
+    ``frame_period`` [s]."""
+    products = getattr(result.received, "products", None) or {}
     points = products.get("points")
-    if points is None:
+    period = getattr(config.radar, "frame_period", None)
+    if points is None or period is None:
         raise SceneError(
             f"record {record}: representation = 'histogram' needs a radar that outputs point "
-            "clouds (e.g. an FMCW sensor with detection); this one outputs none"
+            "clouds frame by frame (e.g. kind = 'fmcw' with points = true); this one does not"
         )
     pts = np.asarray(points, dtype=np.float64)
     frame = pts[:, 0].astype(np.int64)
-    n_frames = int(result.metadata.get("n_frames", int(frame.max()) + 1 if frame.size else 1))
-    period = float(result.metadata["frame_period_s"])
-    return PointCloud(frame, pts[:, 2:5], pts[:, 5], pts[:, 6], period, n_frames)
+    whole = int(np.floor(float(config.motion.duration) / period + 1e-6))
+    n_frames = max(whole, int(frame.max()) + 1 if frame.size else 1)
+    return PointCloud(frame, pts[:, 2:5], pts[:, 5], pts[:, 6], float(period), n_frames)
 
 
 def _blank(value: Any) -> Any:
@@ -923,6 +937,7 @@ def build_dataset(
     """Build (or finish building) a dataset; returns the index rows in record order."""
     from tqdm import tqdm
 
+    note("planning the records (reading each recording once)", progress)
     specs = plan_records(config, base_dir)  # errors in the config stop before any file
     out = Path(out_dir)
     (out / RECORDS).mkdir(parents=True, exist_ok=True)

@@ -25,7 +25,6 @@ from __future__ import annotations
 import csv
 import io
 import json
-import sys
 from collections import Counter
 from collections.abc import Callable, Sequence
 from functools import partial
@@ -50,6 +49,7 @@ from .features import FEATURE_NAMES
 from .interfaces import Classifier
 from .plugins import Registry, default_registry
 from .pointcloud import histogram_vector, histogram_vector_names, velocity_bins
+from .progress import note
 from .settings import StrictModel
 
 
@@ -494,11 +494,6 @@ def classifier_inputs(
     return data, x, list(histogram_vector_names(centres))
 
 
-def _status(progress: bool, message: str) -> None:
-    if progress:
-        print(f"mdf: {message} ...", file=sys.stderr, flush=True)
-
-
 def selected_features_markdown(subsets: Sequence[Sequence[str]], method: str) -> list[str]:
     """Report lines saying which inputs feature selection chose: how often each was chosen over
     the splits, and the most frequent subset."""
@@ -536,7 +531,7 @@ def run_experiment(
     else:
         assert cfg.dataset.path is not None
         data_dir = cfg.dataset.path
-    _status(progress, f"loading the dataset {data_dir}")
+    note(f"loading the dataset {data_dir}", progress)
     data, x_all, names = classifier_inputs(cfg, data_dir)
     figures: list[Callable[[], None]] = []  # drawn at the end
 
@@ -689,7 +684,7 @@ def run_experiment(
             "![train/test](train_test_confusion.png)",
             "",
         ]
-    _status(progress, "feature statistics and figures")
+    note("feature statistics and figures", progress)
     stats = feature_statistics(data)
     (out / "feature_stats.csv").write_text(_csv(stats))
     md = _stats_markdown(stats)
