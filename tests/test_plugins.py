@@ -313,3 +313,43 @@ def test_broken_pipe_ends_quietly() -> None:
     err = proc.stderr.read().decode()
     assert proc.wait(timeout=120) == 0
     assert err == ""
+
+
+def test_an_effect_returning_none_is_named_in_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Not an AttributeError deep in the pipeline: the run names the effect and the check."""
+    from typing import Literal
+
+    from mdframework import Effect, PluginConfig
+
+    class ForgetfulConfig(PluginConfig):
+        """Nothing to configure."""
+
+        kind: Literal["forgetful"] = "forgetful"
+
+    class Forgetful(Effect):
+        """Forgets to return the data."""
+
+        name = "forgetful"
+        Config = ForgetfulConfig
+        stage = "received"
+
+        def apply(self, data: object, context: object) -> None:
+            return None
+
+    module = ModuleType("forgetful_plugin")
+    module.mdframework_register_effects = synthetic.hookimpl(  # type: ignore[attr-defined]
+        lambda: [Forgetful]
+    )
+    from mdframework.config import validate_run_config
+    from mdframework.pipeline import simulate
+
+    reg = build_registry([module])
+    cfg = {
+        "motion": {"kind": "point_targets", "length": 1.0, "targets": [{"position": [50, 0, 0]}]},
+        "scatterers": {"kind": "points"},
+        "effects": [{"kind": "forgetful"}],
+    }
+    with pytest.raises(PluginError, match=r"effect 'forgetful' \(.*Forgetful\) returned NoneType"):
+        simulate(validate_run_config(cfg, registry=reg), reg)

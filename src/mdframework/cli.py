@@ -11,8 +11,10 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import signal
 import sys
 import textwrap
+import threading
 import traceback
 import warnings
 from collections.abc import Iterator, Sequence
@@ -20,7 +22,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from .errors import DataFileError, MdfError
+from .errors import DataFileError, MdfError, OutputError
 from .plugins import (
     DISABLE_ENV,
     DISABLE_PLUGINS_ENV,
@@ -34,6 +36,7 @@ from .plugins import (
 )
 
 EXIT_USAGE = 2
+EXIT_INTERRUPTED = 130
 #: options accepted anywhere on the command line (before a lone ``--``)
 GLOBAL_FLAGS = ("--debug",)
 DISABLE_OPTION = "--disable-plugin"
@@ -46,21 +49,22 @@ def _naming(config_file: str) -> Iterator[None]:
     try:
         yield
     except MdfError as exc:
-        if isinstance(exc, DataFileError) or str(exc).startswith(config_file):
+        if isinstance(exc, (DataFileError, OutputError)) or str(exc).startswith(config_file):
             raise
         raise type(exc)(f"{config_file}: {exc}") from exc
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
     from .config import load_run_config
-    from .output import write_run
+    from .output import run_folder, write_run
     from .pipeline import simulate
 
     config = load_run_config(args.config)
-    with _naming(args.config):
-        result = simulate(config)
-    resolved = json.loads(config.model_dump_json())
-    written = write_run(result, resolved, Path(args.out))
+    with run_folder(args.out, force=args.force, staging_dir=args.staging_dir) as folder:
+        with _naming(args.config):
+            result = simulate(config)
+        resolved = json.loads(config.model_dump_json())
+        written = write_run(result, resolved, folder)
     for path in written:
         print(path)
     return 0
@@ -118,6 +122,7 @@ def _cmd_dataset_build(args: argparse.Namespace) -> int:
             workers=args.workers,
             scheduler=args.scheduler,
             progress=not args.no_progress,
+            force=args.force,
         )
     manifest = json.loads((Path(args.out) / "dataset.json").read_text())
     skipped = manifest.get("n_skipped", 0)
@@ -133,9 +138,26 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
     note("reading the experiment config and the installed plugins", not args.no_progress)
     config = load_experiment_config(args.config)
     with _naming(args.config):
-        run_experiment(config, Path(args.out), source=args.config, progress=not args.no_progress)
+        run_experiment(
+            config,
+            Path(args.out),
+            source=args.config,
+            progress=not args.no_progress,
+            force=args.force,
+            staging_dir=args.staging_dir,
+        )
     print(Path(args.out) / "report.md")
     return 0
+
+
+FORCE_HELP = (
+    "write into an existing folder that holds other files (only this command's files are "
+    "replaced; nothing else is deleted), or rebuild a dataset from a different config"
+)
+STAGING_HELP = (
+    "folder for the files being written (default: inside --out); must be on the same file "
+    "system as --out"
+)
 
 
 def _examples(*lines: str) -> str:
@@ -216,6 +238,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     run.add_argument("config", help="run config file (.toml, .yaml or .json)")
     run.add_argument("--out", required=True, help="output folder")
+    run.add_argument("--force", action="store_true", help=FORCE_HELP)
+    run.add_argument("--staging-dir", default=None, help=STAGING_HELP)
     run.set_defaults(func=_cmd_run)
 
     check = add_command(
@@ -265,6 +289,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="Dask scheduler address, or 'local' for a local Dask cluster",
     )
     build.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    build.add_argument("--force", action="store_true", help=FORCE_HELP)
     build.set_defaults(func=_cmd_dataset_build)
 
     experiment = add_command(
@@ -279,6 +304,8 @@ def build_parser() -> argparse.ArgumentParser:
     experiment.add_argument("config", help="experiment config file")
     experiment.add_argument("--out", required=True, help="report folder")
     experiment.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    experiment.add_argument("--force", action="store_true", help=FORCE_HELP)
+    experiment.add_argument("--staging-dir", default=None, help=STAGING_HELP)
     experiment.set_defaults(func=_cmd_experiment)
 
     plugins = add_command(
@@ -366,7 +393,45 @@ def _quiet_broken_pipe() -> int:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point; returns the exit code."""
+    """Entry point; returns the exit code. Ctrl-C at any moment (plugin loading included) prints
+    one line and returns 130."""
+    try:
+        previous = _catch_interrupts()
+        try:
+            return _main_with_options(argv)
+        finally:
+            if previous is not None:
+                signal.signal(signal.SIGINT, previous)
+    except KeyboardInterrupt:
+        return _interrupted()
+
+
+def _interrupted() -> int:
+    print("mdf: interrupted", file=sys.stderr)
+    return EXIT_INTERRUPTED
+
+
+def _catch_interrupts() -> Any:
+    """The first Ctrl-C raises KeyboardInterrupt (the command cleans up: staging folders, the
+    lock, worker processes) and prints one line; a second one during that clean-up ends the
+    process at once with the same line (the next command on the folder removes what is left).
+    Returns the handler to restore, or None where signals cannot be handled (not the main
+    thread)."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+
+    def again(signum: int, frame: Any) -> None:
+        os.write(2, b"mdf: interrupted\n")
+        os._exit(EXIT_INTERRUPTED)
+
+    def first(signum: int, frame: Any) -> None:
+        signal.signal(signal.SIGINT, again)
+        raise KeyboardInterrupt
+
+    return signal.signal(signal.SIGINT, first)
+
+
+def _main_with_options(argv: Sequence[str] | None) -> int:
     raw = sys.argv[1:] if argv is None else argv
     args_list, debug, disable = split_global_options(raw)
     old_env = os.environ.get(DISABLE_PLUGINS_ENV)
@@ -412,9 +477,6 @@ def _main(argv: list[str], debug: bool) -> int:
             message += _plugins_off_note()
         print(f"mdf: error: {message}", file=sys.stderr)
         return EXIT_USAGE
-    except KeyboardInterrupt:
-        print("mdf: interrupted", file=sys.stderr)
-        return 130
     except Exception as exc:
         if args.debug:
             raise

@@ -24,7 +24,10 @@ representation simulated records get with ``representation = "histogram"``.
 Records are independent pure functions of their spec (including a seed derived from the
 dataset seed and the record's index), so the result is identical whatever the number of workers
 or the scheduler. A killed build, run again, keeps every complete record, removes temp files and
-redoes records whose file is missing or unreadable.
+redoes records whose file is missing or unreadable. It resumes only into a folder built from the
+same config (the marker ``.mdf-dataset.json`` holds it; a different config is an error naming
+the difference, or with ``force`` a rebuild that keeps the old dataset whole until the new index
+is written). The folder rules are those of :mod:`mdframework.outdir`.
 """
 
 from __future__ import annotations
@@ -35,10 +38,10 @@ import io
 import itertools
 import json
 import os
-import tempfile
 import warnings
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Generator, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from contextlib import AbstractContextManager, closing
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -46,13 +49,14 @@ from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import Field, ValidationError, model_validator
+from pydantic import Field, ValidationError, field_validator, model_validator
 
 from .augment import augment_motion
 from .config import format_validation_error, read_config_file, validate_run_config
-from .errors import ConfigError, MdfError, SceneError
+from .errors import ConfigError, DataFileError, MdfError, OutputError, SceneError
 from .features import FEATURE_NAMES, spectrogram_features
 from .interfaces import Motion, RadarRecordingSource, Recording
+from .outdir import OutputFolder, atomic_savez, atomic_write_text, output_folder, safe_name
 from .pipeline import build_stages, load_motion, simulate_motion
 from .plugins import default_registry
 from .pointcloud import (
@@ -79,6 +83,10 @@ SKIPPED = "skipped.csv"
 TEXT_COLUMNS = ("id", "label", "group", "source", "file", "subject", "recording", "dataset")
 INDEX = "index.csv"
 MANIFEST = "dataset.json"
+#: every name a dataset build writes in its folder
+DATASET_FILES = (RECORDS, INDEX, MANIFEST, SKIPPED)
+#: build options that do not change a dataset (ignored when comparing configs)
+BUILD_OPTIONS = ("workers", "scheduler")
 
 
 class FeatureConfig(StrictModel):
@@ -162,6 +170,15 @@ class SourceEntry(StrictModel):
         if (self.motion is None) == (self.recording is None):
             raise ValueError("give exactly one of motion and recording")
         return self
+
+    @field_validator("label", "group")
+    @classmethod
+    def _printable(cls, value: str | None) -> str | None:
+        if value is not None and (not value.strip() or not value.isprintable()):
+            raise ValueError(
+                "must be a non-empty name without control characters (tabs, line breaks)"
+            )
+        return value
 
 
 class Variations(StrictModel):
@@ -634,7 +651,7 @@ def _build_recorded(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
             "time": "s",
         },
     }
-    _atomic_savez(
+    atomic_savez(
         Path(out_dir) / RECORDS / f"{spec.record_id}.npz",
         **arrays,
         meta=np.array(json.dumps(meta)),
@@ -760,7 +777,7 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         },
         "run_config": json.loads(cfg.model_dump_json()),
     }
-    _atomic_savez(
+    atomic_savez(
         Path(out_dir) / RECORDS / f"{spec.record_id}.npz",
         **spectrogram,
         features=feats,
@@ -833,26 +850,6 @@ def _row(meta: dict[str, Any], feats: NDArray[np.float64]) -> dict[str, Any]:
     return row
 
 
-def _atomic_savez(path: Path, **arrays: Any) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".npz", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            np.savez(fh, **arrays)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def _atomic_write_text(path: Path, text: str) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", dir=path.parent)
-    with os.fdopen(fd, "w") as fh:
-        fh.write(text)
-    os.replace(tmp, path)
-
-
 def read_record(path: Path) -> tuple[dict[str, NDArray[Any]], dict[str, Any]]:
     """Arrays and metadata of one record file; raises if it is incomplete or corrupt."""
     with np.load(path) as data:
@@ -877,16 +874,23 @@ def _complete(path: Path) -> dict[str, Any] | None:
 
 def _executor(
     config: DatasetConfig, workers: int | None, scheduler: str | None
-) -> Iterator[Callable[[list[RecordSpec], str], Iterator[dict[str, Any]]]]:
+) -> Generator[Callable[[list[RecordSpec], str], Iterator[dict[str, Any]]], None, None]:
     """Yield a map function running records locally or on Dask (a generator so that clusters
-    are closed afterwards)."""
+    are closed afterwards). Local worker processes end when this process ends, however it ends
+    (:func:`mdframework.workers.die_with_parent` for the process pool; a local Dask cluster's
+    workers watch their parent themselves; both tested by killing the parent)."""
+    from .workers import die_with_parent, stop_pool
+
     address = scheduler or config.scheduler
     n = workers or config.workers or os.cpu_count() or 1
     if address is None:
         if n == 1:
             yield lambda specs, out: (build_record(s, out) for s in specs)
             return
-        with ProcessPoolExecutor(max_workers=n) as pool:
+        pool = ProcessPoolExecutor(
+            max_workers=n, initializer=die_with_parent, initargs=(os.getpid(),)
+        )
+        try:
 
             def run_local(specs: list[RecordSpec], out: str) -> Iterator[dict[str, Any]]:
                 futures = [pool.submit(build_record, s, out) for s in specs]
@@ -894,6 +898,10 @@ def _executor(
                     yield fut.result()
 
             yield run_local
+        except BaseException:
+            stop_pool(pool)  # Ctrl-C or an error: do not wait for the queued records
+            raise
+        pool.shutdown()
         return
     try:
         from distributed import Client, LocalCluster
@@ -925,6 +933,56 @@ def _executor(
             cluster.close()
 
 
+def dataset_folder(out: str | Path, *, force: bool = False) -> AbstractContextManager[OutputFolder]:
+    """Open ``out`` for a dataset build (see :func:`mdframework.outdir.output_folder`)."""
+    return output_folder(out, "dataset", DATASET_FILES, force=force)
+
+
+def _comparable(config: DatasetConfig) -> dict[str, Any]:
+    """The config as JSON, without the build options that do not change the dataset."""
+    data: dict[str, Any] = json.loads(config.model_dump_json())
+    return {k: v for k, v in data.items() if k not in BUILD_OPTIONS}
+
+
+def _built_from(folder: OutputFolder) -> dict[str, Any] | None:
+    """The config the folder's dataset was (or is being) built from; None for a new folder."""
+    if not folder.previous:
+        return None
+    built = folder.marker.get("config")
+    if built is None and (folder.path / MANIFEST).exists():  # built before markers existed
+        try:
+            built = json.loads((folder.path / MANIFEST).read_text()).get("config")
+        except (OSError, ValueError, AttributeError):
+            built = None
+    if not isinstance(built, dict):
+        return None
+    return {k: v for k, v in built.items() if k not in BUILD_OPTIONS}
+
+
+def config_differences(old: Any, new: Any, where: str = "") -> list[str]:
+    """Dotted names of the fields that differ between two JSON-like configs, with both values
+    (``"variations.aspect_deg: [0.0, 45.0] -> [0.0, 30.0]"``)."""
+    if isinstance(old, dict) and isinstance(new, dict):
+        out = []
+        for key in sorted(set(old) | set(new), key=str):
+            name = f"{where}.{key}" if where else str(key)
+            if key not in old:
+                out.append(f"{name}: new")
+            elif key not in new:
+                out.append(f"{name}: removed")
+            else:
+                out += config_differences(old[key], new[key], name)
+        return out
+    if isinstance(old, list) and isinstance(new, list) and len(old) == len(new):
+        out = []
+        for i, (a, b) in enumerate(zip(old, new, strict=True)):
+            out += config_differences(a, b, f"{where}[{i}]")
+        return out
+    if old == new:
+        return []
+    return [f"{where or 'config'}: {json.dumps(old)} -> {json.dumps(new)}"]
+
+
 def build_dataset(
     config: DatasetConfig,
     base_dir: Path,
@@ -933,47 +991,74 @@ def build_dataset(
     workers: int | None = None,
     scheduler: str | None = None,
     progress: bool = True,
+    force: bool = False,
 ) -> list[dict[str, Any]]:
-    """Build (or finish building) a dataset; returns the index rows in record order."""
+    """Build (or finish building) a dataset; returns the index rows in record order.
+
+    ``out_dir`` must be new, empty, or hold a dataset of the same config (resumed); ``force``
+    also accepts other folders (writing only the dataset's files) and other configs (rebuilt;
+    the old dataset stays whole until the new index is written, then its records are removed).
+    """
     from tqdm import tqdm
 
-    note("planning the records (reading each recording once)", progress)
-    specs = plan_records(config, base_dir)  # errors in the config stop before any file
-    out = Path(out_dir)
-    (out / RECORDS).mkdir(parents=True, exist_ok=True)
-    for stale in (out / RECORDS).glob(".tmp-*"):
-        stale.unlink()
-    rows: dict[str, dict[str, Any]] = {}
-    todo = []
-    for spec in specs:
-        row = _complete(out / RECORDS / f"{spec.record_id}.npz")
-        if row is None:
-            todo.append(spec)
-        else:
-            rows[spec.record_id] = row
-    bar = tqdm(
-        total=len(specs), initial=len(rows), desc="records", unit="rec", disable=not progress
-    )
-    skipped: dict[str, dict[str, Any]] = {}
-    for run in _executor(config, workers, scheduler):
-        for row in run(todo, str(out)):
-            if "skipped" in row:
-                skipped[row["id"]] = row
-                warnings.warn(
-                    f"record {row['id']} ({row['file']}, window {row['start_s']:.3f} s + "
-                    f"{row['duration_s']:g} s) skipped: {row['skipped']}",
-                    DatasetWarning,
-                    stacklevel=2,
-                )
+    with dataset_folder(out_dir, force=force) as folder:
+        note("planning the records (reading each recording once)", progress)
+        specs = plan_records(config, base_dir)  # errors in the config stop before any file
+        out = folder.path
+        wanted = _comparable(config)
+        built = _built_from(folder)
+        ours = folder.previous  # the folder holds an earlier build: its files are ours
+        if built is not None and built != wanted and not force:
+            diff = config_differences(built, wanted)
+            shown = "; ".join(diff[:3]) + (f" and {len(diff) - 3} more" if len(diff) > 3 else "")
+            raise OutputError(
+                f"--out {out}: holds a dataset built from a different config ({shown}); "
+                "choose another folder, or add --force to rebuild it"
+            )
+        folder.write_marker(config=wanted, complete=False)
+        (out / RECORDS).mkdir(exist_ok=True)
+        if ours:
+            for stale in (out / RECORDS).glob(".tmp-*"):
+                stale.unlink()
+        rows: dict[str, dict[str, Any]] = {}
+        todo = []
+        for spec in specs:
+            row = _complete(out / RECORDS / f"{spec.record_id}.npz")
+            if row is None:
+                todo.append(spec)
             else:
-                rows[row["id"]] = row
-            bar.update(1)
-    bar.close()
-    ordered = [rows[s.record_id] for s in specs if s.record_id in rows]
-    if not ordered:
-        raise MdfError(f"every record failed; the first: {next(iter(skipped.values()))['skipped']}")
-    dropped = [skipped[s.record_id] for s in specs if s.record_id in skipped]
-    _write_index(out, ordered, config, dropped)
+                rows[spec.record_id] = row
+        bar = tqdm(
+            total=len(specs), initial=len(rows), desc="records", unit="rec", disable=not progress
+        )
+        skipped: dict[str, dict[str, Any]] = {}
+        executor = _executor(config, workers, scheduler)
+        with closing(executor), bar:  # closing: workers stop at once on Ctrl-C or an error
+            for run in executor:
+                for row in run(todo, str(out)):
+                    if "skipped" in row:
+                        skipped[row["id"]] = row
+                        warnings.warn(
+                            f"record {row['id']} ({row['file']}, window {row['start_s']:.3f} s "
+                            f"+ {row['duration_s']:g} s) skipped: {row['skipped']}",
+                            DatasetWarning,
+                            stacklevel=2,
+                        )
+                    else:
+                        rows[row["id"]] = row
+                    bar.update(1)
+        ordered = [rows[s.record_id] for s in specs if s.record_id in rows]
+        if not ordered:
+            first = next(iter(skipped.values()))["skipped"]
+            raise MdfError(f"every record failed; the first: {first}")
+        dropped = [skipped[s.record_id] for s in specs if s.record_id in skipped]
+        _write_index(out, ordered, config, dropped)
+        if ours:  # records of an earlier config, now that the new index is in place
+            keep = {f"{s.record_id}.npz" for s in specs}
+            for old in (out / RECORDS).glob("*.npz"):
+                if old.name not in keep:
+                    old.unlink()
+        folder.write_marker(config=wanted, complete=True)
     return ordered
 
 
@@ -988,14 +1073,14 @@ def _write_index(
     writer = csv.DictWriter(buf, fieldnames=fields, lineterminator="\n", restval="")
     writer.writeheader()
     writer.writerows(rows)
-    _atomic_write_text(out / INDEX, buf.getvalue())
+    atomic_write_text(out / INDEX, buf.getvalue())
     skipped = skipped or []
     if skipped:
         sbuf = io.StringIO()
         swriter = csv.DictWriter(sbuf, fieldnames=list(skipped[0]), lineterminator="\n")
         swriter.writeheader()
         swriter.writerows(skipped)
-        _atomic_write_text(out / SKIPPED, sbuf.getvalue())
+        atomic_write_text(out / SKIPPED, sbuf.getvalue())
     else:
         (out / SKIPPED).unlink(missing_ok=True)
     manifest = {
@@ -1007,7 +1092,7 @@ def _write_index(
         "labels": sorted({r["label"] for r in rows}),
         "config": json.loads(config.model_dump_json()),
     }
-    _atomic_write_text(out / MANIFEST, json.dumps(manifest, indent=2) + "\n")
+    atomic_write_text(out / MANIFEST, json.dumps(manifest, indent=2) + "\n")
 
 
 @dataclass(frozen=True)
@@ -1057,7 +1142,9 @@ def load_dataset(
     hists: list[NDArray[np.float32] | None] | None = [] if histograms else None
     if spectrograms or histograms:
         maps = []
-        for rid in table["id"]:
+        for line, rid in enumerate(table["id"], start=2):
+            if safe_name(str(rid)) != rid:  # a record id names a file inside records/ only
+                raise DataFileError(index, f"record id {str(rid)!r} is not a plain name", line)
             arrays, _ = read_record(root / RECORDS / f"{rid}.npz")
             maps.append(arrays["spectrogram_db"])
             velocity = arrays["velocity_mps"] if velocity is None else velocity

@@ -26,3 +26,8 @@ class DataFileError(MdfError):
 class SceneError(MdfError):
     """The scene cannot be simulated as described (target at the radar, aliasing when strict,
     a record shorter than the STFT window, ...)."""
+
+
+class OutputError(MdfError):
+    """An output folder cannot be used as given (a file, not writable, another command's or the
+    user's files, in use by another command); the message names ``--out`` and what to do."""

@@ -47,10 +47,23 @@ from .dataset import Dataset, build_dataset, load_dataset, load_dataset_config
 from .errors import ConfigError, MdfError
 from .features import FEATURE_NAMES
 from .interfaces import Classifier
+from .outdir import output_folder, safe_name
 from .plugins import Registry, default_registry
 from .pointcloud import histogram_vector, histogram_vector_names, velocity_bins
 from .progress import note
 from .settings import StrictModel
+
+#: every name an experiment writes in its folder (group names are made safe by ``safe_name``)
+EXPERIMENT_FILES = (
+    "report.md",
+    "summary.json",
+    "within_*",
+    "cross_confusion.*",
+    "train_test_confusion.*",
+    "feature_stats.*",
+    "scatter_*.png",
+    "dataset",
+)
 
 
 class DatasetRef(StrictModel):
@@ -516,23 +529,46 @@ def run_experiment(
     source: str = "<experiment>",
     progress: bool = True,
     registry: Registry | None = None,
+    force: bool = False,
+    staging_dir: Path | str | None = None,
 ) -> dict[str, Any]:
-    """Build or load the dataset, run the experiments, write the report. The figures are drawn
-    together at the end, once every number is computed (matplotlib loads only then)."""
+    """Build or load the dataset, run the experiments, write the report. ``out_dir`` follows
+    the rules of :mod:`mdframework.outdir` (``force``, ``staging_dir``); a dataset the
+    experiment builds goes to ``out_dir/dataset`` (resumable, see :func:`build_dataset`)."""
+    with output_folder(
+        out_dir, "experiment", EXPERIMENT_FILES, force=force, staging_dir=staging_dir
+    ) as folder:
+        factory = classifier_factory(cfg.classifier, source, registry)
+        if cfg.dataset.config is not None:
+            dcfg, base = load_dataset_config(cfg.dataset.config)
+            data_dir = folder.path / "dataset"
+            build_dataset(dcfg, base, data_dir, workers=cfg.workers, progress=progress, force=force)
+        else:
+            assert cfg.dataset.path is not None
+            data_dir = cfg.dataset.path
+        note(f"loading the dataset {data_dir}", progress)
+        data, x_all, names = classifier_inputs(cfg, data_dir)
+        stage = folder.stage()
+        summary = _report(cfg, factory, data, x_all, names, data_dir, stage, progress)
+        folder.commit(stage, keep=("dataset",))  # a built dataset is never deleted
+    return summary
+
+
+def _report(
+    cfg: ExperimentConfig,
+    factory: Callable[[], Classifier],
+    data: Dataset,
+    x_all: NDArray[np.float64],
+    names: list[str],
+    data_dir: Path,
+    out: Path,
+    progress: bool = True,
+) -> dict[str, Any]:
+    """Run the experiments on ``data`` (classifier inputs ``x_all`` named ``names``) and write
+    every report file into ``out``. The figures are drawn together at the end, once every number
+    is computed (matplotlib loads only then)."""
     from .figures import plot_confusion, plot_feature_scatter
 
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    factory = classifier_factory(cfg.classifier, source, registry)
-    if cfg.dataset.config is not None:
-        dcfg, base = load_dataset_config(cfg.dataset.config)
-        build_dataset(dcfg, base, out / "dataset", workers=cfg.workers, progress=progress)
-        data_dir = out / "dataset"
-    else:
-        assert cfg.dataset.path is not None
-        data_dir = cfg.dataset.path
-    note(f"loading the dataset {data_dir}", progress)
-    data, x_all, names = classifier_inputs(cfg, data_dir)
     figures: list[Callable[[], None]] = []  # drawn at the end
 
     summary: dict[str, Any] = {
@@ -576,7 +612,7 @@ def run_experiment(
             summary["within"][group] = {"skipped": str(exc)}
             continue
         classes = res["classes"]
-        stem = f"within_{group}"
+        stem = f"within_{safe_name(group)}"
         (out / f"{stem}_confusion.csv").write_text(
             _csv(_matrix_rows(classes, res["confusion_mean"]))
         )

@@ -277,6 +277,13 @@ class RadarWaveform(Plugin):
         Default ``None``: the pipeline takes the STFT of ``signal`` at :attr:`prf`."""
         return None
 
+    def gate_gain(self, ranges: FloatArray, gate_range: FloatArray) -> FloatArray | None:
+        """Power gain (n_pulses, n_scatterers) of each scatterer in the range gate of
+        ``Received.signal`` (1 at the gate, 0 outside it), for the empty-result check
+        (:mod:`mdframework.emptiness`). Default None: the radar has no single range gate, and
+        no scatterer counts as lost to gating."""
+        return None
+
 
 def receive_points(
     waveform: RadarWaveform,

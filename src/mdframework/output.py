@@ -1,5 +1,9 @@
 """Writing a run's results: all files appear together or not at all.
 
+The folder rules (refusing other files, the lock, staging inside the folder, replacing an
+earlier run's files only once every new one is complete) are those of
+:mod:`mdframework.outdir`.
+
 ``DIR/result.npz`` arrays (all float64 unless noted):
 
 - ``signal`` (n_pulses,) complex128: compressed slow-time return at the gate [sqrt(W)]
@@ -32,9 +36,7 @@ and ``metadata.json``.
 from __future__ import annotations
 
 import json
-import os
-import shutil
-import tempfile
+from contextlib import AbstractContextManager
 from pathlib import Path
 from typing import Any
 
@@ -42,6 +44,7 @@ import numpy as np
 
 from .features import FEATURE_NAMES, envelopes, features_from_envelopes
 from .figures import plot_point_cloud, plot_range_doppler, plot_range_time, plot_spectrogram
+from .outdir import OutputFolder, output_folder
 from .physics.spectrogram import power_to_db
 from .pipeline import RunResult
 
@@ -146,49 +149,53 @@ def result_arrays(result: RunResult) -> dict[str, np.ndarray]:
     return arrays
 
 
-def write_run(result: RunResult, resolved_config: dict[str, Any], out_dir: Path) -> list[Path]:
-    """Write a run's files into ``out_dir`` atomically (staged in a temporary folder beside it,
-    then moved in). Returns the written paths."""
-    out_dir = Path(out_dir)
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
-    try:
-        arrays = result_arrays(result)
-        np.savez_compressed(stage / "result.npz", **arrays)  # type: ignore[arg-type]
-        title = str(result.metadata.get("motion", {}).get("activity", ""))
-        plot_spectrogram(
-            stage / "spectrogram.png",
-            arrays["spectrogram_db"],
-            arrays["time_s"],
-            arrays["velocity_mps"],
-            arrays["doppler_hz"],
+def write_run(
+    result: RunResult,
+    resolved_config: dict[str, Any],
+    out: Path | OutputFolder,
+    *,
+    force: bool = False,
+) -> list[Path]:
+    """Write a run's files into ``out`` (a folder path, or a folder already opened with
+    :func:`run_folder`): staged inside it, then moved in. Returns the written paths."""
+    if not isinstance(out, OutputFolder):
+        with run_folder(out, force=force) as folder:
+            return write_run(result, resolved_config, folder)
+    stage = out.stage()
+    arrays = result_arrays(result)
+    np.savez_compressed(stage / "result.npz", **arrays)  # type: ignore[arg-type]
+    title = str(result.metadata.get("motion", {}).get("activity", ""))
+    plot_spectrogram(
+        stage / "spectrogram.png",
+        arrays["spectrogram_db"],
+        arrays["time_s"],
+        arrays["velocity_mps"],
+        arrays["doppler_hz"],
+        title=title,
+    )
+    if "range_time_db" in arrays:
+        plot_range_time(
+            stage / "range_time.png",
+            arrays["range_time_db"],
+            arrays["range_time_time_s"],
+            arrays["range_m"],
             title=title,
         )
-        if "range_time_db" in arrays:
-            plot_range_time(
-                stage / "range_time.png",
-                arrays["range_time_db"],
-                arrays["range_time_time_s"],
-                arrays["range_m"],
-                title=title,
-            )
-        (stage / "features.json").write_text(json.dumps(features_document(arrays), indent=2) + "\n")
-        write_point_products(stage, arrays, title)
-        (stage / "config.resolved.json").write_text(json.dumps(resolved_config, indent=2) + "\n")
-        (stage / "metadata.json").write_text(
-            json.dumps(result.metadata, indent=2, default=_jsonable) + "\n"
-        )
-        out_dir.mkdir(parents=True, exist_ok=True)
-        for name in OUTPUTS:  # an earlier run's file this run does not make (range_time.png)
-            if not (stage / name).exists():
-                (out_dir / name).unlink(missing_ok=True)
-        written = []
-        for f in sorted(stage.iterdir()):
-            os.replace(f, out_dir / f.name)
-            written.append(out_dir / f.name)
-        return written
-    finally:
-        shutil.rmtree(stage, ignore_errors=True)
+    (stage / "features.json").write_text(json.dumps(features_document(arrays), indent=2) + "\n")
+    write_point_products(stage, arrays, title)
+    (stage / "config.resolved.json").write_text(json.dumps(resolved_config, indent=2) + "\n")
+    (stage / "metadata.json").write_text(
+        json.dumps(result.metadata, indent=2, default=_jsonable) + "\n"
+    )
+    return out.commit(stage)
+
+
+def run_folder(
+    out: str | Path, *, force: bool = False, staging_dir: str | Path | None = None
+) -> AbstractContextManager[OutputFolder]:
+    """Open ``out`` for a run's files (a context manager yielding an
+    :class:`~mdframework.outdir.OutputFolder`); see :func:`mdframework.outdir.output_folder`."""
+    return output_folder(out, "run", OUTPUTS, force=force, staging_dir=staging_dir)
 
 
 #: Header of ``points.csv``: the columns of a waveform's ``points`` product.

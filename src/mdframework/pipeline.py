@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from . import conditioning, sanity
+from . import conditioning, emptiness, sanity
 from .errors import SceneError
 from .interfaces import (
     Effect,
@@ -35,7 +35,7 @@ from .interfaces import (
 )
 from .physics import interpolation, radar, scene
 from .physics.spectrogram import RecordTooShortError, Spectrogram, power_to_db, spectrogram
-from .plugins import Registry, default_registry
+from .plugins import PluginError, Registry, default_registry
 from .settings import ConditioningConfig, PersonConfig, RunConfigBase, SanityConfig
 from .skeleton import Skeleton
 
@@ -44,6 +44,10 @@ FloatArray = NDArray[np.float64]
 
 class AliasingWarning(UserWarning):
     """A scatterer moves faster than the PRF can represent without Doppler aliasing."""
+
+
+class EmptyResultWarning(UserWarning):
+    """The record holds (almost) nothing of the target (see :mod:`mdframework.emptiness`)."""
 
 
 #: Range-time rows a record keeps: every pulse's row up to this many pulses, evenly spaced rows
@@ -102,9 +106,16 @@ def build_stages(config: RunConfigBase, registry: Registry | None = None) -> Sta
 
 
 def _apply_effects(stages: Stages, stage: str, data: Any, context: SceneContext) -> Any:
+    expected = type(data)
     for effect in stages.effects:
         if effect.stage == stage:
             data = effect.apply(data, context)
+            if not isinstance(data, expected):
+                raise PluginError(
+                    f"effect {effect.name!r} ({type(effect).__module__}.{type(effect).__name__}) "
+                    f"returned {type(data).__name__} from apply() on the {stage!r} stage instead "
+                    f"of {expected.__name__}; check it with mdframework.testing.check_effect"
+                )
     return data
 
 
@@ -207,6 +218,7 @@ def simulate_motion(
     seeds = np.random.SeedSequence(config.seed).spawn(len(stages.effects) + 1)
     rng = np.random.default_rng(seeds[0])
     stream = _Stream(n, proc.keep_scatterers, proc.aliasing, wf, sc.min_range, t)
+    losses = emptiness.Losses()
     for lo, hi in _blocks(n, proc.block_pulses, wf.block_multiple):
         clock = time.perf_counter()
         tb = t[lo:hi]
@@ -215,6 +227,7 @@ def simulate_motion(
 
         clock = time.perf_counter()
         scat = model.scatterers(motion, at_pulses, radar_pos, lam)
+        rcs_model = scat.rcs
         gate = _gate(sc.gate, at_pulses, radar_pos)
         context = SceneContext(
             radar_pos, wf.prf, wf.carrier_frequency, tb, gate, at_pulses, wf, rng, lo
@@ -222,6 +235,9 @@ def simulate_motion(
         scat = _apply_effects(stages, "scatterers", scat, context)
         ranges = scat.ranges(radar_pos)
         stream.check(lo, scat, ranges)
+        s = slice(None, None, emptiness.SAMPLE_EVERY)
+        gain = wf.gate_gain(ranges[s], gate[s])
+        losses += emptiness.count_losses(ranges[s], gate[s], rcs_model[s], scat.rcs[s], gain)
         timings["scatterers"] = timings.get("scatterers", 0.0) + time.perf_counter() - clock
 
         clock = time.perf_counter()
@@ -233,8 +249,10 @@ def simulate_motion(
     received = stream.received()
     if received.products:
         received = replace(received, products={**received.products, **wf.product_axes()})
+    echo = received.signal.copy()  # the target's echo, before noise and clutter
     context = SceneContext(radar_pos, wf.prf, wf.carrier_frequency, t, stream.gate, None, wf, rng)
     received = _apply_effects(stages, "received", received, context)
+    _check_empty(echo, losses, proc, fixed_gate=sc.gate != "track")
     effects_ran = _describe(stages, "scatterers") + _describe(stages, "received")
     timings["received_effects"] = time.perf_counter() - clock
 
@@ -288,6 +306,22 @@ def simulate_motion(
         shifted,
         stream.scatterers(),
         metadata,
+    )
+
+
+def _check_empty(
+    echo: NDArray[np.complex128], losses: emptiness.Losses, proc: Any, *, fixed_gate: bool
+) -> None:
+    """Warn (or stop, with ``processing.empty = "error"``) when the record is empty."""
+    why = emptiness.empty_result(
+        echo, losses, max_lost_fraction=proc.max_lost_fraction, fixed_gate=fixed_gate
+    )
+    if why is None:
+        return
+    if proc.empty == "error":
+        raise SceneError(f"{why} (processing.empty = 'error')")
+    warnings.warn(
+        f"{why} (processing.empty = 'error' makes this an error)", EmptyResultWarning, stacklevel=3
     )
 
 
@@ -410,7 +444,8 @@ class _Stream:
             self._blocks.append(scat)
         if rec.range_time is not None:
             first = (-lo) % self._rt_step
-            self._rt.append(np.asarray(rec.range_time[first :: self._rt_step]))
+            # a copy: a view would keep the whole block's map alive
+            self._rt.append(np.array(rec.range_time[first :: self._rt_step]))
             self._rt_axis = rec.range_axis
         for key, value in rec.products.items():
             self._products.setdefault(key, []).append(np.asarray(value))

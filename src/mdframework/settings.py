@@ -249,6 +249,20 @@ class ProcessingConfig(StrictModel):
         "Doppler folds over: 'warn' (the warning names the PRF that avoids it; the results are "
         "still written) or 'error' (stop, write nothing). `mdf check` predicts it.",
     )
+    empty: Literal["warn", "error"] = Field(
+        "warn",
+        description="When the result is empty (an all-zero or underflowed echo, or more than "
+        "max_lost_fraction of the scatterer returns lost to the range gate or to the scene "
+        "effects): warn with the cause, or stop.",
+    )
+    max_lost_fraction: float = Field(
+        0.5,
+        gt=0,
+        le=1,
+        description="Largest share of scatterer returns (scatterer x pulse) that may be lost "
+        "(weighted by -20 dB or less by the range gate or the scene effects) before the result "
+        "counts as empty.",
+    )
 
     @model_validator(mode="after")
     def _check(self) -> ProcessingConfig:

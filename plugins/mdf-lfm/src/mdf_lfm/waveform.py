@@ -109,6 +109,19 @@ class LfmPulseDoppler(RadarWaveform):
         amp = self.amplitudes(block.ranges, block.scatterers.rcs)
         return self._receive_raw(block.ranges, amp, block.gate_range)
 
+    def gate_gain(self, ranges: np.ndarray, gate_range: np.ndarray) -> np.ndarray:
+        """Power gain of each scatterer in the range gate: the squared gate weight of the
+        analytic path's response (the raw path reads the exact compressed envelope)."""
+        c = self.config
+        w = radar.gate_weights(
+            ranges,
+            gate_range,
+            pulse_width=c.pulse_width,
+            bandwidth=c.bandwidth,
+            response=c.gate_response if c.path == "analytic" else "exact",
+        )
+        return np.asarray(w * w, dtype=np.float64)
+
     def _receive_analytic(
         self, ranges: np.ndarray, rcs: np.ndarray, gate_range: np.ndarray
     ) -> np.ndarray:

@@ -1,0 +1,443 @@
+"""Output folders that never lose a user's files.
+
+Every command that writes a folder (``mdf run``, ``mdf dataset build``, ``mdf experiment``) opens
+it through :func:`output_folder`, before any work starts:
+
+- ``--out`` may be missing (it is created, with its parents), an empty folder, or a folder that
+  holds an earlier output of the same command (recognised by its marker file
+  ``.mdf-<command>.json``, or, for folders written before markers existed, by holding only files
+  that command writes).
+  Anything else (a file, a non-empty folder of other files, another command's output) is refused
+  with one line, unless ``force``: then the command writes its own files into the folder,
+  replacing files of the same names, and deletes nothing.
+- One lock file (``.mdf.lock``) per folder: a second command on the same folder is refused and
+  told the holder's process id and start time. The lock is an advisory ``flock`` on that file, so
+  the kernel drops it when its holder dies, however it dies: a lock left by a killed process is
+  stale by construction and the next command takes it over.
+- Files are staged in a ``.mdf-staging-*`` folder inside ``--out`` (or in a folder the user
+  chooses on the same file system) and moved into place by renames only once every new file is
+  complete; only then are the earlier output's own files that the new output does not make
+  removed. A killed command leaves the earlier output as it was (and a staging folder that the
+  next command on the folder removes).
+- New files get the permissions the user's umask gives any new file.
+
+POSIX only (``fcntl``).
+"""
+
+from __future__ import annotations
+
+import errno
+import fcntl
+import fnmatch
+import json
+import os
+import re
+import shutil
+import socket
+import tempfile
+import time
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .errors import OutputError
+
+LOCK = ".mdf.lock"
+STAGING_PREFIX = ".mdf-staging-"
+MARKER_PREFIX = ".mdf-"
+MARKER_SUFFIX = ".json"
+#: names a command never counts as user content (its lock, markers, staging folders)
+_INTERNAL = re.compile(r"^\.mdf(\.lock|-.+\.json|-staging-.*)$")
+
+
+def marker_name(command: str) -> str:
+    """The marker file of ``command``'s outputs, e.g. ``.mdf-run.json``."""
+    return f"{MARKER_PREFIX}{command}{MARKER_SUFFIX}"
+
+
+def _umask() -> int:
+    """The process's umask, read without changing it where the system allows."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except OSError:
+        pass
+    mask = os.umask(0o022)  # elsewhere: set and restore (not thread-safe, brief)
+    os.umask(mask)
+    return mask
+
+
+def new_file_mode() -> int:
+    """Permission bits the user's umask gives a new regular file (``0o666 & ~umask``)."""
+    return 0o666 & ~_umask()
+
+
+def _fsync_dir(path: Path) -> None:
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def atomic_write_bytes(path: Path, data: bytes) -> None:
+    """Write ``path`` through a temporary file beside it and a rename: it is either the old file
+    or the complete new one. The file gets the umask's permissions."""
+    fd, tmp = tempfile.mkstemp(prefix=".tmp-", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, new_file_mode())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def atomic_write_text(path: Path, text: str) -> None:
+    """:func:`atomic_write_bytes` of UTF-8 text."""
+    atomic_write_bytes(path, text.encode("utf-8"))
+
+
+def atomic_savez(path: Path, **arrays: Any) -> None:
+    """``numpy.savez`` into ``path`` atomically (temporary file + rename), umask permissions."""
+    import numpy as np
+
+    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".npz", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            np.savez(fh, **arrays)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, new_file_mode())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+_UNSAFE = re.compile(r"[^A-Za-z0-9_-]+")
+
+
+def safe_name(text: str) -> str:
+    """A file-name part made from a name taken from a config or data (a group, a label): ASCII
+    letters, digits, ``_`` and ``-`` only, so it can never name a path outside its folder. A name
+    that had to be changed gets a short digest of the original, so two names never collide
+    (``"a/b"`` -> ``"a_b-1e4a"``, ``"../../x"`` -> ``"x-9c3f"``)."""
+    import hashlib
+
+    clean = _UNSAFE.sub("_", text).strip("_")[:60]
+    if clean == text and clean:
+        return clean
+    digest = hashlib.sha1(text.encode("utf-8")).hexdigest()[:4]
+    return f"{clean}-{digest}" if clean else f"unnamed-{digest}"
+
+
+# --------------------------------------------------------------------------- the lock
+
+
+def _process_start(pid: int) -> str:
+    """When the process started (UTC, from /proc where available; else now)."""
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            ticks = int(fh.read().rsplit(")", 1)[1].split()[19])
+        with open("/proc/stat") as fh:
+            btime = next(int(line.split()[1]) for line in fh if line.startswith("btime"))
+        started = btime + ticks / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError, StopIteration):
+        started = time.time()
+    return time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime(started))
+
+
+def _read_holder(path: Path) -> dict[str, Any]:
+    for _ in range(20):  # the holder writes its details right after taking the lock
+        try:
+            info = json.loads(path.read_text())
+            if isinstance(info, dict) and "pid" in info:
+                return info
+        except (OSError, ValueError):
+            pass
+        time.sleep(0.01)
+    return {}
+
+
+def acquire_lock(folder: Path, command: str) -> int:
+    """Take the folder's lock; returns its file descriptor. Raises :class:`OutputError` naming
+    the holder when another process holds it. A lock file left by a dead process is taken
+    over (the kernel released its ``flock`` when it died)."""
+    path = folder / LOCK
+    for _ in range(10):
+        try:
+            fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+        except OSError as exc:
+            raise OutputError(
+                f"--out {folder}: cannot write into the folder ({exc.strerror}); choose a "
+                "folder you can write to"
+            ) from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as exc:
+            os.close(fd)
+            if exc.errno not in (errno.EAGAIN, errno.EACCES, errno.EWOULDBLOCK):
+                raise
+            info = _read_holder(path)
+            who = (
+                f"process {info.get('pid')} ({info.get('command', 'mdf')}, started "
+                f"{info.get('started', '?')}, host {info.get('host', '?')})"
+                if info
+                else "another process"
+            )
+            raise OutputError(
+                f"--out {folder}: in use by {who}; wait for it to finish or choose another folder"
+            ) from None
+        # the file may have been removed (released) between open and flock: lock the one there
+        try:
+            same = os.path.samestat(os.fstat(fd), os.stat(path))
+        except FileNotFoundError:
+            same = False
+        if not same:
+            os.close(fd)
+            continue
+        info = {
+            "pid": os.getpid(),
+            "command": command,
+            "started": _process_start(os.getpid()),
+            "host": socket.gethostname(),
+        }
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, (json.dumps(info) + "\n").encode(), 0)
+        return fd
+    raise OutputError(f"--out {folder}: could not take the lock {path}; try again")
+
+
+def release_lock(folder: Path, fd: int) -> None:
+    """Remove the lock file (while still holding it) and release the lock."""
+    try:
+        (folder / LOCK).unlink(missing_ok=True)
+    finally:
+        os.close(fd)
+
+
+# --------------------------------------------------------------------------- the folder
+
+
+@dataclass
+class OutputFolder:
+    """An output folder held (locked) by one command.
+
+    ``previous``: the folder holds an earlier output of this command (so the command may
+    replace its own files there); ``marker``: that output's marker (``{}`` for outputs written
+    before markers existed); ``created``: the folder did not exist before.
+    """
+
+    path: Path
+    command: str
+    patterns: tuple[str, ...]
+    previous: bool
+    marker: dict[str, Any]
+    created: bool
+    staging_dir: Path | None = None
+    _stages: list[Path] = field(default_factory=list)
+
+    def own(self, name: str) -> bool:
+        """Whether ``name`` is a file this command writes."""
+        return any(fnmatch.fnmatchcase(name, p) for p in self.patterns)
+
+    def stage(self) -> Path:
+        """A new, empty staging folder on the output's file system."""
+        where = self.staging_dir or self.path
+        stage = Path(tempfile.mkdtemp(prefix=f"{STAGING_PREFIX}{self.command}-", dir=where))
+        self._stages.append(stage)
+        return stage
+
+    def previous_files(self) -> list[str]:
+        """The earlier output's own files (listed in its marker, or all own-named entries)."""
+        if not self.previous:
+            return []
+        listed = self.marker.get("files")
+        if isinstance(listed, list):
+            return [n for n in listed if isinstance(n, str) and self.own(n)]
+        return [p.name for p in self.path.iterdir() if self.own(p.name)]
+
+    def write_marker(self, **extra: Any) -> None:
+        """Write this command's marker (which makes the folder a previous output next time)."""
+        marker = {"command": self.command, **extra}
+        atomic_write_text(self.path / marker_name(self.command), json.dumps(marker, indent=2))
+        self.marker = marker
+        self.previous = True
+
+    def commit(self, stage: Path, *, keep: Sequence[str] = ()) -> list[Path]:
+        """Move every file of ``stage`` into the folder (one rename each, after all of them are
+        complete), then delete the earlier output's own files that were not made again (never
+        the names in ``keep``, never anything else). Returns the new files' paths."""
+        names = sorted(p.name for p in stage.iterdir())
+        for name in names:
+            if not self.own(name):
+                raise RuntimeError(f"{name!r} is not one of the files `{self.command}` writes")
+        stale = [n for n in self.previous_files() if n not in names and n not in keep]
+        written = []
+        for name in names:
+            os.replace(stage / name, self.path / name)
+            written.append(self.path / name)
+        for name in stale:
+            target = self.path / name
+            if target.is_dir() and not target.is_symlink():
+                shutil.rmtree(target)
+            else:
+                target.unlink(missing_ok=True)
+        self.write_marker(files=sorted({*names, *(k for k in keep if (self.path / k).exists())}))
+        _fsync_dir(self.path)
+        shutil.rmtree(stage, ignore_errors=True)
+        return written
+
+    def user_entries(self) -> list[str]:
+        """Entries of the folder other than the lock, markers and staging folders."""
+        return sorted(p.name for p in self.path.iterdir() if not _INTERNAL.match(p.name))
+
+
+def _check_staging_dir(staging_dir: Path, out: Path) -> Path:
+    try:
+        st = os.stat(staging_dir)
+    except OSError as exc:
+        raise OutputError(f"--staging-dir {staging_dir}: {exc.strerror}") from None
+    if not staging_dir.is_dir():
+        raise OutputError(f"--staging-dir {staging_dir}: not a folder")
+    if st.st_dev != os.stat(out).st_dev:
+        raise OutputError(
+            f"--staging-dir {staging_dir}: on another file system than --out {out}; files are "
+            "moved into place by renames, so choose a folder on the same file system"
+        )
+    if not os.access(staging_dir, os.W_OK | os.X_OK):
+        raise OutputError(f"--staging-dir {staging_dir}: cannot write into the folder")
+    return staging_dir
+
+
+def _describe(entries: list[str]) -> str:
+    shown = ", ".join(repr(e) for e in entries[:3])
+    return shown + (f" and {len(entries) - 3} more" if len(entries) > 3 else "")
+
+
+def _inspect(out: Path, command: str, patterns: tuple[str, ...], force: bool) -> OutputFolder:
+    """Classify an existing folder (called with its lock held)."""
+    folder = OutputFolder(out, command, patterns, previous=False, marker={}, created=False)
+    entries = folder.user_entries()
+    markers = sorted(
+        p.name
+        for p in out.iterdir()
+        if p.name.startswith(MARKER_PREFIX) and p.name.endswith(MARKER_SUFFIX)
+    )
+    mine = marker_name(command)
+    if mine in markers:
+        try:
+            marker = json.loads((out / mine).read_text())
+        except (OSError, ValueError):
+            marker = {}
+        folder.marker = marker if isinstance(marker, dict) else {}
+        folder.previous = True
+        return folder
+    others = [m[len(MARKER_PREFIX) : -len(MARKER_SUFFIX)] for m in markers]
+    if not entries and not others:
+        return folder
+    if entries and not others and all(folder.own(e) for e in entries):
+        folder.previous = True  # written before markers existed
+        return folder
+    if force:
+        return folder
+    what = (
+        f"holds the output of `mdf {others[0]}`"
+        if others
+        else f"is not empty ({_describe(entries)}) and holds no earlier `mdf {command}` output"
+    )
+    raise OutputError(
+        f"--out {out}: the folder {what}; choose a new or empty folder, or add --force to "
+        f"write `mdf {command}`'s files into it (replacing files of the same names, deleting "
+        "nothing else)"
+    )
+
+
+@contextmanager
+def output_folder(
+    out: str | Path,
+    command: str,
+    patterns: Sequence[str],
+    *,
+    force: bool = False,
+    staging_dir: str | Path | None = None,
+) -> Iterator[OutputFolder]:
+    """Check, create and lock ``out`` for ``command`` (whose files match ``patterns``), before any
+    work starts; see the module docstring for the rules. On leaving, staging folders are removed
+    and the lock released; when the block fails and the folder was created here and holds
+    nothing of the user's or the command's, it is removed again."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"--out {out}: is a file, not a folder; choose a folder")
+    created = False
+    if not out.exists():
+        missing = [p for p in (out, *out.parents) if not p.exists()]
+        try:
+            out.mkdir(parents=True)
+        except FileExistsError:
+            if not out.is_dir():
+                raise OutputError(f"--out {out}: is a file, not a folder") from None
+        except OSError as exc:
+            for p in missing[1:]:  # folders made on the way, innermost first
+                try:
+                    p.rmdir()
+                except OSError:
+                    pass
+            raise OutputError(
+                f"--out {out}: cannot create the folder ({exc.strerror}); choose a folder you "
+                "can write to"
+            ) from None
+        created = True
+    else:
+        missing = []
+    lock = None
+    folder = None
+    ok = False
+    try:
+        lock = acquire_lock(out, f"mdf {command}")
+        for leftover in out.glob(f"{STAGING_PREFIX}*"):  # from a killed command; ours now
+            shutil.rmtree(leftover, ignore_errors=True)
+        folder = _inspect(out, command, tuple(patterns), force)
+        folder.created = created
+        if staging_dir is not None:
+            folder.staging_dir = _check_staging_dir(Path(staging_dir), out)
+        yield folder
+        ok = True
+    finally:
+        if folder is not None:
+            for stage in folder._stages:
+                shutil.rmtree(stage, ignore_errors=True)
+        if not ok and created:
+            _remove_if_empty(out, missing)  # while still holding the lock
+        if lock is not None:
+            release_lock(out, lock)
+
+
+def _remove_if_empty(out: Path, made: list[Path]) -> None:
+    """Remove a folder this command created (and the parents it made), if it holds nothing but
+    the command's internals."""
+    try:
+        names = [p.name for p in out.iterdir()]
+    except OSError:
+        return
+    if any(not _INTERNAL.match(n) for n in names):
+        return
+    shutil.rmtree(out, ignore_errors=True)
+    for parent in made[1:]:
+        try:
+            parent.rmdir()
+        except OSError:
+            return

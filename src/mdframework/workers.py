@@ -1,0 +1,76 @@
+"""Worker processes that never outlive the command that started them.
+
+A dataset build runs records in local worker processes (a process pool, or a local Dask
+cluster whose workers end with their parent by themselves). If the command is killed (``kill
+-9``, a closed terminal, an out-of-memory kill), its pool workers must not linger: each asks the
+kernel to kill it when its parent process dies (Linux ``PR_SET_PDEATHSIG``) and, as a fallback on
+other systems, watches its parent from a thread and exits when it is gone. Ctrl-C is the
+command's to handle: workers ignore it, and the command stops them (:func:`stop_pool`) and
+prints one line.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import ctypes.util
+import os
+import signal
+import sys
+import threading
+import time
+from concurrent.futures import ProcessPoolExecutor
+from typing import Any
+
+_PR_SET_PDEATHSIG = 1
+#: how often the fallback watcher looks at the parent [s]
+WATCH_INTERVAL_S = 0.5
+
+
+def _parent_death_signal(sig: int) -> bool:
+    """Ask Linux to send ``sig`` to this process when its parent dies; False elsewhere."""
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+        return int(libc.prctl(_PR_SET_PDEATHSIG, sig, 0, 0, 0)) == 0
+    except (OSError, AttributeError):
+        return False
+
+
+def _watch(parent: int) -> None:
+    while True:
+        time.sleep(WATCH_INTERVAL_S)
+        if os.getppid() != parent:  # re-parented: the parent has died
+            os._exit(1)
+
+
+def die_with_parent(parent_pid: int | None = None, *, ignore_interrupt: bool = True) -> None:
+    """Make this (worker) process end when its parent process ends.
+
+    Call it first thing in a worker (a process pool's ``initializer``). ``parent_pid``: the
+    process expected to be the parent (a worker started after its parent died exits at once).
+    ``ignore_interrupt``: ignore Ctrl-C (SIGINT), which the parent handles; only possible from a
+    process's main thread, so it is skipped elsewhere.
+    """
+    parent = os.getppid()
+    if ignore_interrupt and threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _parent_death_signal(signal.SIGKILL)
+    if (parent_pid is not None and parent != parent_pid) or os.getppid() != parent:
+        os._exit(1)  # the parent died before the request above took effect
+    threading.Thread(target=_watch, args=(parent,), name="die-with-parent", daemon=True).start()
+
+
+def stop_pool(pool: ProcessPoolExecutor) -> None:
+    """Stop a process pool now: cancel queued work and end its workers (for Ctrl-C and
+    errors, where waiting for the queued work is wrong)."""
+    terminate = getattr(pool, "terminate_workers", None)  # Python >= 3.14
+    if terminate is not None:
+        terminate()
+        return
+    processes: dict[int, Any] = dict(getattr(pool, "_processes", None) or {})
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in processes.values():
+        proc.terminate()
+    for proc in processes.values():
+        proc.join(timeout=5)

@@ -1,0 +1,143 @@
+"""Empty results: the pure check on named hard cases, and real runs that warn or stop."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mdframework import cli
+from mdframework.emptiness import LOST_GAIN, MIN_POWER_W, Losses, count_losses, empty_result
+from mdframework.settings import ProcessingConfig
+
+POINT = """
+[motion]
+kind = "point_targets"
+length = 1.0
+targets = [{{ position = [{x}, 0.0, 0.0], velocity = [1.0, 0.0, 0.0], rcs = 1.0 }}]
+[scatterers]
+kind = "points"
+[scene]
+radar_position = [0.0, 0.0, 0.0]
+gate = {gate}
+[processing]
+empty = "{empty}"
+"""
+
+
+def losses(total: int, gated: int, cut: int = 0) -> Losses:
+    return Losses(total, gated, cut, (8.0, 10.0), (30.0, 30.0))
+
+
+def test_count_losses_by_hand() -> None:
+    ranges = np.array([[10.0, 11.0, 12.0], [10.0, 11.0, 12.0]])
+    gain = np.array([[1.0, LOST_GAIN, 0.5], [0.0, 0.2, 1.0]])  # at the limit counts as lost
+    rcs_model = np.array([[1.0, 1.0, 1.0], [1.0, 1.0, 2.0]])
+    rcs = np.array([[1.0, 0.0, 0.01], [1.0, 0.5, 0.019]])  # 0.01 of 1: cut; 0.019 of 2: cut
+    got = count_losses(ranges, np.array([10.0, 10.5]), rcs_model, rcs, gain)
+    # gated: (0,1), (1,0); cut and not gated: (0,2), (1,2)
+    assert (got.total, got.gated, got.cut) == (6, 2, 2)
+    assert got.range_m == (10.0, 12.0) and got.gate_m == (10.0, 10.5)
+    # without a gate model nothing is gated; without a comparable model RCS nothing is cut
+    assert count_losses(ranges, np.array([10.0, 10.5]), None, rcs, None).gated == 0
+    assert count_losses(ranges, np.array([10.0, 10.5]), rcs_model[:, :2], rcs, None).cut == 0
+    # blocks add up
+    both = got + got
+    assert (both.total, both.gated, both.cut) == (12, 4, 4)
+
+
+def test_all_zeros_names_the_fixed_gate() -> None:
+    why = empty_result(np.zeros(8, complex), losses(16, 16), max_lost_fraction=0.5, fixed_gate=True)
+    assert why is not None and "all zeros" in why
+    assert "fixed range gate at 30 m" in why and "8-10 m" in why and "scene.gate" in why
+
+
+def test_all_zeros_from_effects_and_from_underflow() -> None:
+    zeros = np.zeros(8, complex)
+    why = empty_result(zeros, losses(16, 4, 12), max_lost_fraction=0.5, fixed_gate=False)
+    assert why is not None and "scene effects" in why
+    why = empty_result(zeros, losses(16, 0, 0), max_lost_fraction=0.5, fixed_gate=False)
+    assert why is not None and "underflow" in why
+
+
+def test_no_power_is_an_underflowed_echo() -> None:
+    tiny = np.full(8, 1e-160 + 0j)  # |y|^2 = 1e-320: a subnormal power
+    assert 0 < np.abs(tiny[0]) ** 2 < MIN_POWER_W
+    why = empty_result(tiny, losses(16, 0), max_lost_fraction=0.5, fixed_gate=False)
+    assert why is not None and "no power in the record" in why
+    weak = np.full(8, 1e-150 + 0j)  # 1e-300 W: small but representable, not empty
+    assert empty_result(weak, losses(16, 0), max_lost_fraction=0.5, fixed_gate=False) is None
+
+
+@pytest.mark.parametrize(
+    ("gated", "cut", "limit", "empty"),
+    [(9, 0, 0.5, True), (8, 0, 0.5, False), (5, 4, 0.5, True), (1, 2, 0.2, False)],
+)
+def test_lost_fraction_threshold(gated: int, cut: int, limit: float, empty: bool) -> None:
+    # 16 returns: more than the limit lost (strictly) is empty; 1 + 2 = 3/16 = 0.19 <= 0.2
+    why = empty_result(np.ones(4, complex), losses(16, gated, cut), max_lost_fraction=limit,
+                       fixed_gate=True)  # fmt: skip
+    assert (why is not None) == empty
+    if why is not None:
+        assert "max_lost_fraction" in why
+        assert ("range gate" in why) == (gated >= cut) and ("scene effects" in why) == (cut > gated)
+
+
+def run(tmp_path: Path, text: str, capsys: pytest.CaptureFixture[str]) -> tuple[int, str, Path]:
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(text)
+    out = tmp_path / "out"
+    code = cli.main(["run", str(cfg), "--out", str(out)])
+    return code, capsys.readouterr().err, out
+
+
+def test_target_outside_a_fixed_gate_warns(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, err, out = run(tmp_path, POINT.format(x=100.0, gate=30.0, empty="warn"), capsys)
+    assert code == 0 and (out / "result.npz").exists()
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("mdf: warning: nearly empty result: 100 %")
+    assert "fixed range gate at 30 m" in lines[0] and "scene.gate = 'track'" in lines[0]
+    assert "processing.empty = 'error'" in lines[0]
+
+
+def test_a_target_in_the_gate_does_not_warn(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, err, _ = run(tmp_path, POINT.format(x=100.0, gate=100.0, empty="error"), capsys)
+    assert code == 0 and err == ""
+
+
+def test_empty_error_stops_and_writes_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, err, out = run(tmp_path, POINT.format(x=100.0, gate=30.0, empty="error"), capsys)
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"mdf: error: {tmp_path / 'c.toml'}: nearly")
+    assert not out.exists()
+
+
+def test_attenuation_underflow_with_snr_noise_is_all_zeros(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    text = POINT.format(x=30000.0, gate='"track"', empty="warn") + (
+        '[[effects]]\nkind = "attenuation"\ngas_db_per_km = 100.0\n'
+        '[[effects]]\nkind = "noise"\nmode = "snr"\nsnr_db = 10.0\n'
+    )
+    code, err, out = run(tmp_path, text, capsys)
+    assert code == 0
+    assert "empty result: the received signal is all zeros: the scene effects" in err
+    with np.load(out / "result.npz") as d:
+        assert not np.any(d["signal"])  # the noise in SNR mode is zero too: truly empty
+    # the getting-started page quotes this very warning, and the limits it states
+    from conftest import ROOT
+
+    page = (ROOT / "docs" / "getting-started.md").read_text()
+    quoted = page.split("```text\n", 1)[1].split("```", 1)[0]
+    assert " ".join(quoted.split()) == err.strip()
+    assert "(below 2.2e-308 W)" in page and f"{MIN_POWER_W:.2g}" == "2.2e-308"
+    assert "(default 0.5)" in page and ProcessingConfig().max_lost_fraction == 0.5
+    assert "-20 dB" in page and LOST_GAIN == 10 ** (-20 / 10)

@@ -1,0 +1,543 @@
+"""Output folders on real runs: nothing a user has is ever lost (no mocks of the file system).
+
+Every test runs the real command (in this process, or as a subprocess where a process must be
+killed, interrupted or hold a lock) on real folders under pytest's tmp_path.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import stat
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import EXAMPLES
+
+from mdframework import cli
+from mdframework.dataset import load_dataset, read_record
+from mdframework.errors import DataFileError
+from mdframework.outdir import LOCK, safe_name
+
+POINT = EXAMPLES / "point_target.toml"
+CMU = EXAMPLES / "data" / "cmu"
+
+
+def mdf(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:
+    """Run ``mdf`` in this process; returns the exit code and stderr."""
+    code = cli.main(args)
+    return code, capsys.readouterr().err
+
+
+def one_error_line(err: str) -> str:
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith("mdf: error: --out "), lines[0]
+    return lines[0]
+
+
+def mdf_process(args: list[str], **kw: object) -> subprocess.Popen[str]:
+    """``mdf`` as its own process (in its own session, so that signals reach only it)."""
+    return subprocess.Popen(
+        [sys.executable, "-m", "mdframework.cli", *args],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+        **kw,  # type: ignore[arg-type]
+    )
+
+
+def snapshot(folder: Path) -> dict[str, bytes]:
+    return {
+        str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()
+    }
+
+
+def point_config(tmp_path: Path, *, raw: bool = False, length: float = 2.0) -> Path:
+    cfg = tmp_path / ("raw.toml" if raw else "point.toml")
+    text = POINT.read_text().replace("length = 2.0", f"length = {length}")
+    if raw:
+        text = text.replace('kind = "lfm"', 'kind = "lfm"\npath = "raw"')
+    cfg.write_text(text)
+    return cfg
+
+
+# --------------------------------------------------------------------------- foreign folders
+
+
+def test_run_refuses_a_folder_of_other_files(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "home"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    (out / "range_time.png").write_bytes(b"my own picture")  # a name the run also writes
+    before = snapshot(out)
+    code, err = mdf(["run", str(POINT), "--out", str(out)], capsys)
+    assert code == 2
+    line = one_error_line(err)
+    assert str(out) in line and "--force" in line and "notes.txt" in line
+    assert snapshot(out) == before
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt", "range_time.png"]
+
+
+def test_force_writes_only_the_runs_files_and_deletes_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "home"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    (out / "range_time.png").write_bytes(b"my own picture")  # the analytic run makes none
+    (out / "metadata.json").write_text("{}")  # a name the run writes: replaced
+    code, err = mdf(["run", str(POINT), "--out", str(out), "--force"], capsys)
+    assert code == 0, err
+    assert (out / "notes.txt").read_text() == "mine"
+    assert (out / "range_time.png").read_bytes() == b"my own picture"
+    assert json.loads((out / "metadata.json").read_text())["prf_hz"] == 2400.0
+    # from now on it is a run output: a second run needs no --force and still keeps the
+    # user's files (it deletes only its own earlier files)
+    code, err = mdf(["run", str(POINT), "--out", str(out)], capsys)
+    assert code == 0, err
+    assert (out / "notes.txt").read_text() == "mine"
+    assert (out / "range_time.png").read_bytes() == b"my own picture"
+
+
+def test_another_commands_output_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "o"
+    assert mdf(["run", str(POINT), "--out", str(out)], capsys)[0] == 0
+    before = snapshot(out)
+    code, err = mdf(
+        ["dataset", "build", str(dataset_config(tmp_path)), "--out", str(out), "--no-progress"],
+        capsys,
+    )
+    assert code == 2
+    assert "holds the output of `mdf run`" in one_error_line(err)
+    assert snapshot(out) == before
+
+
+def test_rerun_replaces_the_previous_output(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "o"
+    assert mdf(["run", str(point_config(tmp_path, raw=True)), "--out", str(out)], capsys)[0] == 0
+    assert (out / "range_time.png").exists()
+    (out / "my_notes.md").write_text("notes")  # the user adds a file to the output
+    code, err = mdf(["run", str(point_config(tmp_path, length=1.5)), "--out", str(out)], capsys)
+    assert code == 0, err
+    # the new run's files, the user's file; the earlier run's range-time picture is gone
+    assert not (out / "range_time.png").exists()
+    assert (out / "my_notes.md").read_text() == "notes"
+    with np.load(out / "result.npz") as d:
+        assert d["pulse_time_s"][-1] == pytest.approx(1.5)  # the new run's record
+        assert "range_time_db" not in d
+    assert not [p for p in out.iterdir() if p.name.startswith(".mdf-staging")]
+    assert not (out / LOCK).exists()
+
+
+def test_failed_rerun_keeps_the_old_output_whole(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "o"
+    assert mdf(["run", str(POINT), "--out", str(out)], capsys)[0] == 0
+    before = snapshot(out)
+    bad = tmp_path / "atradar.toml"  # valid config, fails in the simulation
+    bad.write_text(POINT.read_text().replace("[0.0, 0.0, 0.0]", "[100.0, 0.0, 0.0]"))
+    code, err = mdf(["run", str(bad), "--out", str(out)], capsys)
+    assert code == 2 and "comes within" in err
+    assert snapshot(out) == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["atradar.toml", "o"]
+
+
+def test_killed_rerun_keeps_the_old_output_and_stages_inside_out(tmp_path: Path) -> None:
+    out = tmp_path / "o"
+    first = mdf_process(["run", str(POINT), "--out", str(out)])
+    assert first.wait(120) == 0, first.communicate()[1]
+    before = snapshot(out)
+    # a long raw-path run: kill it while it computes or writes
+    long_cfg = point_config(tmp_path, raw=True, length=30.0)
+    proc = mdf_process(["run", str(long_cfg), "--out", str(out)])
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not (out / LOCK).exists():
+        time.sleep(0.02)
+    time.sleep(1.0)
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    assert {k: v for k, v in snapshot(out).items() if not k.startswith(".mdf")} == {
+        k: v for k, v in before.items() if not k.startswith(".mdf")
+    }
+    # nothing was written beside --out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["o", "raw.toml"]
+    again = mdf_process(["run", str(POINT), "--out", str(out)])
+    assert again.wait(120) == 0, again.communicate()[1]
+    assert not [p for p in out.iterdir() if p.name.startswith(".mdf-staging")]
+
+
+# --------------------------------------------------------------------------- unusable --out
+
+
+def test_out_that_is_a_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    target = tmp_path / "result"
+    target.write_text("precious")
+    code, err = mdf(["run", str(POINT), "--out", str(target)], capsys)
+    assert code == 2 and "is a file, not a folder" in one_error_line(err)
+    assert target.read_text() == "precious"
+
+
+def test_out_root_is_refused(capsys: pytest.CaptureFixture[str]) -> None:
+    listing = sorted(os.listdir("/"))
+    code, err = mdf(["run", str(POINT), "--out", "/"], capsys)
+    assert code == 2 and "is not empty" in one_error_line(err)
+    assert sorted(os.listdir("/")) == listing  # no hidden staging folder in /
+
+
+def test_out_that_cannot_be_created(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    if os.geteuid() == 0:  # root ignores permissions: use a read-only kernel file system
+        parent = Path("/proc/sys")
+    else:
+        parent = tmp_path / "ro"
+        parent.mkdir()
+        parent.chmod(0o555)
+    code, err = mdf(["run", str(POINT), "--out", str(parent / "a" / "b")], capsys)
+    assert code == 2 and "cannot create the folder" in one_error_line(err)
+    assert not (parent / "a").exists()
+
+
+def test_out_is_checked_before_the_simulation(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    target = tmp_path / "file"
+    target.write_text("x")
+    bad = tmp_path / "atradar.toml"  # would fail only in the simulation
+    bad.write_text(POINT.read_text().replace("[0.0, 0.0, 0.0]", "[100.0, 0.0, 0.0]"))
+    code, err = mdf(["run", str(bad), "--out", str(target)], capsys)
+    assert code == 2 and "is a file" in err and "comes within" not in err
+
+
+def test_staging_dir_on_the_same_file_system(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    staging = tmp_path / "staging"
+    staging.mkdir()
+    out = tmp_path / "o"
+    code, err = mdf(["run", str(POINT), "--out", str(out), "--staging-dir", str(staging)], capsys)
+    assert code == 0, err
+    assert (out / "result.npz").exists() and list(staging.iterdir()) == []
+    other = Path("/dev/shm")
+    if not other.is_dir() or other.stat().st_dev == tmp_path.stat().st_dev:
+        pytest.skip("no second file system to stage on")
+    code, err = mdf(["run", str(POINT), "--out", str(out), "--staging-dir", str(other)], capsys)
+    assert code == 2 and "on another file system" in err
+
+
+# --------------------------------------------------------------------------- the lock
+
+
+HOLD = """
+import sys, time
+from pathlib import Path
+from mdframework.outdir import acquire_lock
+acquire_lock(Path(sys.argv[1]), "mdf test-holder")
+print("locked", flush=True)
+time.sleep(600)
+"""
+
+
+def test_second_command_is_refused_and_a_dead_holders_lock_is_taken_over(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "o"
+    out.mkdir()
+    holder = subprocess.Popen(
+        [sys.executable, "-c", HOLD, str(out)], stdout=subprocess.PIPE, text=True
+    )
+    try:
+        assert holder.stdout is not None and holder.stdout.readline().strip() == "locked"
+        code, err = mdf(["run", str(POINT), "--out", str(out)], capsys)
+        assert code == 2
+        line = one_error_line(err)
+        assert f"in use by process {holder.pid}" in line
+        assert "mdf test-holder" in line and "started 20" in line and "UTC" in line
+        assert not (out / "result.npz").exists()
+    finally:
+        holder.kill()
+        holder.wait()
+    assert (out / LOCK).exists()  # left behind by the killed holder: stale
+    code, err = mdf(["run", str(POINT), "--out", str(out)], capsys)
+    assert code == 0, err
+    assert (out / "result.npz").exists() and not (out / LOCK).exists()
+
+
+# --------------------------------------------------------------------------- datasets
+
+
+def dataset_config(tmp_path: Path, aspects: str = "[0.0, 45.0]", name: str = "d.toml") -> Path:
+    p = tmp_path / name
+    p.write_text(f"""
+seed = 3
+[[sources]]
+label = "walk"
+group = "../../escape"
+motion = {{ kind = "cmu", file = "{CMU / "asf-amc" / "02_01.amc"}" }}
+max_records = 1
+[[sources]]
+label = "run"
+group = "../../escape"
+motion = {{ kind = "cmu", file = "{CMU / "asf-amc" / "09_06.amc"}" }}
+[record_lengths]
+walk = 1.0
+run = 1.0
+[variations]
+aspect_deg = {aspects}
+[base.processing]
+nfft = 256
+""")
+    return p
+
+
+def build(cfg: Path, out: Path, capsys: pytest.CaptureFixture[str], *extra: str) -> tuple[int, str]:
+    args = ["dataset", "build", str(cfg), "--out", str(out), "--no-progress", "--workers", "1"]
+    return mdf([*args, *extra], capsys)
+
+
+def test_dataset_resumes_only_with_the_same_config(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "ds"
+    cfg = dataset_config(tmp_path)
+    assert build(cfg, out, capsys)[0] == 0
+    before = snapshot(out)
+    # the same config again (other build options do not count): resumed, nothing redone
+    assert build(cfg, out, capsys, "--workers", "2")[0] == 0
+    assert snapshot(out) == before
+    other = dataset_config(tmp_path, aspects="[0.0, 30.0]", name="other.toml")
+    code, err = build(other, out, capsys)
+    assert code == 2
+    line = one_error_line(err)
+    assert "different config" in line and "variations.aspect_deg[1]: 45.0 -> 30.0" in line
+    assert snapshot(out) == before
+    # --force rebuilds: the old records go only once the new index is complete
+    code, err = build(other, out, capsys, "--force")
+    assert code == 0, err
+    index = (out / "index.csv").read_text().splitlines()
+    ids = {row.split(",")[0] for row in index[1:]}
+    assert {p.stem for p in (out / "records").glob("*.npz")} == ids
+    assert all(",30.0," in row or ",0.0," in row for row in index[1:])
+
+
+def test_dataset_into_a_folder_of_other_files(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "ds"
+    (out / "records").mkdir(parents=True)
+    (out / "records" / "mine.npz").write_bytes(b"user data")
+    (out / "todo.txt").write_text("x")
+    code, err = build(dataset_config(tmp_path), out, capsys)
+    assert code == 2 and "--force" in one_error_line(err)
+    assert build(dataset_config(tmp_path), out, capsys, "--force")[0] == 0
+    assert (out / "records" / "mine.npz").read_bytes() == b"user data"
+    assert (out / "todo.txt").read_text() == "x"
+    # an index whose record id names a path is refused, not followed out of records/
+    index = out / "index.csv"
+    lines = index.read_text().splitlines()
+    first = lines[1].split(",", 1)
+    index.write_text("\n".join([lines[0], "../../todo," + first[1], *lines[2:]]) + "\n")
+    with pytest.raises(DataFileError, match=r"index\.csv:2: record id '\.\./\.\./todo'"):
+        load_dataset(out)
+
+
+def test_names_from_configs_never_leave_the_folder(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    for name in ["../../escape", "/etc/passwd", "a/b", "..", "", "ü", "con", "x" * 300]:
+        safe = safe_name(name)
+        assert safe and len(safe) <= 70 and "/" not in safe and not safe.startswith(".")
+        assert (tmp_path / safe).resolve().parent == tmp_path.resolve()
+    assert safe_name("walk") == "walk" and safe_name("a/b") != safe_name("a_b")
+    exp = tmp_path / "exp.toml"
+    exp.write_text(f"""
+[dataset]
+config = "{dataset_config(tmp_path, aspects="[0.0, 30.0, 60.0]")}"
+[selection]
+method = "none"
+optimistic = false
+[evaluation]
+repeats = 2
+""")
+    work = tmp_path / "work" / "deep"
+    work.mkdir(parents=True)
+    before = sorted(str(p) for p in tmp_path.rglob("*"))
+    code, err = mdf(["experiment", str(exp), "--out", str(work / "exp"), "--no-progress"], capsys)
+    assert code == 0, err
+    after = sorted(str(p) for p in tmp_path.rglob("*"))
+    new = [p for p in after if p not in before]
+    assert new and all(p.startswith(str(work / "exp")) for p in new)
+    stem = f"within_{safe_name('../../escape')}"
+    assert (work / "exp" / f"{stem}_confusion.csv").exists()
+    assert f"]({stem}_confusion.png)" in (work / "exp" / "report.md").read_text()
+
+
+def test_group_names_with_control_characters_are_refused(tmp_path: Path) -> None:
+    from mdframework.dataset import load_dataset_config
+    from mdframework.errors import ConfigError
+
+    p = dataset_config(tmp_path)
+    p.write_text(p.read_text().replace('group = "../../escape"', 'group = "a\\tb"', 1))
+    with pytest.raises(ConfigError, match=r"sources\.0\.group: .*control characters"):
+        load_dataset_config(p)
+
+
+# --------------------------------------------------------------------------- permissions
+
+
+@pytest.mark.parametrize("umask", [0o022, 0o027, 0o002])
+def test_files_get_the_umask_permissions(tmp_path: Path, umask: int) -> None:
+    script = (
+        "import os, sys; os.umask(int(sys.argv[1], 8)); from mdframework.cli import main; "
+        "sys.exit(main(sys.argv[2:]))"
+    )
+    cfg = dataset_config(tmp_path)
+    outs = {"run": tmp_path / "run", "dataset": tmp_path / "ds"}
+    for args in (
+        ["run", str(POINT), "--out", str(outs["run"])],
+        ["dataset", "build", str(cfg), "--out", str(outs["dataset"]), "--no-progress"],
+    ):
+        res = subprocess.run(
+            [sys.executable, "-c", script, oct(umask), *args], capture_output=True, text=True
+        )
+        assert res.returncode == 0, res.stderr
+    expected_file, expected_dir = 0o666 & ~umask, 0o777 & ~umask
+    for out in outs.values():
+        for p in [out, *out.rglob("*")]:
+            mode = stat.S_IMODE(p.stat().st_mode)
+            assert mode == (expected_dir if p.is_dir() else expected_file), (p, oct(mode))
+
+
+# --------------------------------------------------------------------------- processes
+
+
+def descendants(pid: int) -> list[int]:
+    """All processes below ``pid`` (from /proc)."""
+    found = []
+    for task in Path(f"/proc/{pid}/task").glob("*"):
+        try:
+            kids = [int(k) for k in (task / "children").read_text().split()]
+        except OSError:
+            continue
+        for kid in kids:
+            found += [kid, *descendants(kid)]
+    return found
+
+
+def running(pid: int) -> bool:
+    """Alive and not a zombie (an orphan's zombie waits for a reaper that may never come)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state not in ("Z", "X")
+
+
+def long_dataset(tmp_path: Path) -> Path:
+    p = tmp_path / "long.toml"
+    p.write_text(f"""
+[[sources]]
+label = "walk"
+motion = {{ kind = "cmu", file = "{CMU / "asf-amc" / "02_01.amc"}" }}
+hop = 0.05
+[record_lengths]
+walk = 1.0
+[variations]
+aspect_deg = [0.0, 30.0, 60.0]
+[base.processing]
+nfft = 256
+""")
+    return p
+
+
+def start_build(tmp_path: Path, *extra: str) -> tuple[subprocess.Popen[str], Path, list[int]]:
+    """A dataset build with two workers, once both workers exist and a record is written."""
+    out = tmp_path / "ds"
+    args = ["dataset", "build", str(long_dataset(tmp_path)), "--out", str(out), "--no-progress"]
+    proc = mdf_process([*args, "--workers", "2", *extra])
+    deadline = time.monotonic() + 240
+    while time.monotonic() < deadline and proc.poll() is None:
+        workers = descendants(proc.pid)
+        if len(workers) >= 2 and any((out / "records").glob("*.npz")):
+            return proc, out, workers
+        time.sleep(0.1)
+    proc.kill()
+    raise AssertionError(f"the build did not get going: {proc.communicate()[1]}")
+
+
+@pytest.mark.parametrize("scheduler", [[], ["--scheduler", "local"]], ids=["pool", "dask"])
+def test_workers_end_when_the_parent_is_killed(tmp_path: Path, scheduler: list[str]) -> None:
+    if scheduler:
+        pytest.importorskip("distributed")
+    proc, out, workers = start_build(tmp_path, *scheduler)
+    assert all(running(w) for w in workers)
+    os.kill(proc.pid, signal.SIGKILL)  # the parent only, as the out-of-memory killer would
+    proc.wait()
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and any(running(w) for w in workers):
+        time.sleep(0.1)
+    assert not [w for w in workers if running(w)], "workers outlived their parent"
+    # the killed build's lock is stale: the next build takes it over and finishes
+    assert (out / LOCK).exists()
+    args = ["dataset", "build", str(tmp_path / "long.toml"), "--out", str(out), "--no-progress"]
+    again = subprocess.run(
+        [sys.executable, "-m", "mdframework.cli", *args, "--workers", "2"],
+        capture_output=True,
+        text=True,
+    )
+    assert again.returncode == 0, again.stderr
+    assert not (out / LOCK).exists()
+
+
+def test_ctrl_c_during_a_build_is_one_line(tmp_path: Path) -> None:
+    proc, out, workers = start_build(tmp_path)
+    os.killpg(proc.pid, signal.SIGINT)  # Ctrl-C reaches the whole foreground process group
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130
+    assert err.strip() == "mdf: interrupted"
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and any(running(w) for w in workers):
+        time.sleep(0.1)
+    assert not [w for w in workers if running(w)]
+    assert not (out / LOCK).exists()
+    for record in (out / "records").glob("[!.]*.npz"):  # every record file is complete
+        read_record(record)
+
+
+@pytest.mark.parametrize("delay", [0.02, 0.05, 0.15, 0.3, 0.6, 1.0, 2.0])
+def test_ctrl_c_during_start_up_is_one_line(tmp_path: Path, delay: float) -> None:
+    """From the moment ``main`` runs (plugin loading, config loading, the simulation), Ctrl-C
+    prints one line and exits 130. ``delay`` counts from the call of ``main``: the child reports
+    when the command-line module is imported (the interpreter's own start and that module's
+    standard-library imports come before any code of mdf can handle a signal)."""
+    script = (
+        "import sys; import mdframework.cli as c; print('ready', flush=True); "
+        "sys.exit(c.main(sys.argv[1:]))"
+    )
+    out = tmp_path / "o"
+    proc = subprocess.Popen(
+        [sys.executable, "-c", script, "run", str(POINT), "--out", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    assert proc.stdout is not None and proc.stdout.readline().strip() == "ready"
+    time.sleep(delay)
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    assert err.strip() == "mdf: interrupted"
+    assert not (out / LOCK).exists()
