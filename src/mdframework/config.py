@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Annotated, Any, Union, get_args
 
 import yaml
-from pydantic import BaseModel, Field, ValidationError, create_model
+from pydantic import BaseModel, Field, ValidationError, create_model, model_validator
 
 from . import limits
 from .errors import ConfigError, SceneError
@@ -62,10 +62,28 @@ def _run_config_model(key: _ConfigModels) -> type[RunConfigBase]:
             return Field(default={"kind": name}, validate_default=True)
         return ...
 
+    # a section without ``kind`` means its default plugin, whatever else is installed
+    kinds = {
+        section: name
+        for section, name in DEFAULT_KINDS.items()
+        if name in configs.get(PLUGIN_SECTIONS[section], {})
+    }
+
+    class Base(RunConfigBase):
+        @model_validator(mode="before")
+        @classmethod
+        def _default_kinds(cls, data: Any) -> Any:
+            if isinstance(data, dict):
+                for section, name in kinds.items():
+                    value = data.get(section)
+                    if isinstance(value, dict) and "kind" not in value:
+                        data = {**data, section: {"kind": name, **value}}
+            return data
+
     effect_list: Any = list[union("effects")]  # type: ignore[misc]
     model = create_model(
         "RunConfig",
-        __base__=RunConfigBase,
+        __base__=Base,
         effects=(
             effect_list,
             Field(
@@ -74,8 +92,8 @@ def _run_config_model(key: _ConfigModels) -> type[RunConfigBase]:
             ),
         ),
         motion=(union("motion"), ...),
-        scatterers=(union("scatterers"), default("scatterers", "ellipsoid")),
-        radar=(union("radar"), default("radar", "lfm")),
+        scatterers=(union("scatterers"), default("scatterers", DEFAULT_KINDS["scatterers"])),
+        radar=(union("radar"), default("radar", DEFAULT_KINDS["radar"])),
     )
     return model
 
@@ -171,6 +189,8 @@ TOP_LEVEL = ("seed", "motion", "scatterers", "radar", "effects", "scene", "proce
              "conditioning")  # fmt: skip
 #: sections that choose a plugin by ``kind``, and their interface
 PLUGIN_SECTIONS = {"motion": "motion", "scatterers": "scatterers", "radar": "radar"}
+#: the plugin a section without ``kind`` (or no section at all) means
+DEFAULT_KINDS = {"scatterers": "ellipsoid", "radar": "lfm"}
 
 
 def _short(value: Any) -> str:
@@ -358,6 +378,8 @@ def check_plugin_kinds(data: dict[str, Any], source: str, registry: Registry) ->
         if kind is None:
             if len(registry.names(interface)) == 1:
                 continue  # the only plugin's config has its kind as default
+            if DEFAULT_KINDS.get(where) in registry.plugins[interface]:
+                continue  # the section's default plugin (filled in by the run model)
             raise ConfigError(
                 f"{source}: {where}.kind: missing: say which {interface} plugin"
                 f"{_kinds(registry, interface)}"

@@ -225,3 +225,37 @@ def plot_point_cloud(
         fig.suptitle(title)
     fig.savefig(path)
     plt.close(fig)
+
+
+def plot_spectrogram_panels(
+    path: Path,
+    panels: list[tuple[NDArray[np.floating[Any]], NDArray[np.float64], NDArray[np.float64], str]],
+    *,
+    dynamic_range_db: float = 50.0,
+) -> None:
+    """Save spectrograms side by side, each panel ``(spectrogram_db (n_doppler, n_frames),
+    time [s], velocity [m/s] (+ approaching), title)``, on a common colour scale."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(1, len(panels), figsize=(5 * len(panels), 4), dpi=110, sharey=True)
+    axes = np.atleast_1d(axes)
+    im = None
+    for ax, (db, time, velocity, title) in zip(axes, panels, strict=True):
+        dt = time[1] - time[0] if time.size > 1 else 1.0
+        dv = velocity[1] - velocity[0]
+        extent = (time[0] - dt / 2, time[-1] + dt / 2, velocity[0] - dv / 2, velocity[-1] + dv / 2)
+        im = ax.imshow(
+            db,
+            origin="lower",
+            aspect="auto",
+            extent=extent,
+            cmap="jet",
+            vmin=-dynamic_range_db,
+            vmax=0.0,
+            interpolation="nearest",
+        )
+        ax.set_xlabel("time [s]")
+        ax.set_title(title)
+    axes[0].set_ylabel("radial velocity [m/s] (+ approaching)")
+    fig.colorbar(im, ax=list(axes), label="power [dB re peak]")
+    fig.savefig(path)
+    plt.close(fig)

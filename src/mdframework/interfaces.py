@@ -261,6 +261,11 @@ class RadarWaveform(Plugin):
 
         return pulse_times(start, end, self.prf)
 
+    def product_axes(self) -> Mapping[str, NDArray[Any]]:
+        """Axes of this radar's ``products`` (e.g. the range and velocity of range-Doppler
+        maps), saved with them as they are (not stacked over blocks). Default: none."""
+        return {}
+
     @abstractmethod
     def receive(self, block: PulseBlock) -> Received:
         """Received, pulse-compressed data of one block: ``signal`` (block.n_pulses,)."""

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -254,6 +254,8 @@ def simulate_motion(
     clock = time.perf_counter()
     stream.warn_aliasing()
     received = stream.received()
+    if received.products:
+        received = replace(received, products={**received.products, **wf.product_axes()})
     echo = received.signal.copy()  # the target's echo, before noise and clutter
     context = SceneContext(radar_pos, wf.prf, wf.carrier_frequency, t, stream.gate, None, wf, rng)
     received = _apply_effects(stages, "received", received, context)
