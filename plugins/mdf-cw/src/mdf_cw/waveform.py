@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 from pydantic import Field
 
-from mdframework import RadarWaveform, Received
+from mdframework import RadarWaveform, Received, limits
 from mdframework.physics import radar
 from mdframework.settings import RadarPowerConfig
 
@@ -35,8 +35,18 @@ class CwConfig(RadarPowerConfig):
     """CW Doppler radar. Defaults: a 24 GHz K-band module sampled at 2 kHz."""
 
     kind: Literal["cw"] = "cw"
-    carrier_frequency: float = Field(24.125e9, gt=0, description="Carrier frequency [Hz].")
-    sample_rate: float = Field(2000.0, gt=0, description="I/Q sample rate (slow time) [Hz].")
+    carrier_frequency: float = Field(
+        24.125e9,
+        ge=limits.MIN_CARRIER_HZ,
+        le=limits.MAX_CARRIER_HZ,
+        description="Carrier frequency [Hz], 1 MHz .. 1 THz.",
+    )
+    sample_rate: float = Field(
+        2000.0,
+        ge=limits.MIN_PRF_HZ,
+        le=limits.MAX_PRF_HZ,
+        description="I/Q sample rate (slow time) [Hz].",
+    )
 
 
 class CwDoppler(RadarWaveform):

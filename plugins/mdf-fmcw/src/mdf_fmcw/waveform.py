@@ -23,17 +23,26 @@ the scene origin (the default person position), or along +x for a radar above th
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from mdframework import RadarWaveform, Received
+from mdframework import RadarWaveform, Received, limits
 from mdframework.constants import SPEED_OF_LIGHT
 from mdframework.errors import SceneError
 from mdframework.physics import fmcw
-from mdframework.settings import RadarPowerConfig
+from mdframework.settings import (
+    AngleDeg,
+    Bandwidth,
+    Coordinate,
+    Decibels,
+    Distance,
+    LossDb,
+    RadarPowerConfig,
+    Seed,
+)
 
 from .presets import PRESETS
 
@@ -51,13 +60,13 @@ KT0 = 1.380649e-23 * 290.0
 class CfarConfig(BaseModel):
     """CFAR along one axis of the range-Doppler map."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
     mode: Literal["ca", "so", "go"] = Field(
         "ca", description="ca: cell averaging; so: smallest of the two sides; go: greatest of."
     )
-    train: int = Field(8, ge=1, description="Training cells on each side.")
-    guard: int = Field(2, ge=0, description="Guard cells on each side.")
-    threshold_db: float = Field(15.0, description="Detection threshold over the noise [dB].")
+    train: int = Field(8, ge=1, le=1024, description="Training cells on each side.")
+    guard: int = Field(2, ge=0, le=1024, description="Guard cells on each side.")
+    threshold_db: Decibels = Field(15.0, description="Detection threshold over the noise [dB].")
 
 
 class FmcwConfig(RadarPowerConfig):
@@ -70,27 +79,36 @@ class FmcwConfig(RadarPowerConfig):
     preset: Literal["iwr1443_short_range_3d", "iwr6843isk_people_counting_6m"] | None = Field(
         None, description="Sensor preset (see docs/fmcw.md); explicit fields override it."
     )
-    start_frequency: float = Field(77e9, gt=0, description="Chirp start frequency f0 [Hz].")
-    slope: float = Field(30e12, gt=0, description="Chirp slope S [Hz/s].")
-    idle_time: float = Field(10e-6, ge=0, description="Idle time before each ramp [s].")
-    adc_start_time: float = Field(6e-6, ge=0, description="ADC start after the ramp start [s].")
-    ramp_end_time: float = Field(60e-6, gt=0, description="Ramp length [s].")
-    sample_rate: float = Field(5e6, gt=0, description="Complex ADC sample rate [Hz].")
-    n_samples: int = Field(256, ge=2, description="ADC samples per chirp.")
-    n_loops: int = Field(32, ge=1, description="Loops (chirps per TX) per frame.")
-    tdm_order: list[int] = Field(
+    start_frequency: float = Field(
+        77e9,
+        ge=limits.MIN_CARRIER_HZ,
+        le=limits.MAX_CARRIER_HZ,
+        description="Chirp start frequency f0 [Hz].",
+    )
+    slope: float = Field(30e12, gt=0, le=1e16, description="Chirp slope S [Hz/s].")
+    idle_time: float = Field(10e-6, ge=0, le=1.0, description="Idle time before each ramp [s].")
+    adc_start_time: float = Field(
+        6e-6, ge=0, le=1.0, description="ADC start after the ramp start [s]."
+    )
+    ramp_end_time: float = Field(60e-6, gt=0, le=1.0, description="Ramp length [s].")
+    sample_rate: Bandwidth = Field(5e6, description="Complex ADC sample rate [Hz].")
+    n_samples: int = Field(256, ge=2, le=65536, description="ADC samples per chirp.")
+    n_loops: int = Field(32, ge=1, le=65536, description="Loops (chirps per TX) per frame.")
+    tdm_order: list[Annotated[int, Field(ge=0, le=64)]] = Field(
         [1, 3, 2], min_length=1, description="TX (1-based) of each chirp of a loop, in order."
     )
-    frame_period: float = Field(50e-3, gt=0, description="Frame period [s].")
-    max_bandwidth: float = Field(
-        4e9, gt=0, description="The sensor's largest sweep, slope x ramp_end_time [Hz]."
+    frame_period: float = Field(
+        50e-3, gt=0, le=1.0 / limits.MIN_FRAME_RATE_HZ, description="Frame period [s]."
     )
-    tx_positions: list[tuple[float, float]] = Field(
+    max_bandwidth: Bandwidth = Field(
+        4e9, description="The sensor's largest sweep, slope x ramp_end_time [Hz]."
+    )
+    tx_positions: list[tuple[Coordinate, Coordinate]] = Field(
         [(0.0, 0.0), (2.0, 1.0), (4.0, 0.0)],
         min_length=1,
         description="TX antennas (x right, z up) in units of antenna_spacing.",
     )
-    rx_positions: list[tuple[float, float]] = Field(
+    rx_positions: list[tuple[Coordinate, Coordinate]] = Field(
         [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (3.0, 0.0)],
         min_length=1,
         description="RX antennas (x right, z up) in units of antenna_spacing.",
@@ -98,22 +116,23 @@ class FmcwConfig(RadarPowerConfig):
     antenna_spacing: float | None = Field(
         None,
         gt=0,
+        le=1.0,
         description="Unit of the antenna positions [m]; default lambda/2 at the "
         "centre of the sampled band.",
     )
-    boresight_azimuth_deg: float | None = Field(
+    boresight_azimuth_deg: AngleDeg | None = Field(
         None,
         description="Boresight azimuth, degrees from +x toward +y; default: toward the "
         "scene origin.",
     )
-    boresight_elevation_deg: float = Field(0.0, description="Boresight elevation [deg].")
+    boresight_elevation_deg: AngleDeg = Field(0.0, description="Boresight elevation [deg].")
     path: Literal["analytic", "raw"] = Field(
         "analytic",
         description="analytic: closed-form range profiles near the scatterers (far-field "
         "array phases); raw: sampled IF with exact delays per antenna and range FFTs.",
     )
     analytic_margin: int = Field(
-        8, ge=1, description="Analytic path: range bins kept on each side of a scatterer."
+        8, ge=1, le=65536, description="Analytic path: range bins kept on each side of a scatterer."
     )
     range_window: Literal["rect", "hann", "hamming", "blackman"] = Field(
         "hann", description="Window of the range FFT."
@@ -122,25 +141,26 @@ class FmcwConfig(RadarPowerConfig):
         "hann", description="Window of the Doppler FFT."
     )
     range_fft_size: int | None = Field(
-        None, ge=2, description="Range FFT size (>= n_samples); default n_samples."
+        None, ge=2, le=2**20, description="Range FFT size (>= n_samples); default n_samples."
     )
     doppler_fft_size: int | None = Field(
-        None, ge=1, description="Doppler FFT size (>= n_loops); default n_loops."
+        None, ge=1, le=2**20, description="Doppler FFT size (>= n_loops); default n_loops."
     )
     receiver_noise: bool = Field(
         False,
         description="Add the receiver's thermal noise to the IF samples (the presets do: CFAR "
         "needs a noise floor).",
     )
-    noise_figure_db: float = Field(
+    noise_figure_db: LossDb = Field(
         15.0,
         description="Receiver noise figure F [dB]: complex white noise of power k T0 F fs per "
         "ADC sample.",
     )
-    noise_seed: int = Field(0, ge=0, description="Seed of the receiver noise (per frame).")
+    noise_seed: Seed = Field(0, description="Seed of the receiver noise (per frame).")
     gate_width: float = Field(
         2.0,
         gt=0,
+        le=limits.MAX_COORDINATE_M,
         description="Range window around the gate summed into the slow-time signal [m].",
     )
     beyond_max_range: Literal["error", "alias"] = Field(
@@ -161,9 +181,11 @@ class FmcwConfig(RadarPowerConfig):
     peak_grouping: list[Literal["doppler", "range"]] = Field(
         ["doppler"], description="Keep only detections that are local maxima along these axes."
     )
-    detect_min_range: float = Field(0.1, ge=0, description="Nearest range searched [m].")
-    detect_max_range: float | None = Field(
-        None, gt=0, description="Farthest range searched [m]; default the maximum range."
+    detect_min_range: float = Field(
+        0.1, ge=0, le=limits.MAX_COORDINATE_M, description="Nearest range searched [m]."
+    )
+    detect_max_range: Distance | None = Field(
+        None, description="Farthest range searched [m]; default the maximum range."
     )
     multi_object_threshold: float | None = Field(
         0.5,
