@@ -27,8 +27,9 @@ demo: $(STAMP)
 	@ls examples/*.toml | grep -v '/experiment_' | xargs -P $(JOBS) -I{} sh -c \
 		'name=$$(basename {} .toml); echo "mdf run {} --out out/demo/$$name"; \
 		$(BIN)/mdf run {} --out out/demo/$$name || exit 255'
+	$(BIN)/python examples/side_by_side.py out/demo
 	$(BIN)/mdf experiment examples/experiment_cmu.toml --out out/demo/experiment_cmu
-	@echo "spectrograms: out/demo/*/spectrogram.png; experiment report: out/demo/experiment_cmu/report.md"
+	@echo "spectrograms: out/demo/*/spectrogram.png; FMCW points: out/demo/fmcw_walk/points.csv; experiment report: out/demo/experiment_cmu/report.md"
 
 lint: $(STAMP)
 	$(BIN)/ruff check src plugins tests benchmarks docs examples/plugin-example examples/plugin-template

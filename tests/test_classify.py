@@ -143,4 +143,32 @@ def test_bad_estimator_path_is_a_validation_error() -> None:
     with pytest.raises(ValidationError, match=r"cannot import 'sklearn\.svm\.NoSuchThing'"):
         SklearnClassifier.Config(estimator="sklearn.svm.NoSuchThing")  # type: ignore[call-arg]
     with pytest.raises(ValidationError, match="not a classifier"):
-        SklearnClassifier.Config(estimator="numpy.linalg.norm")  # type: ignore[call-arg]
+        SklearnClassifier.Config.model_validate(
+            {"estimator": "numpy.linalg.norm"}, context={"allow_import": True}
+        )
+
+
+def test_estimators_outside_sklearns_classifiers_need_allow_import() -> None:
+    """A config cannot import (and so run) arbitrary modules: only scikit-learn's classifiers
+    are accepted unless the command line passes --allow-import."""
+    import sys
+
+    from pydantic import ValidationError
+
+    for path in ("numpy.linalg.norm", "os.system", "mdf_knn.knn.KnnClassifier"):
+        with pytest.raises(ValidationError, match="--allow-import"):
+            SklearnClassifier.Config(estimator=path)  # type: ignore[call-arg]
+    # a path outside sklearn is refused before anything is imported
+    sys.modules.pop("this", None)
+    with pytest.raises(ValidationError, match="--allow-import"):
+        SklearnClassifier.Config(estimator="this.Zen")  # type: ignore[call-arg]
+    assert "this" not in sys.modules
+    # sklearn estimators that are not classifiers, and private paths, are refused too
+    for path in ("sklearn.linear_model.LinearRegression", "sklearn.svm._classes.SVC"):
+        with pytest.raises(ValidationError, match=r"--allow-import|not one of"):
+            SklearnClassifier.Config(estimator=path)  # type: ignore[call-arg]
+    # with the flag, any class with fit/predict is accepted
+    cfg = SklearnClassifier.Config.model_validate(
+        {"estimator": "sklearn.linear_model.LinearRegression"}, context={"allow_import": True}
+    )
+    assert cfg.estimator.endswith("LinearRegression")

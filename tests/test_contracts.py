@@ -202,6 +202,25 @@ def test_waveform_paths_are_block_invariant(path: str, placed_body: tuple[Any, S
     check_block_invariance(_model("ellipsoid"), lfm(lfm.Config(path=path)), short, motion)
 
 
+@pytest.mark.parametrize(
+    ("kind", "fields"),
+    [
+        ("fmcw", {"beyond_max_range": "alias", "receiver_noise": True}),
+        ("fmcw", {"beyond_max_range": "alias", "path": "raw"}),
+        ("cw", {}),
+    ],
+)
+def test_other_radars_are_block_invariant(
+    kind: str, fields: dict[str, Any], placed_body: tuple[Any, Skeleton]
+) -> None:
+    """The FMCW radar (blocks of whole frames, receiver noise seeded per frame) and the CW
+    radar pass the streaming contract."""
+    motion, skeleton = placed_body
+    short = skeleton.select_frames(slice(0, 480))
+    cls: Any = REGISTRY.get("radar", kind)
+    check_block_invariance(_model("ellipsoid"), cls(cls.Config(**fields)), short, motion)
+
+
 SCATTERER_EFFECTS = [
     n for n in REGISTRY.names("effects") if REGISTRY.get("effects", n).stage == "scatterers"
 ]

@@ -123,7 +123,7 @@ def test_empty_error_stops_and_writes_nothing(
 def test_attenuation_underflow_with_snr_noise_is_all_zeros(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    text = POINT.format(x=30000.0, gate='"track"', empty="warn") + (
+    text = POINT.format(x=10000.0, gate='"track"', empty="warn") + (
         '[[effects]]\nkind = "attenuation"\ngas_db_per_km = 100.0\n'
         '[[effects]]\nkind = "noise"\nmode = "snr"\nsnr_db = 10.0\n'
     )

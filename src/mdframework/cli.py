@@ -172,6 +172,7 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
             Path(args.out),
             source=args.config,
             progress=not args.no_progress,
+            allow_import=args.allow_import,
             force=args.force,
             staging_dir=args.staging_dir,
         )
@@ -336,7 +337,9 @@ def build_parser() -> argparse.ArgumentParser:
     build.add_argument(
         "--scheduler",
         default=None,
-        help="Dask scheduler address, or 'local' for a local Dask cluster",
+        help="Dask scheduler address, or 'local' for a local Dask cluster (default: the "
+        "MDF_DASK_SCHEDULER environment variable, else local processes; connection timeout "
+        "MDF_DASK_TIMEOUT seconds, default 10)",
     )
     build.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     build.add_argument("--force", action="store_true", help=FORCE_HELP)
@@ -354,6 +357,12 @@ def build_parser() -> argparse.ArgumentParser:
     experiment.add_argument("config", help="experiment config file")
     experiment.add_argument("--out", required=True, help="report folder")
     experiment.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    experiment.add_argument(
+        "--allow-import",
+        action="store_true",
+        help="let the config's classifier name any import path (importing runs that module's "
+        "code: use only with configs you trust); default: scikit-learn's classifiers only",
+    )
     experiment.add_argument("--force", action="store_true", help=FORCE_HELP)
     experiment.add_argument("--staging-dir", default=None, help=STAGING_HELP)
     experiment.set_defaults(func=_cmd_experiment)
@@ -492,7 +501,14 @@ def _main_with_options(argv: Sequence[str] | None) -> int:
     old_showwarning = warnings.showwarning
     warnings.showwarning = _show_warning
     try:
-        return _main(args_list, debug)
+        with warnings.catch_warnings():
+            # a numerical warning (overflow, invalid value) in our own code means a result
+            # would not be trustworthy: stop there instead of writing it (valid inputs never
+            # cause one; see benchmarks/fuzz_scenes.py)
+            warnings.filterwarnings(
+                "error", category=RuntimeWarning, module=r"(mdframework|mdf_\w+)\b"
+            )
+            return _main(args_list, debug)
     except BrokenPipeError:
         return _quiet_broken_pipe()
     finally:

@@ -18,12 +18,14 @@ from pathlib import Path
 from typing import Annotated, Any, Union, get_args
 
 import yaml
-from pydantic import BaseModel, Field, ValidationError, create_model
+from pydantic import BaseModel, Field, ValidationError, create_model, model_validator
 
-from .errors import ConfigError
+from . import limits
+from .errors import ConfigError, SceneError
 from .interfaces import PluginConfig
 from .plugins import Registry, default_registry, suggest
 from .settings import RunConfigBase
+from .skeleton import CANONICAL_JOINTS
 
 #: (interface, ((plugin name, its Config model), ...)) for every interface, sorted by name
 _ConfigModels = tuple[tuple[str, tuple[tuple[str, type[PluginConfig]], ...]], ...]
@@ -60,10 +62,28 @@ def _run_config_model(key: _ConfigModels) -> type[RunConfigBase]:
             return Field(default={"kind": name}, validate_default=True)
         return ...
 
+    # a section without ``kind`` means its default plugin, whatever else is installed
+    kinds = {
+        section: name
+        for section, name in DEFAULT_KINDS.items()
+        if name in configs.get(PLUGIN_SECTIONS[section], {})
+    }
+
+    class Base(RunConfigBase):
+        @model_validator(mode="before")
+        @classmethod
+        def _default_kinds(cls, data: Any) -> Any:
+            if isinstance(data, dict):
+                for section, name in kinds.items():
+                    value = data.get(section)
+                    if isinstance(value, dict) and "kind" not in value:
+                        data = {**data, section: {"kind": name, **value}}
+            return data
+
     effect_list: Any = list[union("effects")]  # type: ignore[misc]
     model = create_model(
         "RunConfig",
-        __base__=RunConfigBase,
+        __base__=Base,
         effects=(
             effect_list,
             Field(
@@ -72,29 +92,79 @@ def _run_config_model(key: _ConfigModels) -> type[RunConfigBase]:
             ),
         ),
         motion=(union("motion"), ...),
-        scatterers=(union("scatterers"), default("scatterers", "ellipsoid")),
-        radar=(union("radar"), default("radar", "lfm")),
+        scatterers=(union("scatterers"), default("scatterers", DEFAULT_KINDS["scatterers"])),
+        radar=(union("radar"), default("radar", DEFAULT_KINDS["radar"])),
     )
     return model
 
 
-def read_config_file(path: str | Path) -> dict[str, Any]:
-    """Parse a TOML, YAML or JSON file into a dict; errors name the file and line."""
-    p = Path(path)
+def _decode(p: Path, raw: bytes) -> str:
+    """UTF-8 text, with or without a byte-order mark; anything else is a ConfigError."""
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
+        raise ConfigError(f"{p}: the file is UTF-16; save it as UTF-8")
+    if b"\0" in raw:
+        line = raw[: raw.index(b"\0")].count(b"\n") + 1
+        raise ConfigError(
+            f"{p}: line {line}: a NUL byte: not UTF-8 text (UTF-16 or binary?); save the config "
+            "as UTF-8"
+        )
     try:
-        text = p.read_text(encoding="utf-8")
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        raise ConfigError(
+            f"{p}: line {line}: not UTF-8 text (byte 0x{raw[exc.start]:02x}); save the config "
+            "as UTF-8"
+        ) from None
+
+
+def _check_depth(p: Path, data: Any) -> None:
+    """Refuse tables and lists nested deeper than ``limits.MAX_CONFIG_DEPTH`` (iteratively, so
+    that the check itself cannot overflow the stack)."""
+    stack: list[tuple[Any, int]] = [(data, 1)]
+    while stack:
+        node, depth = stack.pop()
+        if depth > limits.MAX_CONFIG_DEPTH:
+            raise ConfigError(
+                f"{p}: tables and lists are nested more than {limits.MAX_CONFIG_DEPTH} deep"
+            )
+        if isinstance(node, dict):
+            stack.extend((v, depth + 1) for v in node.values())
+        elif isinstance(node, list):
+            stack.extend((v, depth + 1) for v in node)
+
+
+def read_config_file(path: str | Path) -> dict[str, Any]:
+    """Parse a TOML, YAML or JSON file into a dict; errors name the file and line.
+
+    The file must be UTF-8 (a byte-order mark is allowed), at most ``limits.MAX_CONFIG_BYTES``
+    long, with tables and lists nested at most ``limits.MAX_CONFIG_DEPTH`` deep.
+    """
+    p = Path(path)
+    suffix = p.suffix.lower()
+    if suffix not in (".toml", ".yaml", ".yml", ".json"):
+        raise ConfigError(f"{p}: unknown config format {suffix!r} (use .toml, .yaml or .json)")
+    try:
+        size = p.stat().st_size
+        if size > limits.MAX_CONFIG_BYTES:
+            raise ConfigError(
+                f"{p}: {size:,} bytes; a config file may hold at most "
+                f"{limits.MAX_CONFIG_BYTES:,} bytes"
+            )
+        with p.open("rb") as fh:
+            raw = fh.read(limits.MAX_CONFIG_BYTES + 1)
     except OSError as exc:
         raise ConfigError(f"{p}: cannot read: {exc.strerror or exc}") from None
-    suffix = p.suffix.lower()
+    if len(raw) > limits.MAX_CONFIG_BYTES:  # grew while reading, or not a regular file
+        raise ConfigError(f"{p}: a config file may hold at most {limits.MAX_CONFIG_BYTES:,} bytes")
+    text = _decode(p, raw)
     try:
         if suffix == ".toml":
             data: Any = tomllib.loads(text)
-        elif suffix in (".yaml", ".yml"):
-            data = yaml.safe_load(text)
         elif suffix == ".json":
             data = json.loads(text)
         else:
-            raise ConfigError(f"{p}: unknown config format {suffix!r} (use .toml, .yaml or .json)")
+            data = yaml.safe_load(text)
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{p}: invalid TOML: {exc}") from None
     except yaml.YAMLError as exc:
@@ -104,8 +174,13 @@ def read_config_file(path: str | Path) -> dict[str, Any]:
         raise ConfigError(f"{p}: invalid YAML: {where}{problem}") from None
     except json.JSONDecodeError as exc:
         raise ConfigError(f"{p}: invalid JSON: line {exc.lineno}: {exc.msg}") from None
+    except RecursionError:
+        raise ConfigError(
+            f"{p}: tables and lists are nested more than {limits.MAX_CONFIG_DEPTH} deep"
+        ) from None
     if not isinstance(data, dict):
         raise ConfigError(f"{p}: the top level must be a table of sections")
+    _check_depth(p, data)
     return data
 
 
@@ -114,6 +189,8 @@ TOP_LEVEL = ("seed", "motion", "scatterers", "radar", "effects", "scene", "proce
              "conditioning")  # fmt: skip
 #: sections that choose a plugin by ``kind``, and their interface
 PLUGIN_SECTIONS = {"motion": "motion", "scatterers": "scatterers", "radar": "radar"}
+#: the plugin a section without ``kind`` (or no section at all) means
+DEFAULT_KINDS = {"scatterers": "ellipsoid", "radar": "lfm"}
 
 
 def _short(value: Any) -> str:
@@ -230,6 +307,26 @@ def _toml_hint(parts: list[str], source: str) -> str:
     return f"; {parts[-1]!r} is a top-level field: move it out of {where}"
 
 
+def _field_loc(raw: tuple[Any, ...], data: Any) -> list[Any]:
+    """An error location without the tags pydantic inserts for the members of a union (a
+    plugin's ``kind``, or ``literal['track']`` under a number)."""
+    loc: list[Any] = []
+    node = data
+    for part in raw:
+        if isinstance(node, dict) and part not in node and node.get("kind") == part:
+            continue  # the discriminator tag pydantic inserts for plugin sections
+        if node is not None and not isinstance(node, dict | list) and isinstance(part, str):
+            continue  # a union member's tag under a scalar value
+        loc.append(part)
+        if isinstance(node, dict):
+            node = node.get(part)
+        elif isinstance(node, list) and isinstance(part, int) and part < len(node):
+            node = node[part]
+        else:
+            node = None
+    return loc
+
+
 def format_validation_error(
     exc: ValidationError,
     source: str,
@@ -241,30 +338,20 @@ def format_validation_error(
     (the model validated) lets it list the valid field names."""
     errors = exc.errors(include_url=False)
     first = errors[0]
-    parts: list[str] = []
-    loc: list[Any] = []
-    node = data
-    for part in first["loc"]:
-        if isinstance(node, dict) and part not in node and node.get("kind") == part:
-            continue  # the discriminator tag pydantic inserts for plugin sections
-        parts.append(str(part))
-        loc.append(part)
-        if isinstance(node, dict):
-            node = node.get(part)
-        elif isinstance(node, list) and isinstance(part, int) and part < len(node):
-            node = node[part]
-        else:
-            node = None
+    loc = _field_loc(first["loc"], data)
+    parts = [str(part) for part in loc]
     allowed = None
     if first["type"] == "extra_forbidden":
         parent = _model_at(model, tuple(loc[:-1]), data)
         if parent is not None:
             allowed = sorted(parent.model_fields)
-    more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
+    # the members of a union on one field (e.g. 'track' or a number) fail together: one message
+    same = [e for e in errors if _field_loc(e["loc"], data) == loc]
+    more = f" (and {len(errors) - len(same)} more)" if len(errors) > len(same) else ""
     if first["type"] == "union_tag_invalid":
         msg = f"unknown kind {first['input'].get('kind')!r}; " + first["msg"].split(";")[-1].strip()
     else:
-        msg = _plain(first, allowed)
+        msg = " or ".join(dict.fromkeys(_plain(e, allowed) for e in same))
     hint = _toml_hint(parts, source) if first["type"] == "extra_forbidden" else ""
     return f"{source}: {'.'.join(parts) or '(top level)'}: {msg}{hint}{more}"
 
@@ -291,6 +378,8 @@ def check_plugin_kinds(data: dict[str, Any], source: str, registry: Registry) ->
         if kind is None:
             if len(registry.names(interface)) == 1:
                 continue  # the only plugin's config has its kind as default
+            if DEFAULT_KINDS.get(where) in registry.plugins[interface]:
+                continue  # the section's default plugin (filled in by the run model)
             raise ConfigError(
                 f"{source}: {where}.kind: missing: say which {interface} plugin"
                 f"{_kinds(registry, interface)}"
@@ -324,6 +413,26 @@ def validate_run_config(
     check_plugin_kinds(data, source, reg)
     model = run_config_model(reg)
     try:
-        return model.model_validate(data, context={"base_dir": base_dir})
+        config = model.model_validate(data, context={"base_dir": base_dir})
     except ValidationError as exc:
         raise ConfigError(format_validation_error(exc, source, data, model)) from None
+    _check_pulse_budget(config, source)
+    return config
+
+
+def _check_pulse_budget(config: RunConfigBase, source: str) -> None:
+    """When the config alone fixes the record length, refuse a record of more than
+    ``limits.MAX_PULSES`` pulses now (the pipeline checks the others once the motion is
+    loaded)."""
+    cfg: Any = config
+    length = cfg.motion.known_length() if hasattr(cfg.motion, "known_length") else None
+    prf = getattr(cfg.radar, "prf", None)
+    if length is None or prf is None:
+        return
+    n_points = len(getattr(cfg.motion, "targets", ())) or len(CANONICAL_JOINTS)
+    try:
+        limits.check_pulses(
+            length, prf, n_points, "motion.duration", cfg.processing.keep_scatterers
+        )
+    except SceneError as exc:
+        raise ConfigError(f"{source}: {exc}") from None

@@ -45,12 +45,13 @@ from contextlib import AbstractContextManager, closing
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field, ValidationError, field_validator, model_validator
 
+from . import limits
 from .augment import augment_motion
 from .config import format_validation_error, read_config_file, validate_run_config
 from .errors import ConfigError, DataFileError, MdfError, OutputError, SceneError
@@ -69,7 +70,17 @@ from .pointcloud import (
 )
 from .progress import note
 from .randomize import Randomization, set_path
-from .settings import StrictModel
+from .settings import (
+    AngleDeg,
+    BelowPeakDb,
+    Coordinate,
+    Distance,
+    Point3,
+    PositiveSeconds,
+    Seed,
+    StrictModel,
+    Workers,
+)
 
 
 class DatasetWarning(UserWarning):
@@ -83,6 +94,16 @@ SKIPPED = "skipped.csv"
 TEXT_COLUMNS = ("id", "label", "group", "source", "file", "subject", "recording", "dataset")
 INDEX = "index.csv"
 MANIFEST = "dataset.json"
+#: Environment variables that choose a Dask scheduler (when --scheduler is not given) and its
+#: connection timeout [s].
+SCHEDULER_ENV = "MDF_DASK_SCHEDULER"
+SCHEDULER_TIMEOUT_ENV = "MDF_DASK_TIMEOUT"
+#: Default connection timeout to a Dask scheduler [s].
+SCHEDULER_TIMEOUT_S = 10.0
+
+#: A percentile (0 .. 100).
+Percent = Annotated[float, Field(ge=0, le=100)]
+
 #: every name a dataset build writes in its folder
 DATASET_FILES = (RECORDS, INDEX, MANIFEST, SKIPPED)
 #: build options that do not change a dataset (ignored when comparing configs)
@@ -93,9 +114,9 @@ class FeatureConfig(StrictModel):
     """How the seven features are extracted (see :mod:`mdframework.features`)."""
 
     method: Literal["threshold", "percentile"] = Field("threshold", description="Envelopes.")
-    threshold_db: float = Field(-20.0, lt=0, description="Threshold below each column's peak.")
-    floor_db: float = Field(-40.0, lt=0, description="Ignore bins this far below the peak.")
-    percentiles: tuple[float, float] = Field((3.0, 97.0), description="Percentile method.")
+    threshold_db: BelowPeakDb = Field(-20.0, description="Threshold below each column's peak.")
+    floor_db: BelowPeakDb = Field(-40.0, description="Ignore bins this far below the peak.")
+    percentiles: tuple[Percent, Percent] = Field((3.0, 97.0), description="Percentile method.")
     torso: Literal["median", "peak"] = Field(
         "median", description="Torso track: the column's power median, or its peak bin."
     )
@@ -105,14 +126,16 @@ class HistogramConfig(StrictModel):
     """Per-frame Doppler histograms of point clouds (:mod:`mdframework.pointcloud`)."""
 
     bin_width: float = Field(
-        IWR1443_BIN_WIDTH, gt=0, description="Velocity bin [m/s] (default: the IWR1443's)."
+        IWR1443_BIN_WIDTH, gt=0, le=100, description="Velocity bin [m/s] (default: the IWR1443's)."
     )
-    n_bins: int = Field(17, ge=1, description="Number of bins (odd), centred on 0 m/s.")
+    n_bins: int = Field(17, ge=1, le=10_001, description="Number of bins (odd), centred on 0 m/s.")
     weighting: Literal["count", "intensity", "power"] = Field(
         "count", description="Point weight: 1, intensity [dB] (>= 0), or linear power."
     )
-    min_range: float = Field(0.5, ge=0, description="Ignore points nearer than this [m].")
-    max_range: float = Field(3.0, gt=0, description="Ignore points farther than this [m].")
+    min_range: float = Field(
+        0.5, ge=0, le=limits.MAX_COORDINATE_M, description="Ignore points nearer than this [m]."
+    )
+    max_range: Distance = Field(3.0, description="Ignore points farther than this [m].")
 
     @model_validator(mode="after")
     def _check(self) -> HistogramConfig:
@@ -149,11 +172,15 @@ class SourceEntry(StrictModel):
         description="Dataset name recorded with every record; default: the motion's format "
         "(e.g. asf/amc, bvh, utkinect, msr-action3d) or its source.",
     )
-    record_length: float | None = Field(
-        None, gt=0, description="Record length [s]; default: record_lengths[label], else all."
+    record_length: PositiveSeconds | None = Field(
+        None, description="Record length [s]; default: record_lengths[label], else all."
     )
-    hop: float | None = Field(None, gt=0, description="Step between records [s]; default: length.")
-    max_records: int | None = Field(None, ge=1, description="At most this many windows.")
+    hop: PositiveSeconds | None = Field(
+        None, description="Step between records [s]; default: length."
+    )
+    max_records: int | None = Field(
+        None, ge=1, le=limits.MAX_RECORDS, description="At most this many windows."
+    )
     run: dict[str, Any] = Field(
         default_factory=dict,
         description="Run-config sections for this source only, merged over `base` (e.g. "
@@ -184,20 +211,21 @@ class SourceEntry(StrictModel):
 class Variations(StrictModel):
     """Scene variations; every combination multiplies every record."""
 
-    aspect_deg: list[float] | None = Field(
+    aspect_deg: list[AngleDeg] | None = Field(
         None,
         description="Facing relative to the radar [deg]; default: as the (base) scene says.",
     )
-    radar_range: list[float] | None = Field(
+    radar_range: list[Distance] | None = Field(
         None, description="Horizontal distance radar - person's start [m]; default: base scene."
     )
-    radar_height: list[float] | None = Field(None, description="Radar height [m].")
-    radar_position: list[tuple[float, float, float]] | None = Field(
+    radar_height: list[Coordinate] | None = Field(None, description="Radar height [m].")
+    radar_position: list[Point3] | None = Field(
         None,
         description="Radar positions (x, y, z) [m]; exclusive with radar_range/radar_height.",
     )
-    height: list[float] | None = Field(
-        None, description="Person's height [m], for sources whose config has a `height`."
+    height: list[Annotated[float, Field(gt=0.5, lt=2.5)]] | None = Field(
+        None,
+        description="Person's height [m] (0.5 .. 2.5), for sources whose config has a `height`.",
     )
 
     @model_validator(mode="after")
@@ -212,8 +240,8 @@ class Variations(StrictModel):
 class DatasetConfig(StrictModel):
     """A dataset: sources, record lengths, variations, shared run settings, build options."""
 
-    seed: int = Field(0, ge=0, description="Seed of the whole dataset.")
-    record_lengths: dict[str, float] = Field(
+    seed: Seed = Field(0, description="Seed of the whole dataset.")
+    record_lengths: dict[str, PositiveSeconds] = Field(
         default_factory=dict, description="Record length per label [s]."
     )
     sources: list[SourceEntry] = Field(min_length=1)
@@ -231,10 +259,7 @@ class DatasetConfig(StrictModel):
     )
     histogram: HistogramConfig = Field(default_factory=HistogramConfig)
     randomize: Randomization = Field(default_factory=Randomization)
-    workers: int | None = Field(None, ge=1, description="Local processes; default: CPU count.")
-    scheduler: str | None = Field(
-        None, description="Dask scheduler address, or 'local' for a local Dask cluster."
-    )
+    workers: Workers | None = Field(None, description="Local processes; default: CPU count.")
     on_error: Literal["stop", "skip"] = Field(
         "stop",
         description="A record that fails: stop the build (naming the record, its source file, "
@@ -274,6 +299,11 @@ def load_dataset_config(path: str | Path) -> tuple[DatasetConfig, Path]:
     """Read and validate a dataset config; returns it and its folder (for relative paths)."""
     p = Path(path)
     data = read_config_file(p)
+    if "scheduler" in data:
+        raise ConfigError(
+            f"{p}: scheduler: a shared config cannot choose where records are computed; give "
+            f"the Dask scheduler with --scheduler or the {SCHEDULER_ENV} environment variable"
+        )
     try:
         return DatasetConfig.model_validate(data), p.parent
     except ValidationError as exc:
@@ -505,9 +535,17 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
         )
         hop = entry.hop or length
         rz = _randomize(config, entry)
-        starts = float(motion.get("start", 0.0)) + np.arange(0.0, duration - length + 1e-9, hop)
+        n_windows = int(np.ceil((duration - length + 1e-9) / hop))
         if entry.max_records is not None:
-            starts = starts[: entry.max_records]
+            n_windows = min(n_windows, entry.max_records)
+        n_draws = rz.draws if rz.active() else 1
+        if len(specs) + n_windows * len(grid) * n_draws > limits.MAX_RECORDS:
+            raise ConfigError(
+                f"sources[{entry_no}]: {n_windows:,} windows x {len(grid)} variation(s) x "
+                f"{n_draws} draw(s) take the dataset beyond the limit of "
+                f"{limits.MAX_RECORDS:,} records; raise hop or set max_records"
+            )
+        starts = float(motion.get("start", 0.0)) + np.arange(n_windows) * hop
         for start in starts:
             for (aspect, rng_, rheight, rpos, height), _draw in itertools.product(
                 grid, range(rz.draws if rz.active() else 1)
@@ -537,6 +575,12 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
                 specs.append(
                     _spec(config, index, entry, motion["kind"], run, base_dir, draws, hist, meta)
                 )
+                # every record's run config is valid before any file is written (with
+                # on_error = "skip" an invalid record is skipped by the build instead)
+                if config.on_error == "stop":
+                    validate_run_config(
+                        run, source=f"sources[{entry_no}] record {index}", base_dir=base_dir
+                    )
     if not specs:
         raise ConfigError(
             f"no records: every source is shorter than its record length ({', '.join(short)})"
@@ -872,6 +916,46 @@ def _complete(path: Path) -> dict[str, Any] | None:
     return _row(meta, arrays["features"])
 
 
+def scheduler_address(given: str | None) -> str | None:
+    """The Dask scheduler: ``given`` (the command line), else the :data:`SCHEDULER_ENV`
+    environment variable, else ``None`` (local processes). Never a config file: a shared config
+    must not send work, or data, to a machine of its author's choosing."""
+    return given or os.environ.get(SCHEDULER_ENV) or None
+
+
+def scheduler_timeout() -> float:
+    """Connection timeout to a Dask scheduler [s]: :data:`SCHEDULER_TIMEOUT_ENV`, else
+    :data:`SCHEDULER_TIMEOUT_S`."""
+    text = os.environ.get(SCHEDULER_TIMEOUT_ENV)
+    if text is None:
+        return SCHEDULER_TIMEOUT_S
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0 < value <= 3600:
+        raise MdfError(
+            f"{SCHEDULER_TIMEOUT_ENV}={text!r}: give a timeout in seconds, 0 < t <= 3600"
+        )
+    return value
+
+
+def _connect(client_cls: Any, cluster: Any, address: str) -> Any:
+    """A Dask client of the local cluster or of the scheduler at ``address``; an unreachable
+    scheduler is a one-line error after the connection timeout."""
+    if cluster is not None:
+        return client_cls(cluster)
+    timeout = scheduler_timeout()
+    try:
+        return client_cls(address, timeout=timeout)
+    except (OSError, TimeoutError, ValueError, TypeError) as exc:
+        reason = " ".join(str(exc).split()) or type(exc).__name__
+        raise MdfError(
+            f"cannot connect to the Dask scheduler {address!r} within {timeout:g} s ({reason}); "
+            f"check --scheduler or {SCHEDULER_ENV}, or set {SCHEDULER_TIMEOUT_ENV}"
+        ) from None
+
+
 def _executor(
     config: DatasetConfig, workers: int | None, scheduler: str | None
 ) -> Generator[Callable[[list[RecordSpec], str], Iterator[dict[str, Any]]], None, None]:
@@ -881,7 +965,7 @@ def _executor(
     workers watch their parent themselves; both tested by killing the parent)."""
     from .workers import die_with_parent, stop_pool
 
-    address = scheduler or config.scheduler
+    address = scheduler_address(scheduler)
     n = workers or config.workers or os.cpu_count() or 1
     if address is None:
         if n == 1:
@@ -918,7 +1002,7 @@ def _executor(
             if address == "local"
             else None
         )
-    client = Client(cluster if cluster is not None else address)
+    client = _connect(Client, cluster, address)
     try:
 
         def run_dask(specs: list[RecordSpec], out: str) -> Iterator[dict[str, Any]]:

@@ -69,17 +69,47 @@ def _default(field: FieldInfo, target: str) -> str:
     return f"`{field.default!r}`".replace("(", "[").replace(")", "]")
 
 
+def _number(value: float) -> str:
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def numeric_ranges(schema: dict[str, Any]) -> list[str]:
+    """The intervals of every number in a field's JSON schema (members of unions, items of lists
+    and tuples, values of tables), as ``[lo, hi]`` with round brackets for open ends; a number
+    without a bound on one side gives an infinite end (which ``tests`` refuse)."""
+    found: list[str] = []
+    stack = [schema]
+    while stack:
+        node = stack.pop()
+        if node.get("type") in ("number", "integer"):
+            lo, hi = node.get("minimum"), node.get("maximum")
+            lo_open, hi_open = "exclusiveMinimum" in node, "exclusiveMaximum" in node
+            lo = node.get("exclusiveMinimum", lo)
+            hi = node.get("exclusiveMaximum", hi)
+            left = "(-inf" if lo is None else ("(" if lo_open else "[") + _number(lo)
+            right = "inf)" if hi is None else _number(hi) + (")" if hi_open else "]")
+            found.append(f"{left}, {right}")
+        for key in ("anyOf", "oneOf", "allOf", "prefixItems"):
+            stack.extend(reversed(node.get(key, [])))
+        for key in ("items", "additionalProperties"):
+            if isinstance(node.get(key), dict):
+                stack.append(node[key])
+    return list(dict.fromkeys(found))
+
+
 def model_table(
     model: type[BaseModel],
     skip: tuple[str, ...] = (),
     prefix: str = "",
     seen: dict[type[BaseModel], str] | None = None,
 ) -> str:
-    """A Markdown table of a model's fields: name, type, default, description. ``prefix`` is
+    """A Markdown table of a model's fields: name, type, default, allowed range, description
+    (intervals from the JSON schema, :func:`numeric_ranges`). ``prefix`` is
     the model's own section (``scene``), used to name nested sections; ``seen`` maps a model
     already documented to its section."""
     seen = seen or {}
-    rows = ["| field | type | default | description |", "|---|---|---|---|"]
+    rows = ["| field | type | default | range | description |", "|---|---|---|---|---|"]
+    props = model.model_json_schema().get("properties", {})
     for name, field in model.model_fields.items():
         if name in skip:
             continue
@@ -91,7 +121,8 @@ def model_table(
         target = seen.get(sub, own) if sub is not None else own
         if target != own:
             desc += f" Fields: see `[{target}]`."
-        rows.append(f"| `{name}` | `{typ}` | {_default(field, target)} | {desc} |")
+        ranges = " or ".join(numeric_ranges(props.get(field.alias or name, {})))
+        rows.append(f"| `{name}` | `{typ}` | {_default(field, target)} | {ranges} | {desc} |")
     return "\n".join(rows)
 
 

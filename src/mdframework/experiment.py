@@ -51,7 +51,7 @@ from .outdir import output_folder, safe_name
 from .plugins import Registry, default_registry
 from .pointcloud import histogram_vector, histogram_vector_names, velocity_bins
 from .progress import note
-from .settings import StrictModel
+from .settings import Seed, StrictModel, Workers
 
 #: every name an experiment writes in its folder (group names are made safe by ``safe_name``)
 EXPERIMENT_FILES = (
@@ -88,7 +88,7 @@ class SelectionConfig(StrictModel):
     sizes: list[Annotated[int, Field(ge=1, le=len(FEATURE_NAMES))]] = Field(
         [4], min_length=1, description="Subset sizes to try (the paper: 4 of 7)."
     )
-    folds: int = Field(5, ge=2, description="Cross-validation folds.")
+    folds: int = Field(5, ge=2, le=100, description="Cross-validation folds.")
     optimistic: bool = Field(
         True, description="Also report the paper's optimistic selection on the test split."
     )
@@ -97,7 +97,7 @@ class SelectionConfig(StrictModel):
 class EvaluationConfig(StrictModel):
     """Repeated stratified splits."""
 
-    repeats: int = Field(10, ge=1, description="Number of random splits.")
+    repeats: int = Field(10, ge=1, le=10_000, description="Number of random splits.")
     test_fraction: float = Field(0.4, gt=0, lt=1, description="Test share (the paper: 40 %).")
     split: Literal["record", "recording", "groups"] = Field(
         "record",
@@ -112,6 +112,7 @@ class EvaluationConfig(StrictModel):
     folds: int | None = Field(
         None,
         ge=2,
+        le=10_000,
         description="split = 'groups': number of folds (GroupKFold); default: one fold per "
         "value (leave-one-out).",
     )
@@ -156,7 +157,7 @@ class ReportConfig(StrictModel):
 class ExperimentConfig(StrictModel):
     """An experiment."""
 
-    seed: int = Field(0, ge=0)
+    seed: Seed = Field(0)
     dataset: DatasetRef
     input: Literal["features", "histogram"] = Field(
         "features",
@@ -173,7 +174,7 @@ class ExperimentConfig(StrictModel):
         None, description="Train on one selection of records, test on another."
     )
     report: ReportConfig = Field(default_factory=ReportConfig)
-    workers: int | None = Field(None, ge=1, description="Processes for building the dataset.")
+    workers: Workers | None = Field(None, description="Processes for building the dataset.")
 
 
 def load_experiment_config(path: str | Path) -> ExperimentConfig:
@@ -200,9 +201,16 @@ def load_experiment_config(path: str | Path) -> ExperimentConfig:
 
 
 def classifier_factory(
-    section: dict[str, Any], source: str, registry: Registry | None = None
+    section: dict[str, Any],
+    source: str,
+    registry: Registry | None = None,
+    *,
+    allow_import: bool = False,
 ) -> Callable[[], Classifier]:
-    """A factory of fresh classifiers from a [classifier] section (validated once)."""
+    """A factory of fresh classifiers from a [classifier] section (validated once).
+
+    ``allow_import`` (the command line's ``--allow-import``) lets a plugin accept import paths
+    outside its allowlist (the validation context key ``allow_import``)."""
     reg = registry or default_registry()
     kind = section.get("kind")
     try:
@@ -210,7 +218,7 @@ def classifier_factory(
     except KeyError as exc:
         raise ConfigError(f"{source}: classifier.kind: {exc.args[0]}") from None
     try:
-        cfg = cls.Config.model_validate(section)
+        cfg = cls.Config.model_validate(section, context={"allow_import": allow_import})
     except ValidationError as exc:
         raise ConfigError(
             format_validation_error(exc, source, section, cls.Config).replace(
@@ -531,14 +539,16 @@ def run_experiment(
     registry: Registry | None = None,
     force: bool = False,
     staging_dir: Path | str | None = None,
+    allow_import: bool = False,
 ) -> dict[str, Any]:
     """Build or load the dataset, run the experiments, write the report. ``out_dir`` follows
     the rules of :mod:`mdframework.outdir` (``force``, ``staging_dir``); a dataset the
-    experiment builds goes to ``out_dir/dataset`` (resumable, see :func:`build_dataset`)."""
+    experiment builds goes to ``out_dir/dataset`` (resumable, see :func:`build_dataset`).
+    ``allow_import``: see :func:`classifier_factory`."""
     with output_folder(
         out_dir, "experiment", EXPERIMENT_FILES, force=force, staging_dir=staging_dir
     ) as folder:
-        factory = classifier_factory(cfg.classifier, source, registry)
+        factory = classifier_factory(cfg.classifier, source, registry, allow_import=allow_import)
         if cfg.dataset.config is not None:
             dcfg, base = load_dataset_config(cfg.dataset.config)
             data_dir = folder.path / "dataset"

@@ -361,6 +361,41 @@ def plot_point_cloud(
         save(fig, path, caption)
 
 
+def plot_spectrogram_panels(
+    path: Path,
+    panels: list[tuple[NDArray[np.floating[Any]], NDArray[np.float64], NDArray[np.float64], str]],
+    *,
+    dynamic_range_db: float = DYNAMIC_RANGE_DB,
+    velocity_span: str | float = "auto",
+    colormap: str = COLORMAP,
+    caption: str = "",
+) -> None:
+    """Save spectrograms side by side, each panel ``(spectrogram_db (n_doppler, n_frames),
+    time [s], velocity [m/s] (+ approaching), title)``, each in dB re its own peak on one colour
+    scale (see :func:`draw_spectrogram`)."""
+    with style() as plt:
+        fig, axes = plt.subplots(
+            1, len(panels), figsize=(5 * len(panels), 4), sharey=True, layout="constrained"
+        )
+        axes = np.atleast_1d(axes)
+        im = None
+        for k, (ax, (db, time, velocity, title)) in enumerate(zip(axes, panels, strict=True)):
+            im = draw_spectrogram(
+                ax,
+                db,
+                time,
+                velocity,
+                dynamic_range_db=dynamic_range_db,
+                velocity_span=velocity_span,
+                colormap=colormap,
+            )
+            ax.set_title(title)
+            if k:
+                ax.set_ylabel("")
+        fig.colorbar(im, ax=list(axes), label="power [dB re peak]")
+        save(fig, path, caption)
+
+
 def run_caption(
     metadata: Mapping[str, Any],
     config: Mapping[str, Any],

@@ -45,9 +45,10 @@ ComplexArray = NDArray[np.complex128]
 
 
 class PluginConfig(BaseModel):
-    """Base of every plugin's config model: unknown fields are errors."""
+    """Base of every plugin's config model: unknown fields are errors, and float fields must be
+    finite (a field that gives ``inf`` a meaning says so with ``Field(allow_inf_nan=True)``)."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
     kind: str
 
 
@@ -259,6 +260,11 @@ class RadarWaveform(Plugin):
         from .physics.interpolation import pulse_times
 
         return pulse_times(start, end, self.prf)
+
+    def product_axes(self) -> Mapping[str, NDArray[Any]]:
+        """Axes of this radar's ``products`` (e.g. the range and velocity of range-Doppler
+        maps), saved with them as they are (not stacked over blocks). Default: none."""
+        return {}
 
     @abstractmethod
     def receive(self, block: PulseBlock) -> Received:

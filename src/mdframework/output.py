@@ -43,7 +43,13 @@ from typing import Any
 import numpy as np
 
 from .features import FEATURE_NAMES, envelopes, features_from_envelopes
-from .figures import plot_range_time, plot_spectrogram, run_caption
+from .figures import (
+    plot_point_cloud,
+    plot_range_doppler,
+    plot_range_time,
+    plot_spectrogram,
+    run_caption,
+)
 from .outdir import OutputFolder, output_folder
 from .physics.spectrogram import power_to_db
 from .pipeline import RunResult
@@ -55,6 +61,9 @@ OUTPUTS = (
     "spectrogram.png",
     "range_time.png",
     "features.json",
+    "points.csv",
+    "range_doppler.png",
+    "point_cloud.png",
     "config.resolved.json",
     "metadata.json",
     # written by `mdf show` beside the run's files (mdframework.preview)
@@ -196,6 +205,7 @@ def stage_run(result: RunResult, resolved_config: dict[str, Any], stage: Path) -
             colormap=look.get("colormap", "viridis"),
         )
     (stage / "features.json").write_text(json.dumps(features_document(arrays), indent=2) + "\n")
+    write_point_products(stage, arrays, title)
     (stage / "config.resolved.json").write_text(json.dumps(resolved_config, indent=2) + "\n")
     (stage / "metadata.json").write_text(
         json.dumps(result.metadata, indent=2, default=_jsonable) + "\n"
@@ -208,6 +218,49 @@ def run_folder(
     """Open ``out`` for a run's files (a context manager yielding an
     :class:`~mdframework.outdir.OutputFolder`); see :func:`mdframework.outdir.output_folder`."""
     return output_folder(out, "run", OUTPUTS, force=force, staging_dir=staging_dir)
+
+
+#: Header of ``points.csv``: the columns of a waveform's ``points`` product.
+POINTS_HEADER = "frame,t,x,y,z,v,intensity"
+
+
+def write_points_csv(path: Path, points: np.ndarray) -> None:
+    """``points`` (n_points, 7) as CSV with :data:`POINTS_HEADER`: frame index, t [s from the
+    first pulse], x, y, z [m, sensor frame], v [m/s, + approaching], intensity [dB]."""
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(POINTS_HEADER + "\n")
+        for row in points:
+            f.write(f"{int(row[0])}," + ",".join(f"{v:.6g}" for v in row[1:]) + "\n")
+
+
+def write_point_products(stage: Path, arrays: dict[str, np.ndarray], title: str) -> None:
+    """Files of a waveform's range-Doppler maps and point clouds, when it made them:
+    ``points.csv``, and ``range_doppler.png`` / ``point_cloud.png`` of the frame with the most
+    points (the strongest map when there are none)."""
+    points = arrays.get("points")
+    if points is not None:
+        write_points_csv(stage / "points.csv", points)
+    maps = arrays.get("range_doppler")
+    frame = None
+    if points is not None and len(points):
+        counts = np.bincount(points[:, 0].astype(np.int64))
+        frame = int(np.argmax(counts))
+    if maps is not None and len(maps) and "range_doppler_range_m" in arrays:
+        if frame is None or frame >= len(maps):
+            frame = int(np.argmax(maps.reshape(len(maps), -1).max(axis=1)))
+        plot_range_doppler(
+            stage / "range_doppler.png",
+            maps[frame],
+            arrays["range_doppler_range_m"],
+            arrays["range_doppler_velocity_mps"],
+            title=f"{title} frame {frame}".strip(),
+        )
+    if points is not None and len(points) and frame is not None:
+        plot_point_cloud(
+            stage / "point_cloud.png",
+            points[points[:, 0] == frame],
+            title=f"{title} frame {frame}".strip(),
+        )
 
 
 def _jsonable(value: Any) -> Any:

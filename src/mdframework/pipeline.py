@@ -14,13 +14,13 @@ from __future__ import annotations
 
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from . import conditioning, emptiness, sanity
+from . import conditioning, emptiness, limits, sanity
 from .errors import SceneError
 from .interfaces import (
     Effect,
@@ -201,6 +201,13 @@ def simulate_motion(
     clock = time.perf_counter()
     body, conditioning_report, placement = _place(config, stages, motion, radar_pos)
     t_start, t_end = _window(body, cfg.motion.start, cfg.motion.duration)
+    limits.check_pulses(
+        t_end - t_start,
+        wf.prf,
+        body.n_joints,
+        "motion.duration",
+        keep_scatterers=proc.keep_scatterers,
+    )
     t = wf.pulse_times(t_start, t_end)
     frames = interpolation.window_frames(body.time, float(t[0]), float(t[-1]))
     near = body.select_frames(frames)
@@ -247,6 +254,8 @@ def simulate_motion(
     clock = time.perf_counter()
     stream.warn_aliasing()
     received = stream.received()
+    if received.products:
+        received = replace(received, products={**received.products, **wf.product_axes()})
     echo = received.signal.copy()  # the target's echo, before noise and clutter
     context = SceneContext(radar_pos, wf.prf, wf.carrier_frequency, t, stream.gate, None, wf, rng)
     received = _apply_effects(stages, "received", received, context)

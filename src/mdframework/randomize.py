@@ -27,24 +27,29 @@ Motion augmentation (:mod:`mdframework.augment`), per record: ``speed`` (speed f
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Annotated, Any
 
 import numpy as np
 from pydantic import Field, model_validator
 
+from . import limits
 from .settings import StrictModel
 
-Scalar = float | int | str | bool
+#: A number drawn into a config field; the field's own range applies to what is drawn (each
+#: record's config is validated), this only keeps the distribution finite.
+Number = Annotated[float, Field(ge=-limits.MAX_DRAWN_NUMBER, le=limits.MAX_DRAWN_NUMBER)]
+Whole = Annotated[int, Field(ge=-int(limits.MAX_DRAWN_NUMBER), le=int(limits.MAX_DRAWN_NUMBER))]
+Scalar = Number | Whole | str | bool
 
 
 class Distribution(StrictModel):
     """One distribution: give exactly one of the fields."""
 
-    uniform: tuple[float, float] | None = Field(None, description="[low, high].")
-    loguniform: tuple[float, float] | None = Field(
+    uniform: tuple[Number, Number] | None = Field(None, description="[low, high].")
+    loguniform: tuple[Number, Number] | None = Field(
         None, description="[low, high], both > 0: uniform in log."
     )
-    normal: tuple[float, float] | None = Field(None, description="[mean, std].")
+    normal: tuple[Number, Number] | None = Field(None, description="[mean, std].")
     choice: list[Scalar] | None = Field(None, min_length=1, description="Equally likely values.")
 
     @model_validator(mode="after")
@@ -78,7 +83,7 @@ class Distribution(StrictModel):
 class Randomization(StrictModel):
     """Per-record draws (see the module docstring); every field is optional."""
 
-    draws: int = Field(1, ge=1, description="Records drawn per window and grid point.")
+    draws: int = Field(1, ge=1, le=10_000, description="Records drawn per window and grid point.")
     aspect_deg: Distribution | None = Field(None, description="Facing [deg].")
     radar_range: Distribution | None = Field(None, description="Horizontal distance [m].")
     radar_height: Distribution | None = Field(None, description="Radar height [m].")

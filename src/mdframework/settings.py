@@ -7,6 +7,12 @@ pipeline.
 
 Relative paths inside a config are relative to the config file's folder (the validation context's
 ``base_dir``).
+
+Numbers: every float field of every config model (these and every plugin's, through
+:class:`~mdframework.interfaces.PluginConfig`) must be finite (``allow_inf_nan=False``), and every
+numeric field is bounded on both sides. The shared bounded types below (:data:`Coordinate`,
+:data:`Seconds`, :data:`FrameRate`, :data:`Decibels`, ...) take their limits from
+:mod:`mdframework.limits`; ``docs/input-rules.md`` lists them.
 """
 
 from __future__ import annotations
@@ -19,15 +25,50 @@ from pydantic import (
     BaseModel,
     ConfigDict,
     Field,
-    PositiveFloat,
     ValidationInfo,
     field_validator,
     model_validator,
 )
 
+from . import limits
 from .interfaces import FloatArray, PluginConfig
 from .physics import radar
 from .physics.interpolation import Method
+
+# ----------------------------------------------------------------- bounded numeric types
+
+#: A position coordinate [m], |value| <= limits.MAX_COORDINATE_M.
+Coordinate = Annotated[float, Field(ge=-limits.MAX_COORDINATE_M, le=limits.MAX_COORDINATE_M)]
+#: A horizontal position (x, y) [m].
+Point2 = tuple[Coordinate, Coordinate]
+#: A position (x, y, z) [m].
+Point3 = tuple[Coordinate, Coordinate, Coordinate]
+#: A distance > 0 [m], at most limits.MAX_COORDINATE_M.
+Distance = Annotated[float, Field(gt=0, le=limits.MAX_COORDINATE_M)]
+#: An angle [deg] within one turn either way.
+AngleDeg = Annotated[float, Field(ge=-360.0, le=360.0)]
+#: A time or time offset [s], 0 .. limits.MAX_DURATION_S.
+Seconds = Annotated[float, Field(ge=0, le=limits.MAX_DURATION_S)]
+#: A duration > 0 [s], at most limits.MAX_DURATION_S.
+PositiveSeconds = Annotated[float, Field(gt=0, le=limits.MAX_DURATION_S)]
+#: A frame rate [Hz] of a recording or generated track.
+FrameRate = Annotated[float, Field(ge=limits.MIN_FRAME_RATE_HZ, le=limits.MAX_FRAME_RATE_HZ)]
+#: A bandwidth or sample rate > 0 [Hz].
+Bandwidth = Annotated[float, Field(gt=0, le=limits.MAX_BANDWIDTH_HZ)]
+#: A decibel value (gain, ratio) [dB], |value| <= limits.MAX_DB.
+Decibels = Annotated[float, Field(ge=-limits.MAX_DB, le=limits.MAX_DB)]
+#: A loss or attenuation [dB], 0 .. limits.MAX_DB.
+LossDb = Annotated[float, Field(ge=0, le=limits.MAX_DB)]
+#: A level below a peak [dB], -limits.MAX_DB .. < 0.
+BelowPeakDb = Annotated[float, Field(ge=-limits.MAX_DB, lt=0)]
+#: A radar cross section [m^2], 0 .. limits.MAX_RCS_M2.
+Rcs = Annotated[float, Field(ge=0, le=limits.MAX_RCS_M2)]
+#: A seed of random draws (a 64-bit unsigned integer).
+Seed = Annotated[int, Field(ge=0, lt=2**64)]
+#: A step rate [steps/min].
+Cadence = Annotated[float, Field(ge=0, le=1000)]
+#: A worker (process) count.
+Workers = Annotated[int, Field(ge=1, le=1024)]
 
 
 def _resolve_path(value: Path, info: ValidationInfo) -> Path:
@@ -45,9 +86,10 @@ DataPath = Annotated[Path, AfterValidator(_resolve_path)]
 
 
 class StrictModel(BaseModel):
-    """Base of every config model that is not a plugin's: unknown fields are errors."""
+    """Base of every config model that is not a plugin's: unknown fields are errors, and float
+    fields must be finite."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 class SanityConfig(StrictModel):
@@ -65,18 +107,21 @@ class SanityConfig(StrictModel):
     glitch_min_m: float = Field(
         0.02,
         gt=0,
+        le=10,
         description="Smallest glitch [m]: a frame's distance from the line between its two "
         "neighbours must reach this.",
     )
     glitch_ratio: float = Field(
         1.6,
         gt=1,
+        le=1000,
         description="A glitch stands out from its neighbours: its deviation is at least this "
         "many times theirs (a pure one-frame spike gives 2).",
     )
     glitch_local_ratio: float = Field(
         5.0,
         gt=1,
+        le=1000,
         description="... and at least this many times the median deviation of the 13 frames "
         "around it (fast but smooth motion has no such outlier).",
     )
@@ -86,21 +131,22 @@ class SanityConfig(StrictModel):
         "(speed_limits_mps, accel_limits_mps2): warn, flag silently, or stop.",
     )
     speed_scale: float = Field(
-        1.0, gt=0, description="Multiplies every speed and acceleration limit."
+        1.0, gt=0, le=1000, description="Multiplies every speed and acceleration limit."
     )
     bone_tolerance: float = Field(
         0.1,
         gt=0,
+        le=100,
         description="Largest coefficient of variation (std / mean) of a limb bone's length "
         "before the motion is flagged (optical and depth-camera tracks; a rigid rig gives 0).",
     )
     cadence: bool = Field(
         True, description="Check the step rate of motions labelled walk or run/jog."
     )
-    walk_cadence: tuple[float, float] = Field(
+    walk_cadence: tuple[Cadence, Cadence] = Field(
         (70.0, 150.0), description="Plausible walking cadence [steps/min]."
     )
-    run_cadence: tuple[float, float] = Field(
+    run_cadence: tuple[Cadence, Cadence] = Field(
         (130.0, 230.0), description="Plausible running or jogging cadence [steps/min]."
     )
 
@@ -109,9 +155,9 @@ class MotionConfig(PluginConfig):
     """Base of motion-source configs: every source can be cut to a time window, and its
     motion is checked for sanity after loading."""
 
-    start: float = Field(0.0, ge=0, description="Start of the window, s from the first frame.")
-    duration: float | None = Field(
-        None, gt=0, description="Length of the window [s]; default: to the end."
+    start: Seconds = Field(0.0, description="Start of the window, s from the first frame.")
+    duration: PositiveSeconds | None = Field(
+        None, description="Length of the window [s]; default: to the end."
     )
     sanity: SanityConfig = Field(
         default_factory=SanityConfig,
@@ -119,14 +165,21 @@ class MotionConfig(PluginConfig):
         "glitches, bone lengths, cadence).",
     )
 
+    def known_length(self) -> float | None:
+        """Length of the record [s] when the config alone fixes it (``duration``), else
+        ``None`` (known once the motion is loaded). Generators override it."""
+        return self.duration
+
 
 class RadarPowerConfig(PluginConfig):
     """Base of radar configs: transmit power, gains and losses, and the amplitude model."""
 
-    transmit_power: float = Field(1.0, gt=0, description="Peak transmit power [W].")
-    gain_dbi: float = Field(0.0, description="Antenna gain (transmit = receive) [dBi].")
-    system_loss_db: float = Field(0.0, ge=0, description="System loss L_s [dB].")
-    atmospheric_loss_db: float = Field(0.0, ge=0, description="Atmospheric loss L_a [dB].")
+    transmit_power: float = Field(
+        1.0, gt=0, le=1e9, description="Peak transmit power [W], at most 1 GW."
+    )
+    gain_dbi: Decibels = Field(0.0, description="Antenna gain (transmit = receive) [dBi].")
+    system_loss_db: LossDb = Field(0.0, description="System loss L_s [dB].")
+    atmospheric_loss_db: LossDb = Field(0.0, description="Atmospheric loss L_a [dB].")
     amplitude: radar.AmplitudeModel = Field(
         "range_equation",
         description="Scatterer amplitude: the radar range equation, or sqrt(rcs) with no range "
@@ -155,18 +208,23 @@ class PersonConfig(StrictModel):
         description="recorded: keep the recording's translation; treadmill: remove it; "
         "straight: replace it by a straight path at `speed`.",
     )
-    position: tuple[float, float] = Field(
+    position: Point2 = Field(
         (0.0, 0.0), description="Horizontal position (x, y) of the hip centre at the start [m]."
     )
-    heading_deg: float | None = Field(
+    heading_deg: AngleDeg | None = Field(
         None, description="Direction the person faces, degrees from +x toward +y."
     )
-    aspect_deg: float | None = Field(
+    aspect_deg: AngleDeg | None = Field(
         None,
         description="Facing direction relative to the radar: 0 = toward it, 90 = crossing, "
         "180 = away. Default 0 when neither this nor heading_deg is given.",
     )
-    speed: float | None = Field(None, ge=0, description="Speed for motion = 'straight' [m/s].")
+    speed: float | None = Field(
+        None,
+        ge=0,
+        le=limits.MAX_PERSON_SPEED_MPS,
+        description="Speed for motion = 'straight' [m/s].",
+    )
     facing: Literal["auto", "hips", "travel"] = Field(
         "auto",
         description="How the recording's own facing direction is found: from the hip line, "
@@ -187,19 +245,19 @@ class PersonConfig(StrictModel):
 class SceneConfig(StrictModel):
     """The radar's position, the person's placement and the range gate."""
 
-    radar_position: tuple[float, float, float] = Field(
+    radar_position: Point3 = Field(
         (10.0, 0.0, 2.0), description="Radar antenna position (x, y, z) [m]."
     )
     person: PersonConfig = Field(
         default_factory=PersonConfig, description="Where the person is and how they move."
     )
-    gate: Literal["track"] | PositiveFloat = Field(
+    gate: Literal["track"] | Distance = Field(
         "track",
         description="'track': the gate follows the hip centre (or the first point target); "
         "a number: a fixed gate range [m].",
     )
     min_range: float = Field(
-        0.5, gt=0, description="Smallest allowed scatterer range [m]; closer is an error."
+        0.5, gt=0, le=1000, description="Smallest allowed scatterer range [m]; closer is an error."
     )
 
 
@@ -222,10 +280,10 @@ class ProcessingConfig(StrictModel):
             raise ValueError(f"unknown window {value!r}: {exc}") from None
         return value
 
-    window_length: int = Field(256, ge=2, description="STFT window length [pulses].")
-    hop: int = Field(32, ge=1, description="STFT hop [pulses].")
-    nfft: int = Field(1024, ge=2, description="FFT size (>= window_length).")
-    floor_db: float = Field(-60.0, lt=0, description="Spectrogram floor, dB below its peak.")
+    window_length: int = Field(256, ge=2, le=65536, description="STFT window length [pulses].")
+    hop: int = Field(32, ge=1, le=65536, description="STFT hop [pulses].")
+    nfft: int = Field(1024, ge=2, le=2**20, description="FFT size (>= window_length).")
+    floor_db: BelowPeakDb = Field(-60.0, description="Spectrogram floor, dB below its peak.")
     precision: Literal["float32", "float64"] = Field(
         "float32",
         description="STFT arithmetic: float32 (complex64 FFTs and float32 power, the default: "
@@ -282,9 +340,8 @@ class ConditioningConfig(StrictModel):
     zeros_untracked: bool = Field(
         True, description="Treat an exact (0, 0, 0) joint as untracked (Kinect's lost joints)."
     )
-    max_gap_s: float = Field(
+    max_gap_s: PositiveSeconds = Field(
         0.2,
-        gt=0,
         description="Untracked gaps longer than this [s] are flagged (all gaps are bridged by "
         "the spline); about a fifth of a gait cycle.",
     )
@@ -297,14 +354,18 @@ class ConditioningConfig(StrictModel):
         "histogram-derived threshold and predict them from past frames (Erol & Gurbuz).",
     )
     outlier_bin_m: float = Field(
-        0.01, gt=0, description="Histogram bin width of the outlier deviations [m]."
+        0.01, gt=0, le=1, description="Histogram bin width of the outlier deviations [m]."
     )
     outlier_min_threshold_m: float = Field(
-        0.05, gt=0, description="Smallest outlier threshold [m], whatever the histogram says."
+        0.05,
+        gt=0,
+        le=10,
+        description="Smallest outlier threshold [m], whatever the histogram says.",
     )
     foot_length_m: float | None = Field(
         None,
         gt=0,
+        le=0.5,
         description="The subject's measured foot length (ankle to toe) [m]; when given, the toe "
         "is moved along the foot to this length in every frame.",
     )
@@ -319,6 +380,7 @@ class ConditioningConfig(StrictModel):
     max_speed_mps: float = Field(
         6.0,
         gt=0,
+        le=100,
         description="Physical joint speed limit [m/s]: walking feet peak near 4-5 m/s; raise to "
         "about 10 for running (feet reach ~9 m/s).",
     )
@@ -328,7 +390,7 @@ class ConditioningConfig(StrictModel):
         "exceeded the limit, or of all joints.",
     )
     smoothing_sigma_s: float = Field(
-        0.03, ge=0, description="Standard deviation of the smoothing kernel [s]."
+        0.03, ge=0, le=10, description="Standard deviation of the smoothing kernel [s]."
     )
 
 
@@ -339,10 +401,13 @@ class FiguresConfig(StrictModel):
     dynamic_range_db: float = Field(
         40.0,
         gt=0,
+        le=limits.MAX_DB,
         description="Power range shown in colour, dB below the peak; weaker is drawn at the "
         "bottom of the colour map. 40 dB shows a walker's limbs above the window sidelobes.",
     )
-    velocity_span: Literal["auto", "full"] | PositiveFloat = Field(
+    velocity_span: (
+        Literal["auto", "full"] | Annotated[float, Field(gt=0, le=limits.MAX_TARGET_SPEED_MPS)]
+    ) = Field(
         "auto",
         description="Velocity axis of spectrograms: 'auto' covers the velocities where the "
         "shown power is (with a margin, zero included); 'full' the whole unambiguous span "
@@ -367,7 +432,7 @@ class FiguresConfig(StrictModel):
 class RunConfigBase(StrictModel):
     """Fields every run config has besides the plugin sections."""
 
-    seed: int = Field(0, ge=0, description="Seed of every random draw in the run.")
+    seed: Seed = Field(0, description="Seed of every random draw in the run.")
 
     scene: SceneConfig = Field(default_factory=SceneConfig, description="The scene.")
     processing: ProcessingConfig = Field(

@@ -829,13 +829,33 @@ def chirp_profiles(
 
 
 def gate_signal(
-    profiles: ComplexArray, ranges: FloatArray, gate_range: FloatArray, width: float
+    profiles: ComplexArray,
+    ranges: FloatArray,
+    gate_range: FloatArray,
+    width: float,
+    window_name: WindowName,
+    n_samples: int,
 ) -> ComplexArray:
-    """Slow-time signal of each chirp: the first receive antenna's range profile summed over
-    the bins within ``width / 2`` of the gate. ``profiles`` (n_chirps, n_rx, n_bins); ``ranges``
-    (n_bins,) [m]; ``gate_range`` (n_chirps,) [m]. Returns (n_chirps,) complex128."""
+    """Slow-time signal of each chirp from the first receive antenna: its range profile
+    band-limited to the bins within ``width / 2`` of the gate and read at the middle ADC sample
+    ``m0 = n_samples // 2``,
+
+        ``y = sum_{k in gate} X_k exp(-j 2 pi k m0 / K) sum_m w_m / (K w_m0)``.
+
+    Summed over every bin this is exactly the IF sample ``y(m0)``; over the gate's bins, every
+    scatterer well inside the gate contributes its amplitude with the phase of that sample
+    (a flat range response, falling off over a few bins at the gate's edges), and scatterers
+    outside hardly at all. (A plain sum of the bins would not do: neighbouring bins of a
+    windowed profile partly cancel.) ``profiles`` (n_chirps, n_rx, K); ``ranges`` (K,) [m];
+    ``gate_range`` (n_chirps,) [m]. Returns (n_chirps,) complex128 [sqrt(W)].
+    """
+    n_fft = profiles.shape[-1]
+    m0 = n_samples // 2
+    w = window(window_name, n_samples)
+    k = np.arange(n_fft)
+    rot = np.exp(-2j * np.pi * k * m0 / n_fft) * (float(np.sum(w)) / (n_fft * w[m0]))
     inside = np.abs(ranges[None, :] - gate_range[:, None]) <= width / 2.0
-    return np.asarray(np.sum(profiles[:, 0, :] * inside, axis=1), dtype=np.complex128)
+    return np.asarray(np.sum(profiles[:, 0, :] * (inside * rot), axis=1), dtype=np.complex128)
 
 
 def frame_spectrogram(

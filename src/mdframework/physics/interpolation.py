@@ -81,7 +81,12 @@ class TrackResampler:
             bc = "natural" if t.shape[0] < 4 else "not-a-knot"
             f: Any = CubicSpline(t, flat, axis=0, bc_type=bc)
         elif self.method == "pchip":
-            f = PchipInterpolator(t, flat, axis=0)
+            # scipy forms the harmonic mean of neighbouring slopes as 1 / (w1/m1 + w2/m2);
+            # slopes below ~1e-300 (a track that all but stands still) overflow the
+            # reciprocals to inf, whose reciprocal, the derivative, is then exactly its limit
+            # 0: harmless, not reported
+            with np.errstate(over="ignore"):
+                f = PchipInterpolator(t, flat, axis=0)
         else:
             f = Akima1DInterpolator(t, flat, axis=0, method="makima")
         self._groups.append((joints, t, f))

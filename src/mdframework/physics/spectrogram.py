@@ -136,8 +136,15 @@ def power_to_db(power: NDArray[np.floating[Any]], floor_db: float = -60.0) -> ND
         raise ValueError("the power has non-finite values")
     if p_max <= 0.0:
         return np.full(p.shape, float(floor_db), dtype=p.dtype)
-    out = np.maximum(p, p.dtype.type(p_max * 10.0 ** (floor_db / 10.0)))
-    out *= p.dtype.type(1.0 / p_max)
+    floor = p_max * 10.0 ** (floor_db / 10.0)
+    if floor >= np.finfo(p.dtype).tiny:
+        out = np.maximum(p, p.dtype.type(floor))
+        out *= p.dtype.type(1.0 / p_max)
+    else:
+        # a peak near the smallest float: relative to the peak first, since the absolute floor
+        # would underflow to 0 (and the log to -inf)
+        out = np.divide(p, p.dtype.type(p_max))
+        np.maximum(out, p.dtype.type(10.0 ** (floor_db / 10.0)), out=out)
     np.log10(out, out=out)
     out *= p.dtype.type(10.0)
     return np.asarray(out)

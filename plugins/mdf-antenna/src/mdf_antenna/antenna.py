@@ -38,6 +38,7 @@ from numpy.typing import NDArray
 from pydantic import Field, model_validator
 
 from mdframework import Effect, PluginConfig, Scatterers, SceneContext, Skeleton
+from mdframework.settings import AngleDeg
 
 FloatArray = NDArray[np.float64]
 
@@ -76,7 +77,7 @@ class AntennaConfig(PluginConfig):
         description="pointing 'target': fixed at the record's mean position, or re-aimed on "
         "every pulse.",
     )
-    azimuth_deg: float = Field(
+    azimuth_deg: AngleDeg = Field(
         180.0, description="pointing 'angles': boresight azimuth, from +x toward +y [deg]."
     )
     elevation_deg: float = Field(

@@ -35,14 +35,20 @@ class AttenuationConfig(PluginConfig):
 
     kind: Literal["attenuation"] = "attenuation"
     gas_db_per_km: float = Field(
-        0.0, ge=0, description="One-way gaseous specific attenuation [dB/km]."
+        0.0, ge=0, le=1000, description="One-way gaseous specific attenuation [dB/km]."
     )
-    rain_rate_mm_per_h: float = Field(0.0, ge=0, description="Rain rate R_r [mm/h].")
+    rain_rate_mm_per_h: float = Field(0.0, ge=0, le=1000, description="Rain rate R_r [mm/h].")
     rain_k: float | None = Field(
-        None, gt=0, description="ITU-R P.838 coefficient k for the frequency and polarisation."
+        None,
+        gt=0,
+        le=100,
+        description="ITU-R P.838 coefficient k for the frequency and polarisation.",
     )
     rain_alpha: float | None = Field(
-        None, gt=0, description="ITU-R P.838 exponent alpha for the frequency and polarisation."
+        None,
+        gt=0,
+        le=10,
+        description="ITU-R P.838 exponent alpha for the frequency and polarisation.",
     )
     path_fraction: float = Field(
         1.0, gt=0, le=1, description="Fraction of the range over which the medium is present."

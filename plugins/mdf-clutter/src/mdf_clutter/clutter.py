@@ -45,6 +45,7 @@ from pydantic import Field
 from mdframework import Effect, PluginConfig, Received, SceneContext, SceneError, receive_points
 from mdframework.constants import SPEED_OF_LIGHT
 from mdframework.physics import radar
+from mdframework.settings import Decibels, Rcs
 
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
@@ -57,13 +58,13 @@ class ClutterConfig(PluginConfig):
     power: Literal["csr", "rcs"] = Field(
         "csr", description="csr: set by csr_db relative to the signal; rcs: set by rcs_m2."
     )
-    csr_db: float = Field(
+    csr_db: Decibels = Field(
         0.0,
         description="power csr: clutter-to-signal ratio, mean clutter power over mean "
         "compressed signal power at the gate [dB].",
     )
-    rcs_m2: float = Field(
-        0.1, ge=0, description="power rcs: clutter RCS of one range-resolution cell [m^2]."
+    rcs_m2: Rcs = Field(
+        0.1, description="power rcs: clutter RCS of one range-resolution cell [m^2]."
     )
     wind_fraction: float = Field(
         0.3, ge=0, le=1, description="Fraction of the clutter power that is wind-blown."
@@ -71,17 +72,24 @@ class ClutterConfig(PluginConfig):
     spread_mps: float = Field(
         0.1,
         gt=0,
+        le=100,
         description="Standard deviation of the wind-blown clutter's radial-velocity "
         "spectrum [m/s] (Gaussian, centred on zero).",
     )
     patch_spacing_m: float | None = Field(
-        None, gt=0, description="Spacing of the clutter patches [m]; default: resolution/2."
+        None,
+        gt=0,
+        le=1000,
+        description="Spacing of the clutter patches [m]; default: resolution/2.",
     )
     margin_m: float | None = Field(
-        None, ge=0, description="Patches beyond the gate's range span [m]; default: 4 cells."
+        None,
+        ge=0,
+        le=10_000,
+        description="Patches beyond the gate's range span [m]; default: 4 cells.",
     )
     range_resolution: float | None = Field(
-        None, gt=0, description="c/(2B) [m]; default: from the waveform's bandwidth."
+        None, gt=0, le=10_000, description="c/(2B) [m]; default: from the waveform's bandwidth."
     )
 
 

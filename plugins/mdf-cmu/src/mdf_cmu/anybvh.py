@@ -38,6 +38,7 @@ from mdframework import (
     MotionSource,
     Skeleton,
 )
+from mdframework.settings import FrameRate
 
 from .bvh import bvh_forward_kinematics, read_bvh
 from .kinematics import to_project_frame
@@ -188,11 +189,10 @@ class BvhConfig(MotionConfig):
         "the rig's, or maps a rig that is not known (then all 17 canonical joints).",
     )
     unit_m: float | None = Field(
-        None, gt=0, description="Metres per file unit; default: the rig's."
+        None, gt=0, le=1000, description="Metres per file unit; default: the rig's."
     )
-    frame_rate: float | None = Field(
+    frame_rate: FrameRate | None = Field(
         None,
-        gt=0,
         description="Capture rate [Hz]; default: the header's Frame Time (CMU conversions: "
         "corrected from CMU's index for subjects whose header is known to be wrong).",
     )
@@ -244,7 +244,7 @@ class BvhSource(MotionSource):
             file, rig, unit_m, frame_rate_hz and frame_rate_from, subject, activity, the
             header's frame time.
         """
-        from .source import ACKNOWLEDGEMENT, parse_trial_name
+        from .source import ACKNOWLEDGEMENT, check_motion, parse_trial_name
 
         c = self.config
         path = Path(c.file)
@@ -273,6 +273,7 @@ class BvhSource(MotionSource):
             trial=trial,
         )
         time = np.arange(pos.shape[0], dtype=np.float64) / rate
+        check_motion(path, time, pos)
         meta.update(
             source="bvh",
             format="bvh",

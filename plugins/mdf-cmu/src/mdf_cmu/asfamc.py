@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from mdframework import DataFileError
+from mdframework import DataFileError, limits
 
 from .bvh import read_lines
 from .kinematics import fixed_axis_rotation
@@ -146,11 +146,38 @@ def _float_list(path: Path, tokens: list[str], count: int, what: str, line: int)
         raise DataFileError(path, f"bad number {bad!r} in {what}", line) from None
     if not all(map(math.isfinite, out)):
         raise DataFileError(path, f"non-finite number in {what}", line)
+    if max(map(abs, out), default=0.0) > limits.MAX_FILE_COORDINATE:
+        limits.check_values(path, [out], limits.MAX_FILE_COORDINATE, f"{what}:", [line])
     return out
 
 
 def _floats(path: Path, tokens: list[str], count: int, what: str, line: int) -> FloatArray:
     return np.array(_float_list(path, tokens, count, what, line), dtype=np.float64)
+
+
+# ----------------------------------------------------------------- checks of values read
+
+
+def _check_length_unit(path: Path, scale: float, line: int) -> None:
+    """The ``:units length`` scale within 1e-3 .. 1e3 (CMU: 0.45)."""
+    if not 1e-3 <= scale <= 1e3:
+        raise DataFileError(path, f"the length unit {scale:g} is outside 0.001 .. 1000", line)
+
+
+def _check_amc_angles(
+    path: Path,
+    bone: str,
+    vals: FloatArray,
+    order: tuple[str, ...],
+    degrees: bool,
+    lines: list[int],
+) -> None:
+    """Rotation values of one AMC bone (n_frames, n_values) within +-``limits.MAX_ANGLE_DEG``;
+    ``lines``: the file line of each frame's values."""
+    rot = [k for k, c in enumerate(order) if c.upper().startswith("R")]
+    limit = limits.MAX_ANGLE_DEG if degrees else np.deg2rad(limits.MAX_ANGLE_DEG)
+    unit = " deg" if degrees else " rad"
+    limits.check_values(path, vals[:, rot], limit, f"angle of bone {bone!r}:", lines, unit)
 
 
 def _is_float(text: str) -> bool:
@@ -227,6 +254,7 @@ def read_asf(path: str | Path) -> AsfSkeleton:
                 length_scale = float(_floats(p, toks[1:], 1, "the length unit", ln)[0])
                 if length_scale <= 0:
                     raise DataFileError(p, "the length unit must be positive", ln)
+                _check_length_unit(p, length_scale, ln)
             elif key == "angle":
                 if toks[1].lower() not in ("deg", "rad"):
                     raise DataFileError(p, f"angle unit must be deg or rad, got {toks[1]!r}", ln)
@@ -397,6 +425,8 @@ def read_amc(path: str | Path, asf: AsfSkeleton) -> AmcMotion:
     p = Path(path)
     lines = read_lines(p)
     counts = {"root": 6, **{b.name: len(b.dof) for b in asf.bones}}
+    orders = {"root": asf.root_order, **{b.name: b.dof for b in asf.bones}}
+    bone_lines: dict[str, list[int]] = {}
     degrees = asf.angles_in_degrees
     rows: dict[str, list[list[float]]] = {}
     numbers: list[int] = []
@@ -451,6 +481,7 @@ def read_amc(path: str | Path, asf: AsfSkeleton) -> AmcMotion:
         if key in in_frame:
             raise DataFileError(p, f"bone {key!r} appears twice in frame {numbers[-1]}", ln)
         vals = _float_list(p, toks[1:], counts[key], f"the values of bone {key!r}", ln)
+        bone_lines.setdefault(key, []).append(ln)
         in_frame.add(key)
         rows.setdefault(key, []).append(vals)
     if not numbers:
@@ -459,6 +490,7 @@ def read_amc(path: str | Path, asf: AsfSkeleton) -> AmcMotion:
     values: dict[str, FloatArray] = {}
     for name, r in rows.items():
         arr = np.asarray(r, dtype=np.float64).reshape(len(numbers), counts[name])
+        _check_amc_angles(p, name, arr, orders[name], degrees, bone_lines[name])
         if not degrees:
             if name == "root":
                 rot = [k for k, c in enumerate(asf.root_order) if c.startswith("R")]

@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from mdframework import DataFileError
+from mdframework import DataFileError, limits
 
 from .kinematics import intrinsic_rotation
 
@@ -289,7 +289,8 @@ def read_bvh(path: str | Path) -> BvhData:
     if not (np.isfinite(frame_time) and frame_time > 0):
         raise DataFileError(p, f"frame time must be positive, got {ttoks[2]!r}", tline)
 
-    values = np.empty((n_frames, n_channels), dtype=np.float64)
+    _check_frame_time(p, frame_time, tline)
+    values = np.empty((_frames_to_allocate(p, n_frames, lines, i, fline), n_channels))
     k = 0
     last_line = tline
     for li in range(i, len(lines)):
@@ -324,7 +325,45 @@ def read_bvh(path: str | Path) -> BvhData:
             f"file truncated: {k} frames found, 'Frames:' (line {fline}) announces {n_frames}",
             last_line,
         )
+    _check_values(p, joints, values, lines, i)
     return BvhData(p, tuple(joints), values, frame_time)
+
+
+# ----------------------------------------------------------------- checks before allocating
+
+
+def _frames_to_allocate(p: Path, n_frames: int, lines: list[str], first: int, fline: int) -> int:
+    """Rows to allocate for the frames: the declared count must be within
+    ``limits.MAX_FRAMES``, and no more rows than the file has data lines are allocated (a
+    truncated file is then reported by the reader's frame loop)."""
+    limits.check_declared_count(p, fline, "'Frames:'", n_frames)
+    available = sum(1 for ln in lines[first:] if ln.strip())
+    return min(n_frames, available)
+
+
+def _check_frame_time(p: Path, frame_time: float, tline: int) -> None:
+    """The header's frame time within 1/MAX_FRAME_RATE_HZ .. 1/MIN_FRAME_RATE_HZ."""
+    lo, hi = 1.0 / limits.MAX_FRAME_RATE_HZ, 1.0 / limits.MIN_FRAME_RATE_HZ
+    if not lo <= frame_time <= hi:
+        raise DataFileError(p, f"frame time {frame_time:g} s is outside {lo:g} .. {hi:g} s", tline)
+
+
+def _check_values(
+    p: Path, joints: list[BvhJoint], values: FloatArray, lines: list[str], first: int
+) -> None:
+    """Offsets and position channels within +-``limits.MAX_FILE_COORDINATE`` file units,
+    rotation channels within +-``limits.MAX_ANGLE_DEG``; errors name the line."""
+    for j in joints:
+        limits.check_values(
+            p, j.offset[None], limits.MAX_FILE_COORDINATE, f"OFFSET of {j.name!r}", [j.line]
+        )
+    data_lines = [k + 1 for k in range(first, len(lines)) if lines[k].strip()]
+    for j in joints:
+        for k, ch in enumerate(j.channels):
+            limit = limits.MAX_FILE_COORDINATE if ch.endswith("position") else limits.MAX_ANGLE_DEG
+            limits.check_values(
+                p, values[:, j.first_channel + k], limit, f"{ch} of {j.name!r}", data_lines
+            )
 
 
 def _is_float(text: str) -> bool:

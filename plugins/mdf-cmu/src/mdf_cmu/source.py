@@ -71,7 +71,9 @@ from mdframework import (
     MotionConfig,
     MotionSource,
     Skeleton,
+    limits,
 )
+from mdframework.settings import FrameRate
 
 from .anybvh import choose_rate, load_any_bvh
 from .asfamc import asf_forward_kinematics, read_amc, read_asf
@@ -185,9 +187,8 @@ class CmuConfig(MotionConfig):
         description="For a .amc file: its skeleton (.asf). Default: <subject>.asf next to the "
         "AMC file (02.asf for 02_01.amc).",
     )
-    frame_rate: float | None = Field(
+    frame_rate: FrameRate | None = Field(
         None,
-        gt=0,
         description="Capture rate [Hz]. Default: AMC from the subject number (120 Hz, or 60 Hz "
         "for the subjects CMU's index lists at 60 Hz); BVH from the header's Frame Time, "
         "corrected from CMU's index where the header is known to be wrong.",
@@ -230,6 +231,19 @@ class CmuConfig(MotionConfig):
         if self.subject is not None and not re.fullmatch(r"\d+", self.subject.strip()):
             raise ValueError(f"subject must be a CMU subject number, got {self.subject!r}")
         return self
+
+
+def check_motion(path: Path, time: np.ndarray, positions_m: np.ndarray) -> None:
+    """After forward kinematics: at least two distinct time stamps within the limits, and every
+    joint within +-``limits.MAX_COORDINATE_M`` of the origin."""
+    limits.check_time_stamps(path, time)
+    limits.check_values(
+        path,
+        positions_m,
+        limits.MAX_COORDINATE_M,
+        "a joint coordinate after forward kinematics",
+        unit=" m",
+    )
 
 
 class CmuSource(MotionSource):
@@ -292,6 +306,7 @@ class CmuSource(MotionSource):
                 rate, rate_from = DEFAULT_RATE_HZ, "default (subject unknown)"
         n = pos_m.shape[0]
         time = np.arange(n, dtype=np.float64) / rate
+        check_motion(path, time, pos_m)
         activity = c.activity
         if activity is None:
             key = (subject, trial) if subject is not None and trial is not None else None

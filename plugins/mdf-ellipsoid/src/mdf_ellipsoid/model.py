@@ -141,7 +141,9 @@ def surface_scatterers(
     u /= np.linalg.norm(u, axis=-1, keepdims=True)
     w = np.einsum("qj,psj->psq", s, u / scale[None, :, :])
     w = np.clip(w, 0.0, None)
-    w /= np.sum(w, axis=-1, keepdims=True)
+    # with few points none may face the radar: the part's RCS is then shared equally
+    total = np.sum(w, axis=-1, keepdims=True)
+    w = np.where(total > 0, w / np.where(total > 0, total, 1.0), 1.0 / n_points)
     n_p, n_s = sigma.shape
     return pts.reshape(n_p, n_s * n_points, 3), (sigma[:, :, None] * w).reshape(n_p, -1)
 

@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from mdframework import DataFileError
+from mdframework import DataFileError, limits
 from mdframework.conditioning import sort_timestamps, untracked_mask
 
 FloatArray = NDArray[np.float64]
@@ -225,6 +225,26 @@ def parse_floats(path: Path, fields: Sequence[str], line: int, what: str = "fiel
     return out
 
 
+def check_joint_values(
+    path: Path, values: FloatArray, line: int, what: str = "joint coordinate", nan: bool = False
+) -> None:
+    """Joint coordinates [m] of one line within +-``limits.MAX_SENSOR_COORDINATE_M`` (``nan``:
+    NaN marks an untracked joint)."""
+    limits.check_values(
+        path, values[None], limits.MAX_SENSOR_COORDINATE_M, what, [line], " m", allow_nan=nan
+    )
+
+
+def check_frame_number(path: Path, value: float, line: int, what: str = "frame number") -> None:
+    """A frame number (or id) that is a whole number within 0 .. ``limits.MAX_FRAME_NUMBER``."""
+    if not (0 <= value <= limits.MAX_FRAME_NUMBER and value == int(value)):
+        raise DataFileError(
+            path,
+            f"{what} {float(value)!r} is not a whole number in 0 .. {limits.MAX_FRAME_NUMBER:,}",
+            line,
+        )
+
+
 def _finish(
     path: Path,
     names: tuple[str, ...],
@@ -235,8 +255,7 @@ def _finish(
     canonical: dict[str, str],
     meta: dict[str, Any],
 ) -> Recording:
-    if time.shape[0] < 2:
-        raise DataFileError(path, f"only {time.shape[0]} frame(s): a motion needs at least two")
+    limits.check_time_stamps(path, time)
     order = np.argsort(time, kind="stable")
     t, p, ok, rep = sort_timestamps(time, pos, valid)
     keep = order[np.concatenate(([True], np.diff(time[order]) > 0))]
@@ -269,8 +288,8 @@ def read_utkinect(path: Path, rate_hz: float = UTKINECT_RATE_HZ) -> Recording:
                 i,
             )
         vals = parse_floats(path, fields, i)
-        if vals[0] != int(vals[0]) or vals[0] < 0:
-            raise DataFileError(path, f"frame number {fields[0]!r} is not a whole number", i)
+        check_frame_number(path, vals[0], i)
+        check_joint_values(path, vals[1:], i)
         frames.append(int(vals[0]))
         rows.append(vals[1:])
     fr = np.asarray(frames, dtype=np.int64)
@@ -322,6 +341,7 @@ def read_msr(path: Path, rate_hz: float = MSR_RATE_HZ) -> Recording:
                 path, f"{len(fields)} fields; MSR Action3D joint lines hold x y z c", i
             )
         rows.append(parse_floats(path, fields, i))
+        check_joint_values(path, rows[-1], i, "joint value")
         last = i
     if len(rows) % 20:
         raise DataFileError(
@@ -378,6 +398,8 @@ def read_precog(path: Path, rate_hz: float = PRECOG_RATE_HZ) -> Recording:
         if not re.fullmatch(r"\d+", act):
             raise DataFileError(path, f"the action id {act[:40]!r} is not a whole number", i)
         rows.append(np.asarray(xyz))
+        check_joint_values(path, rows[-1], i)
+        check_frame_number(path, float(act), i, "action id")
         actions.append(int(act))
     if not rows:
         raise DataFileError(path, "a header but no frame")
@@ -411,6 +433,9 @@ def read_ntu(path: Path, rate_hz: float = NTU_RATE_HZ, min_tracking: int = 1) ->
     below it (0 not tracked, 1 inferred, 2 tracked) are untracked."""
     lines = read_text(path)
     pos_i = 0
+    # non-blank lines from each line on: declared counts are checked against them before
+    # anything is allocated
+    left = [*np.cumsum([bool(ln.strip()) for ln in reversed(lines)])[::-1].tolist(), 0]
 
     def take(n_fields: int | None, what: str) -> tuple[list[str], int]:
         nonlocal pos_i
@@ -426,28 +451,33 @@ def read_ntu(path: Path, rate_hz: float = NTU_RATE_HZ, min_tracking: int = 1) ->
             )
         return f, pos_i
 
-    def count(what: str) -> int:
+    def count(what: str, lines_per_item: int) -> int:
         f, ln = take(1, what)
         v = parse_floats(path, f, ln)[0]
-        if v != int(v) or v < 0:
+        if not np.isfinite(v) or v != int(v) or v < 0:
             raise DataFileError(path, f"{what} {f[0]!r} is not a count", ln)
+        limits.check_declared_count(path, ln, what, int(v), left[pos_i], lines_per_item)
         return int(v)
 
-    n_frames = count("the frame count")
+    n_frames = count("the frame count", 1)
     body_id: str | None = None
     pos = np.full((n_frames, 25, 3), np.nan)
     state = np.zeros((n_frames, 25))
     for k in range(n_frames):
-        n_bodies = count(f"the body count of frame {k + 1}")
+        n_bodies = count(f"the body count of frame {k + 1}", 27)
         for _ in range(n_bodies):
             info, _ln = take(10, f"a body line of frame {k + 1}")
-            n_joints = count(f"the joint count of frame {k + 1}")
+            n_joints = count(f"the joint count of frame {k + 1}", 1)
             if n_joints != 25:
                 raise DataFileError(path, f"{n_joints} joints; Kinect v2 bodies have 25", pos_i)
             vals = np.empty((25, 12))
             for j in range(25):
                 f, ln = take(12, f"joint {j + 1} of frame {k + 1}")
                 vals[j] = parse_floats(path, f, ln)
+                check_joint_values(path, vals[j, :3], ln)
+                limits.check_values(
+                    path, vals[j, None, 3:], limits.MAX_FILE_COORDINATE, "joint value", [ln]
+                )
             if body_id is None:
                 body_id = info[0]
             if info[0] == body_id:

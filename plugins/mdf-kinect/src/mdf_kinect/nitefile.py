@@ -38,7 +38,15 @@ import numpy as np
 
 from mdframework import DataFileError
 
-from .formats import FloatArray, Recording, _finish, parse_floats, read_text
+from .formats import (
+    FloatArray,
+    Recording,
+    _finish,
+    check_frame_number,
+    check_joint_values,
+    parse_floats,
+    read_text,
+)
 
 MAGIC = "# mdf-nite-skeleton 1"
 
@@ -162,6 +170,20 @@ def write_nite(
         out.write(f"{time[k]:.6f} {int(frames[k])} {user} {row}\n")
 
 
+def _check_row(path: Path, row: FloatArray, line: int) -> None:
+    """One frame line: frame index and user id whole numbers, joints within the sensor limit
+    (NaN: untracked), confidences in 0..1 (or NaN); time stamps are checked with the
+    recording."""
+    check_frame_number(path, row[1], line)
+    check_frame_number(path, row[2], line, "user id")
+    joints = row[3:].reshape(15, 4)
+    check_joint_values(path, joints[:, :3].ravel(), line, nan=True)
+    conf = joints[:, 3]
+    if np.any((conf < 0) | (conf > 1)):
+        bad = float(conf[(conf < 0) | (conf > 1)][0])
+        raise DataFileError(path, f"confidence {bad!r} is outside 0..1", line)
+
+
 def read_nite(path: Path, foot_length: float = 0.2, min_confidence: float = 0.5) -> Recording:
     """Read a NiTE recording written by ``mdf capture`` (see the module docstring)."""
     lines = read_text(path)
@@ -194,6 +216,7 @@ def read_nite(path: Path, foot_length: float = 0.2, min_confidence: float = 0.5)
                 i,
             )
         rows.append(parse_floats(path, f, i))
+        _check_row(path, rows[-1], i)
     if not rows:
         raise DataFileError(path, "no frame")
     a = np.asarray(rows)

@@ -23,12 +23,21 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
 
-from mdframework import DataFileError, DataPath, Motion, MotionConfig, MotionSource, Skeleton
+from mdframework import (
+    DataFileError,
+    DataPath,
+    Motion,
+    MotionConfig,
+    MotionSource,
+    Skeleton,
+    limits,
+)
+from mdframework.settings import FrameRate
 
 from .formats import (
     MSR_RATE_HZ,
@@ -44,6 +53,11 @@ from .formats import (
     to_project_frame,
 )
 from .nitefile import read_nite
+
+#: A coordinate in the Kinect's camera space [m].
+SensorCoordinate = Annotated[
+    float, Field(ge=-limits.MAX_SENSOR_COORDINATE_M, le=limits.MAX_SENSOR_COORDINATE_M)
+]
 
 Format = Literal["utkinect", "msr-action3d", "precog", "nite", "ntu"]
 
@@ -79,21 +93,23 @@ class KinectConfig(MotionConfig):
         description="UTKinect: the sequence in actionLabel.txt (default from the file "
         "name, joints_s01_e01.txt -> s01_e01).",
     )
-    frame_rate: float | None = Field(
+    frame_rate: FrameRate | None = Field(
         None,
-        gt=0,
         description="Rate [Hz] for formats without time stamps (MSR 15, PRECOG 25, NTU 30 by "
         "default); for UTKinect, frame numbers per second (60 by default: two per 30 Hz "
         "frame); NiTE files carry their own time stamps.",
     )
-    floor: Literal["auto"] | float = Field(
+    floor: Literal["auto"] | SensorCoordinate = Field(
         "auto",
         description="Floor height in the Kinect's Y [m], or 'auto' (1st percentile of the "
         "lowest foot joint); the floor becomes z = 0.",
     )
     activity: str | None = Field(None, description="Activity label for the metadata.")
     foot_length: float = Field(
-        0.2, gt=0, description="NiTE: distance of the derived toe point ahead of the foot [m]."
+        0.2,
+        gt=0,
+        le=0.5,
+        description="NiTE: distance of the derived toe point ahead of the foot [m].",
     )
     min_confidence: float = Field(
         0.5, ge=0, le=1, description="NiTE: joints below this position confidence are gaps."

@@ -32,7 +32,7 @@ class KnnConfig(PluginConfig):
     """k-nearest-neighbour classifier."""
 
     kind: Literal["knn"] = "knn"
-    k: int = Field(5, ge=1, description="Number of neighbours.")
+    k: int = Field(5, ge=1, le=10_000, description="Number of neighbours.")
     metric: str = Field("euclidean", description="Distance (any scikit-learn metric name).")
     tie_rule: Literal["nearest", "lowest"] = Field(
         "nearest",

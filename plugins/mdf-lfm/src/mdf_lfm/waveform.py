@@ -25,10 +25,10 @@ from typing import Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from mdframework import PulseBlock, RadarWaveform, Received
+from mdframework import PulseBlock, RadarWaveform, Received, limits
 from mdframework.constants import SPEED_OF_LIGHT
 from mdframework.physics import radar
-from mdframework.settings import RadarPowerConfig
+from mdframework.settings import Bandwidth, RadarPowerConfig
 
 #: Pulses per block on the raw path (bounds memory to ~ block x n_fast complex samples).
 RAW_BLOCK = 1024
@@ -38,10 +38,22 @@ class LfmConfig(RadarPowerConfig):
     """LFM pulse-Doppler radar. Defaults: the paper's radar (15 GHz, 150 MHz, PRF 2400 Hz)."""
 
     kind: Literal["lfm"] = "lfm"
-    carrier_frequency: float = Field(15e9, gt=0, description="Band-centre frequency [Hz].")
-    bandwidth: float = Field(150e6, gt=0, description="Chirp bandwidth [Hz].")
-    prf: float = Field(2400.0, gt=0, description="Pulse repetition frequency [Hz].")
-    pulse_width: float = Field(1e-6, gt=0, description="Pulse length tau [s].")
+    carrier_frequency: float = Field(
+        15e9,
+        ge=limits.MIN_CARRIER_HZ,
+        le=limits.MAX_CARRIER_HZ,
+        description="Band-centre frequency [Hz], 1 MHz .. 1 THz.",
+    )
+    bandwidth: Bandwidth = Field(150e6, description="Chirp bandwidth [Hz] (< 2 x carrier).")
+    prf: float = Field(
+        2400.0,
+        ge=limits.MIN_PRF_HZ,
+        le=limits.MAX_PRF_HZ,
+        description="Pulse repetition frequency [Hz], 1 Hz .. 10 MHz.",
+    )
+    pulse_width: float = Field(
+        1e-6, gt=0, le=0.1, description="Pulse length tau [s] (at most 1/PRF)."
+    )
     path: Literal["analytic", "raw"] = Field(
         "analytic", description="analytic: closed-form compressed return; raw: sampled chirps."
     )
@@ -56,15 +68,25 @@ class LfmConfig(RadarPowerConfig):
         "float32 amplitudes, weights and phasors; float64: the reference). The raw path is "
         "float64.",
     )
-    sample_rate: float | None = Field(
-        None, gt=0, description="Raw path: fast-time sample rate [Hz]; default 2 x bandwidth."
+    sample_rate: Bandwidth | None = Field(
+        None, description="Raw path: fast-time sample rate [Hz]; default 2 x bandwidth."
     )
     range_margin: float = Field(
-        3.0, ge=0, description="Raw path: range-time window beyond the scatterers [m]."
+        3.0, ge=0, le=1000, description="Raw path: range-time window beyond the scatterers [m]."
     )
 
     @model_validator(mode="after")
     def _check(self) -> LfmConfig:
+        if self.bandwidth >= 2 * self.carrier_frequency:
+            raise ValueError(
+                f"bandwidth ({self.bandwidth:g} Hz) must be below twice the carrier frequency "
+                f"({self.carrier_frequency:g} Hz): the band cannot reach 0 Hz"
+            )
+        if self.pulse_width * self.prf > 1.0:
+            raise ValueError(
+                f"pulse_width ({self.pulse_width:g} s) must not exceed the pulse interval "
+                f"1/prf ({1.0 / self.prf:g} s)"
+            )
         if self.bandwidth * self.pulse_width < 1.0:
             raise ValueError("bandwidth x pulse_width must be >= 1 for a pulse-compression radar")
         if self.sample_rate is not None and self.sample_rate < self.bandwidth:

@@ -18,7 +18,7 @@ the RCS equals that of the ``ellipsoid`` model with the same placement (tested).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -37,6 +37,9 @@ from mdframework.physics.body import PART_RADII, SEGMENT_FRACTIONS
 
 from .body_model import PART_JOINTS, PART_NAMES, PART_SEGMENT, WalkerBody
 from .source import BoulicMotion
+
+#: A body part's semi-axis [m]: above 0, at most 1 m.
+SemiAxis = Annotated[float, Field(gt=0, le=1.0)]
 
 FloatArray = NDArray[np.float64]
 
@@ -65,7 +68,7 @@ class MujocoBodyConfig(PluginConfig):
         description="centres: each part's scatterer at its ellipsoid's centre; chen16: at Chen's "
         "points (head top, hand, toe, shoulder and hip joints, midpoints otherwise).",
     )
-    radii: dict[str, tuple[float, float]] | None = Field(
+    radii: dict[str, tuple[SemiAxis, SemiAxis]] | None = Field(
         None,
         description="Semi-axes (a, b) [m] per segment (head, torso, shoulder, upper_arm, "
         "lower_arm, hip, upper_leg, lower_leg, foot); a is forward (up for the feet). "
@@ -84,8 +87,6 @@ class MujocoBodyConfig(PluginConfig):
             bad = sorted(set(v) - set(PART_RADII))
             if bad:
                 raise ValueError(f"unknown segments {bad}; known: {sorted(PART_RADII)}")
-            if any(min(ab) <= 0 for ab in v.values()):
-                raise ValueError("semi-axes must be > 0")
         return v
 
 

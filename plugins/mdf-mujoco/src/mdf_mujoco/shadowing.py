@@ -73,10 +73,16 @@ class ShadowingConfig(PluginConfig):
 
     kind: Literal["shadowing"] = "shadowing"
     attenuation_db: float = Field(
-        20.0, ge=0, description="RCS reduction of a blocked scatterer [dB]; inf removes it."
+        20.0,
+        ge=0,
+        allow_inf_nan=True,
+        description="RCS reduction of a blocked scatterer [dB]; inf removes it.",
     )
     decimation: int = Field(
-        1, ge=1, description="Cast rays on every k-th pulse and hold the result in between."
+        1,
+        ge=1,
+        le=1_000_000,
+        description="Cast rays on every k-th pulse and hold the result in between.",
     )
     bodies: Literal["auto", "ellipsoids", "capsules"] = Field(
         "auto",
@@ -84,7 +90,7 @@ class ShadowingConfig(PluginConfig):
         "skeleton; auto: ellipsoids when the scatterer model gives shapes.",
     )
     tolerance: float = Field(
-        1e-3, ge=0, description="A hit must be this much nearer than the scatterer [m]."
+        1e-3, ge=0, le=1, description="A hit must be this much nearer than the scatterer [m]."
     )
 
 

@@ -22,7 +22,7 @@ from typing import Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from mdframework import CANONICAL_JOINTS, Motion, MotionConfig, MotionSource, Skeleton
+from mdframework import CANONICAL_JOINTS, Motion, MotionConfig, MotionSource, Skeleton, limits
 from mdframework.physics.body import LEG_FRACTION
 
 from .body_model import WalkerBody
@@ -44,15 +44,17 @@ class BoulicConfig(MotionConfig):
     speed: float | None = Field(
         None,
         gt=0,
+        le=limits.MAX_PERSON_SPEED_MPS,
         description="Walking speed [m/s]; sets rv = speed / H_t (chen_compatible: rv = speed, "
         "since Chen's base moves at rv m/s).",
     )
     n_cycles: int | None = Field(
         None,
         ge=1,
+        le=10_000,
         description="Gait cycles to generate; default: enough for start + duration, else 3.",
     )
-    nt: int = Field(512, ge=4, description="Samples per gait cycle (even).")
+    nt: int = Field(512, ge=4, le=65536, description="Samples per gait cycle (even).")
     chen_compatible: bool = Field(
         False,
         description="Reproduce the quirks of Chen's MATLAB code (speed scale, gait-a sign flip, "

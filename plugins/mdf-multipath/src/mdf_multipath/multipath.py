@@ -50,6 +50,7 @@ from pydantic import Field
 
 from mdframework import Effect, PluginConfig, Scatterers, SceneContext, SceneError
 from mdframework.physics import radar, rcs
+from mdframework.settings import AngleDeg, Coordinate
 
 FloatArray = NDArray[np.float64]
 
@@ -58,11 +59,11 @@ class MultipathConfig(PluginConfig):
     """Specular ground-bounce multipath from a flat ground plane."""
 
     kind: Literal["multipath"] = "multipath"
-    ground_height: float = Field(0.0, description="Height z of the ground plane [m].")
+    ground_height: Coordinate = Field(0.0, description="Height z of the ground plane [m].")
     reflection_magnitude: float = Field(
         0.6, ge=0, le=1, description="|Gamma|, the ground's amplitude reflection coefficient."
     )
-    reflection_phase_deg: float = Field(
+    reflection_phase_deg: AngleDeg = Field(
         180.0, description="Phase of Gamma [deg]; 180 = sign inversion (grazing incidence)."
     )
     paths: Literal["all", "image"] = Field(

@@ -42,6 +42,7 @@ from pydantic import Field, model_validator
 
 from mdframework import Effect, PluginConfig, Received, SceneContext, SceneError
 from mdframework.constants import BOLTZMANN
+from mdframework.settings import Bandwidth, Decibels, LossDb
 
 ComplexArray = NDArray[np.complex128]
 
@@ -55,25 +56,26 @@ class NoiseConfig(PluginConfig):
         description="snr: noise set by snr_db relative to the signal; thermal: k T F B from "
         "the receiver (physical SNR through the range equation).",
     )
-    snr_db: float = Field(
+    snr_db: Decibels = Field(
         20.0,
         description="mode snr: mean power of the noise-free compressed return at the gate over "
         "the noise power per pulse [dB] (per pulse, after pulse compression).",
     )
-    noise_figure_db: float = Field(
-        3.0, ge=0, description="mode thermal: receiver noise figure F [dB]."
-    )
+    noise_figure_db: LossDb = Field(3.0, description="mode thermal: receiver noise figure F [dB].")
     temperature: float = Field(
-        290.0, gt=0, description="mode thermal: system noise temperature T [K]."
+        290.0, gt=0, le=1e5, description="mode thermal: system noise temperature T [K]."
     )
-    noise_bandwidth: float | None = Field(
-        None, gt=0, description="mode thermal: noise bandwidth B_n [Hz]; default: chirp bandwidth."
+    noise_bandwidth: Bandwidth | None = Field(
+        None, description="mode thermal: noise bandwidth B_n [Hz]; default: chirp bandwidth."
     )
     pulse_width: float | None = Field(
-        None, gt=0, description="mode thermal: pulse width tau [s]; default: the waveform's."
+        None,
+        gt=0,
+        le=0.1,
+        description="mode thermal: pulse width tau [s]; default: the waveform's.",
     )
-    bandwidth: float | None = Field(
-        None, gt=0, description="mode thermal: chirp bandwidth B [Hz]; default: the waveform's."
+    bandwidth: Bandwidth | None = Field(
+        None, description="mode thermal: chirp bandwidth B [Hz]; default: the waveform's."
     )
 
     @model_validator(mode="after")

@@ -7,7 +7,7 @@ sampled at ``frame_rate`` (the motion is linear, so any interpolation of it is e
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
@@ -20,18 +20,23 @@ from mdframework import (
     ScattererModel,
     Scatterers,
     Skeleton,
+    limits,
 )
+from mdframework.settings import FrameRate, Point3, PositiveSeconds, Rcs
+
+#: A velocity component [m/s].
+Speed = Annotated[float, Field(ge=-limits.MAX_TARGET_SPEED_MPS, le=limits.MAX_TARGET_SPEED_MPS)]
 
 
 class Target(BaseModel):
     """One point scatterer."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
-    position: tuple[float, float, float] = Field(description="Position at t = 0 [m].")
-    velocity: tuple[float, float, float] = Field(
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+    position: Point3 = Field(description="Position at t = 0 [m].")
+    velocity: tuple[Speed, Speed, Speed] = Field(
         (0.0, 0.0, 0.0), description="Constant velocity [m/s]."
     )
-    rcs: float = Field(1.0, ge=0, description="Radar cross section [m^2].")
+    rcs: Rcs = Field(1.0, description="Radar cross section [m^2].")
 
 
 class PointTargetsConfig(MotionConfig):
@@ -39,9 +44,13 @@ class PointTargetsConfig(MotionConfig):
 
     kind: Literal["point_targets"] = "point_targets"
     targets: list[Target] = Field(min_length=1, description="The scatterers.")
-    length: float = Field(gt=0, description="Length of the generated recording [s].")
-    frame_rate: float = Field(100.0, gt=0, description="Sampling of the tracks [Hz].")
+    length: PositiveSeconds = Field(description="Length of the generated recording [s].")
+    frame_rate: FrameRate = Field(100.0, description="Sampling of the tracks [Hz].")
     label: str = Field("point_targets", description="Activity label recorded with the run.")
+
+    def known_length(self) -> float | None:
+        """The record's length [s]: ``duration``, else the generated length after ``start``."""
+        return self.duration if self.duration is not None else self.length - self.start
 
 
 class PointTargets(MotionSource):
@@ -71,8 +80,8 @@ class IsotropicPointsConfig(PluginConfig):
     """Every joint is an isotropic point scatterer."""
 
     kind: Literal["points"] = "points"
-    rcs: float | None = Field(
-        None, ge=0, description="RCS of every point [m^2]; default: the source's, else 1 m^2."
+    rcs: Rcs | None = Field(
+        None, description="RCS of every point [m^2]; default: the source's, else 1 m^2."
     )
     body: bool = Field(
         False,

@@ -39,7 +39,14 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field
 
-from mdframework import DataFileError, DataPath, PluginConfig, RadarRecordingSource, Recording
+from mdframework import (
+    DataFileError,
+    DataPath,
+    PluginConfig,
+    RadarRecordingSource,
+    Recording,
+    limits,
+)
 from mdframework.pointcloud import PointCloud, frames_from_point_ids, range_rate_to_approaching
 
 #: Frame period of the sensor configuration ``1443es1_short_range_3d.cfg`` (frameCfg) [s].
@@ -199,7 +206,10 @@ class RadharSource(RadarRecordingSource):
             None, min_length=1, description="NPZ only: the recordings to read; default: all."
         )
         frame_period: float = Field(
-            FRAME_PERIOD_S, gt=0, description="Sensor frame period [s] (frame k at k x this)."
+            FRAME_PERIOD_S,
+            ge=1.0 / limits.MAX_FRAME_RATE_HZ,
+            le=1.0 / limits.MIN_FRAME_RATE_HZ,
+            description="Sensor frame period [s] (frame k at k x this).",
         )
 
     config: Config

@@ -1,9 +1,15 @@
-"""Wrap any scikit-learn classifier, chosen by its import path in the config::
+"""Wrap a scikit-learn classifier, chosen by its import path in the config::
 
     [classifier]
     kind = "sklearn"
     estimator = "sklearn.svm.SVC"
     params = { C = 10.0, gamma = "scale" }
+
+Only scikit-learn's own classifiers are accepted (the ones ``sklearn.utils.all_estimators``
+lists as classifiers, named by a public ``sklearn.`` module path): importing a module runs its
+code, so a config shared by someone else must not be able to name any module it likes. Another
+import path needs the command-line flag ``mdf experiment --allow-import`` (passed to validation as
+the context key ``allow_import``).
 
 Features are standardised with training statistics (zero-variance guarded) unless
 ``standardize = false``.
@@ -12,14 +18,18 @@ Features are standardised with training statistics (zero-variance guarded) unles
 from __future__ import annotations
 
 import importlib
+from functools import lru_cache
 from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import Field, field_validator
+from pydantic import Field, ValidationInfo, field_validator
 
 from mdframework import Classifier, PluginConfig
 from mdframework.classify import Standardizer
+
+#: Validation-context key that allows any import path (set by ``--allow-import``).
+ALLOW_IMPORT = "allow_import"
 
 
 def _import(path: str) -> Any:
@@ -32,22 +42,52 @@ def _import(path: str) -> Any:
         raise ValueError(f"cannot import {path!r}: {exc}") from None
 
 
+@lru_cache(maxsize=1)
+def sklearn_classifiers() -> frozenset[type]:
+    """scikit-learn's own classifier classes (the allowlist)."""
+    from sklearn.utils import all_estimators
+
+    return frozenset(cls for _, cls in all_estimators(type_filter="classifier"))
+
+
+def check_estimator_path(path: str, allow_import: bool = False) -> Any:
+    """The estimator class at ``path``: a scikit-learn classifier, or (with ``allow_import``)
+    any class with ``fit`` and ``predict``. Raises ``ValueError`` naming the problem; a path
+    outside ``sklearn.`` is not imported at all unless ``allow_import`` is set."""
+    parts = path.split(".")
+    if not allow_import and (parts[0] != "sklearn" or any(p.startswith("_") for p in parts)):
+        raise ValueError(
+            f"{path!r} is not a scikit-learn classifier path such as 'sklearn.svm.SVC'; other "
+            "import paths run code from wherever they point and need the command-line flag "
+            "--allow-import"
+        )
+    est = _import(path)
+    if not allow_import and est not in sklearn_classifiers():
+        raise ValueError(
+            f"{path!r} is not one of scikit-learn's classifiers; other estimators need the "
+            "command-line flag --allow-import"
+        )
+    if not (hasattr(est, "fit") and hasattr(est, "predict")):
+        raise ValueError(f"{path!r} has no fit/predict: not a classifier")
+    return est
+
+
 class SklearnConfig(PluginConfig):
     """A scikit-learn estimator."""
 
     kind: Literal["sklearn"] = "sklearn"
     estimator: str = Field(
-        description="Import path, e.g. 'sklearn.ensemble.RandomForestClassifier'."
+        description="A scikit-learn classifier's public path, e.g. "
+        "'sklearn.ensemble.RandomForestClassifier' (other import paths need "
+        "`mdf experiment --allow-import`)."
     )
     params: dict[str, Any] = Field(default_factory=dict, description="Constructor arguments.")
     standardize: bool = Field(True, description="z-score features with training statistics.")
 
     @field_validator("estimator")
     @classmethod
-    def _check(cls, value: str) -> str:
-        est = _import(value)
-        if not (hasattr(est, "fit") and hasattr(est, "predict")):
-            raise ValueError(f"{value!r} has no fit/predict: not a classifier")
+    def _check(cls, value: str, info: ValidationInfo) -> str:
+        check_estimator_path(value, bool((info.context or {}).get(ALLOW_IMPORT, False)))
         return value
 
 

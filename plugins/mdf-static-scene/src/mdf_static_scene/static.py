@@ -19,15 +19,21 @@ that act on every scatterer (antenna, multipath) so those act on the room as wel
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from mdframework import Effect, PluginConfig, Scatterers, SceneContext
+from mdframework import Effect, PluginConfig, Scatterers, SceneContext, limits
+from mdframework.settings import AngleDeg, Coordinate, Point3, Seed
 
 FloatArray = NDArray[np.float64]
+
+#: An RCS > 0 [m^2], at most limits.MAX_RCS_M2.
+PositiveRcs = Annotated[float, Field(gt=0, le=limits.MAX_RCS_M2)]
+#: A horizontal distance from the radar [m], 0 .. limits.MAX_COORDINATE_M.
+Reach = Annotated[float, Field(ge=0, le=limits.MAX_COORDINATE_M)]
 
 #: semi-axis [m] of the small sphere that stands for a reflector's shape
 SPHERE_M = 0.05
@@ -36,9 +42,9 @@ SPHERE_M = 0.05
 class Reflector(BaseModel):
     """One static reflector."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
-    position: tuple[float, float, float] = Field(description="Scene position (x, y, z) [m].")
-    rcs_m2: float = Field(gt=0, description="RCS [m^2].")
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+    position: Point3 = Field(description="Scene position (x, y, z) [m].")
+    rcs_m2: PositiveRcs = Field(description="RCS [m^2].")
 
 
 class StaticSceneConfig(PluginConfig):
@@ -46,15 +52,17 @@ class StaticSceneConfig(PluginConfig):
 
     kind: Literal["static_scene"] = "static_scene"
     reflectors: list[Reflector] = Field(default_factory=list, description="Explicit reflectors.")
-    count: int = Field(0, ge=0, description="Number of random reflectors.")
-    seed: int = Field(0, ge=0, description="Seed of the random reflectors (the room).")
-    distance_m: tuple[float, float] = Field(
+    count: int = Field(0, ge=0, le=10_000, description="Number of random reflectors.")
+    seed: Seed = Field(0, description="Seed of the random reflectors (the room).")
+    distance_m: tuple[Reach, Reach] = Field(
         (0.5, 4.0), description="Horizontal distance from the radar [m], [low, high]."
     )
-    azimuth_deg: float = Field(180.0, description="Centre direction from the radar [deg].")
+    azimuth_deg: AngleDeg = Field(180.0, description="Centre direction from the radar [deg].")
     spread_deg: float = Field(60.0, ge=0, le=180, description="Half-width of the directions.")
-    height_m: tuple[float, float] = Field((0.0, 2.0), description="Height [m], [low, high].")
-    rcs_m2: tuple[float, float] = Field(
+    height_m: tuple[Coordinate, Coordinate] = Field(
+        (0.0, 2.0), description="Height [m], [low, high]."
+    )
+    rcs_m2: tuple[PositiveRcs, PositiveRcs] = Field(
         (0.01, 1.0), description="RCS [m^2], log-uniform in [low, high]."
     )
 

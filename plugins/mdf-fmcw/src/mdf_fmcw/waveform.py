@@ -1,0 +1,472 @@
+"""Chirp-sequence FMCW radar with time-division MIMO (kind ``fmcw``).
+
+The physics is :mod:`mdframework.physics.fmcw`; this plugin holds the config, the sensor presets
+and the wiring:
+
+- ``pulse_times``: the chirp timing (idle time, TDM slots, frame gaps); ``block_multiple``: the
+  chirps of one frame, so a frame never straddles two blocks.
+- ``receive(block)``, frame by frame: the range profiles of every chirp and receive antenna
+  (``path = "raw"``: sampled de-chirped IF with exact delays per antenna, then the range FFT;
+  ``"analytic"``: the same profile in closed form near the scatterers), optional receiver noise,
+  then the slow-time signal (first RX, summed over the range bins within ``gate_width`` of the
+  gate), the range-Doppler map and the point cloud. Products: ``range_doppler`` (n_frames,
+  n_doppler, n_range) float32 [W], the power summed over the virtual antennas, and ``points``
+  (n_points, 7) float64 with columns frame, t [s from the first chirp], x, y, z [m, sensor
+  frame], v [m/s, + approaching], intensity [dB over the CFAR noise estimate].
+- ``spectrogram``: from the first TDM slot's chirps (one sample per loop): an STFT when the frames
+  follow each other without gaps, else one Doppler spectrum per frame.
+
+The sensor frame: x to the right, y along boresight, z up (the TI convention). The boresight
+points at ``boresight_azimuth_deg``/``boresight_elevation_deg``, by default horizontally toward
+the scene origin (the default person position), or along +x for a radar above the origin.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Annotated, Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from mdframework import RadarWaveform, Received, limits
+from mdframework.constants import SPEED_OF_LIGHT
+from mdframework.errors import SceneError
+from mdframework.physics import fmcw
+from mdframework.settings import (
+    AngleDeg,
+    Bandwidth,
+    Coordinate,
+    Decibels,
+    Distance,
+    LossDb,
+    RadarPowerConfig,
+    Seed,
+)
+
+from .presets import PRESETS
+
+if TYPE_CHECKING:
+    from mdframework.interfaces import PulseBlock
+    from mdframework.physics.spectrogram import Spectrogram
+    from mdframework.settings import ProcessingConfig
+
+FloatArray = NDArray[np.float64]
+
+#: Boltzmann constant x 290 K [W/Hz]: thermal noise density at the reference temperature.
+KT0 = 1.380649e-23 * 290.0
+
+
+class CfarConfig(BaseModel):
+    """CFAR along one axis of the range-Doppler map."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+    mode: Literal["ca", "so", "go"] = Field(
+        "ca", description="ca: cell averaging; so: smallest of the two sides; go: greatest of."
+    )
+    train: int = Field(8, ge=1, le=1024, description="Training cells on each side.")
+    guard: int = Field(2, ge=0, le=1024, description="Guard cells on each side.")
+    threshold_db: Decibels = Field(15.0, description="Detection threshold over the noise [dB].")
+
+
+class FmcwConfig(RadarPowerConfig):
+    """Chirp-sequence FMCW radar with TDM-MIMO. ``preset`` fills every field it names unless the
+    config gives it. Without a preset the defaults are a generic 77 GHz sensor with the
+    IWR1443's antennas and a 25 m range (30 MHz/us, 256 samples at 5 Msps, 32 loops of three
+    chirps every 50 ms); the presets are the vendors' demo configurations."""
+
+    kind: Literal["fmcw"] = "fmcw"
+    preset: Literal["iwr1443_short_range_3d", "iwr6843isk_people_counting_6m"] | None = Field(
+        None, description="Sensor preset (see docs/fmcw.md); explicit fields override it."
+    )
+    start_frequency: float = Field(
+        77e9,
+        ge=limits.MIN_CARRIER_HZ,
+        le=limits.MAX_CARRIER_HZ,
+        description="Chirp start frequency f0 [Hz].",
+    )
+    slope: float = Field(30e12, gt=0, le=1e16, description="Chirp slope S [Hz/s].")
+    idle_time: float = Field(10e-6, ge=0, le=1.0, description="Idle time before each ramp [s].")
+    adc_start_time: float = Field(
+        6e-6, ge=0, le=1.0, description="ADC start after the ramp start [s]."
+    )
+    ramp_end_time: float = Field(60e-6, gt=0, le=1.0, description="Ramp length [s].")
+    sample_rate: Bandwidth = Field(5e6, description="Complex ADC sample rate [Hz].")
+    n_samples: int = Field(256, ge=2, le=65536, description="ADC samples per chirp.")
+    n_loops: int = Field(32, ge=1, le=65536, description="Loops (chirps per TX) per frame.")
+    tdm_order: list[Annotated[int, Field(ge=0, le=64)]] = Field(
+        [1, 3, 2], min_length=1, description="TX (1-based) of each chirp of a loop, in order."
+    )
+    frame_period: float = Field(
+        50e-3, gt=0, le=1.0 / limits.MIN_FRAME_RATE_HZ, description="Frame period [s]."
+    )
+    max_bandwidth: Bandwidth = Field(
+        4e9, description="The sensor's largest sweep, slope x ramp_end_time [Hz]."
+    )
+    tx_positions: list[tuple[Coordinate, Coordinate]] = Field(
+        [(0.0, 0.0), (2.0, 1.0), (4.0, 0.0)],
+        min_length=1,
+        description="TX antennas (x right, z up) in units of antenna_spacing.",
+    )
+    rx_positions: list[tuple[Coordinate, Coordinate]] = Field(
+        [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (3.0, 0.0)],
+        min_length=1,
+        description="RX antennas (x right, z up) in units of antenna_spacing.",
+    )
+    antenna_spacing: float | None = Field(
+        None,
+        gt=0,
+        le=1.0,
+        description="Unit of the antenna positions [m]; default lambda/2 at the "
+        "centre of the sampled band.",
+    )
+    boresight_azimuth_deg: AngleDeg | None = Field(
+        None,
+        description="Boresight azimuth, degrees from +x toward +y; default: toward the "
+        "scene origin.",
+    )
+    boresight_elevation_deg: AngleDeg = Field(0.0, description="Boresight elevation [deg].")
+    path: Literal["analytic", "raw"] = Field(
+        "analytic",
+        description="analytic: closed-form range profiles near the scatterers (far-field "
+        "array phases); raw: sampled IF with exact delays per antenna and range FFTs.",
+    )
+    analytic_margin: int = Field(
+        8, ge=1, le=65536, description="Analytic path: range bins kept on each side of a scatterer."
+    )
+    range_window: Literal["rect", "hann", "hamming", "blackman"] = Field(
+        "hann", description="Window of the range FFT."
+    )
+    doppler_window: Literal["rect", "hann", "hamming", "blackman"] = Field(
+        "hann", description="Window of the Doppler FFT."
+    )
+    range_fft_size: int | None = Field(
+        None, ge=2, le=2**20, description="Range FFT size (>= n_samples); default n_samples."
+    )
+    doppler_fft_size: int | None = Field(
+        None, ge=1, le=2**20, description="Doppler FFT size (>= n_loops); default n_loops."
+    )
+    receiver_noise: bool = Field(
+        False,
+        description="Add the receiver's thermal noise to the IF samples (the presets do: CFAR "
+        "needs a noise floor).",
+    )
+    noise_figure_db: LossDb = Field(
+        15.0,
+        description="Receiver noise figure F [dB]: complex white noise of power k T0 F fs per "
+        "ADC sample.",
+    )
+    noise_seed: Seed = Field(0, description="Seed of the receiver noise (per frame).")
+    gate_width: float = Field(
+        2.0,
+        gt=0,
+        le=limits.MAX_COORDINATE_M,
+        description="Range window around the gate summed into the slow-time signal [m].",
+    )
+    beyond_max_range: Literal["error", "alias"] = Field(
+        "error",
+        description="A scatterer beyond the maximum range (beat frequency above sample_rate): "
+        "stop, or let it alias in the IF as a real sensor does.",
+    )
+    clutter_removal: bool = Field(
+        False, description="Subtract each range bin's mean over the frame (static clutter)."
+    )
+    points: bool = Field(True, description="Extract a point cloud from every frame.")
+    save_range_doppler: bool = Field(True, description="Keep every frame's range-Doppler map.")
+    cfar_range: CfarConfig | None = Field(
+        CfarConfig(mode="so", train=8, guard=4, threshold_db=15.0),
+        description="CFAR along range (null: none).",
+    )
+    cfar_doppler: CfarConfig | None = Field(None, description="CFAR along Doppler (null: none).")
+    peak_grouping: list[Literal["doppler", "range"]] = Field(
+        ["doppler"], description="Keep only detections that are local maxima along these axes."
+    )
+    detect_min_range: float = Field(
+        0.1, ge=0, le=limits.MAX_COORDINATE_M, description="Nearest range searched [m]."
+    )
+    detect_max_range: Distance | None = Field(
+        None, description="Farthest range searched [m]; default the maximum range."
+    )
+    multi_object_threshold: float | None = Field(
+        0.5,
+        gt=0,
+        le=1,
+        description="A second direction per cell when its beam power reaches this fraction "
+        "of the strongest (TI's multi-object beamforming); null: one direction per cell.",
+    )
+    tdm_compensation: bool = Field(
+        True, description="Correct the phase a moving target gains between TDM slots."
+    )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _apply_preset(cls, data: Any) -> Any:
+        if isinstance(data, dict) and data.get("preset") is not None:
+            preset = PRESETS.get(str(data["preset"]))
+            if preset is not None:
+                return {**preset, **data}
+        return data
+
+    @model_validator(mode="after")
+    def _check(self) -> FmcwConfig:
+        problems = self.sequence().problems(self.max_bandwidth)
+        if problems:
+            raise ValueError(problems[0])
+        n_tx = len(self.tx_positions)
+        bad = [t for t in self.tdm_order if not 1 <= t <= n_tx]
+        if bad:
+            raise ValueError(f"tdm_order: TX {bad[0]} does not exist (tx_positions has {n_tx})")
+        if len(set(self.tdm_order)) != len(self.tdm_order):
+            raise ValueError("tdm_order: each TX may appear once per loop")
+        if self.range_fft_size is not None and self.range_fft_size < self.n_samples:
+            raise ValueError(f"range_fft_size must be >= n_samples ({self.n_samples})")
+        if self.doppler_fft_size is not None and self.doppler_fft_size < self.n_loops:
+            raise ValueError(f"doppler_fft_size must be >= n_loops ({self.n_loops})")
+        return self
+
+    def sequence(self) -> fmcw.ChirpSequence:
+        """The chirp timing of this config."""
+        return fmcw.ChirpSequence(
+            start_frequency=self.start_frequency,
+            slope=self.slope,
+            idle_time=self.idle_time,
+            adc_start_time=self.adc_start_time,
+            ramp_end_time=self.ramp_end_time,
+            sample_rate=self.sample_rate,
+            n_samples=self.n_samples,
+            n_loops=self.n_loops,
+            tdm_order=tuple(t - 1 for t in self.tdm_order),
+            frame_period=self.frame_period,
+        )
+
+
+def _cfar(c: CfarConfig | None) -> fmcw.Cfar | None:
+    return None if c is None else fmcw.Cfar(c.mode, c.train, c.guard, c.threshold_db)
+
+
+class FmcwRadar(RadarWaveform):
+    """Chirp-sequence FMCW radar (TDM-MIMO): slow-time signal, range-Doppler maps, points."""
+
+    name = "fmcw"
+    Config = FmcwConfig
+    config: FmcwConfig
+
+    def __init__(self, config: FmcwConfig) -> None:  # type: ignore[override]
+        super().__init__(config)
+        self.sequence = config.sequence()
+        #: blocks hold whole frames
+        self.block_multiple = self.sequence.chirps_per_frame
+
+    # ----------------------------------------------------------------- derived quantities
+
+    @property
+    def carrier_frequency(self) -> float:
+        """Centre of the sampled band [Hz]: Doppler and angles refer to it."""
+        return self.sequence.centre_frequency
+
+    @property
+    def prf(self) -> float:
+        """Slow-time rate of one virtual channel [Hz]: one chirp per loop, ``1 / (n_tx T_c)``."""
+        return 1.0 / self.sequence.loop_period
+
+    @property
+    def n_range(self) -> int:
+        """Range bins."""
+        return self.config.range_fft_size or self.config.n_samples
+
+    @property
+    def n_doppler(self) -> int:
+        """Doppler bins."""
+        return self.config.doppler_fft_size or self.config.n_loops
+
+    @property
+    def antennas(self) -> fmcw.Antennas:
+        """TX and RX offsets [m] in the sensor plane, the virtual array centred on the sensor."""
+        d = self.config.antenna_spacing or self.sequence.wavelength / 2.0
+        return fmcw.Antennas(
+            np.asarray(self.config.tx_positions, np.float64) * d,
+            np.asarray(self.config.rx_positions, np.float64) * d,
+        ).centred()
+
+    def axes(self) -> dict[str, FloatArray]:
+        """Axes of the products: ``range_m`` (n_range,), ``doppler_hz`` and ``velocity_mps``
+        (n_doppler,) ascending (+ approaching)."""
+        doppler = fmcw.doppler_axis(self.sequence, self.n_doppler)
+        return {
+            "range_m": fmcw.range_axis(self.sequence, self.n_range),
+            "doppler_hz": doppler,
+            "velocity_mps": doppler * self.sequence.wavelength / 2.0,
+        }
+
+    def product_axes(self) -> dict[str, FloatArray]:
+        """Axes of the ``range_doppler`` product: ``range_doppler_range_m`` (n_range,),
+        ``range_doppler_doppler_hz`` and ``range_doppler_velocity_mps`` (n_doppler,)."""
+        return {f"range_doppler_{k}": v for k, v in self.axes().items()}
+
+    @property
+    def max_unambiguous_velocity(self) -> float:
+        """``lambda_c / (4 n_tx T_chirp)`` [m/s]: one sample per loop on each virtual antenna."""
+        return self.sequence.max_velocity
+
+    def start_record(self, times: FloatArray, range_span: tuple[float, float]) -> None:
+        """Stop before any block when the body's farthest joint is beyond the maximum range."""
+        self._check_ranges(np.asarray([range_span[1]]))
+
+    def sensor_axes(self, radar_position: FloatArray) -> FloatArray:
+        """Sensor axes (rows x right, y boresight, z up) in the scene frame."""
+        c = self.config
+        if c.boresight_azimuth_deg is None:
+            at_origin = np.hypot(radar_position[0], radar_position[1]) < 1e-9
+            az = 0.0 if at_origin else float(np.arctan2(-radar_position[1], -radar_position[0]))
+        else:
+            az = float(np.deg2rad(c.boresight_azimuth_deg))
+        return fmcw.sensor_axes(az, float(np.deg2rad(c.boresight_elevation_deg)))
+
+    # ----------------------------------------------------------------- the streaming interface
+
+    def pulse_times(self, start: float, end: float) -> FloatArray:
+        """Ramp-start times of the chirps of every whole frame in ``[start, end]`` [s]."""
+        return fmcw.chirp_times(self.sequence, start, end)
+
+    def receive(self, block: PulseBlock) -> Received:
+        """Range profiles, slow-time signal, range-Doppler maps and points of whole frames."""
+        seq, c = self.sequence, self.config
+        ranges = np.asarray(block.ranges, np.float64)
+        self._check_ranges(ranges)
+        n_frames = fmcw.split_frames(ranges.shape[0], seq)
+        first_frame = block.start // seq.chirps_per_frame
+        positions = block.scatterers.positions
+        amp = c.amplitudes(block.scatterers.rcs, ranges, seq.wavelength)
+        radar_position = np.asarray(block.radar_position, np.float64)
+        sensor = self.sensor_axes(radar_position)
+        antennas = self.antennas
+        axes = self.axes()
+        raxis = axes["range_m"]
+        grid = fmcw.angle_grid(antennas.virtual, seq.wavelength)
+        slots = antennas.slot_of_virtual(seq)
+        detection = self.detection()
+        signal = np.empty(ranges.shape[0], dtype=np.complex128)
+        maps: list[NDArray[np.float32]] = []
+        frames: list[tuple[int, float, FloatArray]] = []
+        for f in range(n_frames):
+            sl = slice(f * seq.chirps_per_frame, (f + 1) * seq.chirps_per_frame)
+            index = first_frame + f
+            gate = block.gate_range[sl]
+            step = seq.range_resolution / 2
+            extra = np.arange(gate.min() - c.gate_width / 2, gate.max() + c.gate_width / 2, step)
+            profiles = fmcw.chirp_profiles(
+                positions[sl],
+                amp[sl],
+                radar_position,
+                sensor,
+                seq,
+                antennas,
+                window_name=c.range_window,
+                n_fft=self.n_range,
+                path=c.path,
+                margin=c.analytic_margin,
+                extra_ranges=extra,
+                noise=self._noise(index, antennas.rx.shape[0]),
+            )
+            signal[sl] = fmcw.gate_signal(
+                profiles, raxis, gate, c.gate_width, c.range_window, c.n_samples
+            )
+            if not (c.points or c.save_range_doppler):
+                continue
+            cube = fmcw.virtual_cube(profiles, seq, antennas.tx.shape[0])
+            rd = fmcw.range_doppler(cube, c.doppler_window, self.n_doppler, c.clutter_removal)
+            if c.save_range_doppler:
+                maps.append(fmcw.detection_map(rd).astype(np.float32))
+            if c.points:
+                pts = fmcw.detect_points(
+                    rd,
+                    raxis,
+                    axes["doppler_hz"],
+                    grid,
+                    slots,
+                    seq.chirp_period,
+                    seq.wavelength,
+                    detection,
+                )
+                frames.append((index, index * seq.frame_period, pts))
+        products: dict[str, NDArray[Any]] = {}
+        if c.save_range_doppler:
+            products["range_doppler"] = (
+                np.stack(maps) if maps else np.zeros((0, self.n_doppler, self.n_range), np.float32)
+            )
+        if c.points:
+            products["points"] = fmcw.as_points(frames)
+        return Received(signal, products=products)
+
+    def spectrogram(
+        self, signal: NDArray[np.complex128], times: FloatArray, processing: ProcessingConfig
+    ) -> Spectrogram:
+        """Micro-Doppler spectrogram from the first TDM slot's chirps (one sample per loop):
+        an STFT (``processing`` window, length, hop, FFT size) when the frames follow each other
+        without gaps, else one Doppler spectrum per frame (window over the frame's loops, FFT
+        size ``processing.nfft``), at the frame's middle loop."""
+        from mdframework.physics.spectrogram import Spectrogram, spectrogram
+
+        seq = self.sequence
+        p = processing
+        if seq.frame_period <= seq.chirps_per_frame * seq.chirp_period * (1 + 1e-9):
+            return spectrogram(
+                np.asarray(signal)[:: seq.n_tx],
+                self.prf,
+                window=p.window,
+                window_length=p.window_length,
+                hop=p.hop,
+                nfft=p.nfft,
+            )
+        power, doppler, time = fmcw.frame_spectrogram(
+            np.asarray(signal), seq, p.window, max(p.nfft, seq.n_loops)
+        )
+        return Spectrogram(power, doppler, time)
+
+    # ----------------------------------------------------------------- helpers
+
+    def detection(self) -> fmcw.Detection:
+        """The detection settings of this config."""
+        c = self.config
+        return fmcw.Detection(
+            cfar_range=_cfar(c.cfar_range),
+            cfar_doppler=_cfar(c.cfar_doppler),
+            group_doppler="doppler" in c.peak_grouping,
+            group_range="range" in c.peak_grouping,
+            min_range=c.detect_min_range,
+            max_range=c.detect_max_range or self.sequence.max_range,
+            multi_peak=c.multi_object_threshold,
+            tdm_compensation=c.tdm_compensation,
+        )
+
+    def noise_power(self) -> float:
+        """Receiver noise power per complex ADC sample, ``k T0 F fs`` [W] (0 without noise)."""
+        c = self.config
+        if not c.receiver_noise:
+            return 0.0
+        return KT0 * 10.0 ** (c.noise_figure_db / 10.0) * c.sample_rate
+
+    def _noise(self, frame: int, n_rx: int) -> NDArray[np.complex128] | None:
+        """Complex white noise of one frame, (chirps_per_frame, n_rx, n_samples), seeded by
+        (noise_seed, frame index): the same whatever the blocks."""
+        power = self.noise_power()
+        if power == 0.0:
+            return None
+        rng = np.random.default_rng([self.config.noise_seed, frame])
+        shape = (self.sequence.chirps_per_frame, n_rx, self.config.n_samples)
+        scale = np.sqrt(power / 2.0)
+        return rng.normal(0.0, scale, shape) + 1j * rng.normal(0.0, scale, shape)
+
+    def _check_ranges(self, ranges: FloatArray) -> None:
+        if self.config.beyond_max_range == "alias" or ranges.size == 0:
+            return
+        far = float(np.max(ranges))
+        seq = self.sequence
+        if far >= seq.max_range:
+            beat = 2.0 * seq.slope * far / SPEED_OF_LIGHT
+            raise SceneError(
+                f"radar.sample_rate: the farthest scatterer at {far:.2f} m beats at "
+                f"{beat / 1e6:.3f} MHz, above the ADC rate {seq.sample_rate / 1e6:.3f} MHz "
+                f"(maximum range {seq.max_range:.2f} m): raise sample_rate, lower slope, or "
+                "set beyond_max_range = 'alias'"
+            )

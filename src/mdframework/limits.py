@@ -1,0 +1,193 @@
+"""Documented limits of every input, and the checks that readers run before they allocate.
+
+Every number a user can give (config fields, values in motion files) is finite and lies within a
+physical range; the ranges are listed in ``docs/input-rules.md``. Config models take their bounds
+from the constants here (through the annotated types of :mod:`mdframework.settings`); file readers
+call :func:`check_declared_count`, :func:`check_values` and :func:`check_time_stamps`, which raise
+:class:`~mdframework.errors.DataFileError` naming the file, the line and the problem.
+
+The limits are generous for human motion and radar (a scene of 10 km, recordings of a day) and
+exist so that absurd values (``1e308``, ``inf``, a declared count of ``10**12``) stop with a clear
+message before they overflow or exhaust memory.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .errors import DataFileError, SceneError
+
+#: Largest |x|, |y|, |z| of any position (config or motion data) [m].
+MAX_COORDINATE_M = 10_000.0
+#: Largest |coordinate| of a depth-camera (Kinect) joint [m]: the sensors see up to ~8 m.
+MAX_SENSOR_COORDINATE_M = 100.0
+#: Largest |coordinate| in the file units of a motion-capture file (BVH, ASF/AMC): the scene
+#: limit in millimetres, the smallest unit such files use.
+MAX_FILE_COORDINATE = MAX_COORDINATE_M * 1000.0
+#: Largest |angle| of a rotation channel in a motion-capture file [deg] (unwrapped angles of a
+#: subject turning many times are allowed).
+MAX_ANGLE_DEG = 100_000.0
+#: Longest recording, window or time stamp [s] (one day).
+MAX_DURATION_S = 86_400.0
+#: Frame rates of recordings and generated tracks [Hz].
+MIN_FRAME_RATE_HZ = 1.0
+MAX_FRAME_RATE_HZ = 10_000.0
+#: Most frames a motion file may declare or hold, and the largest frame number in one.
+MAX_FRAMES = 10_000_000
+MAX_FRAME_NUMBER = 1_000_000_000
+#: Carrier frequency range [Hz] (1 MHz .. 1 THz).
+MIN_CARRIER_HZ = 1e6
+MAX_CARRIER_HZ = 1e12
+#: Largest chirp, noise or sampling bandwidth [Hz].
+MAX_BANDWIDTH_HZ = 1e12
+#: Pulse repetition frequency range [Hz].
+MIN_PRF_HZ = 1.0
+MAX_PRF_HZ = 1e7
+#: Most pulses in one run (record length x PRF).
+MAX_PULSES = 5_000_000
+#: Largest radar cross section of a point [m^2].
+MAX_RCS_M2 = 1e6
+#: Largest speed of a generated target or walker [m/s].
+MAX_TARGET_SPEED_MPS = 1_000.0
+MAX_PERSON_SPEED_MPS = 15.0
+#: Largest magnitude of a decibel value (gains, losses, ratios) [dB].
+MAX_DB = 400.0
+#: Largest config file [bytes] and deepest nesting of tables and lists in it.
+MAX_CONFIG_BYTES = 4 * 1024 * 1024
+MAX_CONFIG_DEPTH = 32
+#: Most records one dataset config may plan.
+MAX_RECORDS = 1_000_000
+#: Largest |value| of a random distribution's parameters in a dataset config (what is drawn
+#: must then lie in the range of the field it is drawn into).
+MAX_DRAWN_NUMBER = 1e12
+
+#: Bytes the streaming pipeline holds per pulse of a record (time, gate range, the complex
+#: slow-time signal and its float32 STFT input), and per pulse and scatterer when the result keeps
+#: every scatterer (``processing.keep_scatterers``: positions, RCS, range): the basis of the
+#: memory estimate in :func:`check_pulses`.
+_BYTES_PER_PULSE = 8 + 8 + 16 + 8
+_BYTES_PER_PULSE_SCATTERER = 5 * 8
+
+
+def memory_estimate_bytes(
+    n_pulses: float, n_scatterers: int, keep_scatterers: bool = False
+) -> float:
+    """Approximate bytes a run of ``n_pulses`` holds for the whole record (the per-block
+    arrays of the streaming pipeline do not grow with it, unless every scatterer is kept)."""
+    per_pulse = _BYTES_PER_PULSE
+    if keep_scatterers:
+        per_pulse += _BYTES_PER_PULSE_SCATTERER * max(n_scatterers, 1)
+    return n_pulses * per_pulse
+
+
+def _size(n_bytes: float) -> str:
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
+        if n_bytes < 1024 or unit == "PiB":
+            return f"{n_bytes:.3g} {unit}"
+        n_bytes /= 1024
+    raise AssertionError("unreachable")  # pragma: no cover
+
+
+def pulse_count(duration_s: float, prf_hz: float) -> float:
+    """Pulses in a record of ``duration_s`` at ``prf_hz`` (a float: it may be absurdly large)."""
+    return float(np.floor(duration_s * prf_hz)) + 1.0
+
+
+def check_pulses(
+    duration_s: float,
+    prf_hz: float,
+    n_scatterers: int,
+    where: str,
+    keep_scatterers: bool = False,
+) -> None:
+    """Refuse a run of more than :data:`MAX_PULSES` pulses, saying how much memory it would take.
+
+    ``where`` names what to change (e.g. ``"motion.duration"``). Raises :class:`SceneError`.
+    """
+    n = pulse_count(duration_s, prf_hz)
+    if n > MAX_PULSES:
+        need = _size(memory_estimate_bytes(n, n_scatterers, keep_scatterers))
+        kept = f", keeping {n_scatterers} scatterer(s) per pulse" if keep_scatterers else ""
+        raise SceneError(
+            f"{where}: a record of {duration_s:g} s at PRF {prf_hz:g} Hz is {n:.4g} pulses "
+            f"(about {need} of memory{kept}); the limit is {MAX_PULSES:,} pulses: shorten the "
+            "record or lower the PRF"
+        )
+
+
+def check_declared_count(
+    path: str | Path,
+    line: int,
+    what: str,
+    declared: int,
+    available: int | None = None,
+    per_item: int = 1,
+) -> None:
+    """A count declared in a file must fit the data present before anything is allocated for
+    it: at most :data:`MAX_FRAMES`, and (when ``available`` is given) ``declared * per_item`` at
+    most the ``available`` lines that follow."""
+    if declared > MAX_FRAMES:
+        raise DataFileError(path, f"{what} {declared} exceeds the limit of {MAX_FRAMES:,}", line)
+    if available is not None and declared * per_item > available:
+        raise DataFileError(
+            path,
+            f"{what} {declared} needs at least {declared * per_item} more line(s), but the file "
+            f"holds {available}: the file is truncated or the count is wrong",
+            line,
+        )
+
+
+def check_values(
+    path: str | Path,
+    values: ArrayLike,
+    limit: float,
+    what: str,
+    line_of: Callable[[int], int] | Sequence[int] | None = None,
+    unit: str = "",
+    allow_nan: bool = False,
+) -> None:
+    """Every value finite and ``|value| <= limit`` (``allow_nan``: NaN marks a missing value
+    and passes; infinities never do).
+
+    ``values`` has its records along axis 0 (frames or lines); ``line_of`` maps a record index to
+    its 1-based line in the file (a function or a sequence). The error names the first bad record.
+    """
+    a = np.asarray(values, dtype=np.float64)
+    if a.size == 0:
+        return
+    rows = a.reshape(a.shape[0] if a.ndim else 1, -1)
+    with np.errstate(invalid="ignore"):
+        bad = ~(np.abs(rows) <= limit)  # NaN compares False: caught here too
+    if allow_nan:
+        bad &= ~np.isnan(rows)
+    if not bad.any():
+        return
+    record = int(np.argmax(bad.any(axis=1)))
+    value = float(rows[record][bad[record]][0])
+    line = None
+    if line_of is not None:
+        line = line_of(record) if callable(line_of) else int(line_of[record])
+    problem = "is not finite" if not np.isfinite(value) else f"is beyond +-{limit:g}{unit}"
+    raise DataFileError(path, f"{what} {value!r} {problem}", line)
+
+
+def check_time_stamps(path: str | Path, time: NDArray[np.float64], line: int | None = None) -> None:
+    """Time stamps [s] finite, within +-:data:`MAX_DURATION_S`, spanning at least two distinct
+    instants (a motion needs two)."""
+    t = np.asarray(time, dtype=np.float64)
+    check_values(path, t, MAX_DURATION_S, "time stamp", None, " s")
+    if t.size < 2:
+        raise DataFileError(
+            path, f"only {t.size} frame(s): a motion needs at least two time stamps", line
+        )
+    if not np.any(t != t[0]):
+        raise DataFileError(
+            path,
+            f"all {t.size} frames have the same time stamp ({t[0]:g} s): a motion needs at "
+            "least two distinct time stamps",
+            line,
+        )

@@ -1,0 +1,824 @@
+"""The bad-input corpus: bad and awkward inputs made from the real files in ``examples/data``.
+
+Every case is a command line of ``mdf`` on a generated input (a motion file of every supported
+format truncated, corrupted, re-encoded, with absurd values or huge declared counts; config files
+that cannot be decoded, nest too deep or are too large; an absurd value in every config section;
+dataset and experiment configs that reach outside the process). ``tests/test_bad_input_corpus.py``
+runs every case and asserts the rule for bad input: exit code 2, one line on stderr naming the
+file (and line) or the config field, no traceback, and nothing written to ``--out``.
+
+Run on its own to look at the corpus::
+
+    python tests/corpus/make_corpus.py OUT_DIR    # writes the cases and lists them
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+DATA = ROOT / "examples" / "data"
+BVH = DATA / "cmu" / "bvh" / "16_21.bvh"
+AMC = DATA / "cmu" / "asf-amc" / "02_01.amc"
+ASF = DATA / "cmu" / "asf-amc" / "02.asf"
+UTK = DATA / "kinect" / "utkinect" / "joints_s01_e01.txt"
+UTK_LABELS = DATA / "kinect" / "utkinect" / "actionLabel.txt"
+MSR = DATA / "kinect" / "msr-action3d" / "a16_s01_e01_skeleton3D.txt"
+PRECOG = DATA / "kinect" / "precog" / "Seq1_1.csv"
+ONI = DATA / "kinect" / "oni" / "test.oni"
+
+
+@dataclass(frozen=True)
+class Case:
+    """One bad input: ``argv`` for ``mdf``; ``expect``: texts the one error line must contain
+    (the file and line, or the config field); ``out``: the folder that must stay empty."""
+
+    name: str
+    argv: tuple[str, ...]
+    expect: tuple[str, ...]
+    out: Path
+
+
+class _Corpus:
+    def __init__(self, root: Path) -> None:
+        self.root = root
+        self.cases: list[Case] = []
+
+    def folder(self, name: str) -> Path:
+        d = self.root / name
+        d.mkdir(parents=True, exist_ok=False)
+        return d
+
+    def run(self, name: str, config: Path, *expect: str) -> None:
+        out = config.parent / "out"
+        self.cases.append(Case(name, ("run", str(config), "--out", str(out)), expect, out))
+
+    def command(self, name: str, argv: list[str], out: Path, *expect: str) -> None:
+        self.cases.append(Case(name, tuple(argv), expect, out))
+
+
+# ----------------------------------------------------------------------------- file helpers
+
+
+def _lines(path: Path) -> list[str]:
+    return path.read_text(encoding="utf-8").splitlines(keepends=True)
+
+
+def _json_config(folder: Path, config: dict[str, Any], name: str = "run.json") -> Path:
+    path = folder / name
+    path.write_text(json.dumps(config, indent=1), encoding="utf-8")  # inf/nan as Infinity/NaN
+    return path
+
+
+def _replace_field(line: str, index: int, value: str) -> str:
+    """A whitespace-separated line with field ``index`` replaced (line end kept)."""
+    end = line[len(line.rstrip("\r\n")) :]
+    fields = line.split()
+    fields[index] = value
+    return " ".join(fields) + end
+
+
+def _bvh_motion_start(lines: list[str]) -> int:
+    """Index of the first frame line of a BVH file."""
+    return next(i for i, ln in enumerate(lines) if ln.startswith("MOTION")) + 3
+
+
+# ------------------------------------------------------------------- motion files, per format
+
+
+def _motion_cases(c: _Corpus) -> None:
+    bvh = _lines(BVH)
+    first = _bvh_motion_start(bvh)
+    rng = np.random.default_rng(10)
+
+    def bvh_case(name: str, text: str | bytes, *expect: str, keep_first: bool = False) -> None:
+        d = c.folder(f"bvh-{name}")
+        f = d / "16_21.bvh"
+        f.write_bytes(text if isinstance(text, bytes) else text.encode("utf-8"))
+        motion: dict[str, Any] = {"kind": "cmu", "file": f.name}
+        if keep_first:
+            motion["keep_first_frame"] = True
+        c.run(f"bvh-{name}", _json_config(d, {"motion": motion}), f.name, *expect)
+
+    def with_line(lines: list[str], index: int, new: str) -> str:
+        return "".join([*lines[:index], new, *lines[index + 1 :]])
+
+    bvh_case("truncated-hierarchy", "".join(bvh[:40]), "ends inside the hierarchy")
+    bvh_case("truncated-frames", "".join(bvh[: first + 20]), "truncated")
+    bvh_case("truncated-mid-line", "".join(bvh[: first + 20]) + bvh[first + 20][:25], "values")
+    frames_line = first - 2
+    bvh_case(
+        "huge-frame-count",
+        with_line(bvh, frames_line, "Frames: 1000000000000\n"),
+        f":{frames_line + 1}:",
+        "exceeds the limit",
+    )
+    bvh_case(
+        "frame-count-beyond-data",
+        with_line(bvh, frames_line, "Frames: 5000000\n"),
+        "truncated",
+    )
+    k = first + 7
+    bvh_case(
+        "coordinate-1e308", with_line(bvh, k, _replace_field(bvh[k], 0, "1e308")), f":{k + 1}:"
+    )
+    bvh_case("angle-1e30", with_line(bvh, k, _replace_field(bvh[k], 5, "1e30")), f":{k + 1}:")
+    bvh_case("nan-value", with_line(bvh, k, _replace_field(bvh[k], 3, "nan")), f":{k + 1}:")
+    bvh_case("inf-value", with_line(bvh, k, _replace_field(bvh[k], 1, "-inf")), f":{k + 1}:")
+    bvh_case("bad-number", with_line(bvh, k, _replace_field(bvh[k], 2, "1.2.3")), f":{k + 1}:")
+    off = next(i for i, ln in enumerate(bvh) if "OFFSET" in ln)
+    root = next(i for i, ln in enumerate(bvh) if ln.split()[:1] == ["ROOT"])
+    bvh_case(
+        "offset-1e300",
+        with_line(bvh, off, "OFFSET 1e300 0 0\n"),
+        f":{root + 1}:",  # the joint's line
+        "OFFSET of 'Hips'",
+    )
+    bvh_case(
+        "crlf-truncated",
+        "".join(ln.rstrip("\n") + "\r\n" for ln in bvh[: first + 10]),
+        "truncated",
+    )
+    bvh_case(
+        "frame-time-zero", with_line(bvh, first - 1, "Frame Time: 0\n"), f":{first}:", "frame time"
+    )
+    bvh_case(
+        "frame-time-1e300",
+        with_line(bvh, first - 1, "Frame Time: 1e300\n"),
+        f":{first}:",
+        "frame time",
+    )
+    one = "".join(bvh[: first - 2]) + "Frames: 2\n" + bvh[first - 1] + bvh[first] + bvh[first + 1]
+    bvh_case("one-frame-after-t-pose", one, "frame")
+    same = "".join(bvh[: first - 2]) + "Frames: 1\n" + bvh[first - 1] + bvh[first]
+    bvh_case("single-frame", same, "at least two", keep_first=True)
+    bvh_case("empty", "", "empty")
+    bvh_case("random-bytes", rng.integers(0, 256, 4000, dtype=np.uint8).tobytes(), "16_21.bvh")
+    bvh_case("utf16", "".join(bvh).encode("utf-16"), "16_21.bvh")
+    bvh_case("nul-bytes", "".join(bvh[:first]).encode() + b"\0" * 100, "16_21.bvh")
+
+    # ASF/AMC
+    amc = _lines(AMC)
+    asf = _lines(ASF)
+
+    def amc_case(name: str, amc_text: str | bytes, asf_text: str, bad: str, *expect: str) -> None:
+        d = c.folder(f"amc-{name}")
+        (d / "02_01.amc").write_bytes(
+            amc_text if isinstance(amc_text, bytes) else amc_text.encode("utf-8")
+        )
+        (d / "02.asf").write_text(asf_text, encoding="utf-8")
+        motion = {"kind": "cmu", "file": "02_01.amc"}
+        c.run(f"amc-{name}", _json_config(d, {"motion": motion}), bad, *expect)
+
+    asf_text = "".join(asf)
+    root_line = next(i for i, ln in enumerate(amc) if ln.startswith("root"))
+    amc_case(
+        "truncated-mid-frame", "".join(amc[: root_line + 40]), asf_text, "02_01.amc", "lacks bone"
+    )
+    r = root_line + 30 * 0  # the first frame's root line
+    amc_case(
+        "root-1e308",
+        "".join([*amc[:r], _replace_field(amc[r], 1, "1e308"), *amc[r + 1 :]]),
+        asf_text,
+        "02_01.amc",
+        f":{r + 1}:",
+    )
+    b = root_line + 3
+    amc_case(
+        "angle-1e30",
+        "".join([*amc[:b], _replace_field(amc[b], 1, "1e30"), *amc[b + 1 :]]),
+        asf_text,
+        "02_01.amc",
+        f":{b + 1}:",
+    )
+    amc_case(
+        "nan",
+        "".join([*amc[:b], _replace_field(amc[b], 2, "nan"), *amc[b + 1 :]]),
+        asf_text,
+        "02_01.amc",
+        f":{b + 1}:",
+    )
+    frame2 = next(i for i, ln in enumerate(amc) if ln.strip() == "2")
+    amc_case("one-frame", "".join(amc[:frame2]), asf_text, "02_01.amc", "at least two")
+    amc_case(
+        "random-bytes",
+        rng.integers(0, 256, 3000, dtype=np.uint8).tobytes(),
+        asf_text,
+        "02_01.amc",
+    )
+    amc_case("empty", "", asf_text, "02_01.amc", "zero frames")
+    amc_case("asf-truncated", "".join(amc), "".join(asf[:30]), "02.asf")
+    unit = next(i for i, ln in enumerate(asf) if ln.strip().startswith("length"))
+    amc_case(
+        "asf-length-unit-1e-300",
+        "".join(amc),
+        "".join([*asf[:unit], "  length 1e-300\n", *asf[unit + 1 :]]),
+        "02.asf",
+        f":{unit + 1}:",
+    )
+    bone_len = next(
+        i for i, ln in enumerate(asf) if ln.strip().startswith("length") and i > unit + 5
+    )
+    amc_case(
+        "asf-bone-length-1e308",
+        "".join(amc),
+        "".join([*asf[:bone_len], "     length 1e308\n", *asf[bone_len + 1 :]]),
+        "02.asf",
+        f":{bone_len + 1}:",
+    )
+
+    # Kinect text formats
+    def kinect_case(
+        name: str, fmt: str, fname: str, data: str | bytes, *expect: str, **extra: Any
+    ) -> None:
+        d = c.folder(f"{fmt}-{name}")
+        (d / fname).write_bytes(data if isinstance(data, bytes) else data.encode("utf-8"))
+        motion = {"kind": "kinect", "format": fmt, "file": fname, **extra}
+        c.run(f"{fmt}-{name}", _json_config(d, {"motion": motion}), fname, *expect)
+
+    utk = _lines(UTK)
+    uname = UTK.name
+    kinect_case("truncated-line", "utkinect", uname, "".join(utk[:30]) + utk[30][:40], ":31:")
+    kinect_case(
+        "coordinate-1e308",
+        "utkinect",
+        uname,
+        "".join([*utk[:9], _replace_field(utk[9], 4, "1e308"), *utk[10:]]),
+        ":10:",
+    )
+    kinect_case(
+        "frame-number-1e300",
+        "utkinect",
+        uname,
+        "".join([*utk[:9], _replace_field(utk[9], 0, "1e300"), *utk[10:]]),
+        ":10:",
+    )
+    kinect_case(
+        "all-frame-numbers-equal",
+        "utkinect",
+        uname,
+        "".join(_replace_field(ln, 0, "7") for ln in utk if ln.strip()),
+        "same time stamp",
+    )
+    kinect_case("one-line", "utkinect", uname, utk[0], "at least two")
+    kinect_case(
+        "random-bytes", "utkinect", uname, rng.integers(0, 256, 2000, dtype=np.uint8).tobytes()
+    )
+    kinect_case("utf16", "utkinect", uname, "".join(utk).encode("utf-16"))
+    kinect_case("empty", "utkinect", uname, "", "empty")
+    d = c.folder("utkinect-bad-labels")
+    (d / uname).write_text("".join(utk), encoding="utf-8")
+    (d / "actionLabel.txt").write_text("s01_e01\nwalk: 1e400 nope\n", encoding="utf-8")
+    c.run(
+        "utkinect-bad-labels",
+        _json_config(
+            d,
+            {"motion": {"kind": "kinect", "format": "utkinect", "file": uname, "segment": "walk"}},
+        ),
+        "actionLabel.txt",
+    )
+
+    msr = _lines(MSR)
+    mname = MSR.name
+    kinect_case("truncated-frame", "msr-action3d", mname, "".join(msr[:47]), "whole number")
+    kinect_case(
+        "value-inf",
+        "msr-action3d",
+        mname,
+        "".join([*msr[:12], _replace_field(msr[12], 1, "inf"), *msr[13:]]),
+        ":13:",
+    )
+    kinect_case("one-frame", "msr-action3d", mname, "".join(msr[:20]), "at least two")
+    kinect_case(
+        "huge-value",
+        "msr-action3d",
+        mname,
+        "".join([*msr[:40], _replace_field(msr[40], 2, "-3e200"), *msr[41:]]),
+        ":41:",
+    )
+
+    pc = _lines(PRECOG)
+    pname = PRECOG.name
+    kinect_case("bad-header", "precog", pname, "x;y\n" + "".join(pc[1:]), ":1:")
+    row = pc[5].split(";")
+    row[3] = "0.1 1e308 2.0"
+    kinect_case(
+        "coordinate-1e308", "precog", pname, "".join([*pc[:5], ";".join(row), *pc[6:]]), ":6:"
+    )
+    row = pc[5].rstrip("\r\n").split(";")
+    row[20] = "1000000000000000000000"
+    kinect_case(
+        "action-id-huge",
+        "precog",
+        pname,
+        "".join([*pc[:5], ";".join(row) + "\n", *pc[6:]]),
+        ":6:",
+    )
+    kinect_case("header-only", "precog", pname, pc[0], "no frame")
+
+    # NTU (Kinect v2) and NiTE files, written from the real UTKinect recording
+    ntu = _ntu_lines(UTK)
+    nname = "S001C001P001R001A001.skeleton"
+    kinect_case(
+        "declared-frames-1e12", "ntu", nname, "1000000000000\n" + "".join(ntu[1:]), ":1:", "limit"
+    )
+    kinect_case("truncated", "ntu", nname, "".join(ntu[:100]), ":1:", "frame count")
+    kinect_case(
+        "body-count-huge",
+        "ntu",
+        nname,
+        "".join([ntu[0], "99999999\n", *ntu[2:]]),
+        ":2:",
+        "body count",
+    )
+    kinect_case(
+        "coordinate-1e308",
+        "ntu",
+        nname,
+        "".join([*ntu[:10], _replace_field(ntu[10], 0, "1e308"), *ntu[11:]]),
+        ":11:",
+    )
+    kinect_case("frame-count-inf", "ntu", nname, "inf\n" + "".join(ntu[1:]), ":1:")
+
+    nite = _nite_lines(UTK)
+    tname = "walk.nite.txt"
+    data0 = next(i for i, ln in enumerate(nite) if ln[:1].isdigit())
+    equal = nite[:data0] + [_replace_field(ln, 0, "0.5") for ln in nite[data0:]]
+    kinect_case("all-times-equal", "nite", tname, "".join(equal), "same time stamp")
+    kinect_case(
+        "time-inf",
+        "nite",
+        tname,
+        "".join([*nite[:data0], _replace_field(nite[data0], 0, "inf"), *nite[data0 + 1 :]]),
+        "time stamp",
+    )
+    kinect_case(
+        "time-1e300",
+        "nite",
+        tname,
+        "".join(
+            [*nite[: data0 + 3], _replace_field(nite[data0 + 3], 0, "1e300"), *nite[data0 + 4 :]]
+        ),
+        "time stamp",
+    )
+    kinect_case(
+        "frame-index-nan",
+        "nite",
+        tname,
+        "".join([*nite[:data0], _replace_field(nite[data0], 1, "nan"), *nite[data0 + 1 :]]),
+        f":{data0 + 1}:",
+    )
+    kinect_case(
+        "coordinate-1e308",
+        "nite",
+        tname,
+        "".join([*nite[:data0], _replace_field(nite[data0], 5, "1e308"), *nite[data0 + 1 :]]),
+        f":{data0 + 1}:",
+    )
+    kinect_case("truncated-line", "nite", tname, "".join(nite[: data0 + 5]) + nite[data0 + 5][:50])
+    kinect_case("one-frame", "nite", tname, "".join(nite[: data0 + 1]), "at least two")
+
+    # .oni recordings (mdf kinect info): truncated and random bytes
+    d = c.folder("oni-truncated")
+    (d / "test.oni").write_bytes(ONI.read_bytes()[:3000])
+    c.command("oni-truncated", ["kinect", "info", str(d / "test.oni")], d / "out", "test.oni")
+    d = c.folder("oni-random-bytes")
+    (d / "test.oni").write_bytes(rng.integers(0, 256, 5000, dtype=np.uint8).tobytes())
+    c.command("oni-random-bytes", ["kinect", "info", str(d / "test.oni")], d / "out", "test.oni")
+
+
+def _ntu_lines(utk: Path) -> list[str]:
+    """An NTU RGB+D .skeleton file (Kinect v2 layout) holding the real UTKinect recording."""
+    from mdf_kinect import KINECT_V1_JOINTS, KINECT_V2_JOINTS, read_utkinect
+
+    rec = read_utkinect(utk)
+    v1 = {n: i for i, n in enumerate(KINECT_V1_JOINTS)}
+    alias = {
+        "SpineBase": "HipCenter",
+        "SpineMid": "Spine",
+        "Neck": "ShoulderCenter",
+        "SpineShoulder": "ShoulderCenter",
+        "HandTipLeft": "HandLeft",
+        "ThumbLeft": "HandLeft",
+        "HandTipRight": "HandRight",
+        "ThumbRight": "HandRight",
+    }
+    lines = [f"{rec.time.shape[0]}\n"]
+    for k in range(rec.time.shape[0]):
+        lines += ["1\n", "72057594037931101 0 1 1 1 1 0 0.1 0.2 2\n", "25\n"]
+        for name in KINECT_V2_JOINTS:
+            x, y, z = rec.positions[k, v1[alias.get(name, name)]]
+            lines.append(f"{x:.6f} {y:.6f} {z:.6f} 250.1 180.2 900.3 500.4 0.1 0.2 0.3 0.9 2\n")
+    return lines
+
+
+def _nite_lines(utk: Path) -> list[str]:
+    """A NiTE recording (``mdf capture``'s format) holding the real UTKinect recording."""
+    import io
+
+    from mdf_kinect import KINECT_V1_JOINTS, read_utkinect
+    from mdf_kinect.nitefile import NITE_JOINTS, write_nite
+
+    rec = read_utkinect(utk)
+    v1 = {n: i for i, n in enumerate(KINECT_V1_JOINTS)}
+    names = {
+        "HEAD": "Head",
+        "NECK": "ShoulderCenter",
+        "LEFT_SHOULDER": "ShoulderLeft",
+        "RIGHT_SHOULDER": "ShoulderRight",
+        "LEFT_ELBOW": "ElbowLeft",
+        "RIGHT_ELBOW": "ElbowRight",
+        "LEFT_HAND": "HandLeft",
+        "RIGHT_HAND": "HandRight",
+        "TORSO": "Spine",
+        "LEFT_HIP": "HipLeft",
+        "RIGHT_HIP": "HipRight",
+        "LEFT_KNEE": "KneeLeft",
+        "RIGHT_KNEE": "KneeRight",
+        "LEFT_FOOT": "FootLeft",
+        "RIGHT_FOOT": "FootRight",
+    }
+    pos = rec.positions[:, [v1[names[j]] for j in NITE_JOINTS]]
+    buf = io.StringIO()
+    write_nite(
+        buf,
+        rec.time - rec.time[0],
+        rec.frame_numbers.tolist(),
+        1,
+        pos,
+        np.ones(pos.shape[:2]),
+        {"source": "UTKinect-Action3D joints_s01_e01 (corpus)"},
+    )
+    return buf.getvalue().splitlines(keepends=True)
+
+
+# ------------------------------------------------------------------------------ config files
+
+
+def _config_file_cases(c: _Corpus) -> None:
+    good = {
+        "motion": {"kind": "point_targets", "length": 1.0, "targets": [{"position": [50, 0, 0]}]},
+        "scatterers": {"kind": "points"},
+        "scene": {"radar_position": [0.0, 0.0, 0.0]},
+    }
+    text = json.dumps(good)
+
+    def file_case(name: str, fname: str, data: bytes, *expect: str) -> None:
+        d = c.folder(f"config-{name}")
+        f = d / fname
+        f.write_bytes(data)
+        c.run(f"config-{name}", f, fname, *expect)
+
+    file_case("utf16-json", "run.json", text.encode("utf-16"), "UTF-8")
+    file_case("utf16-le-no-bom", "run.json", text.encode("utf-16-le"), "UTF-8")
+    file_case(
+        "latin1-toml", "run.toml", '# caf\xe9\n[motion]\nkind = "x"\n'.encode("latin-1"), "UTF-8"
+    )
+    rng = np.random.default_rng(3)
+    for ext in ("toml", "yaml", "json"):
+        file_case(
+            f"random-bytes-{ext}",
+            f"run.{ext}",
+            rng.integers(0, 256, 3000, dtype=np.uint8).tobytes(),
+        )
+    depth = 50_000
+    file_case("deep-json", "run.json", ("[" * depth + "]" * depth).encode(), "nested")
+    file_case(
+        "deep-json-object", "run.json", ('{"a":' * depth + "1" + "}" * depth).encode(), "nested"
+    )
+    file_case(
+        "deep-toml", "run.toml", ("x = " + "[" * depth + "]" * depth + "\n").encode(), "nested"
+    )
+    file_case(
+        "deep-toml-inline",
+        "run.toml",
+        ("x = " + "{a=" * depth + "1" + "}" * depth).encode(),
+        "nested",
+    )
+    file_case(
+        "deep-yaml", "run.yaml", ("x: " + "[" * depth + "]" * depth + "\n").encode(), "nested"
+    )
+    file_case(
+        "moderately-deep-json",
+        "run.json",
+        ('{"motion":' + "[" * 100 + "]" * 100 + "}").encode(),
+        "nested",
+    )
+    big = '{"motion": {"kind": "point_targets"}, "pad": "' + "x" * (5 * 1024 * 1024) + '"}'
+    file_case("too-large", "run.json", big.encode(), "at most")
+    file_case("not-a-table", "run.json", b"[1, 2, 3]", "top level")
+    file_case("wrong-extension", "run.ini", text.encode(), "unknown config format")
+    file_case("invalid-toml", "run.toml", b"[motion\nkind = 1\n", "invalid TOML")
+    file_case("invalid-yaml", "run.yaml", b"motion: [1, 2\n", "invalid YAML")
+    file_case("invalid-json", "run.json", b'{"motion": }', "invalid JSON")
+    file_case("empty-json", "run.json", b"", "invalid JSON")
+    d = c.folder("config-missing")
+    c.run("config-missing", d / "nope.toml", "nope.toml", "cannot read")
+
+
+# --------------------------------------------------------------- absurd values, every section
+
+
+def _field_cases(c: _Corpus) -> None:
+    point = {"kind": "point_targets", "length": 1.0, "targets": [{"position": [50, 0, 0]}]}
+    base: dict[str, Any] = {
+        "motion": point,
+        "scatterers": {"kind": "points"},
+        "scene": {"radar_position": [0.0, 0.0, 0.0]},
+    }
+    inf, nan = float("inf"), float("nan")
+
+    def case(name: str, section: str, change: dict[str, Any], field: str) -> None:
+        cfg = json.loads(json.dumps(base))
+        if section == "effects":
+            cfg["effects"] = [change]
+        elif section == "":
+            cfg.update(change)
+        else:
+            cfg[section] = {**cfg.get(section, {}), **change}
+        d = c.folder(f"field-{name}")
+        c.run(f"field-{name}", _json_config(d, cfg), "run.json", field)
+
+    radar = {"kind": "lfm"}
+    case("prf-inf", "radar", {**radar, "prf": inf}, "radar.prf")
+    case("prf-1e300", "radar", {**radar, "prf": 1e300}, "radar.prf")
+    case("prf-nan", "radar", {**radar, "prf": nan}, "radar.prf")
+    case("carrier-inf", "radar", {**radar, "carrier_frequency": inf}, "radar.carrier_frequency")
+    case("carrier-1hz", "radar", {**radar, "carrier_frequency": 1.0}, "radar.carrier_frequency")
+    case("bandwidth-inf", "radar", {**radar, "bandwidth": inf}, "radar.bandwidth")
+    case(
+        "bandwidth-above-carrier",
+        "radar",
+        {**radar, "carrier_frequency": 1e8, "bandwidth": 5e8},
+        "radar",
+    )
+    case("pulse-longer-than-interval", "radar", {**radar, "pulse_width": 0.01}, "pulse_width")
+    case("power-1e300", "radar", {**radar, "transmit_power": 1e300}, "radar.transmit_power")
+    case("gain-nan", "radar", {**radar, "gain_dbi": nan}, "radar.gain_dbi")
+    case("loss-1e9", "radar", {**radar, "system_loss_db": 1e9}, "radar.system_loss_db")
+    case("length-inf", "motion", {"length": inf}, "motion.length")
+    case("length-1e9", "motion", {"length": 1e9}, "motion.length")
+    case(
+        "target-nan",
+        "motion",
+        {"targets": [{"position": [nan, 0, 0]}]},
+        "motion.targets.0.position",
+    )
+    case(
+        "target-1e300",
+        "motion",
+        {"targets": [{"position": [1e300, 0, 0]}]},
+        "motion.targets.0.position",
+    )
+    case(
+        "velocity-inf",
+        "motion",
+        {"targets": [{"position": [50, 0, 0], "velocity": [inf, 0, 0]}]},
+        "motion.targets.0.velocity",
+    )
+    case(
+        "rcs-inf",
+        "motion",
+        {"targets": [{"position": [50, 0, 0], "rcs": inf}]},
+        "motion.targets.0.rcs",
+    )
+    case("frame-rate-zero", "motion", {"frame_rate": 0.0}, "motion.frame_rate")
+    case("frame-rate-1e12", "motion", {"frame_rate": 1e12}, "motion.frame_rate")
+    case("start-inf", "motion", {"start": inf}, "motion.start")
+    case("duration-nan", "motion", {"duration": nan}, "motion.duration")
+    case(
+        "pulses-beyond-limit",
+        "motion",
+        {"length": 80_000.0},
+        "pulses",
+    )
+    case("radar-position-inf", "scene", {"radar_position": [inf, 0, 0]}, "scene.radar_position")
+    case(
+        "gate-inf",
+        "scene",
+        {"gate": inf},
+        "scene.gate: must be one of 'track' (got inf) or must be a finite number",
+    )
+    case("min-range-inf", "scene", {"min_range": inf}, "scene.min_range")
+    case("person-nan", "scene", {"person": {"position": [nan, 0]}}, "scene.person.position")
+    case("heading-1e9", "scene", {"person": {"heading_deg": 1e9}}, "scene.person.heading_deg")
+    case(
+        "speed-inf",
+        "scene",
+        {"person": {"motion": "straight", "speed": inf}},
+        "scene.person.speed",
+    )
+    case("window-1e9", "processing", {"window_length": 10**9}, "processing.window_length")
+    case("nfft-huge", "processing", {"nfft": 2**40}, "processing.nfft")
+    case("floor-minus-inf", "processing", {"floor_db": -inf}, "processing.floor_db")
+    case("hop-zero", "processing", {"hop": 0}, "processing.hop")
+    case("gap-inf", "conditioning", {"max_gap_s": inf}, "conditioning.max_gap_s")
+    case("joint-speed-nan", "conditioning", {"max_speed_mps": nan}, "conditioning.max_speed_mps")
+    case("points-rcs-inf", "scatterers", {"rcs": inf}, "scatterers.rcs")
+    case("seed-negative", "", {"seed": -1}, "seed")
+    case("seed-2-to-the-70", "", {"seed": 2**70}, "seed")
+    case("noise-snr-inf", "effects", {"kind": "noise", "snr_db": inf}, "effects.0.snr_db")
+    case("clutter-csr-nan", "effects", {"kind": "clutter", "csr_db": nan}, "effects.0.csr_db")
+    case(
+        "multipath-ground-inf",
+        "effects",
+        {"kind": "multipath", "ground_height": inf},
+        "effects.0.ground_height",
+    )
+    case(
+        "antenna-azimuth-1e9",
+        "effects",
+        {"kind": "antenna", "pointing": "angles", "azimuth_deg": 1e9},
+        "effects.0.azimuth_deg",
+    )
+    case(
+        "attenuation-rain-inf",
+        "effects",
+        {"kind": "attenuation", "rain_rate_mm_per_h": inf},
+        "effects.0.rain_rate_mm_per_h",
+    )
+
+    # body models and the other motion sources
+    body = {"kind": "cmu", "file": str(BVH)}
+
+    def body_case(name: str, cfg: dict[str, Any], field: str) -> None:
+        d = c.folder(f"field-{name}")
+        c.run(f"field-{name}", _json_config(d, cfg), "run.json", field)
+
+    body_case("cmu-frame-rate-inf", {"motion": {**body, "frame_rate": inf}}, "motion.frame_rate")
+    body_case("cmu-start-1e9", {"motion": {**body, "start": 1e9}}, "motion.start")
+    body_case(
+        "kinect-frame-rate-inf",
+        {
+            "motion": {
+                "kind": "kinect",
+                "format": "msr-action3d",
+                "file": str(MSR),
+                "frame_rate": inf,
+            }
+        },
+        "motion.frame_rate",
+    )
+    body_case(
+        "ellipsoid-points-1e6",
+        {"motion": body, "scatterers": {"kind": "ellipsoid", "surface_points": 10**6}},
+        "scatterers.surface_points",
+    )
+    body_case(
+        "ellipsoid-height-inf",
+        {"motion": body, "scatterers": {"kind": "ellipsoid", "height": inf}},
+        "scatterers.height",
+    )
+    body_case(
+        "kinect-floor-inf",
+        {"motion": {"kind": "kinect", "format": "utkinect", "file": str(UTK), "floor": inf}},
+        "motion.floor: must be one of 'auto' (got inf) or must be a finite number",
+    )
+    body_case("boulic-speed-inf", {"motion": {"kind": "boulic", "speed": inf}}, "motion.speed")
+    body_case(
+        "boulic-cycles-1e12", {"motion": {"kind": "boulic", "n_cycles": 10**12}}, "motion.n_cycles"
+    )
+    body_case(
+        "shadowing-decimation-0",
+        {"motion": {"kind": "boulic"}, "effects": [{"kind": "shadowing", "decimation": 0}]},
+        "effects.0.decimation",
+    )
+    body_case(
+        "mujoco-radii-inf",
+        {
+            "motion": {"kind": "boulic"},
+            "scatterers": {"kind": "mujoco_body", "radii": {"head": [inf, 0.1]}},
+        },
+        "scatterers.radii",
+    )
+    # a recording without a duration: the pulse count is checked once the motion is loaded
+    body_case(
+        "recording-pulses-beyond-limit",
+        {"motion": body, "radar": {"kind": "lfm", "prf": 1e7, "pulse_width": 1e-7}},
+        "pulses",
+    )
+
+
+# ------------------------------------------------------------- dataset and experiment configs
+
+
+def _dataset_cases(c: _Corpus) -> None:
+    source = {"label": "walk", "motion": {"kind": "cmu", "file": str(BVH)}}
+
+    def ds_case(name: str, cfg: dict[str, Any], *expect: str, fmt: str = "json") -> None:
+        d = c.folder(f"dataset-{name}")
+        f = _json_config(d, cfg, f"dataset.{fmt}")
+        out = d / "out"
+        c.command(
+            f"dataset-{name}", ["dataset", "build", str(f), "--out", str(out)], out, f.name, *expect
+        )
+
+    inf, nan = float("inf"), float("nan")
+    ds_case("record-length-inf", {"sources": [{**source, "record_length": inf}]}, "record_length")
+    ds_case("hop-tiny", {"sources": [{**source, "record_length": 1.0, "hop": 1e-9}]}, "records")
+    ds_case("aspect-nan", {"sources": [source], "variations": {"aspect_deg": [nan]}}, "aspect_deg")
+    ds_case("range-inf", {"sources": [source], "variations": {"radar_range": [inf]}}, "radar_range")
+    ds_case(
+        "scheduler-in-config",
+        {"sources": [source], "scheduler": "tcp://203.0.113.1:8786"},
+        "scheduler",
+        "--scheduler",
+    )
+    ds_case("workers-1e6", {"sources": [source], "workers": 10**6}, "workers")
+    ds_case(
+        "percentile-1e9",
+        {"sources": [source], "features": {"method": "percentile", "percentiles": [1e9, 2e9]}},
+        "features.percentiles",
+    )
+    ds_case(
+        "base-prf-inf",
+        {
+            "sources": [{**source, "record_length": 1.0}],
+            "base": {"radar": {"kind": "lfm", "prf": inf}},
+        },
+        "radar.prf",
+    )
+    ds_case("seed-nan", {"sources": [source], "seed": nan}, "seed")
+    ds_case(
+        "record-lengths-nan",
+        {"sources": [source], "record_lengths": {"walk": nan}},
+        "record_lengths",
+    )
+    ds_case("max-records-1e12", {"sources": [{**source, "max_records": 10**12}]}, "max_records")
+    ds_case("hop-nan", {"sources": [{**source, "hop": nan}]}, "hop")
+
+    def exp_case(name: str, cfg: dict[str, Any], *expect: str, argv: tuple[str, ...] = ()) -> None:
+        d = c.folder(f"experiment-{name}")
+        f = _json_config(d, cfg, "experiment.json")
+        out = d / "out"
+        c.command(
+            f"experiment-{name}",
+            ["experiment", str(f), "--out", str(out), "--no-progress", *argv],
+            out,
+            f.name,
+            *expect,
+        )
+
+    ds = {"path": str(c.root / "no-dataset-needed")}
+    exp_case(
+        "estimator-os-system",
+        {"dataset": ds, "classifier": {"kind": "sklearn", "estimator": "os.system"}},
+        "classifier.estimator",
+        "--allow-import",
+    )
+    exp_case(
+        "estimator-outside-sklearn",
+        {"dataset": ds, "classifier": {"kind": "sklearn", "estimator": "numpy.linalg.norm"}},
+        "classifier.estimator",
+    )
+    exp_case("repeats-1e9", {"dataset": ds, "evaluation": {"repeats": 10**9}}, "evaluation.repeats")
+    exp_case(
+        "test-fraction-nan", {"dataset": ds, "evaluation": {"test_fraction": nan}}, "test_fraction"
+    )
+    exp_case(
+        "knn-k-1e9", {"dataset": ds, "classifier": {"kind": "knn", "k": 10**9}}, "classifier.k"
+    )
+    exp_case("folds-inf", {"dataset": ds, "selection": {"folds": inf}}, "selection.folds")
+    exp_case("seed-2-to-the-70", {"dataset": ds, "seed": 2**70}, "seed")
+
+
+def make_corpus(root: Path) -> list[Case]:
+    """Write every case under ``root`` (an empty folder) and return them."""
+    root.mkdir(parents=True, exist_ok=True)
+    c = _Corpus(root)
+    _motion_cases(c)
+    _config_file_cases(c)
+    _field_cases(c)
+    _dataset_cases(c)
+    names = [case.name for case in c.cases]
+    assert len(names) == len(set(names)), "case names must be unique"
+    return c.cases
+
+
+def case_names() -> list[str]:
+    """The names of the corpus's cases (writes them to a temporary folder)."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        return [case.name for case in make_corpus(Path(tmp) / "corpus")]
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python tests/corpus/make_corpus.py OUT_DIR``: write the corpus and list its cases."""
+    args = sys.argv[1:] if argv is None else argv
+    if len(args) != 1:
+        print(__doc__)
+        return 2
+    for case in make_corpus(Path(args[0])):
+        print(f"{case.name:40s} mdf {' '.join(case.argv)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

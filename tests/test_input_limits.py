@@ -1,0 +1,339 @@
+"""Input limits (issue 10): every numeric config field finite and bounded, config files decoded
+and size/depth-limited, readers that check declared counts before they allocate, classifiers and
+Dask schedulers that a shared config cannot choose."""
+
+from __future__ import annotations
+
+import json
+import math
+import socket
+import time
+import tracemalloc
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from conftest import EXAMPLES
+from pydantic import BaseModel
+
+from mdframework import ConfigError, DataFileError, MdfError, SceneError, limits
+from mdframework.config import read_config_file, run_config_model, validate_run_config
+from mdframework.dataset import (
+    SCHEDULER_ENV,
+    SCHEDULER_TIMEOUT_ENV,
+    DatasetConfig,
+    _connect,
+    scheduler_address,
+)
+from mdframework.docgen import numeric_ranges
+from mdframework.experiment import ExperimentConfig
+from mdframework.interfaces import PluginConfig
+from mdframework.plugins import default_registry
+from mdframework.settings import StrictModel
+
+#: Fields that may be infinite on purpose (documented in their description).
+INFINITE_ALLOWED = {("ShadowingConfig", "attenuation_db")}
+
+
+def _config_models() -> list[type[BaseModel]]:
+    reg = default_registry()
+    classifiers = [reg.plugins["classifier"][n].cls.Config for n in reg.names("classifier")]
+    return [run_config_model(), DatasetConfig, ExperimentConfig, *classifiers]
+
+
+def _schemas() -> list[tuple[str, str, dict[str, Any]]]:
+    out = []
+    for model in _config_models():
+        schema = model.model_json_schema()
+        for name, definition in [(model.__name__, schema), *schema.get("$defs", {}).items()]:
+            for field, prop in definition.get("properties", {}).items():
+                out.append((name, field, prop))
+    return out
+
+
+def test_every_numeric_config_field_is_bounded_on_both_sides() -> None:
+    numeric = 0
+    for model, field, prop in _schemas():
+        ranges = numeric_ranges(prop)
+        numeric += bool(ranges)
+        if (model, field) in INFINITE_ALLOWED:
+            continue
+        assert ranges == [r for r in ranges if "inf" not in r], (model, field, ranges)
+    assert numeric > 80  # the walk found the numbers (radar, scene, effects, datasets, ...)
+
+
+def _all_models(model: type[BaseModel], seen: set[type[BaseModel]]) -> None:
+    if model in seen:
+        return
+    seen.add(model)
+    for field in model.model_fields.values():
+        stack = [field.annotation]
+        while stack:
+            t = stack.pop()
+            if isinstance(t, type) and issubclass(t, BaseModel):
+                _all_models(t, seen)
+            stack.extend(getattr(t, "__args__", ()))
+
+
+def test_every_config_model_refuses_inf_and_nan() -> None:
+    seen: set[type[BaseModel]] = set()
+    for model in _config_models():
+        _all_models(model, seen)
+    assert len(seen) > 20
+    for model in seen:
+        assert model.model_config.get("allow_inf_nan") is False, model
+    # a field-level exception must be one of the documented ones
+    for model in seen:
+        for name, field in model.model_fields.items():
+            allow = [m for m in field.metadata if getattr(m, "allow_inf_nan", None) is True]
+            if allow:
+                assert (model.__name__, name) in INFINITE_ALLOWED
+
+
+@pytest.mark.parametrize("value", [math.inf, -math.inf, math.nan])
+def test_non_finite_values_are_refused_in_every_section(value: float) -> None:
+    base = {
+        "motion": {"kind": "point_targets", "length": 1.0, "targets": [{"position": [50, 0, 0]}]},
+        "scatterers": {"kind": "points"},
+    }
+    for path in (
+        ("radar", "prf"),
+        ("radar", "carrier_frequency"),
+        ("radar", "bandwidth"),
+        ("motion", "length"),
+        ("scene", "min_range"),
+        ("processing", "floor_db"),
+        ("conditioning", "max_speed_mps"),
+    ):
+        cfg = json.loads(json.dumps(base))
+        cfg.setdefault(path[0], {"kind": "lfm"} if path[0] == "radar" else {})[path[1]] = value
+        with pytest.raises(ConfigError, match=rf"{path[0]}\.{path[1]}:"):
+            validate_run_config(cfg)
+
+
+def test_the_pulse_limit_names_the_memory_a_run_would_take() -> None:
+    cfg = {
+        "motion": {
+            "kind": "point_targets",
+            "length": 3000.0,
+            "targets": [{"position": [50, 0, 0]}],
+        },
+        "scatterers": {"kind": "points"},
+        "radar": {"kind": "lfm", "prf": 2400.0},
+    }
+    with pytest.raises(ConfigError) as exc:
+        validate_run_config(cfg)
+    n = math.floor(3000.0 * 2400.0) + 1  # 7.2e6 pulses
+    mib = n * (8 + 8 + 16 + 8) / 1024**2  # time, gate, complex signal, STFT input
+    assert f"{n:.4g} pulses" in str(exc.value)
+    assert f"about {mib:.3g} MiB of memory)" in str(exc.value)
+    assert "motion.duration" in str(exc.value)
+    # keeping every scatterer adds positions, RCS and range per pulse and scatterer
+    cfg["processing"] = {"keep_scatterers": True}
+    with pytest.raises(ConfigError) as exc:
+        validate_run_config(cfg)
+    gib = n * (8 + 8 + 16 + 8 + 5 * 8 * 1) / 1024**2
+    assert f"about {gib:.3g} MiB of memory, keeping 1 scatterer(s) per pulse" in str(exc.value)
+    del cfg["processing"]
+    # just below the limit the config is valid
+    cfg["motion"]["length"] = (limits.MAX_PULSES - 2) / 2400.0
+    validate_run_config(cfg)
+    # a window of a recording whose length is known only once it is loaded: checked by the run
+    with pytest.raises(SceneError, match="pulses"):
+        limits.check_pulses(1000.0, 1e7, 17, "motion.duration")
+
+
+# ----------------------------------------------------------------------------- config files
+
+GOOD = 'seed = 1\n[motion]\nkind = "point_targets"\nlength = 1.0\n'
+
+
+def test_utf8_with_or_without_bom_is_read(tmp_path: Path) -> None:
+    for name, data in (
+        ("plain.toml", GOOD.encode("utf-8")),
+        ("bom.toml", GOOD.encode("utf-8-sig")),
+        ("accents.toml", ("# café, Δt\n" + GOOD).encode("utf-8")),
+        ("bom.json", json.dumps({"seed": 1}).encode("utf-8-sig")),
+        ("bom.yaml", "seed: 1\n".encode("utf-8-sig")),
+    ):
+        (tmp_path / name).write_bytes(data)
+        assert read_config_file(tmp_path / name)["seed"] == 1
+
+
+def test_other_encodings_are_refused_naming_the_file(tmp_path: Path) -> None:
+    for name, data, msg in (
+        ("u16.toml", GOOD.encode("utf-16"), "UTF-16"),
+        ("u16be.toml", GOOD.encode("utf-16-be"), "NUL byte"),
+        ("latin1.toml", ("# caf\xe9\n" + GOOD).encode("latin-1"), "line 1: not UTF-8"),
+    ):
+        (tmp_path / name).write_bytes(data)
+        with pytest.raises(ConfigError, match=msg) as exc:
+            read_config_file(tmp_path / name)
+        assert str(exc.value).startswith(str(tmp_path / name))
+
+
+@pytest.mark.parametrize("fmt", ["json", "toml", "yaml"])
+def test_nesting_is_limited_at_the_documented_depth(tmp_path: Path, fmt: str) -> None:
+    def nested(depth: int) -> str:  # the top-level table is depth 1
+        inner = "[" * (depth - 1) + "]" * (depth - 1)
+        return {"json": f'{{"x": {inner}}}', "toml": f"x = {inner}\n", "yaml": f"x: {inner}\n"}[fmt]
+
+    ok = tmp_path / f"ok.{fmt}"
+    ok.write_text(nested(limits.MAX_CONFIG_DEPTH))
+    read_config_file(ok)
+    deep = tmp_path / f"deep.{fmt}"
+    deep.write_text(nested(limits.MAX_CONFIG_DEPTH + 1))
+    with pytest.raises(ConfigError, match="nested more than"):
+        read_config_file(deep)
+    deeper = tmp_path / f"deeper.{fmt}"
+    deeper.write_text(nested(100_000))  # would overflow the parser's stack
+    with pytest.raises(ConfigError, match="nested more than"):
+        read_config_file(deeper)
+
+
+def test_config_size_is_limited(tmp_path: Path) -> None:
+    big = tmp_path / "big.toml"
+    big.write_text(GOOD + "# " + "x" * limits.MAX_CONFIG_BYTES + "\n")
+    with pytest.raises(ConfigError, match="at most"):
+        read_config_file(big)
+
+
+# ------------------------------------------------------------------------------------ readers
+
+
+def test_a_huge_declared_frame_count_allocates_nothing(tmp_path: Path) -> None:
+    """A BVH header announcing the maximum frame count over 20 frames of data: the error comes
+    without allocating the (10^7 x 96 float64 = 7.7 GB) array the header asks for."""
+    from mdf_cmu.bvh import read_bvh
+
+    lines = (EXAMPLES / "data" / "cmu" / "bvh" / "16_21.bvh").read_text().splitlines(True)
+    at = next(i for i, ln in enumerate(lines) if ln.startswith("Frames:"))
+    lines[at] = f"Frames: {limits.MAX_FRAMES}\n"
+    path = tmp_path / "16_21.bvh"
+    path.write_text("".join(lines[: at + 22]))
+    tracemalloc.start()
+    try:
+        with pytest.raises(DataFileError, match="truncated: 20 frames found"):
+            read_bvh(path)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 50e6
+    lines[at] = f"Frames: {limits.MAX_FRAMES + 1}\n"
+    path.write_text("".join(lines))
+    with pytest.raises(DataFileError, match=rf"16_21\.bvh:{at + 1}: 'Frames:' .* exceeds"):
+        read_bvh(path)
+
+
+def test_check_values_names_the_first_bad_line() -> None:
+    values = np.zeros((5, 3))
+    values[3, 1] = 2e4
+    with pytest.raises(DataFileError, match=r"f\.txt:14: coordinate 20000\.0 is beyond"):
+        limits.check_values("f.txt", values, 1e4, "coordinate", [10, 11, 12, 14, 15])
+    values[1, 2] = np.nan
+    with pytest.raises(DataFileError, match=r"f\.txt:11: coordinate nan is not finite"):
+        limits.check_values("f.txt", values, 1e4, "coordinate", lambda k: 10 + k)
+    values[3, 1] = 0.0
+    limits.check_values("f.txt", values, 1e4, "coordinate", allow_nan=True)
+    values[2, 0] = -np.inf
+    with pytest.raises(DataFileError, match="-inf is not finite"):
+        limits.check_values("f.txt", values, 1e4, "coordinate", allow_nan=True)
+
+
+def test_time_stamps_need_two_distinct_finite_values() -> None:
+    limits.check_time_stamps("t", np.array([0.0, 0.0, 0.1]))
+    for t, msg in (
+        ([0.5], "only 1 frame"),
+        ([0.5, 0.5, 0.5], "same time stamp"),
+        ([0.0, np.inf], "not finite"),
+        ([0.0, 1e6], "beyond"),
+    ):
+        with pytest.raises(DataFileError, match=msg):
+            limits.check_time_stamps("t", np.array(t))
+
+
+# ------------------------------------------------------------------- code and hosts from configs
+
+
+def test_dask_scheduler_comes_from_the_command_line_or_the_environment(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    monkeypatch.delenv(SCHEDULER_ENV, raising=False)
+    assert scheduler_address(None) is None
+    monkeypatch.setenv(SCHEDULER_ENV, "tcp://10.0.0.1:8786")
+    assert scheduler_address(None) == "tcp://10.0.0.1:8786"
+    assert scheduler_address("local") == "local"  # the command line wins
+    cfg = tmp_path / "ds.toml"
+    cfg.write_text('scheduler = "tcp://10.0.0.1:8786"\n[[sources]]\nlabel = "a"\nmotion = {}\n')
+    from mdframework.dataset import load_dataset_config
+
+    with pytest.raises(ConfigError, match="scheduler: a shared config cannot choose"):
+        load_dataset_config(cfg)
+
+
+def test_an_unreachable_scheduler_is_a_clear_error_after_the_timeout(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from distributed import Client
+
+    with socket.socket() as s:  # a port with nothing listening
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    monkeypatch.setenv(SCHEDULER_TIMEOUT_ENV, "1.5")
+    t0 = time.monotonic()
+    with pytest.raises(MdfError, match=r"cannot connect to the Dask scheduler .* within 1\.5 s"):
+        _connect(Client, None, f"tcp://127.0.0.1:{port}")
+    assert time.monotonic() - t0 < 20  # not the 30 s default
+    monkeypatch.setenv(SCHEDULER_TIMEOUT_ENV, "soon")
+    with pytest.raises(MdfError, match=SCHEDULER_TIMEOUT_ENV):
+        _connect(Client, None, f"tcp://127.0.0.1:{port}")
+
+
+def test_plugin_configs_inherit_the_finite_rule() -> None:
+    class Mine(PluginConfig):
+        kind: str = "mine"
+        gain: float = 1.0
+
+    with pytest.raises(ValueError, match="finite"):
+        Mine(gain=math.inf)
+
+    class Strict(StrictModel):
+        x: float = 0.0
+
+    with pytest.raises(ValueError, match="finite"):
+        Strict(x=math.nan)
+
+
+def test_the_documented_limits_are_the_code_s() -> None:
+    import re
+
+    from conftest import ROOT
+
+    from mdframework.dataset import SCHEDULER_TIMEOUT_S, scheduler_timeout
+
+    page = (ROOT / "docs" / "input-rules.md").read_text()
+    rows = re.findall(r"^\| `([A-Z0-9_]+)` \| ([0-9.e+]+) \|", page, flags=re.M)
+    names = {n for n in dir(limits) if n.isupper() and not n.startswith("_")}
+    assert {name for name, _ in rows} == names  # every limit documented, nothing else
+    for name, value in rows:
+        assert float(value) == getattr(limits, name), name
+    assert f"`MDF_DASK_TIMEOUT` seconds (default {SCHEDULER_TIMEOUT_S:g})" in page
+    assert scheduler_timeout() == SCHEDULER_TIMEOUT_S == 10
+
+
+def test_a_numerical_warning_in_our_code_stops_the_command(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An overflow inside mdframework (or a plugin) is never a bare warning followed by a
+    result: the command stops with one line and exit 1 (an internal error: valid inputs never
+    cause one)."""
+    from mdframework import cli
+
+    namespace: dict[str, Any] = {"__name__": "mdframework.stage", "np": np}
+    exec("def stage(args):\n    return int(np.float64(1e308) * 10.0 > 0)\n", namespace)
+    monkeypatch.setattr(cli, "_cmd_plugins", namespace["stage"])
+    assert cli.main(["plugins"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "overflow encountered" in err[0], err
+    assert "Traceback" not in err[0]
