@@ -538,6 +538,8 @@ def test_ctrl_c_during_start_up_is_one_line(tmp_path: Path, delay: float) -> Non
     time.sleep(delay)
     os.killpg(proc.pid, signal.SIGINT)
     _, err = proc.communicate(timeout=120)
+    if proc.returncode == 0 and delay >= 1.0:  # a fast machine finished the run first
+        pytest.skip(f"the run ended within {delay} s, before the signal")
     assert proc.returncode == 130, err
     assert err.strip() == "mdf: interrupted"
     assert not (out / LOCK).exists()
