@@ -2,16 +2,16 @@
 ``tests/test_random_scenes.py`` on many more scenes).
 
 Draws scenes with Hypothesis from ``tests/scenes.py`` (point targets and the shipped CMU and
-Kinect recordings, every scatterer model that fits, the LFM radar, any subset of effects, the
-geometry and the STFT, all within the documented ranges) and checks that each either runs to
-finite outputs (``ok``) or is refused with a one-line user error (``refused``). Any other outcome
-(an internal error, a numerical warning, a non-finite output) is a failure; the first few are
-printed with their configs, and the exit code is 1.
+Kinect recordings, every scatterer model that fits, the LFM, FMCW and CW radars, any subset of
+effects, the geometry and the STFT, all within the documented ranges) and checks that each
+either runs to finite outputs (``ok``) or is refused with a one-line user error (``refused``).
+Any other outcome (an internal error, a numerical warning, a non-finite output) is a failure;
+the first few are printed with their configs, and the exit code is 1.
 
     .venv/bin/python benchmarks/fuzz_scenes.py [--examples 10000] [--seed 0]
 
-Reports the counts of each outcome, the refusal reasons (the error's first words) and the time
-per scene (median over all scenes, one run).
+Reports the counts of each outcome (in all and per radar kind), the refusal reasons (the error's
+first words) and the time per scene (median over all scenes, one run).
 """
 
 from __future__ import annotations
@@ -45,6 +45,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
 
     outcomes: collections.Counter[str] = collections.Counter()
+    by_radar: collections.Counter[tuple[str, str]] = collections.Counter()
     reasons: collections.Counter[str] = collections.Counter()
     failures: list[tuple[dict[str, Any], str]] = []
     times: list[float] = []
@@ -59,6 +60,7 @@ def main(argv: list[str] | None = None) -> int:
         times.append(time.perf_counter() - t0)
         kind, _, message = outcome.partition(": ")
         outcomes[kind] += 1
+        by_radar[(cfg["radar"]["kind"], kind)] += 1
         if kind == "refused":
             # the field or problem: the message without the config's name
             words = message.split(": ", 1)[-1].split()
@@ -76,6 +78,9 @@ def main(argv: list[str] | None = None) -> int:
 
     total = sum(outcomes.values())
     print(f"scenes: {total}  " + "  ".join(f"{k}: {v}" for k, v in sorted(outcomes.items())))
+    for radar in sorted({r for r, _ in by_radar}):
+        counts = "  ".join(f"{k}: {v}" for (r, k), v in sorted(by_radar.items()) if r == radar)
+        print(f"  radar {radar}: {counts}")
     print(f"median time per scene: {statistics.median(times) * 1e3:.1f} ms")
     print("refusals (first words of the error):")
     for text, count in reasons.most_common(12):

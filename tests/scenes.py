@@ -2,13 +2,14 @@
 benchmark (``benchmarks/fuzz_scenes.py``).
 
 A scene is a run config drawn from the documented ranges: point targets or a real recording
-(CMU BVH and ASF/AMC, UTKinect), every scatterer model that fits the motion, the LFM radar
-(carrier, bandwidth, PRF, pulse width, gains, gate response, precision), any subset of the
-effects (noise, clutter, multipath, antenna, attenuation), the scene geometry, conditioning and
-the STFT. :func:`run_scene` simulates one and reports what happened: ``"ok"`` (every output
-finite), ``"refused: ..."`` (a one-line :class:`~mdframework.MdfError`, e.g. a target inside
-``min_range`` or a record shorter than the STFT window), or raises for anything else (an internal
-error, a numerical warning, a non-finite output).
+(CMU BVH and ASF/AMC, UTKinect), every scatterer model that fits the motion, a radar (LFM:
+carrier, bandwidth, PRF, pulse width, gains, gate response, precision; FMCW: the chirp timing,
+antennas, FFTs, noise, detection, both paths, the presets; CW: carrier and I/Q rate), any
+subset of the effects (noise, clutter, multipath, antenna, attenuation), the scene geometry,
+conditioning and the STFT. :func:`run_scene` simulates one and reports what happened:
+``"ok"`` (every output finite), ``"refused: ..."`` (a one-line :class:`~mdframework.MdfError`,
+e.g. a target inside ``min_range`` or a record shorter than the STFT window), or raises for
+anything else (an internal error, a numerical warning, a non-finite output).
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from typing import Any
 import numpy as np
 from hypothesis import assume
 from hypothesis import strategies as st
+from mdf_fmcw.presets import PRESETS
 
 from mdframework import MdfError, Motion
 from mdframework.config import validate_run_config
@@ -44,8 +46,108 @@ def _log_uniform(lo: float, hi: float) -> st.SearchStrategy[float]:
     return st.floats(np.log10(lo), np.log10(hi)).map(lambda e: float(10.0**e))
 
 
+def radar_sections() -> st.SearchStrategy[dict[str, Any]]:
+    """Any radar: LFM pulse-Doppler, FMCW chirp sequence or CW Doppler."""
+    return st.one_of(lfm_sections(), fmcw_sections(), cw_sections())
+
+
+def pulse_rate(radar: dict[str, Any]) -> float:
+    """Pulses per second of a drawn radar (chirps for FMCW, I/Q samples for CW) [Hz]."""
+    if radar["kind"] == "fmcw":
+        radar = {**PRESETS.get(radar.get("preset") or "", {}), **radar}
+        return float(len(radar["tdm_order"]) * radar["n_loops"] / radar["frame_period"])
+    if radar["kind"] == "cw":
+        return float(radar["sample_rate"])
+    return float(radar["prf"])
+
+
+def slow_time_rate(radar: dict[str, Any]) -> float:
+    """Slow-time samples per second of a drawn radar (the STFT's input) [Hz]."""
+    if radar["kind"] == "fmcw":
+        radar = {**PRESETS.get(radar.get("preset") or "", {}), **radar}
+        return float(radar["n_loops"] / radar["frame_period"])
+    return pulse_rate(radar)
+
+
+def _power(draw: st.DrawFn) -> dict[str, Any]:
+    return {
+        "transmit_power": draw(_log_uniform(1e-3, 1e4)),
+        "gain_dbi": draw(st.floats(-10.0, 45.0)),
+        "system_loss_db": draw(st.floats(0.0, 20.0)),
+        "amplitude": draw(st.sampled_from(["range_equation", "sqrt_rcs"])),
+    }
+
+
 @st.composite
-def radar_sections(draw: st.DrawFn) -> dict[str, Any]:
+def cw_sections(draw: st.DrawFn) -> dict[str, Any]:
+    """A CW Doppler radar: any carrier of the documented range that radars use, I/Q rate."""
+    return {
+        "kind": "cw",
+        "carrier_frequency": draw(_log_uniform(1e9, 1e11)),
+        "sample_rate": draw(_log_uniform(200.0, 20_000.0)),
+        **_power(draw),
+    }
+
+
+@st.composite
+def fmcw_sections(draw: st.DrawFn) -> dict[str, Any]:
+    """An FMCW chirp sequence that fits its frame (or a sensor preset), drawn from the
+    documented ranges: the ADC within the ramp, the sweep within the bandwidth, the chirps
+    within the frame; antennas, windows, FFT sizes, noise, CFAR and the two paths."""
+    common = {
+        "path": draw(st.sampled_from(["analytic", "raw"])),
+        "points": draw(st.booleans()),
+        "save_range_doppler": draw(st.booleans()),
+        "beyond_max_range": draw(st.sampled_from(["error", "alias"])),
+        **_power(draw),
+    }
+    if draw(st.integers(0, 3)) == 0:
+        preset = draw(st.sampled_from(["iwr1443_short_range_3d", "iwr6843isk_people_counting_6m"]))
+        return {"kind": "fmcw", "preset": preset, "n_loops": draw(st.integers(2, 16)), **common}
+    n_samples = draw(st.integers(8, 256))
+    sample_rate = draw(_log_uniform(1e6, 2e7))
+    adc_start = draw(st.floats(0.0, 10e-6))
+    ramp = adc_start + n_samples / sample_rate * draw(st.floats(1.0, 1.5))
+    max_bandwidth = draw(_log_uniform(2e8, 4e9))
+    slope = draw(_log_uniform(1e11, max(1e11, min(1e15, max_bandwidth / ramp))))
+    assume(slope * ramp <= max_bandwidth)
+    idle = draw(st.floats(2e-6, 100e-6))
+    n_tx = draw(st.integers(1, 3))
+    tdm = draw(st.permutations(list(range(1, n_tx + 1))))
+    n_loops = draw(st.integers(2, 32))
+    busy = n_loops * n_tx * (idle + ramp)
+    frame_period = busy * draw(st.sampled_from([1.0, 1.0, 1.5, 3.0]))
+    assume(frame_period <= 1.0)
+    n_rx = draw(st.integers(1, 4))
+    return {
+        "kind": "fmcw",
+        "start_frequency": draw(_log_uniform(1e9, 1.2e11)),
+        "slope": slope,
+        "idle_time": idle,
+        "adc_start_time": adc_start,
+        "ramp_end_time": ramp,
+        "sample_rate": sample_rate,
+        "n_samples": n_samples,
+        "n_loops": n_loops,
+        "tdm_order": tdm,
+        "frame_period": frame_period,
+        "max_bandwidth": max_bandwidth,
+        "tx_positions": [[2.0 * i, float(i % 2)] for i in range(n_tx)],
+        "rx_positions": [[float(i), 0.0] for i in range(n_rx)],
+        "range_window": draw(st.sampled_from(["rect", "hann", "hamming", "blackman"])),
+        "doppler_window": draw(st.sampled_from(["rect", "hann", "hamming", "blackman"])),
+        "range_fft_size": draw(st.one_of(st.none(), st.integers(n_samples, 2 * n_samples))),
+        "receiver_noise": draw(st.booleans()),
+        "noise_figure_db": draw(st.floats(0.0, 30.0)),
+        "clutter_removal": draw(st.booleans()),
+        "cfar_doppler": draw(st.one_of(st.none(), st.just({"mode": "ca", "train": 2}))),
+        "gate_width": draw(st.floats(0.1, 10.0)),
+        **common,
+    }
+
+
+@st.composite
+def lfm_sections(draw: st.DrawFn) -> dict[str, Any]:
     """An LFM radar within the documented limits (B x tau >= 1, tau <= 1/PRF)."""
     carrier = draw(_log_uniform(3e8, 1e11))
     bandwidth = draw(_log_uniform(1e6, min(2e9, carrier)))
@@ -79,6 +181,8 @@ def effect_sections(draw: st.DrawFn) -> list[dict[str, Any]]:
                 "csr_db": draw(st.floats(-30.0, 30.0)),
                 "wind_fraction": draw(st.floats(0.0, 1.0)),
                 "spread_mps": draw(st.floats(0.01, 2.0)),
+                # radars without a bandwidth (CW, FMCW) need it
+                "range_resolution": draw(st.one_of(st.none(), st.floats(0.05, 20.0))),
             }
         )
     if draw(st.booleans()):
@@ -129,7 +233,7 @@ def point_scenes(draw: st.DrawFn) -> dict[str, Any]:
     """Point targets moving at constant velocity."""
     radar = draw(radar_sections())
     length = draw(st.floats(0.05, 3.0))
-    assume(length * radar["prf"] <= MAX_SCENE_PULSES)
+    assume(length * pulse_rate(radar) <= MAX_SCENE_PULSES)
     targets = [
         {
             "position": [draw(_coordinate(-300.0, 300.0)) for _ in range(3)],
@@ -154,7 +258,7 @@ def point_scenes(draw: st.DrawFn) -> dict[str, Any]:
             "gate": draw(st.one_of(st.just("track"), st.floats(1.0, 500.0))),
             "min_range": draw(st.floats(0.1, 2.0)),
         },
-        "processing": draw(processing_sections(length * radar["prf"])),
+        "processing": draw(processing_sections(length * slow_time_rate(radar))),
     }
 
 
@@ -173,7 +277,7 @@ def body_scenes(draw: st.DrawFn) -> dict[str, Any]:
     name = draw(st.sampled_from(sorted(RECORDINGS)))
     radar = draw(radar_sections())
     duration = draw(st.floats(0.1, 1.0))
-    assume(duration * radar["prf"] <= MAX_SCENE_PULSES)
+    assume(duration * pulse_rate(radar) <= MAX_SCENE_PULSES)
     motion = {**RECORDINGS[name], "start": draw(st.floats(0.0, 0.1)), "duration": duration}
     mode = draw(st.sampled_from(["recorded", "treadmill", "straight"]))
     person: dict[str, Any] = {
@@ -209,7 +313,7 @@ def body_scenes(draw: st.DrawFn) -> dict[str, Any]:
             "person": person,
             "gate": draw(st.one_of(st.just("track"), st.floats(1.0, 60.0))),
         },
-        "processing": draw(processing_sections(duration * radar["prf"])),
+        "processing": draw(processing_sections(duration * slow_time_rate(radar))),
         "conditioning": conditioning,
     }
 
@@ -260,4 +364,7 @@ def run_scene(cfg: dict[str, Any]) -> str:
     ):
         if not np.all(np.isfinite(array)):
             raise AssertionError(f"non-finite {name} for {cfg}")
+    for name, array in result.received.products.items():
+        if not np.all(np.isfinite(array)):
+            raise AssertionError(f"non-finite product {name} for {cfg}")
     return "ok"

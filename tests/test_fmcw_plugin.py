@@ -95,8 +95,54 @@ def test_impossible_settings_are_config_errors_naming_field_and_limit(
     with pytest.raises(ConfigError) as err:
         validate_run_config(cfg, source="run.toml")
     msg = str(err.value)
-    assert msg.startswith("run.toml: radar") and field in msg and limit in msg
+    assert msg.startswith(f"run.toml: radar.{field}") and limit in msg
     assert "\n" not in msg
+
+
+@pytest.mark.parametrize(
+    ("change", "start", "limit"),
+    [
+        ({"slope": 2e15}, "radar.slope: must be at most", "1e+15"),
+        ({"idle_time": 0.02}, "radar.idle_time: must be at most", "0.01"),
+        ({"sample_rate": 2e9}, "radar.sample_rate: must be at most", "1e+09"),
+        ({"n_loops": 5000}, "radar.n_loops: must be at most", "4096"),
+        ({"tdm_order": [0]}, "radar.tdm_order.0: must be at least", "1"),
+        ({"rx_positions": [[1e4, 0.0]]}, "radar.rx_positions.0.0: must be at most", "1000"),
+        (
+            {
+                "n_loops": 1000,
+                "tdm_order": [1],
+                "tx_positions": [[0.0, 0.0]],
+                "rx_positions": [[float(i), 0.0] for i in range(8)],
+                "n_samples": 4096,
+                "ramp_end_time": 9e-4,
+                "slope": 4e12,
+                "frame_period": 1.0,
+            },
+            "radar.n_samples: one frame's chirps x RX x range bins (1000 x 8 x 4096)",
+            "the limit is 16,777,216",
+        ),
+        (
+            {"doppler_fft_size": 65536, "range_fft_size": 4096},
+            "radar.doppler_fft_size: one frame's virtual antennas x Doppler bins",
+            "(12 x 65536 x 4096) is 3,221,225,472 complex values (about 48 GiB)",
+        ),
+    ],
+)
+def test_absurd_settings_are_refused_before_any_frame(
+    change: dict[str, Any], start: str, limit: str
+) -> None:
+    """Each chirp, frame and antenna setting has a physical bound (docs/input-rules.md), and a
+    frame whose largest array would exceed limits.MAX_FRAME_CELLS is refused with its memory."""
+    cfg = {
+        "motion": {"kind": "point_targets", "length": 1.0, "targets": [{"position": [3, 0, 0]}]},
+        "scatterers": {"kind": "points"},
+        "radar": {"kind": "fmcw", **change},
+    }
+    with pytest.raises(ConfigError) as err:
+        validate_run_config(cfg, source="run.toml")
+    msg = str(err.value)
+    assert msg.startswith(f"run.toml: {start}") and limit in msg, msg
 
 
 def test_scatterer_beyond_max_range_is_an_error_or_aliases() -> None:
@@ -268,3 +314,139 @@ def test_a_radar_section_without_kind_is_still_the_lfm_radar() -> None:
         }
     )
     assert cfg.radar.kind == "lfm" and cfg.radar.carrier_frequency == 10e9  # type: ignore[attr-defined]
+
+
+def test_the_pulse_budget_counts_chirps_and_iq_samples() -> None:
+    """MAX_PULSES counts what the radar computes: the IWR1443 preset sends 48 chirps per
+    33.333 ms frame (1440 per second; its slow-time rate within a frame, 1 / (3 x 64.14 us),
+    says nothing of the gaps), a CW radar one I/Q sample per 1/sample_rate; a record over the
+    limit is refused when the config is read."""
+    from mdframework import limits
+
+    assert FmcwConfig(preset="iwr1443_short_range_3d").pulse_rate() == pytest.approx(1440.0, 1e-4)
+    sensor = FmcwRadar(IWR1443)
+    assert sensor.pulse_rate == pytest.approx(1440.0, 1e-4)
+    assert sensor.pulse_times(0.0, 10.0).size == 300 * 48  # what the budget bounds
+    assert CwConfig(sample_rate=2000.0).pulse_rate() == 2000.0
+    seconds = limits.MAX_PULSES / 1440.0 * 1.01  # just over the budget in chirps
+    for radar_cfg in ({"kind": "fmcw", "preset": "iwr1443_short_range_3d"}, {"kind": "cw"}):
+        cfg = {
+            "motion": {
+                "kind": "point_targets",
+                "length": seconds,
+                "targets": [{"position": [3, 0, 0]}],
+            },
+            "scatterers": {"kind": "points"},
+            "radar": radar_cfg,
+        }
+        if radar_cfg["kind"] == "cw":
+            cfg["radar"] = {"kind": "cw", "sample_rate": 1440.0}
+        with pytest.raises(ConfigError, match=r"run\.toml: motion\.duration: .* pulses"):
+            validate_run_config(cfg, source="run.toml")
+
+
+def test_range_doppler_maps_beyond_the_product_limit_are_refused_before_the_first_frame() -> None:
+    """One TX, one RX, 4096 x 4096 maps (64 MiB of float32 each) over 20 frames are 1.25 GiB,
+    more than limits.MAX_PRODUCT_BYTES: refused naming save_range_doppler; without the maps
+    the same radar is within every limit."""
+    big = {
+        "tdm_order": [1],
+        "tx_positions": [[0.0, 0.0]],
+        "rx_positions": [[0.0, 0.0]],
+        "range_fft_size": 4096,
+        "doppler_fft_size": 4096,
+        "n_loops": 16,
+        "frame_period": 0.05,
+        "points": False,
+        **QUIET,
+    }
+    target = [{"position": [3.0, 0.0, 0.0], "rcs": 1.0}]
+    with pytest.raises(SceneError, match=r"radar\.save_range_doppler: .*20 frames.*1\.25 GiB"):
+        fmcw_run(target, duration=1.0, **big)
+    assert FmcwConfig(**{**big, "save_range_doppler": False}).n_loops == 16
+
+
+def test_a_noise_free_detection_has_a_finite_intensity() -> None:
+    """Hard case (found by benchmarks/fuzz_scenes.py): without receiver noise the analytic
+    path leaves the CFAR training cells at exactly 0; the intensity of a detection over a
+    noise estimate of 0 used to be +inf. Now it is finite (over the smallest positive float),
+    and cells without power are never detections."""
+    from mdframework.physics import fmcw
+
+    radar_ = FmcwRadar(IWR1443)
+    rd = np.zeros((12, 16, 240), dtype=np.complex128)
+    rd[:, 8, 50] = 1e-3  # one target, nothing in its training cells
+    axes = radar_.axes()
+    pts = fmcw.detect_points(
+        rd,
+        axes["range_m"],
+        axes["doppler_hz"],
+        fmcw.angle_grid(radar_.antennas.virtual, radar_.sequence.wavelength),
+        radar_.antennas.slot_of_virtual(radar_.sequence),
+        radar_.sequence.chirp_period,
+        radar_.sequence.wavelength,
+        radar_.detection(),
+    )
+    assert pts.shape[0] >= 1 and np.all(np.isfinite(pts))
+    expected = 10 * np.log10(12 * 1e-6) - 10 * np.log10(np.finfo(np.float64).tiny)
+    assert pts[0, 4] == pytest.approx(expected)
+
+
+def test_a_gate_narrower_than_a_range_bin_reads_the_nearest_bin() -> None:
+    """Hard case (fuzz): a 4 cm gate between two 4.4 cm bins selected no bin, so the slow-time
+    signal was 0; now it reads the bin nearest to the gate, like a gate one bin wide."""
+    from mdframework.physics import fmcw
+
+    ranges = np.arange(8) * 0.0436
+    profiles = np.zeros((1, 1, 8), dtype=np.complex128)
+    profiles[0, 0, 3] = 1.0
+    narrow = fmcw.gate_signal(profiles, ranges, np.array([3.2 * 0.0436]), 0.04, "hann", 8)
+    wide = fmcw.gate_signal(profiles, ranges, np.array([3 * 0.0436]), 0.05, "hann", 8)
+    assert abs(narrow[0]) > 0 and narrow[0] == pytest.approx(wide[0])
+
+
+def test_the_input_rules_page_states_the_radar_bounds_and_messages_of_the_code() -> None:
+    """docs/input-rules.md: the FMCW table's bounds are the plugin's, and the messages it quotes
+    are the ones the code gives."""
+    import mdf_fmcw.waveform as w
+    from conftest import ROOT
+
+    page = " ".join((ROOT / "docs" / "input-rules.md").read_text().split())
+    rows = {
+        "at most 1e15 Hz/s (1000 MHz/us)": w.MAX_SLOPE_HZ_PER_S == 1e15,
+        "| 0 .. 10 ms (the ramp > 0) |": w.MAX_CHIRP_TIME_S == 10e-3,
+        "| > 0, at most 1 GHz |": w.MAX_ADC_RATE_HZ == 1e9,
+        "| 2 .. 16384 |": w.MAX_SAMPLES == 16384,
+        "| 1 .. 4096 |": w.MAX_LOOPS == 4096,
+        "1 .. 64 entries; TX numbers 1 .. 64": w.MAX_ANTENNAS == 64,
+        "within +-1000 units of `antenna_spacing`": w.MAX_ANTENNA_UNITS == 1000,
+        "| at most 65536 (and at least `n_samples`, `n_loops`) |": w.MAX_FFT == 65536,
+        "| 1 Hz .. 10 MHz;": CwConfig.model_json_schema()["properties"]["sample_rate"]["maximum"]
+        == 1e7,
+    }
+    for text, matches in rows.items():
+        assert text in page and matches, text
+    schema = FmcwConfig.model_json_schema()["properties"]
+    assert schema["slope"]["maximum"] == w.MAX_SLOPE_HZ_PER_S
+    assert schema["n_loops"]["maximum"] == w.MAX_LOOPS
+    quoted = {
+        "sample_rate": (1e6, "radar.ramp_end_time: the ADC samples until 247.000 us"),
+        "n_loops": (2000, "radar.frame_period: 6000 chirps of 64.140 us need 384.8400 ms"),
+        "slope": (100e12, "radar.slope: slope x ramp_end_time sweeps 5.7140 GHz"),
+    }
+    for field, (value, text) in quoted.items():
+        cfg = {
+            "motion": {
+                "kind": "point_targets",
+                "length": 1.0,
+                "targets": [{"position": [3, 0, 0]}],
+            },
+            "radar": {"kind": "fmcw", "preset": "iwr1443_short_range_3d", field: value},
+        }
+        with pytest.raises(ConfigError) as err:
+            validate_run_config(cfg, source="run.toml")
+        assert f"run.toml: {text}" in str(err.value) and text in page, text
+    with pytest.raises(SceneError) as scene_err:
+        fmcw_run([{"position": [12.0, 0.0, 0.0], "rcs": 1.0}], duration=0.2, **QUIET)
+    text = str(scene_err.value).split(": raise")[0]
+    assert text in page, text

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from . import limits
 from .errors import SceneError
 from .physics import radar
 from .pipeline import _place, _window, build_stages, load_motion
@@ -114,6 +115,9 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
     motion = load_motion(stages.source)
     body, _, _ = _place(config, stages, motion, radar_pos)
     t_start, t_end = _window(body, cfg.motion.start, cfg.motion.duration)
+    limits.check_pulses(
+        t_end - t_start, wf.pulse_rate, body.n_joints, "motion.duration", proc.keep_scatterers
+    )
     n_pulses = int(wf.pulse_times(t_start, t_end).shape[0])
     if n_pulses < proc.window_length:
         raise SceneError(

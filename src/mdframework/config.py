@@ -352,8 +352,22 @@ def format_validation_error(
         msg = f"unknown kind {first['input'].get('kind')!r}; " + first["msg"].split(";")[-1].strip()
     else:
         msg = " or ".join(dict.fromkeys(_plain(e, allowed) for e in same))
+    if first["type"] == "value_error" and not more:
+        parts, msg = _field_in_message(parts, msg, _model_at(model, tuple(loc), data))
     hint = _toml_hint(parts, source) if first["type"] == "extra_forbidden" else ""
     return f"{source}: {'.'.join(parts) or '(top level)'}: {msg}{hint}{more}"
+
+
+def _field_in_message(
+    parts: list[str], msg: str, section: type[BaseModel] | None
+) -> tuple[list[str], str]:
+    """A check across a section's fields names the field it blames first (``"ramp_end_time:
+    the ADC samples until ..."``): move that field into the location, so the line reads
+    ``radar.ramp_end_time: the ADC samples until ...``."""
+    name, sep, rest = msg.partition(": ")
+    if sep and section is not None and name in section.model_fields:
+        return [*parts, name], rest
+    return parts, msg
 
 
 def check_plugin_kinds(data: dict[str, Any], source: str, registry: Registry) -> None:
@@ -426,7 +440,8 @@ def _check_pulse_budget(config: RunConfigBase, source: str) -> None:
     loaded)."""
     cfg: Any = config
     length = cfg.motion.known_length() if hasattr(cfg.motion, "known_length") else None
-    prf = getattr(cfg.radar, "prf", None)
+    rate = getattr(cfg.radar, "pulse_rate", None)
+    prf = rate() if callable(rate) else getattr(cfg.radar, "prf", None)
     if length is None or prf is None:
         return
     n_points = len(getattr(cfg.motion, "targets", ())) or len(CANONICAL_JOINTS)

@@ -242,6 +242,13 @@ class RadarWaveform(Plugin):
         """Pulse repetition frequency, i.e. the (mean) slow-time sample rate [Hz]."""
 
     @property
+    def pulse_rate(self) -> float:
+        """Pulses per second of a record [Hz], for the pulse budget (:mod:`mdframework.limits`).
+        Default: :attr:`prf`; a radar with several pulses per slow-time sample (FMCW chirps of
+        several transmitters) overrides it."""
+        return self.prf
+
+    @property
     def max_unambiguous_velocity(self) -> float:
         """Largest |radial velocity| [m/s] the slow-time sampling represents without aliasing.
         Default: ``lambda * prf / 4`` (complex samples at ``prf``)."""

@@ -13,6 +13,7 @@ message before they overflow or exhaust memory.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -65,6 +66,15 @@ MAX_RECORDS = 1_000_000
 #: must then lie in the range of the field it is drawn into).
 MAX_DRAWN_NUMBER = 1e12
 
+#: Most complex values in one radar frame's largest array (an FMCW radar's IF samples or
+#: range profiles of every chirp and receive antenna, or its range-Doppler cube): 2**24, that is
+#: 256 MiB at complex128 (a TI sensor's largest frame, 255 loops x 12 virtual antennas x 1024
+#: range bins, is 3.1e6).
+MAX_FRAME_CELLS = 2**24
+#: Most bytes of the arrays a radar keeps for a whole record besides the slow-time signal (an
+#: FMCW radar's range-Doppler map of every frame).
+MAX_PRODUCT_BYTES = 2**30
+
 #: Bytes the streaming pipeline holds per pulse of a record (time, gate range, the complex
 #: slow-time signal and its float32 STFT input), and per pulse and scatterer when the result keeps
 #: every scatterer (``processing.keep_scatterers``: positions, RCS, range): the basis of the
@@ -116,6 +126,29 @@ def check_pulses(
             f"{where}: a record of {duration_s:g} s at PRF {prf_hz:g} Hz is {n:.4g} pulses "
             f"(about {need} of memory{kept}); the limit is {MAX_PULSES:,} pulses: shorten the "
             "record or lower the PRF"
+        )
+
+
+def check_frame_cells(shape: tuple[int, ...], what: str, field: str) -> None:
+    """Refuse a radar setting whose frame needs an array (``what``, of axes' lengths ``shape``)
+    of more than :data:`MAX_FRAME_CELLS` complex values; ``field``: the field the message names.
+    Raises ``ValueError`` (for config validators)."""
+    n = math.prod(shape)
+    if n > MAX_FRAME_CELLS:
+        raise ValueError(
+            f"{field}: one frame's {what} ({' x '.join(map(str, shape))}) is {n:,} complex "
+            f"values (about {_size(16.0 * n)}); the limit is {MAX_FRAME_CELLS:,}: use fewer "
+            "loops, samples or antennas, or smaller FFT sizes"
+        )
+
+
+def check_product_bytes(n_bytes: float, what: str, field: str) -> None:
+    """Refuse a record whose kept radar products (``what``) would take more than
+    :data:`MAX_PRODUCT_BYTES`; ``field`` is what to change. Raises :class:`SceneError`."""
+    if n_bytes > MAX_PRODUCT_BYTES:
+        raise SceneError(
+            f"{field}: {what} would take about {_size(n_bytes)} of memory; the limit is "
+            f"{_size(MAX_PRODUCT_BYTES)}: shorten the record or set {field} = false"
         )
 
 

@@ -203,7 +203,7 @@ def simulate_motion(
     t_start, t_end = _window(body, cfg.motion.start, cfg.motion.duration)
     limits.check_pulses(
         t_end - t_start,
-        wf.prf,
+        wf.pulse_rate,
         body.n_joints,
         "motion.duration",
         keep_scatterers=proc.keep_scatterers,

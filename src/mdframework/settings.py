@@ -186,6 +186,12 @@ class RadarPowerConfig(PluginConfig):
         "dependence (Chen's walker code; power, gain and losses unused).",
     )
 
+    def pulse_rate(self) -> float | None:
+        """Pulses (slow-time samples) per second [Hz] for the pulse budget: the ``prf`` field of
+        radars that have one; radars with another timing override this."""
+        prf = getattr(self, "prf", None)
+        return None if prf is None else float(prf)
+
     def amplitudes(self, rcs: FloatArray, ranges: FloatArray, wavelength: float) -> FloatArray:
         """Amplitude [sqrt(W)] of each scatterer (:func:`physics.radar.scatterer_amplitudes`)."""
         return radar.scatterer_amplitudes(

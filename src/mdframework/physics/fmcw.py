@@ -163,20 +163,23 @@ class ChirpSequence:
             out.append(
                 f"ramp_end_time: the ADC samples until {adc_end * 1e6:.3f} us "
                 f"(adc_start_time + n_samples / sample_rate) but the ramp ends at "
-                f"{self.ramp_end_time * 1e6:.3f} us"
+                f"{self.ramp_end_time * 1e6:.3f} us: lengthen the ramp, raise sample_rate or "
+                "take fewer samples"
             )
         busy = self.chirps_per_frame * self.chirp_period
         if busy > self.frame_period * (1 + 1e-9):
             out.append(
                 f"frame_period: {self.chirps_per_frame} chirps of "
                 f"{self.chirp_period * 1e6:.3f} us need {busy * 1e3:.4f} ms, more than the "
-                f"frame period {self.frame_period * 1e3:.4f} ms"
+                f"frame period {self.frame_period * 1e3:.4f} ms: lengthen frame_period or use "
+                "fewer loops, shorter chirps or fewer TX slots"
             )
         swept = self.slope * self.ramp_end_time
         if max_bandwidth is not None and swept > max_bandwidth * (1 + 1e-9):
             out.append(
                 f"slope: slope x ramp_end_time sweeps {swept / 1e9:.4f} GHz, more than the "
-                f"sensor's {max_bandwidth / 1e9:.4f} GHz bandwidth"
+                f"sensor's {max_bandwidth / 1e9:.4f} GHz max_bandwidth: lower slope or "
+                "ramp_end_time"
             )
         return out
 
@@ -643,10 +646,12 @@ def detect_points(
     estimation of each detected cell. Returns (n_points, 5) float64: ``x, y, z`` [m] in the
     sensor frame, radial velocity ``v`` [m/s] (positive approaching) and intensity [dB]: the
     cell's power over its CFAR noise estimate (the range CFAR's, else the Doppler CFAR's;
-    without CFAR, the cell's power in dB re 1 W).
+    without CFAR, the cell's power in dB re 1 W). A cell without power is never a detection; a
+    noise estimate of 0 (a noise-free simulation whose training cells hold no power) counts as
+    the smallest positive float, so the intensity is large but finite.
     """
     power = detection_map(rd)
-    mask = np.ones(power.shape, dtype=bool)
+    mask = power > 0
     noise = np.full(power.shape, np.nan)
     if settings.cfar_doppler is not None:
         det, noise = cfar(power, settings.cfar_doppler, axis=0, cyclic=True)
@@ -654,8 +659,6 @@ def detect_points(
     if settings.cfar_range is not None:
         det, noise = cfar(power, settings.cfar_range, axis=1, cyclic=False)
         mask &= det
-    if settings.cfar_range is None and settings.cfar_doppler is None:
-        mask &= power > 0
     mask &= ((ranges >= settings.min_range) & (ranges <= settings.max_range))[None, :]
     mask = peak_grouping(power, mask, doppler=settings.group_doppler, range_=settings.group_range)
     di, ri = np.nonzero(mask)
@@ -667,9 +670,8 @@ def detect_points(
     r = ranges[ri][which]
     uy = np.sqrt(np.clip(1.0 - ux**2 - uz**2, 0.0, None))
     v = fd[which] * wavelength / 2.0
-    ref = np.nan_to_num(noise[di, ri], nan=1.0) if np.any(mask) else np.zeros(0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        snr = 10.0 * np.log10(power[di, ri] / ref)[which]
+    ref = np.maximum(np.nan_to_num(noise[di, ri], nan=1.0), np.finfo(np.float64).tiny)
+    snr = 10.0 * (np.log10(power[di, ri]) - np.log10(ref))[which]
     return np.column_stack([r * ux, r * uy, r * uz, v, snr]).astype(np.float64)
 
 
@@ -837,7 +839,8 @@ def gate_signal(
     n_samples: int,
 ) -> ComplexArray:
     """Slow-time signal of each chirp from the first receive antenna: its range profile
-    band-limited to the bins within ``width / 2`` of the gate and read at the middle ADC sample
+    band-limited to the bins within ``width / 2`` of the gate (at least the bin nearest to it)
+    and read at the middle ADC sample
     ``m0 = n_samples // 2``,
 
         ``y = sum_{k in gate} X_k exp(-j 2 pi k m0 / K) sum_m w_m / (K w_m0)``.
@@ -854,7 +857,9 @@ def gate_signal(
     w = window(window_name, n_samples)
     k = np.arange(n_fft)
     rot = np.exp(-2j * np.pi * k * m0 / n_fft) * (float(np.sum(w)) / (n_fft * w[m0]))
-    inside = np.abs(ranges[None, :] - gate_range[:, None]) <= width / 2.0
+    off = np.abs(ranges[None, :] - gate_range[:, None])
+    inside = off <= width / 2.0
+    inside[np.arange(off.shape[0]), np.argmin(off, axis=1)] = True  # a gate narrower than a bin
     return np.asarray(np.sum(profiles[:, 0, :] * (inside * rot), axis=1), dtype=np.complex128)
 
 

@@ -48,6 +48,10 @@ class CwConfig(RadarPowerConfig):
         description="I/Q sample rate (slow time) [Hz].",
     )
 
+    def pulse_rate(self) -> float:
+        """I/Q samples per second [Hz]: the rate of the pulse budget."""
+        return self.sample_rate
+
 
 class CwDoppler(RadarWaveform):
     """Monostatic CW Doppler radar: complex baseband of every scatterer, no range gating."""

@@ -36,7 +36,6 @@ from mdframework.physics import fmcw
 from mdframework.settings import (
     AngleDeg,
     Bandwidth,
-    Coordinate,
     Decibels,
     Distance,
     LossDb,
@@ -55,6 +54,27 @@ FloatArray = NDArray[np.float64]
 
 #: Boltzmann constant x 290 K [W/Hz]: thermal noise density at the reference temperature.
 KT0 = 1.380649e-23 * 290.0
+
+# Bounds of the chirp and frame settings: physical, and generous beside the single-chip sensors
+# they describe (TI's mmWaveLink profile and frame limits in brackets; docs/input-rules.md).
+#: Steepest chirp [Hz/s], 1000 MHz/us (TI: 100 MHz/us at 77 GHz, 250 MHz/us at 60 GHz).
+MAX_SLOPE_HZ_PER_S = 1e15
+#: Longest idle time, ADC start and ramp [s], 10 ms (TI: 5.24 ms, 41 us and 5 ms).
+MAX_CHIRP_TIME_S = 10e-3
+#: Fastest complex ADC [Hz], 1 GHz (TI: 37.5 Msps real or complex 2x, 18.75 Msps complex 1x).
+MAX_ADC_RATE_HZ = 1e9
+#: Most ADC samples per chirp (TI: 1024 complex samples with 4 RX, 4096 with 2 RX real).
+MAX_SAMPLES = 16384
+#: Most loops per frame (TI: 255).
+MAX_LOOPS = 4096
+#: Most TX slots per loop and antennas of each kind (TI: 3 TX, 4 RX; 12 TX, 16 RX cascaded).
+MAX_ANTENNAS = 64
+#: Largest antenna coordinate, in units of ``antenna_spacing`` (a 77 GHz array spans tens).
+MAX_ANTENNA_UNITS = 1000.0
+#: Largest range and Doppler FFT [bins].
+MAX_FFT = 65536
+
+AntennaUnits = Annotated[float, Field(ge=-MAX_ANTENNA_UNITS, le=MAX_ANTENNA_UNITS)]
 
 
 class CfarConfig(BaseModel):
@@ -85,17 +105,24 @@ class FmcwConfig(RadarPowerConfig):
         le=limits.MAX_CARRIER_HZ,
         description="Chirp start frequency f0 [Hz].",
     )
-    slope: float = Field(30e12, gt=0, le=1e16, description="Chirp slope S [Hz/s].")
-    idle_time: float = Field(10e-6, ge=0, le=1.0, description="Idle time before each ramp [s].")
-    adc_start_time: float = Field(
-        6e-6, ge=0, le=1.0, description="ADC start after the ramp start [s]."
+    slope: float = Field(30e12, gt=0, le=MAX_SLOPE_HZ_PER_S, description="Chirp slope S [Hz/s].")
+    idle_time: float = Field(
+        10e-6, ge=0, le=MAX_CHIRP_TIME_S, description="Idle time before each ramp [s]."
     )
-    ramp_end_time: float = Field(60e-6, gt=0, le=1.0, description="Ramp length [s].")
-    sample_rate: Bandwidth = Field(5e6, description="Complex ADC sample rate [Hz].")
-    n_samples: int = Field(256, ge=2, le=65536, description="ADC samples per chirp.")
-    n_loops: int = Field(32, ge=1, le=65536, description="Loops (chirps per TX) per frame.")
-    tdm_order: list[Annotated[int, Field(ge=0, le=64)]] = Field(
-        [1, 3, 2], min_length=1, description="TX (1-based) of each chirp of a loop, in order."
+    adc_start_time: float = Field(
+        6e-6, ge=0, le=MAX_CHIRP_TIME_S, description="ADC start after the ramp start [s]."
+    )
+    ramp_end_time: float = Field(60e-6, gt=0, le=MAX_CHIRP_TIME_S, description="Ramp length [s].")
+    sample_rate: float = Field(
+        5e6, gt=0, le=MAX_ADC_RATE_HZ, description="Complex ADC sample rate [Hz]."
+    )
+    n_samples: int = Field(256, ge=2, le=MAX_SAMPLES, description="ADC samples per chirp.")
+    n_loops: int = Field(32, ge=1, le=MAX_LOOPS, description="Loops (chirps per TX) per frame.")
+    tdm_order: list[Annotated[int, Field(ge=1, le=MAX_ANTENNAS)]] = Field(
+        [1, 3, 2],
+        min_length=1,
+        max_length=MAX_ANTENNAS,
+        description="TX (1-based) of each chirp of a loop, in order.",
     )
     frame_period: float = Field(
         50e-3, gt=0, le=1.0 / limits.MIN_FRAME_RATE_HZ, description="Frame period [s]."
@@ -103,14 +130,16 @@ class FmcwConfig(RadarPowerConfig):
     max_bandwidth: Bandwidth = Field(
         4e9, description="The sensor's largest sweep, slope x ramp_end_time [Hz]."
     )
-    tx_positions: list[tuple[Coordinate, Coordinate]] = Field(
+    tx_positions: list[tuple[AntennaUnits, AntennaUnits]] = Field(
         [(0.0, 0.0), (2.0, 1.0), (4.0, 0.0)],
         min_length=1,
+        max_length=MAX_ANTENNAS,
         description="TX antennas (x right, z up) in units of antenna_spacing.",
     )
-    rx_positions: list[tuple[Coordinate, Coordinate]] = Field(
+    rx_positions: list[tuple[AntennaUnits, AntennaUnits]] = Field(
         [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (3.0, 0.0)],
         min_length=1,
+        max_length=MAX_ANTENNAS,
         description="RX antennas (x right, z up) in units of antenna_spacing.",
     )
     antenna_spacing: float | None = Field(
@@ -132,7 +161,10 @@ class FmcwConfig(RadarPowerConfig):
         "array phases); raw: sampled IF with exact delays per antenna and range FFTs.",
     )
     analytic_margin: int = Field(
-        8, ge=1, le=65536, description="Analytic path: range bins kept on each side of a scatterer."
+        8,
+        ge=1,
+        le=MAX_FFT,
+        description="Analytic path: range bins kept on each side of a scatterer.",
     )
     range_window: Literal["rect", "hann", "hamming", "blackman"] = Field(
         "hann", description="Window of the range FFT."
@@ -141,10 +173,10 @@ class FmcwConfig(RadarPowerConfig):
         "hann", description="Window of the Doppler FFT."
     )
     range_fft_size: int | None = Field(
-        None, ge=2, le=2**20, description="Range FFT size (>= n_samples); default n_samples."
+        None, ge=2, le=MAX_FFT, description="Range FFT size (>= n_samples); default n_samples."
     )
     doppler_fft_size: int | None = Field(
-        None, ge=1, le=2**20, description="Doppler FFT size (>= n_loops); default n_loops."
+        None, ge=1, le=MAX_FFT, description="Doppler FFT size (>= n_loops); default n_loops."
     )
     receiver_noise: bool = Field(
         False,
@@ -222,7 +254,29 @@ class FmcwConfig(RadarPowerConfig):
             raise ValueError(f"range_fft_size must be >= n_samples ({self.n_samples})")
         if self.doppler_fft_size is not None and self.doppler_fft_size < self.n_loops:
             raise ValueError(f"doppler_fft_size must be >= n_loops ({self.n_loops})")
+        for field, what, shape in self.frame_arrays():
+            limits.check_frame_cells(shape, what, field)
         return self
+
+    def frame_arrays(self) -> list[tuple[str, str, tuple[int, ...]]]:
+        """The largest arrays one frame needs (complex values): the IF samples or range
+        profiles of every chirp and RX, and the range-Doppler cube of every virtual antenna,
+        each as (the field that sizes it most, what it is, its axes' lengths)."""
+        n_rx = len(self.rx_positions)
+        n_range = max(self.range_fft_size or 0, self.n_samples)
+        n_doppler = max(self.doppler_fft_size or 0, self.n_loops)
+        by_range = "range_fft_size" if n_range > self.n_samples else "n_samples"
+        by_doppler = "doppler_fft_size" if n_doppler > self.n_loops else "n_loops"
+        profiles = (len(self.tdm_order) * self.n_loops, n_rx, n_range)
+        cube = (len(self.tx_positions) * n_rx, n_doppler, n_range)
+        return [
+            (by_range, "chirps x RX x range bins", profiles),
+            (by_doppler, "virtual antennas x Doppler bins x range bins", cube),
+        ]
+
+    def pulse_rate(self) -> float:
+        """Chirps per second over whole frames [Hz]: the rate of the pulse budget."""
+        return len(self.tdm_order) * self.n_loops / self.frame_period
 
     def sequence(self) -> fmcw.ChirpSequence:
         """The chirp timing of this config."""
@@ -308,9 +362,24 @@ class FmcwRadar(RadarWaveform):
         """``lambda_c / (4 n_tx T_chirp)`` [m/s]: one sample per loop on each virtual antenna."""
         return self.sequence.max_velocity
 
+    @property
+    def pulse_rate(self) -> float:
+        """Chirps per second over whole frames [Hz] (the pulse budget counts chirps)."""
+        return self.sequence.chirps_per_frame / self.sequence.frame_period
+
     def start_record(self, times: FloatArray, range_span: tuple[float, float]) -> None:
-        """Stop before any block when the body's farthest joint is beyond the maximum range."""
+        """Stop before any block when the body's farthest joint is beyond the maximum range,
+        or when the record's range-Doppler maps would not fit the product limit."""
         self._check_ranges(np.asarray([range_span[1]]))
+        if self.config.save_range_doppler:
+            n_frames = times.shape[0] // self.sequence.chirps_per_frame
+            size = 4.0 * n_frames * self.n_doppler * self.n_range  # float32 maps
+            limits.check_product_bytes(
+                size,
+                f"the range-Doppler maps of {n_frames} frames ({self.n_doppler} x "
+                f"{self.n_range} each)",
+                "radar.save_range_doppler",
+            )
 
     def sensor_axes(self, radar_position: FloatArray) -> FloatArray:
         """Sensor axes (rows x right, y boresight, z up) in the scene frame."""
