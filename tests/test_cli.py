@@ -371,3 +371,82 @@ def test_progress_notes_only_on_a_terminal(monkeypatch: pytest.MonkeyPatch) -> N
         progress.note("planning")
         progress.note("hidden", enabled=False)
         assert stream.getvalue() == expected
+
+
+def _screen(text: str) -> list[str]:
+    """The lines a terminal shows after ``text`` (newline, carriage return, cursor up, clear
+    line): a small model of a terminal for the status-line tests."""
+    lines, row, col = [""], 0, 0
+    i = 0
+    while i < len(text):
+        if text.startswith("\x1b[1A", i):
+            row, i = max(row - 1, 0), i + 4
+            continue
+        if text.startswith("\x1b[2K", i):
+            lines[row], i = "", i + 4
+            continue
+        ch = text[i]
+        i += 1
+        if ch == "\n":
+            row, col = row + 1, 0
+            if row == len(lines):
+                lines.append("")
+        elif ch == "\r":
+            col = 0
+        else:
+            line = lines[row].ljust(col)
+            lines[row] = line[:col] + ch + line[col + 1 :]
+            col += 1
+    while lines and not lines[-1]:
+        lines.pop()
+    return lines
+
+
+def test_a_bad_experiment_config_leaves_one_line_on_a_terminal(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """On a terminal `mdf experiment` notes what it is doing while it reads the config and the
+    plugins; when the config turns out bad, that note is erased, so the error is the only line
+    left (it used to leave two). A note followed by other output stays."""
+    import io
+
+    from mdframework import progress
+
+    class Tty(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    bad = tmp_path / "experiment.json"
+    bad.write_text(json.dumps({"dataset": {"path": str(tmp_path)}, "classifier": {"k": 10**9}}))
+    term = Tty()
+    monkeypatch.setattr(sys, "stderr", term)
+    assert cli.main(["experiment", str(bad), "--out", str(tmp_path / "out")]) == 2
+    shown = _screen(term.getvalue())
+    assert term.getvalue().startswith("mdf: reading the experiment config")  # it was shown
+    assert len(shown) == 1 and shown[0].startswith("mdf: error: ") and "classifier.k" in shown[0]
+    # the same for a dataset whose recording is refused while the records are planned
+    (tmp_path / "bad.txt").write_text("point_id: 0\nx: 1e308\n")
+    ds = tmp_path / "dataset.json"
+    source = {"label": "a", "recording": {"kind": "radhar", "file": "bad.txt"}}
+    ds.write_text(json.dumps({"sources": [source]}))
+    term = Tty()
+    monkeypatch.setattr(sys, "stderr", term)
+    assert cli.main(["dataset", "build", str(ds), "--out", str(tmp_path / "ds")]) == 2
+    shown = _screen(term.getvalue())
+    assert "mdf: planning the records" in term.getvalue()
+    assert len(shown) == 1 and shown[0].startswith("mdf: error: ") and "bad.txt:2: x" in shown[0]
+    # a note followed by other output (a warning) stays; so does one when nothing fails
+    term = Tty()
+    monkeypatch.setattr(sys, "stderr", term)
+    progress.note("step one")
+    progress.printed()
+    print("mdf: warning: something", file=sys.stderr)
+    progress.retract()
+    progress.note("step two")
+    assert _screen(term.getvalue()) == [
+        "mdf: step one ...",
+        "mdf: warning: something",
+        "mdf: step two ...",
+    ]
+    progress.retract()
+    assert _screen(term.getvalue())[-1] == "mdf: warning: something"

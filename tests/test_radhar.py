@@ -98,19 +98,24 @@ def test_contract_and_config() -> None:
     assert "RadHAR" in recs[0].metadata["citation"]
 
 
+def _message(point_id: float, secs: int = 100, nsecs: int = 0, **values: object) -> str:
+    """One RadarScan message as rostopic echo writes it (x 1 m ahead unless given)."""
+    fields = {"x": 1.0, "y": 0.0, "z": 0.0, "velocity": 0.0, "intensity": 30.0, **values}
+    head = f"header: \n  seq: 1\n  stamp: \n    secs: {secs}\n    nsecs: {nsecs}\n"
+    body = "".join(f"{k}: {v}\n" for k, v in fields.items())
+    return f'{head}  frame_id: "ti_mmwave"\npoint_id: {point_id}\n{body}---\n'
+
+
 def test_bad_files_name_the_file_and_line(tmp_path: Path) -> None:
     bad = tmp_path / "bad.txt"
-    bad.write_text(
-        "point_id: 0\nx: 1.0\ny: 0.0\nz: 0.0\nvelocity: 0.0\nintensity: 3\n---\n"
-        "point_id: 1\nx: abc\n"
-    )
-    with pytest.raises(DataFileError, match=r"bad\.txt:9: x: not a number"):
+    bad.write_text(_message(0) + _message(1, x="abc"))
+    with pytest.raises(DataFileError, match=r"bad\.txt:21: x: not a number"):
         read_rostopic_text(bad)
     bad.write_text("point_id: 0\nx: 1.0\ny: 0.0\nz: 0.0\nintensity: 3\n---\n")
-    with pytest.raises(DataFileError, match=r"bad\.txt:1: message has no velocity"):
+    with pytest.raises(DataFileError, match=r"bad\.txt:1: message has no velocity, header\.stamp"):
         read_rostopic_text(bad)
-    bad.write_text("point_id: 3\nx: 1.0\ny: 0.0\nz: 0.0\nvelocity: 0\nintensity: 3\n---\n")
-    with pytest.raises(DataFileError, match="point_id 3, not 0"):
+    bad.write_text(_message(3) + _message(0, nsecs=5))
+    with pytest.raises(DataFileError, match=r"bad\.txt:7: the first message has point_id 3, not 0"):
         text_recording(bad)
     npz = tmp_path / "bad.npz"
     np.savez(npz, files=np.array(["a"]), file_index=np.zeros(2, np.int16))
@@ -118,6 +123,131 @@ def test_bad_files_name_the_file_and_line(tmp_path: Path) -> None:
         npz_recordings(npz)
     with pytest.raises(DataFileError, match=r"no recording named 'nope\.txt'"):
         npz_recordings(DATA / "radhar_walk_subset.npz", names=["nope.txt"])
+
+
+@pytest.mark.parametrize(
+    ("values", "problem"),
+    [
+        ({"x": "1e308"}, r"x 1e\+308 is outside the sensor's range -10\.5021 \.\. 10\.5021 m"),
+        ({"z": "nan"}, "z nan is not finite"),
+        ({"y": "-inf"}, "y -inf is not finite"),
+        ({"velocity": "5.0"}, r"velocity 5 is outside the sensor's range -4\.91735 \.\. 4\.30268"),
+        ({"intensity": "-3"}, r"intensity -3 is outside the sensor's range 0 \.\. 48\.1648 dB"),
+        ({"intensity": "1e9"}, "intensity 1e\\+09 is outside"),
+    ],
+)
+def test_values_beyond_what_the_sensor_reports_name_their_line(
+    tmp_path: Path, values: dict[str, str], problem: str
+) -> None:
+    """The IWR1443 configuration reports points within 10.46 m (240 range bins of 4.36 cm; one
+    bin of slack), range rates in Doppler bins -8 .. +7 of 0.6147 m/s and intensities
+    10 log10(peak + 1) of a 16-bit peak (0 .. 48.16 dB): anything else is a damaged file."""
+    bad = tmp_path / "bad.txt"
+    bad.write_text(_message(0) + _message(1, nsecs=10, **values))
+    key = next(iter(values))
+    line = 14 + ["x", "y", "z", "velocity", "intensity"].index(key) + 7
+    with pytest.raises(DataFileError, match=rf"bad\.txt:{line}: {problem}"):
+        read_rostopic_text(bad)
+
+
+def test_points_beyond_the_maximum_range_and_broken_order_are_refused(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.txt"
+    bad.write_text(_message(0) + _message(1, x=8.0, y=8.0))  # each within 10.5 m, 11.3 m away
+    with pytest.raises(DataFileError, match=r"bad\.txt:14: point at 11\.31 m is beyond"):
+        read_rostopic_text(bad)
+    bad.write_text(_message(0) + _message(5) + _message(2))
+    with pytest.raises(DataFileError, match=r"bad\.txt:33: point_id 2 after 5: point numbers rise"):
+        read_rostopic_text(bad)
+    bad.write_text(_message(0, secs=101) + _message(1, secs=100))
+    with pytest.raises(DataFileError, match=r"bad\.txt:17: time stamp 100\.000000000 s is earlier"):
+        read_rostopic_text(bad)
+    bad.write_text(_message(0, nsecs=10**9))
+    with pytest.raises(DataFileError, match=r"bad\.txt:5: nsecs 1e\+09 is outside"):
+        read_rostopic_text(bad)
+    bad.write_text(_message(0.5))
+    with pytest.raises(DataFileError, match=r"bad\.txt:7: point_id 0\.5 is not a whole number"):
+        read_rostopic_text(bad)
+
+
+def test_a_recording_needs_two_frames_and_two_time_stamps(tmp_path: Path) -> None:
+    bad = tmp_path / "one.txt"
+    bad.write_text(_message(0) + _message(1))
+    with pytest.raises(DataFileError, match=r"one\.txt: all 2 messages have the same time stamp"):
+        read_rostopic_text(bad)
+    bad.write_text(_message(0) + _message(1, nsecs=1) + _message(2, nsecs=2))
+    with pytest.raises(DataFileError, match=r"one\.txt: only 1 frame\(s\): a recording needs"):
+        text_recording(bad)
+    bad.write_text(_message(0) + _message(0, nsecs=33_333_000))
+    assert text_recording(bad).n_frames == 2
+
+
+def test_crlf_line_ends_read_the_same(tmp_path: Path) -> None:
+    """A text file whose line ends were converted to CRLF is the same recording."""
+    raw = gzip.decompress((DATA / "text" / "20_jump_1.txt.gz").read_bytes())
+    crlf = tmp_path / "20_jump_1.txt"
+    crlf.write_bytes(raw.replace(b"\n", b"\r\n"))
+    a, b = text_recording(crlf), text_recording(DATA / "text" / "20_jump_1.txt.gz")
+    np.testing.assert_array_equal(a.positions, b.positions)
+    np.testing.assert_array_equal(a.frame, b.frame)
+
+
+def _rewrite_npz(src: Path, dst: Path, **change: np.ndarray) -> None:
+    with np.load(src) as data:
+        arrays = {k: data[k] for k in data.files}
+    arrays.update(change)
+    np.savez(dst, **arrays)
+
+
+def test_npz_sizes_are_checked_before_anything_is_allocated(tmp_path: Path) -> None:
+    """A damaged or crafted NPZ may declare any array size: the declared size of every array is
+    compared with the bytes the file holds before numpy allocates it."""
+    src = DATA / "radhar_jump_subset.npz"
+    bad = tmp_path / "bad.npz"
+    raw = src.read_bytes()
+    bad.write_bytes(raw[: len(raw) // 2])
+    with pytest.raises(DataFileError, match=r"bad\.npz: not a readable NPZ file"):
+        npz_recordings(bad)
+    # an x array whose header declares 10^12 values but holds the real ones
+    import zipfile
+
+    with zipfile.ZipFile(src) as zin, zipfile.ZipFile(bad, "w") as zout:
+        for info in zin.infolist():
+            data = zin.read(info)
+            if info.filename == "x.npy":
+                n = int(np.load(src)["x"].size)
+                data = data.replace(f"({n},)".encode(), b"(1000000000000,)".ljust(len(f"({n},)")))
+            zout.writestr(info, data)
+    with pytest.raises(DataFileError, match=r"bad\.npz: x declares 1,000,000,000,000 values, more"):
+        npz_recordings(bad)
+
+
+def test_npz_values_and_frames_are_checked(tmp_path: Path) -> None:
+    src = DATA / "radhar_walk_subset.npz"
+    bad = tmp_path / "bad.npz"
+    with np.load(src) as data:
+        x, frame, index = data["x"].copy(), data["frame"].copy(), data["file_index"].copy()
+        n_files = data["files"].size
+    x[7] = np.inf
+    _rewrite_npz(src, bad, x=x)
+    with pytest.raises(DataFileError, match=r"bad\.npz: x\[7\]: x inf is not finite"):
+        npz_recordings(bad)
+    far = frame.copy()
+    far[np.nonzero(index == 0)[0][-1]] = 2**31 - 1
+    _rewrite_npz(src, bad, frame=far)
+    with pytest.raises(
+        DataFileError, match=r"recording '.*': frame 2147483647 .* beyond the 86400"
+    ):
+        npz_recordings(bad)
+    wrong = index.copy()
+    wrong[3] = n_files
+    _rewrite_npz(src, bad, file_index=wrong)
+    with pytest.raises(DataFileError, match=rf"file_index\[3\] = {n_files} does not name one"):
+        npz_recordings(bad)
+    single = frame.copy()
+    single[index == 0] = 0
+    _rewrite_npz(src, bad, frame=single)
+    with pytest.raises(DataFileError, match=r"only 1 frame\(s\)"):
+        npz_recordings(bad)
 
 
 def test_the_numbers_on_the_sim_to_real_page() -> None:
@@ -138,3 +268,16 @@ def test_the_numbers_on_the_sim_to_real_page() -> None:
         assert n_moving / frames == pytest.approx(expected, abs=0.05), activity
         if activity == "boxing":
             assert np.percentile(fast, 99) == pytest.approx(5 * IWR1443_BIN_WIDTH, abs=1e-6)
+
+
+def test_the_input_rules_page_states_the_sensor_limits_of_the_reader() -> None:
+    """docs/input-rules.md quotes the reader's bounds."""
+    from conftest import ROOT
+    from mdf_radhar import source
+
+    page = " ".join((ROOT / "docs" / "input-rules.md").read_text().split())
+    assert f"maximum range, 241 range bins of 0.043577 m ({source.MAX_RANGE_M:.2f} m" in page
+    low, high = source.MIN_RANGE_RATE_MPS, source.MAX_RANGE_RATE_MPS
+    assert f"-8 .. +7 bins ({low:.3f} .. +{high:.3f} m/s)" in page
+    assert f"within 0 .. {source.MAX_INTENSITY_DB:.2f} dB" in page
+    assert f"a whole number 0 .. {source.MAX_POINT_ID}" in page

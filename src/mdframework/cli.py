@@ -34,6 +34,7 @@ from .plugins import (
     disabled_by_user,
     reset_default_registry,
 )
+from .progress import printed, retract
 
 EXIT_USAGE = 2
 EXIT_INTERRUPTED = 130
@@ -431,6 +432,7 @@ def split_global_options(argv: Sequence[str]) -> tuple[list[str], bool, list[str
 
 
 def _show_warning(message: Any, category: Any, *rest: Any, **kw: Any) -> None:
+    printed()
     print(f"mdf: warning: {_one_line(str(message))}", file=sys.stderr)
 
 
@@ -466,6 +468,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _interrupted() -> int:
+    retract()
     print("mdf: interrupted", file=sys.stderr)
     return EXIT_INTERRUPTED
 
@@ -541,11 +544,13 @@ def _main(argv: list[str], debug: bool) -> int:
         message = _one_line(str(exc))
         if "disabled" not in message:
             message += _plugins_off_note()
+        retract()
         print(f"mdf: error: {message}", file=sys.stderr)
         return EXIT_USAGE
     except Exception as exc:
         if args.debug:
             raise
+        retract()
         print(
             f"mdf: internal error: {type(exc).__name__}: {_one_line(str(exc))} "
             "(run with --debug for the traceback)",

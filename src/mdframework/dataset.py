@@ -68,7 +68,7 @@ from .pointcloud import (
     histogram_features,
     velocity_bins,
 )
-from .progress import note
+from .progress import note, printed
 from .randomize import Randomization, set_path
 from .settings import (
     AngleDeg,
@@ -1112,6 +1112,7 @@ def build_dataset(
                 todo.append(spec)
             else:
                 rows[spec.record_id] = row
+        printed()
         bar = tqdm(
             total=len(specs), initial=len(rows), desc="records", unit="rec", disable=not progress
         )

@@ -32,6 +32,8 @@ UTK_LABELS = DATA / "kinect" / "utkinect" / "actionLabel.txt"
 MSR = DATA / "kinect" / "msr-action3d" / "a16_s01_e01_skeleton3D.txt"
 PRECOG = DATA / "kinect" / "precog" / "Seq1_1.csv"
 ONI = DATA / "kinect" / "oni" / "test.oni"
+RADHAR_TEXT = DATA / "radhar" / "text" / "20_jump_1.txt.gz"
+RADHAR_NPZ = DATA / "radhar" / "radhar_walk_subset.npz"
 
 
 @dataclass(frozen=True)
@@ -458,6 +460,125 @@ def _nite_lines(utk: Path) -> list[str]:
     return buf.getvalue().splitlines(keepends=True)
 
 
+# ----------------------------------------------------------- real radar recordings (RadHAR)
+
+
+def _radhar_cases(c: _Corpus) -> None:
+    """The RadHAR rostopic text and compact NPZ, read by a dataset's ``recording`` source."""
+    import gzip
+    import zipfile
+
+    packed = RADHAR_TEXT.read_bytes()
+    text = gzip.decompress(packed).decode("utf-8")
+    lines = text.splitlines(keepends=True)
+    rng = np.random.default_rng(12)
+
+    def case(name: str, fname: str, data: bytes, *expect: str) -> None:
+        d = c.folder(f"radhar-{name}")
+        (d / fname).write_bytes(data)
+        cfg = {"sources": [{"label": "jump", "recording": {"kind": "radhar", "file": fname}}]}
+        f = _json_config(d, cfg, "dataset.json")
+        out = d / "out"
+        argv = ["dataset", "build", str(f), "--out", str(out), "--no-progress"]
+        c.command(f"radhar-{name}", argv, out, fname, *expect)
+
+    def line_of(prefix: str, nth: int = 0) -> int:
+        """0-based index of the ``nth`` line starting with ``prefix``."""
+        return [i for i, ln in enumerate(lines) if ln.startswith(prefix)][nth]
+
+    def with_value(prefix: str, value: str, nth: int = 5) -> tuple[bytes, int]:
+        i = line_of(prefix, nth)
+        key = prefix.split(":")[0]
+        new = [*lines[:i], f"{key}: {value}\n", *lines[i + 1 :]]
+        return "".join(new).encode(), i + 1
+
+    name = "20_jump_1.txt"
+    for label, key, value, problem in (
+        ("x-1e308", "x:", "1e308", "outside the sensor's range"),
+        ("y-nan", "y:", "nan", "not finite"),
+        ("z-minus-inf", "z:", "-inf", "not finite"),
+        ("velocity-42", "velocity:", "42.0", "outside the sensor's range"),
+        ("intensity-minus-1e9", "intensity:", "-1e9", "outside the sensor's range"),
+        ("point-id-fraction", "point_id:", "2.5", "not a whole number"),
+        ("x-decimal-comma", "x:", "1,5", "not a number"),
+    ):
+        data, line = with_value(key, value)
+        case(f"text-{label}", name, data, f"{name}:{line}:", problem)
+    # a message cut in the middle (the last one), the gzip stream cut or damaged
+    last = max(i for i, ln in enumerate(lines[:40]) if ln.startswith("---")) + 2
+    case("text-truncated", name, "".join(lines[:40]).encode(), f"{name}:{last}:", "has no")
+    case("gz-truncated", name + ".gz", packed[: len(packed) // 3], "truncated or damaged")
+    damaged = bytearray(packed)
+    damaged[2000:2040] = bytes(40)
+    case("gz-damaged", name + ".gz", bytes(damaged), "truncated or damaged")
+    # order: a point number that falls within a frame, a time stamp that goes back
+    first_ids = [i for i, ln in enumerate(lines) if ln.startswith("point_id:")]
+    i = first_ids[3]
+    swapped = [*lines[:i], "point_id: 1\n", *lines[i + 1 :]]
+    case("text-point-id-falls", name, "".join(swapped).encode(), f"{name}:{i + 1}:", "rise")
+    secs = [i for i, ln in enumerate(lines) if ln.strip().startswith("secs:")]
+    j = secs[10]
+    back = [*lines[:j], "    secs: 1000\n", *lines[j + 1 :]]
+    case("text-stamp-goes-back", name, "".join(back).encode(), f"{name}:{j + 1}:", "earlier")
+    same = "".join(
+        "    secs: 1561683224\n" if ln.strip().startswith("secs:") else ln for ln in lines
+    )
+    same = "".join(
+        "    nsecs: 0\n" if ln.strip().startswith("nsecs:") else ln
+        for ln in same.splitlines(keepends=True)
+    )
+    case("text-same-stamps", name, same.encode(), "same time stamp")
+    one_frame = "".join(lines[: first_ids[5] - 6])  # the first frame's first messages only
+    case("text-one-frame", name, one_frame.encode(), "only 1 frame")
+    case("text-utf16", name, text.encode("utf-16"), "not UTF-8")
+    case("text-nul-bytes", name, text[:3000].encode() + bytes(64), "NUL")
+    case("text-random-bytes", name, rng.integers(0, 256, 5000, dtype=np.uint8).tobytes())
+    case("text-empty", name, b"", "no point messages")
+
+    # the compact NPZ
+    with np.load(RADHAR_NPZ) as data:
+        arrays = {k: data[k] for k in data.files}
+    raw = RADHAR_NPZ.read_bytes()
+    npz = RADHAR_NPZ.name
+
+    def npz_case(name: str, *expect: str, **change: Any) -> None:
+        import io
+
+        buf = io.BytesIO()
+        new = {k: v for k, v in {**arrays, **change}.items() if v is not None}
+        np.savez(buf, **new)
+        case(f"npz-{name}", npz, buf.getvalue(), *expect)
+
+    case("npz-truncated", npz, raw[: len(raw) // 2], "not a readable NPZ")
+    x = arrays["x"].copy()
+    x[100] = np.float32("inf")
+    npz_case("x-inf", "x[100]", "not finite", x=x)
+    v = arrays["velocity"].copy()
+    v[5] = 1e30
+    npz_case("velocity-1e30", "velocity[5]", "outside", velocity=v)
+    frame = arrays["frame"].copy()
+    frame[np.nonzero(arrays["file_index"] == 0)[0][-1]] = np.iinfo(frame.dtype).max
+    npz_case("frame-huge", "frame 2147483647", "beyond", frame=frame)
+    index = arrays["file_index"].copy()
+    index[0] = 999
+    npz_case("file-index-outside", "file_index[0] = 999", file_index=index)
+    npz_case("x-as-text", "x holds", x=np.array(["a"] * arrays["x"].size))
+    npz_case("missing-intensity", "missing arrays: intensity", intensity=None)
+    # an array whose header declares 10^12 values (a crafted or damaged file)
+    import io
+
+    buf = io.BytesIO()
+    n = arrays["x"].size
+    with zipfile.ZipFile(io.BytesIO(raw)) as zin, zipfile.ZipFile(buf, "w") as zout:
+        for info in zin.infolist():
+            member = zin.read(info)
+            if info.filename == "y.npy":
+                declared = b"(1000000000000,)".ljust(len(f"({n},)"))
+                member = member.replace(f"({n},)".encode(), declared)
+            zout.writestr(info, member)
+    case("npz-declared-1e12", npz, buf.getvalue(), "y declares 1,000,000,000,000 values")
+
+
 # ------------------------------------------------------------------------------ config files
 
 
@@ -793,6 +914,7 @@ def make_corpus(root: Path) -> list[Case]:
     root.mkdir(parents=True, exist_ok=True)
     c = _Corpus(root)
     _motion_cases(c)
+    _radhar_cases(c)
     _config_file_cases(c)
     _field_cases(c)
     _dataset_cases(c)
