@@ -68,7 +68,7 @@ from .pointcloud import (
     histogram_features,
     velocity_bins,
 )
-from .progress import note
+from .progress import note, progress_enabled
 from .randomize import Randomization, set_path
 from .settings import (
     AngleDeg,
@@ -1113,7 +1113,11 @@ def build_dataset(
             else:
                 rows[spec.record_id] = row
         bar = tqdm(
-            total=len(specs), initial=len(rows), desc="records", unit="rec", disable=not progress
+            total=len(specs),
+            initial=len(rows),
+            desc="records",
+            unit="rec",
+            disable=not progress_enabled(progress),
         )
         skipped: dict[str, dict[str, Any]] = {}
         executor = _executor(config, workers, scheduler)
