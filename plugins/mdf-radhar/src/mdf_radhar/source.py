@@ -45,8 +45,8 @@ from mdframework import (
     DataFileError,
     DataPath,
     PluginConfig,
-    RadarRecordingSource,
     Recording,
+    RecordingSource,
     limits,
 )
 from mdframework.pointcloud import (
@@ -411,7 +411,7 @@ def npz_recordings(
     return out
 
 
-class RadharSource(RadarRecordingSource):
+class RadharSource(RecordingSource):
     """RadHAR point clouds of a TI IWR1443 radar (rostopic text, .txt.gz or compact NPZ)."""
 
     name = "radhar"
