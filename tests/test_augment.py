@@ -149,3 +149,33 @@ def test_the_documented_randomize_section_is_valid() -> None:
     rz = Randomization.model_validate(tomllib.loads(block)["randomize"])
     draws = rz.sample(np.random.default_rng(0))
     assert {"radar_height", "speed", "effects.0.snr_db", "time_warp"} <= set(draws)
+
+
+def test_augmentation_factors_stay_within_their_ranges() -> None:
+    """A speed factor lies in 0.1 .. 10 and a body factor in 0.5 .. 2: a distribution reaching
+    beyond (a normal one counted to 4 standard deviations) is refused naming the field; the rare
+    normal draw beyond 4 standard deviations is clipped, so no record gets an absurd factor."""
+    from mdframework.randomize import FACTOR_RANGES
+
+    assert FACTOR_RANGES == {"speed": (0.1, 10.0), "body_scale": (0.5, 2.0)}
+    for bad, words in (
+        ({"speed": {"loguniform": [1e-12, 1e-11]}}, "speed: draws 1e-12 .. 1e-11"),
+        ({"speed": {"normal": [1.0, 0.5]}}, "speed: draws -1 .. 3"),
+        ({"body_scale": {"uniform": [-2.0, -1.0]}}, "outside the factor's range 0.5 .. 2"),
+        ({"speed": {"choice": ["fast"]}}, "speed: the choices must be numbers"),
+        ({"speed": {"loguniform": [0.05, 1.3]}}, "speed: draws 0.05 .. 1.3"),  # docs/datasets.md
+    ):
+        with pytest.raises(ValidationError, match=words):
+            Randomization.model_validate(bad)
+    ok = Randomization.model_validate(
+        {"speed": {"normal": [1.0, 0.2]}, "body_scale": {"choice": [0.5, 2.0]}}
+    )
+    rng = np.random.default_rng(0)
+    speeds = [ok.sample(rng)["speed"] for _ in range(20_000)]
+    assert 0.1 <= min(speeds) and max(speeds) <= 10.0
+    assert np.std(speeds) == pytest.approx(0.2, rel=0.03)
+    from conftest import ROOT
+
+    page = " ".join((ROOT / "docs" / "datasets.md").read_text().split())
+    assert "`speed` 0.1 .. 10 and `body_scale` 0.5 .. 2" in page
+    assert "randomize.speed: draws 0.05 .. 1.3 (...), outside the factor's range 0.1 .. 10" in page

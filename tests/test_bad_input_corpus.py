@@ -31,7 +31,9 @@ def test_the_corpus_covers_every_format_and_config_section() -> None:
     fields = " ".join(NAMES)
     for section in ("prf", "carrier", "target", "gate", "window", "gap", "seed", "noise"):
         assert section in fields
-    assert len(NAMES) >= 150
+    for part in ("fmcw", "cw-", "randomize-", "sklearn"):
+        assert part in fields, part
+    assert len(NAMES) >= 240
 
 
 @pytest.mark.parametrize("name", NAMES)

@@ -365,8 +365,8 @@ def _field_in_message(
     the ADC samples until ..."``): move that field into the location, so the line reads
     ``radar.ramp_end_time: the ADC samples until ...``."""
     name, sep, rest = msg.partition(": ")
-    if sep and section is not None and name in section.model_fields:
-        return [*parts, name], rest
+    if sep and section is not None and name.split(".")[0] in section.model_fields:
+        return [*parts, *name.split(".")], rest
     return parts, msg
 
 

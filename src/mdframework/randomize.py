@@ -20,9 +20,11 @@ field is drawn through ``params`` with its dotted path, list items by position::
     "effects.0.snr_db" = { uniform = [5.0, 25.0] }
     "radar.beamwidth_elevation_deg" = { uniform = [20.0, 60.0] }
 
-Motion augmentation (:mod:`mdframework.augment`), per record: ``speed`` (speed factor),
-``body_scale`` (height factor), ``mirror`` (probability of the mirror image) and ``time_warp``
-(strength ``s`` < 1: three warp coefficients drawn uniformly from ``[-s/3, s/3]``).
+Motion augmentation (:mod:`mdframework.augment`), per record: ``speed`` (speed factor,
+0.1 .. 10), ``body_scale`` (height factor, 0.5 .. 2), ``mirror`` (probability of the mirror
+image) and ``time_warp`` (strength ``s`` < 1: three warp coefficients drawn uniformly from
+``[-s/3, s/3]``). The factors' distributions must lie within their ranges (a normal one to 4
+standard deviations; a rarer draw beyond is clipped).
 """
 
 from __future__ import annotations
@@ -66,6 +68,22 @@ class Distribution(StrictModel):
             raise ValueError("the standard deviation must be >= 0")
         return self
 
+    def support(self) -> tuple[float, float] | None:
+        """The smallest and largest value drawn (a normal distribution: 4 standard deviations
+        about its mean); None for a choice that is not all numbers."""
+        if self.uniform is not None:
+            return self.uniform
+        if self.loguniform is not None:
+            return self.loguniform
+        if self.normal is not None:
+            mean, std = self.normal
+            return mean - 4.0 * std, mean + 4.0 * std
+        assert self.choice is not None
+        numbers = [v for v in self.choice if isinstance(v, int | float) and not isinstance(v, bool)]
+        if len(numbers) != len(self.choice):
+            return None
+        return float(min(numbers)), float(max(numbers))
+
     def draw(self, rng: np.random.Generator) -> Scalar:
         """One value."""
         if self.uniform is not None:
@@ -78,6 +96,11 @@ class Distribution(StrictModel):
         assert self.choice is not None
         value = self.choice[int(rng.integers(len(self.choice)))]
         return value
+
+
+#: Range of a motion augmentation's factors: ``speed`` plays a motion ten times slower to ten
+#: times faster; ``body_scale`` makes a body of half to twice the size.
+FACTOR_RANGES = {"speed": (0.1, 10.0), "body_scale": (0.5, 2.0)}
 
 
 class Randomization(StrictModel):
@@ -95,6 +118,20 @@ class Randomization(StrictModel):
     body_scale: Distribution | None = Field(None, description="Body size factor.")
     mirror: float = Field(0.0, ge=0, le=1, description="Probability of the mirror image.")
     time_warp: float = Field(0.0, ge=0, lt=1, description="Time-warp strength s (< 1).")
+
+    @model_validator(mode="after")
+    def _factors(self) -> Randomization:
+        for name, (lo, hi) in FACTOR_RANGES.items():
+            dist = getattr(self, name)
+            span = None if dist is None else dist.support()
+            if dist is not None and span is None:
+                raise ValueError(f"{name}: the choices must be numbers")
+            if span is not None and not lo <= span[0] <= span[1] <= hi:
+                raise ValueError(
+                    f"{name}: draws {span[0]:g} .. {span[1]:g} (a normal distribution counted to "
+                    f"4 standard deviations), outside the factor's range {lo:g} .. {hi:g}"
+                )
+        return self
 
     def active(self) -> bool:
         """Whether anything is drawn."""
@@ -120,10 +157,10 @@ class Randomization(StrictModel):
                 out[name] = dist.draw(rng)
         for path in sorted(self.params):
             out[path] = self.params[path].draw(rng)
-        if self.speed is not None:
-            out["speed"] = self.speed.draw(rng)
-        if self.body_scale is not None:
-            out["body_scale"] = self.body_scale.draw(rng)
+        for name, (lo, hi) in FACTOR_RANGES.items():
+            dist = getattr(self, name)
+            if dist is not None:  # a normal draw beyond 4 standard deviations is clipped
+                out[name] = float(np.clip(float(dist.draw(rng)), lo, hi))
         if self.mirror:
             out["mirror"] = bool(rng.uniform() < self.mirror)
         if self.time_warp:

@@ -765,6 +765,99 @@ def _field_cases(c: _Corpus) -> None:
         "effects.0.rain_rate_mm_per_h",
     )
 
+    # the FMCW and CW radars: absurd single fields, and chirp sequences that cannot exist
+    fmcw = {"kind": "fmcw", "preset": "iwr1443_short_range_3d"}
+    case("fmcw-start-inf", "radar", {**fmcw, "start_frequency": inf}, "radar.start_frequency")
+    case("fmcw-slope-1e300", "radar", {**fmcw, "slope": 1e300}, "radar.slope")
+    case("fmcw-slope-negative", "radar", {**fmcw, "slope": -70e12}, "radar.slope")
+    case("fmcw-idle-nan", "radar", {**fmcw, "idle_time": nan}, "radar.idle_time")
+    case("fmcw-loops-1e9", "radar", {**fmcw, "n_loops": 10**9}, "radar.n_loops")
+    case("fmcw-samples-zero", "radar", {**fmcw, "n_samples": 0}, "radar.n_samples")
+    case("fmcw-adc-1e12", "radar", {**fmcw, "sample_rate": 1e12}, "radar.sample_rate")
+    case("fmcw-tx-zero", "radar", {**fmcw, "tdm_order": [0, 1]}, "radar.tdm_order.0")
+    case("fmcw-tx-missing", "radar", {**fmcw, "tdm_order": [1, 9]}, "radar.tdm_order: TX 9")
+    case(
+        "fmcw-antenna-1e9",
+        "radar",
+        {**fmcw, "rx_positions": [[1e9, 0.0]]},
+        "radar.rx_positions.0.0",
+    )
+    case("fmcw-noise-figure-inf", "radar", {**fmcw, "noise_figure_db": inf}, "noise_figure_db")
+    case(
+        "fmcw-cfar-threshold-nan",
+        "radar",
+        {**fmcw, "cfar_range": {"threshold_db": nan}},
+        "radar.cfar_range.threshold_db",
+    )
+    case("fmcw-gate-width-inf", "radar", {**fmcw, "gate_width": inf}, "radar.gate_width")
+    case("fmcw-fft-1e9", "radar", {**fmcw, "range_fft_size": 10**9}, "radar.range_fft_size")
+    case(
+        "fmcw-adc-beyond-ramp",
+        "radar",
+        {**fmcw, "sample_rate": 1e6},
+        "radar.ramp_end_time: the ADC samples until 247.000 us",
+    )
+    case(
+        "fmcw-chirps-beyond-frame",
+        "radar",
+        {**fmcw, "n_loops": 2000},
+        "radar.frame_period: 6000 chirps",
+    )
+    case(
+        "fmcw-sweep-beyond-bandwidth",
+        "radar",
+        {**fmcw, "slope": 100e12},
+        "radar.slope: slope x ramp_end_time sweeps 5.7140 GHz",
+    )
+    case(
+        "fmcw-frame-cube-48gib",
+        "radar",
+        {**fmcw, "doppler_fft_size": 65536, "range_fft_size": 4096},
+        "radar.doppler_fft_size: one frame's",
+    )
+    case(
+        "fmcw-beat-above-adc",  # the target at 50 m beats above the 4.884 MHz ADC
+        "radar",
+        fmcw,
+        "radar.sample_rate: the farthest scatterer at 50.00 m",
+    )
+    case(
+        "fmcw-maps-beyond-limit",
+        "",
+        {
+            "motion": {**point, "length": 2.0, "targets": [{"position": [3, 0, 0]}]},
+            "radar": {
+                "kind": "fmcw",
+                "tdm_order": [1],
+                "tx_positions": [[0.0, 0.0]],
+                "rx_positions": [[0.0, 0.0]],
+                "range_fft_size": 4096,
+                "doppler_fft_size": 4096,
+                "n_loops": 16,
+                "frame_period": 0.05,
+            },
+        },
+        "radar.save_range_doppler",
+    )
+    case(
+        "fmcw-chirps-beyond-budget",
+        "",
+        {"motion": {**point, "length": 4000.0}, "radar": fmcw},
+        "motion.duration",
+    )
+    cw = {"kind": "cw"}
+    case("cw-carrier-inf", "radar", {**cw, "carrier_frequency": inf}, "radar.carrier_frequency")
+    case("cw-carrier-1hz", "radar", {**cw, "carrier_frequency": 1.0}, "radar.carrier_frequency")
+    case("cw-rate-nan", "radar", {**cw, "sample_rate": nan}, "radar.sample_rate")
+    case("cw-rate-1e12", "radar", {**cw, "sample_rate": 1e12}, "radar.sample_rate")
+    case("cw-power-inf", "radar", {**cw, "transmit_power": inf}, "radar.transmit_power")
+    case(
+        "cw-samples-beyond-budget",
+        "",
+        {"motion": {**point, "length": 1000.0}, "radar": {**cw, "sample_rate": 1e5}},
+        "motion.duration",
+    )
+
     # body models and the other motion sources
     body = {"kind": "cmu", "file": str(BVH)}
 
@@ -874,6 +967,39 @@ def _dataset_cases(c: _Corpus) -> None:
     ds_case("max-records-1e12", {"sources": [{**source, "max_records": 10**12}]}, "max_records")
     ds_case("hop-nan", {"sources": [{**source, "hop": nan}]}, "hop")
 
+    # [randomize]: distributions and the motion augmentations
+    one = {**source, "record_length": 1.0, "max_records": 1}
+
+    def rz_case(name: str, randomize: dict[str, Any], *expect: str) -> None:
+        ds_case(f"randomize-{name}", {"sources": [one], "randomize": randomize}, *expect)
+
+    rz_case("uniform-inf", {"aspect_deg": {"uniform": [0.0, inf]}}, "randomize.aspect_deg")
+    rz_case("normal-std-nan", {"radar_range": {"normal": [5.0, nan]}}, "randomize.radar_range")
+    rz_case("normal-std-negative", {"radar_range": {"normal": [5.0, -1.0]}}, "deviation")
+    rz_case("loguniform-zero", {"speed": {"loguniform": [0.0, 1.0]}}, "randomize.speed")
+    rz_case("low-above-high", {"aspect_deg": {"uniform": [10.0, 0.0]}}, "low must not exceed")
+    rz_case("two-distributions", {"aspect_deg": {"uniform": [0, 1], "normal": [0, 1]}}, "one of")
+    rz_case("choice-empty", {"aspect_deg": {"choice": []}}, "randomize.aspect_deg.choice")
+    rz_case("draws-1e9", {"draws": 10**9}, "randomize.draws")
+    rz_case("bound-1e300", {"radar_range": {"uniform": [1.0, 1e300]}}, "randomize.radar_range")
+    rz_case("speed-1e-12", {"speed": {"loguniform": [1e-12, 1e-11]}}, "randomize.speed", "0.1")
+    rz_case("speed-1e10", {"speed": {"uniform": [1e9, 1e10]}}, "randomize.speed", "10")
+    rz_case("body-scale-negative", {"body_scale": {"uniform": [-2.0, -1.0]}}, "body_scale")
+    rz_case("body-scale-1e6", {"body_scale": {"normal": [1.0, 1e6]}}, "randomize.body_scale")
+    rz_case("speed-choice-text", {"speed": {"choice": ["fast"]}}, "randomize.speed")
+    rz_case("mirror-probability-2", {"mirror": 2.0}, "randomize.mirror")
+    rz_case("time-warp-1", {"time_warp": 1.0}, "randomize.time_warp")
+    rz_case("time-warp-nan", {"time_warp": nan}, "randomize.time_warp")
+    rz_case("param-beyond-field", {"params": {"radar.prf": {"uniform": [1e9, 1e10]}}}, "prf")
+    rz_case("param-unknown-field", {"params": {"radar.nope": {"uniform": [1, 2]}}}, "nope")
+    rz_case("param-no-list-item", {"params": {"effects.3.snr_db": {"uniform": [1, 2]}}}, "effects")
+    rz_case("radar-range-absurd", {"radar_range": {"normal": [0.0, 1e9]}}, "radar_position")
+    ds_case(
+        "source-randomize-speed-inf",
+        {"sources": [{**one, "randomize": {"speed": {"uniform": [1.0, inf]}}}]},
+        "randomize.speed",
+    )
+
     def exp_case(name: str, cfg: dict[str, Any], *expect: str, argv: tuple[str, ...] = ()) -> None:
         d = c.folder(f"experiment-{name}")
         f = _json_config(d, cfg, "experiment.json")
@@ -907,6 +1033,50 @@ def _dataset_cases(c: _Corpus) -> None:
     )
     exp_case("folds-inf", {"dataset": ds, "selection": {"folds": inf}}, "selection.folds")
     exp_case("seed-2-to-the-70", {"dataset": ds, "seed": 2**70}, "seed")
+    exp_case("sizes-zero", {"dataset": ds, "selection": {"sizes": [0]}}, "selection.sizes")
+    exp_case("sizes-1e9", {"dataset": ds, "selection": {"sizes": [10**9]}}, "selection.sizes")
+    exp_case("folds-one", {"dataset": ds, "selection": {"folds": 1}}, "selection.folds")
+    exp_case(
+        "test-fraction-one", {"dataset": ds, "evaluation": {"test_fraction": 1.0}}, "test_fraction"
+    )
+    exp_case("workers-1e6", {"dataset": ds, "workers": 10**6}, "workers")
+    exp_case("no-dataset", {"classifier": {"kind": "knn"}}, "dataset")
+    exp_case("dataset-both", {"dataset": {**ds, "config": "x.toml"}}, "dataset")
+    exp_case("dataset-missing", {"dataset": ds}, "no-dataset-needed")
+    exp_case(
+        "sklearn-param-inf",
+        {
+            "dataset": ds,
+            "classifier": {
+                "kind": "sklearn",
+                "estimator": "sklearn.svm.SVC",
+                "params": {"C": inf},
+            },
+        },
+        "classifier.params.C: must be a finite number",
+    )
+    svc = {"kind": "sklearn", "estimator": "sklearn.svm.SVC"}
+    exp_case(
+        "sklearn-param-negative",
+        {"dataset": ds, "classifier": {**svc, "params": {"C": -1.0}}},
+        "classifier.params: The 'C' parameter of SVC must be",
+    )
+    exp_case(
+        "sklearn-param-unknown",
+        {"dataset": ds, "classifier": {**svc, "params": {"nope": 1}}},
+        "classifier.params:",
+        "'nope'",
+    )
+    exp_case(
+        "scatter-pair-unknown",
+        {"dataset": ds, "report": {"scatter_pairs": [["nope", "upper_max"]]}},
+        "report.scatter_pairs",
+    )
+    exp_case(
+        "cross-source-not-a-table",
+        {"dataset": ds, "cross_source": [{"train": "a", "test": "b"}]},
+        "cross_source",
+    )
 
 
 def make_corpus(root: Path) -> list[Case]:

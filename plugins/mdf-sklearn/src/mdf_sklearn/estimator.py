@@ -18,12 +18,13 @@ Features are standardised with training statistics (zero-variance guarded) unles
 from __future__ import annotations
 
 import importlib
+import math
 from functools import lru_cache
 from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import Field, ValidationInfo, field_validator
+from pydantic import Field, ValidationInfo, field_validator, model_validator
 
 from mdframework import Classifier, PluginConfig
 from mdframework.classify import Standardizer
@@ -89,6 +90,35 @@ class SklearnConfig(PluginConfig):
     def _check(cls, value: str, info: ValidationInfo) -> str:
         check_estimator_path(value, bool((info.context or {}).get(ALLOW_IMPORT, False)))
         return value
+
+    @model_validator(mode="after")
+    def _check_params(self) -> SklearnConfig:
+        """Every number in ``params`` finite, and the estimator accepts them (its own parameter
+        check, where it has one), so that a bad parameter stops before any fit."""
+        _finite_numbers(self.params, "params")
+        try:
+            estimator = _import(self.estimator)(**self.params)
+        except TypeError as exc:
+            raise ValueError(f"params: {exc}") from None
+        validate = getattr(estimator, "_validate_params", None)  # scikit-learn >= 1.2
+        if callable(validate):
+            try:
+                validate()
+            except (TypeError, ValueError) as exc:
+                raise ValueError(f"params: {exc}") from None
+        return self
+
+
+def _finite_numbers(value: Any, where: str) -> None:
+    """Refuse an infinite or NaN number anywhere in ``value`` (nested lists and tables)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        raise ValueError(f"{where}: must be a finite number (got {value})")
+    if isinstance(value, dict):
+        for key, item in value.items():
+            _finite_numbers(item, f"{where}.{key}")
+    elif isinstance(value, list | tuple):
+        for i, item in enumerate(value):
+            _finite_numbers(item, f"{where}.{i}")
 
 
 class SklearnClassifier(Classifier):
