@@ -5,6 +5,7 @@ both, the wall time of
 
 - A: ``mdf run examples/point_target.toml --out <tmp>`` (a 2 s point-target record, every file
   written: result.npz, spectrogram.png, config and metadata), a fresh output folder each time;
+  and the same with ``--no-figures`` (no spectrogram.png, so no matplotlib);
 - B: ``python -c "import numpy, scipy.fft, pydantic"`` (the floor: the libraries every run needs);
 
 and prints the medians, the median of the per-pair ratios A/B (the goal is <= 2), and the same
@@ -79,6 +80,7 @@ def main() -> None:
     run = [mdf, "run", str(ROOT / "examples" / "point_target.toml")]
     results = {
         "run point_target": paired(run, args.pairs, fresh_out=True),
+        "run --no-figures": paired([*run, "--no-figures"], args.pairs, fresh_out=True),
         "--help": paired([mdf, "--help"], args.pairs, fresh_out=False),
         "plugins": paired([mdf, "plugins"], args.pairs, fresh_out=False),
     }
@@ -89,6 +91,15 @@ def main() -> None:
             "config schema": heavy_imports(["config", "schema"]),
             "run point_target": heavy_imports(
                 ["run", str(ROOT / "examples" / "point_target.toml"), "--out", f"{tmp}/o"]
+            ),
+            "run --no-figures": heavy_imports(
+                [
+                    "run",
+                    str(ROOT / "examples" / "point_target.toml"),
+                    "--no-figures",
+                    "--out",
+                    f"{tmp}/n",
+                ]
             ),
         }
     for name, r in results.items():
