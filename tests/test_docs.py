@@ -442,3 +442,18 @@ def test_every_page_with_python_blocks_is_checked() -> None:
     pages = {b.file.name for b in blocks() if b.lang == "python"}
     assert pages == {p.name for p in PYTHON_PAGES} | set(OWN_TEST)
     assert {"getting-started.md", "datasets.md", "figures.md", "fmcw.md"} <= pages
+
+
+def test_the_site_lists_every_page_and_the_examples_table_every_example() -> None:
+    """Every docs page is in the site's navigation (mkdocs only logs pages left out), every
+    public module of the core is in the API reference, and the examples table of the getting
+    started page names every example config."""
+    nav = (ROOT / "mkdocs.yml").read_text()
+    for page in (ROOT / "docs").glob("*.md"):
+        assert f": {page.name}" in nav, f"{page.name} is not in the nav of mkdocs.yml"
+    api = (ROOT / "docs" / "api.md").read_text()
+    for module in ("interfaces", "hookspecs", "plugins", "testing", "pipeline", "figures"):
+        assert f"::: mdframework.{module}\n" in api, module
+    table = (ROOT / "docs" / "getting-started.md").read_text().split("## Examples")[1]
+    for config in (ROOT / "examples").glob("*.toml"):
+        assert f"`{config.name}`" in table, f"{config.name} missing from the examples table"
