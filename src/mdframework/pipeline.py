@@ -358,7 +358,7 @@ def _check_empty(
     if proc.empty == "error":
         raise SceneError(f"{why} (processing.empty = 'error')")
     warnings.warn(
-        f"{why} (processing.empty = 'error' makes this an error)", EmptyResultWarning, stacklevel=3
+        f"{why} (processing.empty = 'error' makes this an error)", EmptyResultWarning, stacklevel=4
     )
 
 
@@ -469,7 +469,7 @@ class _Stream:
     def warn_aliasing(self) -> None:
         """Warn once when the record's fastest scatterer aliases."""
         if self.speed > self.v_max:
-            warnings.warn(self._aliasing_message(), AliasingWarning, stacklevel=3)
+            warnings.warn(self._aliasing_message(), AliasingWarning, stacklevel=4)
 
     def add(self, lo: int, gate: FloatArray, scat: Scatterers, rec: Received) -> None:
         """Store one block's received data."""
