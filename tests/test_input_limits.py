@@ -290,6 +290,39 @@ def test_an_unreachable_scheduler_is_a_clear_error_after_the_timeout(
         _connect(Client, None, f"tcp://127.0.0.1:{port}")
 
 
+def test_a_server_that_is_not_a_dask_scheduler_is_a_clear_error(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Hard case: an address where something else answers (here a web server's reply; a proxy
+    did this to an unreachable address) made Dask read a frame length of 3.5e18 bytes, a
+    MemoryError and an internal error. Now a one-line error names the address."""
+    import threading
+
+    from distributed import Client
+
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen(4)
+    port = server.getsockname()[1]
+
+    def answer() -> None:
+        while True:
+            try:
+                conn, _ = server.accept()
+            except OSError:
+                return
+            with conn:
+                conn.sendall(b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\n\r\n" * 4)
+
+    threading.Thread(target=answer, daemon=True).start()
+    monkeypatch.setenv(SCHEDULER_TIMEOUT_ENV, "3")
+    try:
+        with pytest.raises(MdfError, match=rf"127\.0\.0\.1:{port}"):
+            _connect(Client, None, f"tcp://127.0.0.1:{port}")
+    finally:
+        server.close()
+
+
 def test_plugin_configs_inherit_the_finite_rule() -> None:
     class Mine(PluginConfig):
         kind: str = "mine"

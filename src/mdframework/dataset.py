@@ -954,6 +954,13 @@ def _connect(client_cls: Any, cluster: Any, address: str) -> Any:
             f"cannot connect to the Dask scheduler {address!r} within {timeout:g} s ({reason}); "
             f"check --scheduler or {SCHEDULER_ENV}, or set {SCHEDULER_TIMEOUT_ENV}"
         ) from None
+    except Exception as exc:  # whatever answers there is not a Dask scheduler
+        reason = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
+        raise MdfError(
+            f"the Dask scheduler {address!r} gave an answer Dask cannot read ({reason[:200]}): "
+            f"it is not a Dask scheduler, or not of this version; check --scheduler or "
+            f"{SCHEDULER_ENV}"
+        ) from None
 
 
 def _executor(
