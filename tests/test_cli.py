@@ -204,6 +204,17 @@ FIX_HINTS = {
         "[radar]\nkind = 'lfm'\nfrequency = 24e9\n",
         "radar.frequency: unknown field 'frequency' (did you mean 'carrier_frequency'?)",
     ),
+    "nearest field of a default kind": (  # [radar] without kind is lfm
+        '[motion]\nkind = "point_targets"\nlength = 1.0\n'
+        "targets = [{ position = [10, 0, 0] }]\n[scatterers]\nkind = 'points'\n"
+        "[radar]\nfrequency = 24e9\n",
+        "radar.frequency: unknown field 'frequency' (did you mean 'carrier_frequency'?)",
+    ),
+    "nearest field of the default scatterer model": (
+        '[motion]\nkind = "point_targets"\nlength = 1.0\n'
+        "targets = [{ position = [10, 0, 0] }]\n[scatterers]\nplacment = 'joints17'\n",
+        "scatterers.placment: unknown field 'placment' (did you mean 'placement'?)",
+    ),
     "nearest kind": (
         '[motion]\nkind = "point_target"\n',
         "motion.kind: no motion plugin named 'point_target' (did you mean 'point_targets'?); "
