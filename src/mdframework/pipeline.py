@@ -236,9 +236,9 @@ def _simulate_motion(
     t = wf.pulse_times(t_start, t_end)
     frames = interpolation.window_frames(body.time, float(t[0]), float(t[-1]))
     near = body.select_frames(frames)
-    resample = interpolation.TrackResampler(
-        near.time, near.positions, near.valid, proc.interpolation
-    )
+    exact_linear = motion.linear_tracks and body is motion.skeleton
+    method = "linear" if exact_linear else proc.interpolation
+    resample = interpolation.TrackResampler(near.time, near.positions, near.valid, method)
     record_body = near.select_frames(_inside(near.time, t_start, t_end))
     model.start_record(record_body)
     wf.start_record(t, _range_span(record_body, radar_pos))
