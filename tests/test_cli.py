@@ -382,3 +382,21 @@ def test_progress_notes_only_on_a_terminal(monkeypatch: pytest.MonkeyPatch) -> N
         progress.note("planning")
         progress.note("hidden", enabled=False)
         assert stream.getvalue() == expected
+
+
+def test_ctrl_c_wrapped_by_python_is_still_an_interrupt(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Ctrl-C while a class is created (an import) reaches us as a RuntimeError whose cause is
+    the KeyboardInterrupt (Python 3.11): one line, exit 130, not an internal error."""
+    from mdframework import cli
+
+    def interrupted(args: Any) -> int:
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as exc:
+            raise RuntimeError("Error calling __set_name__ on 'Field' instance") from exc
+
+    monkeypatch.setattr(cli, "_cmd_plugins", interrupted)
+    assert cli.main(["plugins"]) == cli.EXIT_INTERRUPTED
+    assert capsys.readouterr().err == "mdf: interrupted\n"
