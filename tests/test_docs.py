@@ -95,14 +95,33 @@ def commands() -> list[tuple[str, str]]:
 COMMANDS = commands()
 
 
+def out_folder(command: str) -> str | None:
+    """The ``--out`` folder of a command line, if it has one."""
+    argv = command.split()
+    return argv[argv.index("--out") + 1] if "--out" in argv[:-1] else None
+
+
+def command_params() -> list[Any]:
+    """The commands as test parameters. Commands that share an output folder (the dataset
+    commands that resume one build) form one xdist group, so that they run in order on one
+    worker (``--dist loadgroup``); every other command runs wherever a worker is free."""
+    outs = [out_folder(c) for _, c in COMMANDS]
+    params = []
+    for (where, command), out in zip(COMMANDS, outs, strict=True):
+        shared = out is not None and outs.count(out) > 1
+        marks = [pytest.mark.xdist_group(f"docs {out}")] if shared else []
+        params.append(pytest.param(where, command, id=command, marks=marks))
+    return params
+
+
 @pytest.fixture(scope="module")
 def workdir(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """One output root for the module's commands, as for a reader who runs them in order (the
-    dataset commands that share an output folder resume one build)."""
+    """One output root for the module's commands (on each worker), as for a reader who runs
+    them in order (the dataset commands that share an output folder resume one build)."""
     return tmp_path_factory.mktemp("docs_commands")
 
 
-@pytest.mark.parametrize(("where", "command"), COMMANDS, ids=[c for _, c in COMMANDS])
+@pytest.mark.parametrize(("where", "command"), command_params())
 def test_every_documented_command_runs(where: str, command: str, workdir: Path) -> None:
     """Each command in its own process, from the repository root, as a reader runs it."""
     if command in NOT_RUNNABLE:
