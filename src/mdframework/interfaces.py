@@ -24,6 +24,7 @@ must give the same output whether a record is processed as one block or as many
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -328,8 +329,9 @@ class Recording:
     metadata: Mapping[str, Any] = field(default_factory=dict)
 
 
-class RadarRecordingSource(Plugin):
-    """Reads recordings of a real radar (point clouds), for datasets and experiments."""
+class RecordingSource(Plugin):
+    """Reads recordings of a real radar (point clouds), for datasets and experiments (the
+    ``recording`` entry of a dataset source)."""
 
     @abstractmethod
     def load(self) -> list[Recording]:
@@ -407,3 +409,21 @@ class Effect(Plugin):
     def describe(self) -> dict[str, Any]:
         """What this effect did, for the run's metadata (default: its config)."""
         return dict(self.config.model_dump())
+
+
+# --------------------------------------------------------------------------- old names
+
+#: old public name -> current one (each still importable, with a DeprecationWarning)
+OLD_NAMES = {"RadarRecordingSource": "RecordingSource"}
+
+
+def __getattr__(name: str) -> Any:
+    if name in OLD_NAMES:
+        new = OLD_NAMES[name]
+        warnings.warn(
+            f"{__name__}.{name} is deprecated: use {__name__}.{new}",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return globals()[new]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
