@@ -101,17 +101,14 @@ def out_folder(command: str) -> str | None:
     return argv[argv.index("--out") + 1] if "--out" in argv[:-1] else None
 
 
-def command_params() -> list[Any]:
-    """The commands as test parameters. Commands that share an output folder (the dataset
-    commands that resume one build) form one xdist group, so that they run in order on one
-    worker (``--dist loadgroup``); every other command runs wherever a worker is free."""
-    outs = [out_folder(c) for _, c in COMMANDS]
-    params = []
-    for (where, command), out in zip(COMMANDS, outs, strict=True):
-        shared = out is not None and outs.count(out) > 1
-        marks = [pytest.mark.xdist_group(f"docs {out}")] if shared else []
-        params.append(pytest.param(where, command, id=command, marks=marks))
-    return params
+def command_units() -> list[list[tuple[str, str]]]:
+    """The commands in scheduling units: the commands that share an output folder (the dataset
+    commands that resume one build) form one unit, in order; every other command is a unit of
+    its own."""
+    units: dict[str, list[tuple[str, str]]] = {}
+    for where, command in COMMANDS:
+        units.setdefault(out_folder(command) or command, []).append((where, command))
+    return list(units.values())
 
 
 @pytest.fixture(scope="module")
@@ -121,9 +118,9 @@ def workdir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return tmp_path_factory.mktemp("docs_commands")
 
 
-@pytest.mark.parametrize(("where", "command"), command_params())
-def test_every_documented_command_runs(where: str, command: str, workdir: Path) -> None:
-    """Each command in its own process, from the repository root, as a reader runs it."""
+def run_documented_command(where: str, command: str, workdir: Path) -> None:
+    """Run one documented command in its own process, from the repository root, as a reader
+    runs it (outputs under ``workdir``); skip the ones that cannot run here, saying why."""
     if command in NOT_RUNNABLE:
         pytest.skip(f"{where}: {NOT_RUNNABLE[command]}")
     if command in NEEDS_PLUGIN:
@@ -137,6 +134,30 @@ def test_every_documented_command_runs(where: str, command: str, workdir: Path) 
     mdf = [sys.executable, "-m", "mdframework.cli"]
     done = subprocess.run([*mdf, *argv], cwd=ROOT, capture_output=True, text=True, check=False)
     assert done.returncode == 0, f"{where}: `{command}` exited {done.returncode}: {done.stderr}"
+
+
+def _command_class(index: int, unit: list[tuple[str, str]]) -> type:
+    """A test class running ``unit``'s commands: under ``--dist loadscope`` each class is a unit
+    that pytest-xdist sends to whichever worker is free, so the long commands run side by side
+    while the rest of this file (and every other file) stays on one worker."""
+
+    @pytest.mark.parametrize(("where", "command"), [pytest.param(*wc, id=wc[1]) for wc in unit])
+    def test_every_documented_command_runs(
+        self: object, where: str, command: str, workdir: Path
+    ) -> None:
+        """Each command in its own process, from the repository root, as a reader runs it."""
+        run_documented_command(where, command, workdir)
+
+    return type(
+        f"TestDocumentedCommands{index:02d}",
+        (),
+        {"test_every_documented_command_runs": test_every_documented_command_runs},
+    )
+
+
+for _index, _unit in enumerate(command_units()):
+    _cls = _command_class(_index, _unit)
+    globals()[_cls.__name__] = _cls
 
 
 def test_commands_that_cannot_run_here_are_still_documented() -> None:
