@@ -32,4 +32,4 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     unit of its own that pytest-xdist sends to whichever worker is free, and the long ones
     (experiments, dataset builds) finish last on one worker unless they start early. Every
     other test keeps its order, and each file its worker."""
-    items.sort(key=lambda item: 0 if "::TestDocumentedCommands" in item.nodeid else 1)
+    items.sort(key=lambda item: 0 if "::TestDocumentedCommand" in item.nodeid else 1)

@@ -68,6 +68,9 @@ def _cmd_run(args: argparse.Namespace) -> int:
         from .pipeline import simulate
 
         config = load_run_config(args.config)
+    if args.no_figures:
+        figures = config.figures.model_copy(update={"enabled": False})
+        config = config.model_copy(update={"figures": figures})
     with run_folder(args.out, force=args.force, staging_dir=args.staging_dir) as folder:
         with _naming(args.config):
             result = simulate(config, progress=progress)
@@ -287,12 +290,19 @@ def build_parser() -> argparse.ArgumentParser:
         [
             "mdf run examples/point_target.toml --out out/pt",
             "mdf run examples/cmu_walk.toml --out out/walk --debug",
+            "mdf run examples/point_target.toml --out out/pt-arrays --no-figures",
         ],
     )
     run.add_argument("config", help="run config file (.toml, .yaml or .json)")
     run.add_argument("--out", required=True, help="output folder")
     run.add_argument("--force", action="store_true", help=FORCE_HELP)
     run.add_argument("--staging-dir", default=None, help=STAGING_HELP)
+    run.add_argument(
+        "--no-figures",
+        action="store_true",
+        help="write no figures, only the arrays and JSON/CSV files (as [figures] enabled = "
+        "false; the run does not import matplotlib)",
+    )
     run.add_argument("--no-progress", action="store_true", help=PROGRESS_HELP)
     run.set_defaults(func=_cmd_run)
 

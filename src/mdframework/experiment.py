@@ -604,8 +604,9 @@ def _report(
         f"{round(100 * cfg.evaluation.test_fraction)}.",
         "",
     ]
+    source = cfg.dataset.config.name if cfg.dataset.config is not None else Path(data_dir).name
     caption = (
-        f"dataset {Path(data_dir).name} ({len(data.labels)} records); classifier "
+        f"dataset {source} ({len(data.labels)} records); classifier "
         f"{json.dumps(cfg.classifier)}; selection {cfg.selection.method}"
     )
     for group in sorted(set(data.groups.tolist())):

@@ -77,12 +77,16 @@ class Motion:
     bodies (point targets). ``point_rcs`` (n_joints,) [m^2] is set by sources whose joints are
     isotropic point scatterers. ``metadata`` holds subject, activity label, source file, frame rate
     and anything else worth recording with a run (JSON-serialisable values only).
+    ``linear_tracks`` is set by sources whose joints move exactly linearly in time between frames
+    (constant-velocity targets): the pipeline then resamples them linearly, which is exact and
+    needs no spline, unless conditioning changes the tracks.
     """
 
     skeleton: Skeleton
     metadata: Mapping[str, Any] = field(default_factory=dict)
     canonical_map: Mapping[str, str] | None = None
     point_rcs: FloatArray | None = None
+    linear_tracks: bool = False
 
     def canonical(self) -> Skeleton:
         """The skeleton mapped to the canonical 17 joints; ``ValueError`` if there is no map."""

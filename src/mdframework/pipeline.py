@@ -236,9 +236,9 @@ def _simulate_motion(
     t = wf.pulse_times(t_start, t_end)
     frames = interpolation.window_frames(body.time, float(t[0]), float(t[-1]))
     near = body.select_frames(frames)
-    resample = interpolation.TrackResampler(
-        near.time, near.positions, near.valid, proc.interpolation
-    )
+    exact_linear = motion.linear_tracks and body is motion.skeleton
+    method = "linear" if exact_linear else proc.interpolation
+    resample = interpolation.TrackResampler(near.time, near.positions, near.valid, method)
     record_body = near.select_frames(_inside(near.time, t_start, t_end))
     model.start_record(record_body)
     wf.start_record(t, _range_span(record_body, radar_pos))
@@ -358,7 +358,7 @@ def _check_empty(
     if proc.empty == "error":
         raise SceneError(f"{why} (processing.empty = 'error')")
     warnings.warn(
-        f"{why} (processing.empty = 'error' makes this an error)", EmptyResultWarning, stacklevel=3
+        f"{why} (processing.empty = 'error' makes this an error)", EmptyResultWarning, stacklevel=4
     )
 
 
@@ -469,7 +469,7 @@ class _Stream:
     def warn_aliasing(self) -> None:
         """Warn once when the record's fastest scatterer aliases."""
         if self.speed > self.v_max:
-            warnings.warn(self._aliasing_message(), AliasingWarning, stacklevel=3)
+            warnings.warn(self._aliasing_message(), AliasingWarning, stacklevel=4)
 
     def add(self, lo: int, gate: FloatArray, scat: Scatterers, rec: Received) -> None:
         """Store one block's received data."""
