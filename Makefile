@@ -17,11 +17,14 @@ $(STAMP): pyproject.toml $(PLUGINS)
 	@echo "Installing mdframework and $(words $(PLUGINS)) plugins into $(VENV)"
 	$(BIN)/python -m pip install --progress-bar on "setuptools>=70.1"
 	@# uv installs every distribution in one call, downloading and building the editable ones in
-	@# parallel with the setuptools just installed; where uv cannot be had or fails (or with
-	@# INSTALLER=pip), one pip call does the same, listing each distribution as it goes
+	@# parallel with the setuptools just installed, and compiles their bytecode as pip does (else
+	@# the examples that make demo runs side by side would each compile it on first import);
+	@# where uv cannot be had or fails (or with INSTALLER=pip), one pip call does the same,
+	@# listing each distribution as it goes
 	@if [ "$(INSTALLER)" = uv ] && echo "Installing with uv" \
 		&& $(BIN)/python -m pip install --progress-bar on uv \
-		&& $(BIN)/uv pip install --python $(BIN)/python --no-build-isolation $(EDITABLES); then \
+		&& $(BIN)/uv pip install --python $(BIN)/python --no-build-isolation --compile-bytecode \
+			$(EDITABLES); then \
 		:; \
 	else \
 		echo "Installing with pip"; \
