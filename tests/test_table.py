@@ -56,9 +56,9 @@ def test_example_walk_through_the_table_source_matches_the_kinect_source() -> No
     # the cadence found by the sanity checks is a walking one (about 102 steps a minute)
     base = body.joint("base")
     speed = np.linalg.norm(base[-1, :2] - base[0, :2]) / (body.time[-1] - body.time[0])
-    assert 0.5 < speed < 1.2
+    assert speed == pytest.approx(0.70, abs=0.01)
     cad = motion.metadata["sanity"]["cadence"]
-    assert cad["ok"] and 70 < cad["steps_per_min"] < 150
+    assert cad["ok"] and cad["steps_per_min"] == pytest.approx(102, abs=1)
 
 
 # --------------------------------------------------------------------------- written tables
