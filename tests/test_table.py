@@ -157,7 +157,7 @@ def test_missing_values_and_unsorted_rows(tmp_path: Path) -> None:
     head, rows = lines[0], lines[1:]
     # the head's row of frame 3 loses its coordinates; frames 5 and 6 swap places
     k = 3 * 17 + CANONICAL_JOINTS.index("head")
-    rows[k] = ",".join(rows[k].split(",")[:2] + ["", "", "", "0"])
+    rows[k] = ",".join([*rows[k].split(",")[:2], "", "", "", "0"])
     rows[5 * 17 : 7 * 17] = rows[6 * 17 : 7 * 17] + rows[5 * 17 : 6 * 17]
     path.write_text("\n".join([head, *rows]) + "\n")
     body = TableSource(TableConfig(file=path)).load().canonical()

@@ -24,8 +24,8 @@ from mdframework import (
     MotionConfig,
     MotionSource,
     Skeleton,
+    limits,
 )
-from mdframework import limits
 from mdframework.settings import FrameRate
 from mdframework.skeleton import group_means, reorient
 
