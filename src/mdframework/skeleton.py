@@ -218,7 +218,7 @@ def group_means(
     Raises ``KeyError`` naming a group member that is not among ``names``.
     """
     p = np.asarray(positions, dtype=np.float64)
-    ok: BoolArray = np.isfinite(p).all(axis=2) if valid is None else np.asarray(valid, dtype=bool)
+    ok = np.asarray(np.isfinite(p).all(axis=2) if valid is None else valid, dtype=np.bool_)
     index = {n: i for i, n in enumerate(names)}
     out = np.full((p.shape[0], len(groups), 3), np.nan)
     out_ok = np.zeros((p.shape[0], len(groups)), dtype=bool)
