@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -30,6 +30,8 @@ from mdframework.settings import FrameRate
 from mdframework.skeleton import group_means, reorient
 
 Axis = Literal["x", "y", "z", "-x", "-y", "-z"]
+#: A value of a time column in its own unit (frame numbers, milliseconds, seconds).
+ColumnTime = Annotated[float, Field(ge=-limits.MAX_FRAME_NUMBER, le=limits.MAX_FRAME_NUMBER)]
 
 #: Metres per unit of ``units``.
 UNITS_M = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254, "ft": 0.3048}
@@ -72,7 +74,7 @@ class TableConfig(MotionConfig):
         description="The time column holds frame numbers at this rate [Hz] (or, with no time "
         "column, the rows are frames at this rate).",
     )
-    time_range: tuple[float, float] | None = Field(
+    time_range: tuple[ColumnTime, ColumnTime] | None = Field(
         None,
         description="Keep the frames whose time column lies in [first, last], in the column's "
         "own unit (e.g. frame numbers): a segment of a longer recording.",
@@ -119,6 +121,8 @@ class TableConfig(MotionConfig):
             )
         if sorted(a[-1] for a in self.axes) != ["x", "y", "z"]:
             raise ValueError(f"axes must name x, y and z once each, got {list(self.axes)}")
+        if self.time_range is not None and self.time_range[0] > self.time_range[1]:
+            raise ValueError(f"time_range: first {self.time_range[0]:g} is after last")
         if not self.header and self.columns is None and self.joints is None:
             raise ValueError("a table without a header row needs columns or joints")
         return self
