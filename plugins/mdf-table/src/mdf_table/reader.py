@@ -41,9 +41,7 @@ where missing; ``time`` (n_frames,) float64 [s], strictly increasing.
 
 from __future__ import annotations
 
-import csv
 import re
-import zipfile
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -188,6 +186,8 @@ def _split(path: Path, lines: list[tuple[int, str]], delimiter: Delimiter) -> li
         delimiter = {".csv": ",", ".tsv": "tab"}.get(path.suffix.lower(), "whitespace")
     if delimiter == "whitespace":
         return [s.split() for _, s in lines]
+    import csv
+
     sep = "\t" if delimiter == "tab" else delimiter
     return [[f.strip() for f in row] for row in csv.reader((s for _, s in lines), delimiter=sep)]
 
@@ -364,6 +364,8 @@ def _wide_text(
 
 def _npz_shapes(path: Path) -> dict[str, tuple[tuple[int, ...], np.dtype[Any]]]:
     """Each member's shape and dtype from its .npy header, without reading its data."""
+    import zipfile
+
     out: dict[str, tuple[tuple[int, ...], np.dtype[Any]]] = {}
     try:
         with zipfile.ZipFile(path) as z:
