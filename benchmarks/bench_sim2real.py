@@ -238,6 +238,8 @@ def point_stats(path: Path, group: str) -> dict[str, dict[str, float]]:
     for label in sorted(set(data.labels.tolist())):
         pick = (data.labels == label) & (data.groups == group)
         hs = [h for h, p in zip(data.histograms or [], pick, strict=True) if p and h is not None]
+        if not hs:  # records without point clouds (a one-gate spectrogram)
+            continue
         h = np.concatenate(hs)
         centre = h.shape[1] // 2
         total = h.sum(axis=1)
@@ -379,10 +381,11 @@ def main() -> None:
             "what": what,
             **{key: _summary(runs) for key, runs in per.items()},
         }
-        results["points"][variant] = {
-            label: {q: float(np.mean([st[label][q] for st in stats])) for q in stats[0][label]}
-            for label in stats[0]
-        }
+        if stats[0]:
+            results["points"][variant] = {
+                label: {q: float(np.mean([st[label][q] for st in stats])) for q in stats[0][label]}
+                for label in stats[0]
+            }
         (out / "partial.json").write_text(json.dumps(results, indent=2) + "\n")
     results["wall_s"] = time.perf_counter() - clock
     results["load_average_end"] = list(os.getloadavg())
