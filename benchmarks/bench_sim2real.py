@@ -108,6 +108,27 @@ def _no_draw(*names: str) -> Callable[[dict[str, Any]], None]:
     return change
 
 
+def _middle(*names: str) -> Callable[[dict[str, Any]], None]:
+    """Fix uniform draws of the dataset and of every source at the middle of their range (so a
+    source keeps its own typical value: walks still walk away or toward, slowly)."""
+
+    def change(cfg: dict[str, Any]) -> None:
+        for table in [cfg.get("randomize", {})] + [
+            s.get("randomize") or {} for s in cfg["sources"]
+        ]:
+            for name in names:
+                if name in table:
+                    lo, hi = table[name]["uniform"]
+                    table[name] = {"uniform": [(lo + hi) / 2, (lo + hi) / 2]}
+
+    return change
+
+
+def _no_augmentation(cfg: dict[str, Any]) -> None:
+    _middle("speed")(cfg)
+    _no_draw("body_scale", "mirror", "time_warp")(cfg)
+
+
 def _fixed_height(cfg: dict[str, Any]) -> None:
     _no_draw("radar_height")(cfg)
     cfg["base"]["scene"]["radar_position"][2] = 0.8
@@ -160,12 +181,12 @@ VARIANTS: dict[str, tuple[str, Callable[[dict[str, Any]], None]]] = {
     "full": ("the shipped config", lambda cfg: None),
     "no_static_scene": ("no static reflectors (room)", _drop_effect("static_scene")),
     "wide_elevation_beam": ("elevation beam 120 deg instead of 20-60 deg", _wide_elevation),
-    "fixed_aspect": ("aspect fixed at the base scene's", _no_draw("aspect_deg")),
+    "fixed_aspect": ("aspect fixed at the middle of each source's range", _middle("aspect_deg")),
     "radar_at_0.8m": ("radar height fixed at 0.8 m", _fixed_height),
     "fixed_sensor": ("no CFAR threshold, noise figure or noise draws", _fixed_sensor),
     "no_augmentation": (
-        "no speed, body-size, mirror or time-warp augmentation",
-        _no_draw("speed", "body_scale", "mirror", "time_warp"),
+        "speed fixed at the middle of each source's range; no body-size, mirror or time-warp draws",
+        _no_augmentation,
     ),
     "lively_jumps": (
         "jumps at the dataset's speeds (0.8-1.25) instead of 0.3-0.6",
