@@ -291,29 +291,32 @@ def mean_histograms(path: Path, group: str) -> dict[str, np.ndarray]:
 
 
 def plot_histograms(path: Path, out: Path) -> None:
-    """Mean per-frame histograms per class, real beside simulated (log scale)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    """Mean per-frame histograms per class, real beside simulated (log scale), in the
+    project's figure style."""
+    from mdframework.figures import save, style
 
     r, s = mean_histograms(path, REAL), mean_histograms(path, SIM)
     velocity = load_dataset(path, spectrograms=False, histograms=True).velocity
     assert velocity is not None
-    fig, axes = plt.subplots(1, len(r), figsize=(4 * len(r), 3.2), sharey=True)
-    for ax, label in zip(np.atleast_1d(axes), sorted(r), strict=True):
-        w = 0.4 * (velocity[1] - velocity[0])
-        ax.bar(velocity - w / 2, r[label], width=w, label="real (RadHAR)")
-        ax.bar(velocity + w / 2, s.get(label, 0 * velocity), width=w, label="simulated")
-        ax.set_yscale("log")
-        ax.set_ylim(1e-4, 1.5)
-        ax.set_title(label)
-        ax.set_xlabel("radial velocity [m/s] (+ approaching)")
-    np.atleast_1d(axes)[0].set_ylabel("mean share of a frame's points")
-    np.atleast_1d(axes)[0].legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
+    with style() as plt:
+        fig, axes = plt.subplots(
+            1, len(r), figsize=(4 * len(r), 3.4), sharey=True, layout="constrained"
+        )
+        for ax, label in zip(np.atleast_1d(axes), sorted(r), strict=True):
+            w = 0.4 * (velocity[1] - velocity[0])
+            ax.bar(velocity - w / 2, r[label], width=w, label="real (RadHAR)")
+            ax.bar(velocity + w / 2, s.get(label, 0 * velocity), width=w, label="simulated")
+            ax.set_yscale("log")
+            ax.set_ylim(1e-4, 1.5)
+            ax.set_title(label)
+            ax.set_xlabel("radial velocity [m/s] (+ approaching)")
+        np.atleast_1d(axes)[0].set_ylabel("mean share of a frame's points")
+        np.atleast_1d(axes)[0].legend()
+        caption = (
+            f"dataset {path.name}: per class, the mean over records of each frame's share of "
+            "points in each radial-velocity bin; real RadHAR recordings beside simulated records"
+        )
+        save(fig, out, caption)
 
 
 def _summary(runs: list[dict[str, Any]]) -> dict[str, Any]:

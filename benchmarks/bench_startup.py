@@ -5,9 +5,11 @@ both, the wall time of
 
 - A: ``mdf run examples/point_target.toml --out <tmp>`` (a 2 s point-target record, every file
   written: result.npz, spectrogram.png, config and metadata), a fresh output folder each time;
+  and the same with ``--no-figures`` (no spectrogram.png, so no matplotlib);
 - B: ``python -c "import numpy, scipy.fft, pydantic"`` (the floor: the libraries every run needs);
 
-and prints the medians, the median of the per-pair ratios A/B (the goal is <= 2), and the same
+with the project's bytecode caches written first (as an installed package has them), and prints
+the medians, the median of the per-pair ratios A/B (the goal is <= 2), and the same
 for ``mdf --help`` and ``mdf plugins``. It also lists which of the heavy libraries (scikit-learn,
 MuJoCo, matplotlib, Dask, OpenNI) each command imports.
 
@@ -73,12 +75,20 @@ def main() -> None:
     parser.add_argument("--pairs", type=int, default=15, help="A/B pairs (default 15)")
     args = parser.parse_args()
     mdf = str(BIN / "mdf")
+    # bytecode caches of the core and the plugins, as an installed package has them (`make
+    # bytecode`); without them, under PYTHONDONTWRITEBYTECODE, every process compiles them again
+    subprocess.run(
+        [sys.executable, "-m", "compileall", "-q", str(ROOT / "src"), str(ROOT / "plugins")],
+        check=True,
+        stdout=subprocess.DEVNULL,
+    )
     for _ in range(2):  # warm the file cache
         _wall(FLOOR)
         _wall([mdf, "--help"])
     run = [mdf, "run", str(ROOT / "examples" / "point_target.toml")]
     results = {
         "run point_target": paired(run, args.pairs, fresh_out=True),
+        "run --no-figures": paired([*run, "--no-figures"], args.pairs, fresh_out=True),
         "--help": paired([mdf, "--help"], args.pairs, fresh_out=False),
         "plugins": paired([mdf, "plugins"], args.pairs, fresh_out=False),
     }
@@ -89,6 +99,15 @@ def main() -> None:
             "config schema": heavy_imports(["config", "schema"]),
             "run point_target": heavy_imports(
                 ["run", str(ROOT / "examples" / "point_target.toml"), "--out", f"{tmp}/o"]
+            ),
+            "run --no-figures": heavy_imports(
+                [
+                    "run",
+                    str(ROOT / "examples" / "point_target.toml"),
+                    "--no-figures",
+                    "--out",
+                    f"{tmp}/n",
+                ]
             ),
         }
     for name, r in results.items():

@@ -1,10 +1,14 @@
-"""The docs match the code: every `mdf` command shown in README.md and docs/ runs, every config
-shown parses (and matches the example file it quotes), the generated reference is current and
-covers every section, every hook is documented, and nothing points outside the repository."""
+"""The docs match the code: every `mdf` command shown in README.md and docs/ runs, every Python
+block of every page runs (after the documented commands that make the files it reads), every
+config shown parses (and matches the example file it quotes), the generated reference is current
+and covers every section, every hook is documented, and nothing points outside the repository."""
 
 from __future__ import annotations
 
 import argparse
+import ast
+import builtins
+import importlib.util
 import inspect
 import os
 import re
@@ -77,6 +81,10 @@ def blocks() -> list[Block]:
     return found
 
 
+#: ``mdf ...``, optionally after environment assignments (``MDF_PROGRESS=1 mdf run ...``)
+MDF_LINE = re.compile(r"^(?:[A-Z_][A-Z0-9_]*=\S*\s+)*mdf\s")
+
+
 def commands() -> list[tuple[str, str]]:
     """(where, command) for every distinct `mdf` command line of the shell blocks (comments
     removed), where it first appears."""
@@ -87,7 +95,7 @@ def commands() -> list[tuple[str, str]]:
         for k, raw in enumerate(block.text.splitlines()):
             line = raw.removeprefix("$ ").split("  #")[0].split(" # ")[0].strip()
             line = line.removeprefix(".venv/bin/")
-            if line.startswith("mdf "):
+            if MDF_LINE.match(line):
                 found.setdefault(" ".join(line.split()), f"{block.where}+{k + 1}")
     return [(where, command) for command, where in found.items()]
 
@@ -95,28 +103,59 @@ def commands() -> list[tuple[str, str]]:
 COMMANDS = commands()
 
 
+class Reader:
+    """Runs documented commands as a reader would, each once, with their outputs under one
+    root (``--out out/x`` writes ``ROOT/out/x``; the dataset commands that share an output
+    folder resume one build). Python blocks run with the root as working directory, where
+    ``examples`` is the repository's."""
+
+    def __init__(self, root: Path) -> None:
+        self.root = root
+        (root / "examples").symlink_to(EXAMPLES, target_is_directory=True)
+        self.done: dict[str, subprocess.CompletedProcess[str]] = {}
+
+    def run(self, command: str) -> subprocess.CompletedProcess[str]:
+        """Run ``[VAR=value ...] mdf ARGS`` from the repository root (inputs as documented,
+        outputs under the root); the result of an earlier run of the same command otherwise."""
+        if command not in self.done:
+            words = shlex.split(command)
+            k = next(i for i, w in enumerate(words) if w == "mdf")
+            env = {**os.environ, **dict(w.split("=", 1) for w in words[:k])}
+            argv = words[k + 1 :]
+            for i, arg in enumerate(argv[:-1]):
+                if arg == "--out":
+                    argv[i + 1] = str(self.root / argv[i + 1])
+            mdf = [sys.executable, "-m", "mdframework.cli"]
+            self.done[command] = subprocess.run(
+                [*mdf, *argv], cwd=ROOT, env=env, capture_output=True, text=True, check=False
+            )
+        return self.done[command]
+
+
 @pytest.fixture(scope="module")
-def workdir(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """One output root for the module's commands, as for a reader who runs them in order (the
-    dataset commands that share an output folder resume one build)."""
-    return tmp_path_factory.mktemp("docs_commands")
+def reader(tmp_path_factory: pytest.TempPathFactory) -> Reader:
+    """One output root for the module's commands and Python blocks."""
+    return Reader(tmp_path_factory.mktemp("docs_commands"))
 
 
-@pytest.mark.parametrize(("where", "command"), COMMANDS, ids=[c for _, c in COMMANDS])
-def test_every_documented_command_runs(where: str, command: str, workdir: Path) -> None:
-    """Each command in its own process, from the repository root, as a reader runs it."""
+def skip_reason(where: str, command: str) -> str | None:
+    """Why a documented command cannot run here, or None."""
     if command in NOT_RUNNABLE:
-        pytest.skip(f"{where}: {NOT_RUNNABLE[command]}")
+        return f"{where}: {NOT_RUNNABLE[command]}"
     if command in NEEDS_PLUGIN:
         interface, kind = NEEDS_PLUGIN[command]
         if kind not in default_registry().names(interface):
-            pytest.skip(f"{where}: needs the {interface} plugin {kind!r}, not installed")
-    argv = shlex.split(command)[1:]
-    for i, arg in enumerate(argv[:-1]):
-        if arg == "--out":  # outputs go to the temporary root, inputs stay as documented
-            argv[i + 1] = str(workdir / argv[i + 1])
-    mdf = [sys.executable, "-m", "mdframework.cli"]
-    done = subprocess.run([*mdf, *argv], cwd=ROOT, capture_output=True, text=True, check=False)
+            return f"{where}: needs the {interface} plugin {kind!r}, not installed"
+    return None
+
+
+@pytest.mark.parametrize(("where", "command"), COMMANDS, ids=[c for _, c in COMMANDS])
+def test_every_documented_command_runs(where: str, command: str, reader: Reader) -> None:
+    """Each command in its own process, from the repository root, as a reader runs it."""
+    why = skip_reason(where, command)
+    if why:
+        pytest.skip(why)
+    done = reader.run(command)
     assert done.returncode == 0, f"{where}: `{command}` exited {done.returncode}: {done.stderr}"
 
 
@@ -322,3 +361,99 @@ def test_the_plugin_template_passes_its_own_tests() -> None:
     )
     assert proc.returncode == 0, proc.stdout[-3000:]
     assert " passed" in proc.stdout and "failed" not in proc.stdout
+
+
+#: Modules that Python blocks may use although the project does not depend on them: a block
+#: importing one that is not installed is compiled and its names checked, not run.
+OPTIONAL_MODULES = {"torch": "PyTorch, for the deep-learning example of the datasets page"}
+#: Pages whose Python blocks have their own test.
+OWN_TEST = {
+    "plugins.md": "test_every_example_in_the_plugin_guide_runs_and_passes_the_contract_suite"
+}
+PYTHON_PAGES = sorted(
+    {b.file for b in blocks() if b.lang == "python" and b.file.name not in OWN_TEST}
+)
+
+
+def _imports(tree: ast.AST) -> set[str]:
+    """Top-level modules a block imports."""
+    found = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found |= {a.name.split(".")[0] for a in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+            found.add(node.module.split(".")[0])
+    return found
+
+
+def _free_names(tree: ast.AST) -> set[str]:
+    """Names a block reads without defining them itself (nor importing, nor builtins)."""
+    stored, loaded = set(), set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Name):
+            (loaded if isinstance(node.ctx, ast.Load) else stored).add(node.id)
+        elif isinstance(node, (ast.Import, ast.ImportFrom)):
+            stored |= {(a.asname or a.name).split(".")[0] for a in node.names}
+        elif isinstance(node, (ast.FunctionDef, ast.ClassDef)):
+            stored.add(node.name)
+        elif isinstance(node, ast.arg):
+            stored.add(node.arg)
+    return loaded - stored - set(dir(builtins))
+
+
+def producer(out: str) -> str | None:
+    """The first documented command that can run here and writes ``--out out``."""
+    for where, command in COMMANDS:
+        words = shlex.split(command)
+        writes = [words[i + 1] for i, w in enumerate(words[:-1]) if w == "--out"]
+        if writes == [out] and not skip_reason(where, command):
+            return command
+    return None
+
+
+@pytest.mark.parametrize("page", PYTHON_PAGES, ids=[p.name for p in PYTHON_PAGES])
+def test_every_python_block_of_a_page_runs(
+    page: Path, reader: Reader, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A page's ```python blocks run in order in one namespace (as a reader pastes them into
+    one session), from a folder where ``examples/`` is the repository's and ``out/`` holds what
+    the page's documented commands write (each file a block reads from ``out/`` is made first
+    by the command the docs show for it)."""
+    code = [b for b in blocks() if b.file == page and b.lang == "python"]
+    for out in sorted(set(re.findall(r"[\"'](out/[\w.-]+)", "\n".join(b.text for b in code)))):
+        command = producer(out)
+        assert command, f"{page.name}: no documented command writes {out}"
+        done = reader.run(command)
+        assert done.returncode == 0, f"`{command}` exited {done.returncode}: {done.stderr}"
+    monkeypatch.chdir(reader.root)
+    namespace: dict[str, object] = {"__name__": f"docs_{page.stem}"}
+    for block in code:
+        tree = ast.parse(block.text, block.where)
+        missing = {m for m in _imports(tree) if importlib.util.find_spec(m) is None}
+        assert missing <= set(OPTIONAL_MODULES), f"{block.where}: cannot import {missing}"
+        if missing:  # compiled above; what it takes from earlier blocks must exist
+            undefined = _free_names(tree) - set(namespace)
+            assert not undefined, f"{block.where}: {sorted(undefined)} defined by no block above"
+            continue
+        exec(compile(tree, block.where, "exec"), namespace)
+
+
+def test_every_page_with_python_blocks_is_checked() -> None:
+    pages = {b.file.name for b in blocks() if b.lang == "python"}
+    assert pages == {p.name for p in PYTHON_PAGES} | set(OWN_TEST)
+    assert {"getting-started.md", "datasets.md", "figures.md", "fmcw.md"} <= pages
+
+
+def test_the_site_lists_every_page_and_the_examples_table_every_example() -> None:
+    """Every docs page is in the site's navigation (mkdocs only logs pages left out), every
+    public module of the core is in the API reference, and the examples table of the getting
+    started page names every example config."""
+    nav = (ROOT / "mkdocs.yml").read_text()
+    for page in (ROOT / "docs").glob("*.md"):
+        assert f": {page.name}" in nav, f"{page.name} is not in the nav of mkdocs.yml"
+    api = (ROOT / "docs" / "api.md").read_text()
+    for module in ("interfaces", "hookspecs", "plugins", "testing", "pipeline", "figures"):
+        assert f"::: mdframework.{module}\n" in api, module
+    table = (ROOT / "docs" / "getting-started.md").read_text().split("## Examples")[1]
+    for config in (ROOT / "examples").glob("*.toml"):
+        assert f"`{config.name}`" in table, f"{config.name} missing from the examples table"

@@ -200,3 +200,36 @@ def test_points_model_on_a_placed_body(registry: Registry) -> None:
     assert np.all(res.scatterers.rcs == 0.1)
     v_peak = res.velocity[np.argmax(res.spectrogram.power, axis=0)]
     assert np.median(v_peak) == pytest.approx(1.2, abs=0.1)
+
+
+def test_constant_velocity_targets_resample_linearly_as_exactly_as_a_spline() -> None:
+    """Point targets declare linear tracks; the pipeline resamples them linearly (no spline).
+    The signal is the spline path's to 1e-9 (relative): both are exact for linear motion, the
+    difference is rounding. Two targets, one crossing the radar's axis obliquely."""
+    import dataclasses
+
+    from mdframework.pipeline import build_stages, load_motion, simulate_motion
+
+    config = validate_run_config(
+        {
+            "motion": {
+                "kind": "point_targets",
+                "length": 0.5,
+                "frame_rate": 37.0,
+                "targets": [
+                    {"position": [50.0, 2.0, 1.0], "velocity": [-2.0, 0.5, 0.1]},
+                    {"position": [30.0, -3.0, 0.0], "velocity": [1.5, 2.0, -0.3], "rcs": 0.1},
+                ],
+            },
+            "scatterers": {"kind": "points"},
+            "processing": {"interpolation": "cubic"},
+        }
+    )
+    stages = build_stages(config)
+    motion = load_motion(stages.source)
+    assert motion.linear_tracks
+    linear = simulate_motion(config, stages, motion).received.signal
+    spline = simulate_motion(
+        config, build_stages(config), dataclasses.replace(motion, linear_tracks=False)
+    ).received.signal
+    assert np.max(np.abs(linear - spline)) <= 1e-9 * np.max(np.abs(spline))

@@ -300,6 +300,39 @@ def test_old_spellings_still_work_with_a_deprecation_warning() -> None:
         check_waveform(reg.get("radar", "lfm")(reg.get("radar", "lfm").Config()))
 
 
+def test_the_recording_interface_keeps_its_old_hook_and_class_name() -> None:
+    """``recording`` follows the naming rule (``RecordingSource``,
+    ``mdframework_register_recording_sources``, ``check_recording_source``); a plugin written
+    against the old names registers and runs the same, with DeprecationWarnings."""
+    from mdf_radhar.source import RadharSource
+
+    import mdframework
+    from mdframework import interfaces
+    from mdframework.hookspecs import mdframework_register_recording_sources
+    from mdframework.plugins import INTERFACES
+
+    assert INTERFACES["recording"].hook == mdframework_register_recording_sources.__name__
+    assert INTERFACES["recording"].base is mdframework.RecordingSource
+    with pytest.warns(DeprecationWarning, match="use mdframework.RecordingSource"):
+        old_base = mdframework.RadarRecordingSource
+    with pytest.warns(DeprecationWarning, match="use mdframework.interfaces.RecordingSource"):
+        assert interfaces.RadarRecordingSource is old_base is mdframework.RecordingSource
+    assert issubclass(RadharSource, old_base)  # a subclass of either name is the same class
+
+    old = ModuleType("old_recordings")
+
+    def mdframework_register_recordings() -> list[type]:
+        return [RadharSource]
+
+    old.mdframework_register_recordings = synthetic.hookimpl(  # type: ignore[attr-defined]
+        mdframework_register_recordings
+    )
+    with pytest.warns(DeprecationWarning, match="mdframework_register_recording_sources"):
+        reg = build_registry([old], autoload=False)
+    assert reg.names("recording") == ["radhar"]
+    assert reg.get("recording", "radhar") is RadharSource
+
+
 def test_broken_pipe_ends_quietly() -> None:
     """`mdf plugins | true`: the reader is gone before mdf writes (its end of the pipe is closed
     before the interpreter has even started): no traceback, no message, exit 0."""

@@ -8,6 +8,7 @@ is measured by ``benchmarks/bench_startup.py``, never here.
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -58,3 +59,17 @@ def test_a_point_target_run_imports_only_matplotlib_of_the_heavy_libraries(
     assert top_level(modules) & HEAVY == {"matplotlib"}
     assert "scipy.fft" in modules  # but not scipy.signal (windows) or scipy.stats
     assert not {"scipy.signal", "scipy.stats"} & modules
+    # constant-velocity targets are resampled linearly (exact): no spline library; and the
+    # run's figure is a bare Figure: no pyplot
+    assert not {"scipy.interpolate", "matplotlib.pyplot"} & modules
+
+
+def test_a_run_without_figures_imports_no_heavy_library(tmp_path: Path) -> None:
+    modules = imported_modules(
+        ["run", str(EXAMPLES / "point_target.toml"), "--out", str(tmp_path / "o"), "--no-figures"]
+    )
+    written = {p.name for p in (tmp_path / "o").iterdir() if not p.name.startswith(".")}
+    assert written == {"result.npz", "features.json", "config.resolved.json", "metadata.json"}
+    assert top_level(modules) & HEAVY == set()
+    resolved = json.loads((tmp_path / "o" / "config.resolved.json").read_text())
+    assert resolved["figures"]["enabled"] is False  # recorded with the run

@@ -10,6 +10,7 @@ See ``docs/plugins.md`` for writing a plugin distribution.
 from __future__ import annotations
 
 import importlib
+import warnings
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -22,15 +23,16 @@ if TYPE_CHECKING:
         MotionSource,
         PluginConfig,
         PulseBlock,
-        RadarRecordingSource,
         RadarWaveform,
         Received,
         Recording,
+        RecordingSource,
         ScattererModel,
         Scatterers,
         SceneContext,
         receive_points,
     )
+    from .interfaces import RecordingSource as RadarRecordingSource  # noqa: F401 (old name)
     from .settings import DataPath, MotionConfig
     from .skeleton import CANONICAL_JOINTS, CANONICAL_SEGMENTS, Skeleton, to_canonical
 
@@ -48,7 +50,7 @@ _EXPORTS = {
     "MotionSource": "interfaces",
     "PluginConfig": "interfaces",
     "PulseBlock": "interfaces",
-    "RadarRecordingSource": "interfaces",
+    "RecordingSource": "interfaces",
     "RadarWaveform": "interfaces",
     "Received": "interfaces",
     "Recording": "interfaces",
@@ -65,7 +67,19 @@ _EXPORTS = {
 }
 
 
+#: old public name -> current one (still importable, with a DeprecationWarning)
+_OLD_EXPORTS = {"RadarRecordingSource": "RecordingSource"}
+
+
 def __getattr__(name: str) -> Any:
+    if name in _OLD_EXPORTS:  # not cached: every use warns
+        new = _OLD_EXPORTS[name]
+        warnings.warn(
+            f"mdframework.{name} is deprecated: use mdframework.{new}",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return __getattr__(new)
     module = _EXPORTS.get(name)
     if module is None:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
@@ -94,10 +108,10 @@ __all__ = [
     "MotionSource",
     "PluginConfig",
     "PulseBlock",
-    "RadarRecordingSource",
     "RadarWaveform",
     "Received",
     "Recording",
+    "RecordingSource",
     "ScattererModel",
     "Scatterers",
     "SceneContext",

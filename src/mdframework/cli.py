@@ -34,6 +34,7 @@ from .plugins import (
     disabled_by_user,
     reset_default_registry,
 )
+from .progress import Progress
 
 EXIT_USAGE = 2
 EXIT_INTERRUPTED = 130
@@ -54,38 +55,58 @@ def _naming(config_file: str) -> Iterator[None]:
         raise type(exc)(f"{config_file}: {exc}") from exc
 
 
-def _cmd_run(args: argparse.Namespace) -> int:
-    from .config import load_run_config
-    from .output import run_folder, write_run
-    from .pipeline import simulate
+def _progress(args: argparse.Namespace) -> Progress:
+    """The command's progress reporter (``--no-progress``, ``MDF_PROGRESS``, a terminal)."""
+    return Progress(not args.no_progress)
 
-    config = load_run_config(args.config)
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    progress = _progress(args)
+    with progress.step("reading the config and the installed plugins"):
+        from .config import load_run_config
+        from .output import run_folder, write_run
+        from .pipeline import simulate
+
+        config = load_run_config(args.config)
+    if args.no_figures:
+        figures = config.figures.model_copy(update={"enabled": False})
+        config = config.model_copy(update={"figures": figures})
     with run_folder(args.out, force=args.force, staging_dir=args.staging_dir) as folder:
         with _naming(args.config):
-            result = simulate(config)
+            result = simulate(config, progress=progress)
         resolved = json.loads(config.model_dump_json())
-        written = write_run(result, resolved, folder)
+        written = write_run(result, resolved, folder, progress=progress)
     for path in written:
         print(path)
     return 0
 
 
 def _cmd_show(args: argparse.Namespace) -> int:
-    from .config import load_run_config
-    from .output import run_folder, stage_run
-    from .pipeline import simulate
-    from .preview import check_instants, stage_preview
+    progress = _progress(args)
+    with progress.step("reading the config and the installed plugins"):
+        from .config import load_run_config
+        from .output import run_folder, stage_run
+        from .pipeline import simulate
+        from .preview import check_instants, stage_preview
 
-    config = load_run_config(args.config)
+        config = load_run_config(args.config)
     with run_folder(args.out, force=args.force, staging_dir=args.staging_dir) as folder:
         with _naming(args.config):
-            result = simulate(config)
+            result = simulate(config, progress=progress)
         if args.at is not None:
             check_instants(result.body, args.at)  # before anything is written
         resolved = json.loads(config.model_dump_json())
         stage = folder.stage()
-        stage_run(result, resolved, stage)
-        stage_preview(result, resolved, stage, fmt=args.format, fps=args.fps, instants=args.at)
+        stage_run(result, resolved, stage, progress)
+        stage_preview(
+            result,
+            resolved,
+            stage,
+            fmt=args.format,
+            fps=args.fps,
+            instants=args.at,
+            progress=progress,
+        )
         written = folder.commit(stage)
     for path in written:
         print(path)
@@ -100,12 +121,13 @@ def _positive_int(text: str) -> int:
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
-    from .check import format_plan, plan_run
-    from .config import load_run_config
+    with _progress(args).step("reading the config, the installed plugins and the motion"):
+        from .check import format_plan, plan_run
+        from .config import load_run_config
 
-    config = load_run_config(args.config)
-    with _naming(args.config):
-        plan = plan_run(config)
+        config = load_run_config(args.config)
+        with _naming(args.config):
+            plan = plan_run(config)
     if args.json:
         print(json.dumps(plan.as_dict(), indent=2))
     else:
@@ -183,6 +205,10 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
 FORCE_HELP = (
     "write into an existing folder that holds other files (only this command's files are "
     "replaced; nothing else is deleted), or rebuild a dataset from a different config"
+)
+PROGRESS_HELP = (
+    "hide the progress of steps that take more than a second (shown on stderr when it is a "
+    "terminal, or with MDF_PROGRESS=1)"
 )
 STAGING_HELP = (
     "folder for the files being written (default: inside --out); must be on the same file "
@@ -264,12 +290,20 @@ def build_parser() -> argparse.ArgumentParser:
         [
             "mdf run examples/point_target.toml --out out/pt",
             "mdf run examples/cmu_walk.toml --out out/walk --debug",
+            "mdf run examples/point_target.toml --out out/pt-arrays --no-figures",
         ],
     )
     run.add_argument("config", help="run config file (.toml, .yaml or .json)")
     run.add_argument("--out", required=True, help="output folder")
     run.add_argument("--force", action="store_true", help=FORCE_HELP)
     run.add_argument("--staging-dir", default=None, help=STAGING_HELP)
+    run.add_argument(
+        "--no-figures",
+        action="store_true",
+        help="write no figures, only the arrays and JSON/CSV files (as [figures] enabled = "
+        "false; the run does not import matplotlib)",
+    )
+    run.add_argument("--no-progress", action="store_true", help=PROGRESS_HELP)
     run.set_defaults(func=_cmd_run)
 
     show = add_command(
@@ -285,6 +319,7 @@ def build_parser() -> argparse.ArgumentParser:
     show.add_argument("--out", required=True, help="output folder")
     show.add_argument("--force", action="store_true", help=FORCE_HELP)
     show.add_argument("--staging-dir", default=None, help=STAGING_HELP)
+    show.add_argument("--no-progress", action="store_true", help=PROGRESS_HELP)
     show.add_argument("--format", choices=("gif", "mp4"), default="gif", help="animation format")
     show.add_argument("--fps", type=_positive_int, default=12, help="animation frames per second")
     show.add_argument(
@@ -308,6 +343,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     check.add_argument("config", help="run config file (.toml, .yaml or .json)")
     check.add_argument("--json", action="store_true", help="print the report as JSON")
+    check.add_argument("--no-progress", action="store_true", help=PROGRESS_HELP)
     check.set_defaults(func=_cmd_check)
 
     dataset = add_command(

@@ -56,7 +56,7 @@ from .augment import augment_motion
 from .config import format_validation_error, read_config_file, validate_run_config
 from .errors import ConfigError, DataFileError, MdfError, OutputError, SceneError
 from .features import FEATURE_NAMES, spectrogram_features
-from .interfaces import Motion, RadarRecordingSource, Recording
+from .interfaces import Motion, Recording, RecordingSource
 from .outdir import OutputFolder, atomic_savez, atomic_write_text, output_folder, safe_name
 from .pipeline import build_stages, load_motion, simulate_motion
 from .plugins import default_registry
@@ -68,7 +68,7 @@ from .pointcloud import (
     histogram_features,
     velocity_bins,
 )
-from .progress import note
+from .progress import note, progress_enabled
 from .randomize import Randomization, set_path
 from .settings import (
     AngleDeg,
@@ -373,7 +373,7 @@ def _load_recordings(section_json: str, base_dir: str) -> tuple[Recording, ...]:
     except ValidationError as exc:
         raise ConfigError(format_validation_error(exc, "recording", section)) from None
     source: Any = cls(cfg)
-    assert isinstance(source, RadarRecordingSource)
+    assert isinstance(source, RecordingSource)
     return tuple(source.load())
 
 
@@ -1113,7 +1113,11 @@ def build_dataset(
             else:
                 rows[spec.record_id] = row
         bar = tqdm(
-            total=len(specs), initial=len(rows), desc="records", unit="rec", disable=not progress
+            total=len(specs),
+            initial=len(rows),
+            desc="records",
+            unit="rec",
+            disable=not progress_enabled(progress),
         )
         skipped: dict[str, dict[str, Any]] = {}
         executor = _executor(config, workers, scheduler)

@@ -50,7 +50,7 @@ from .interfaces import Classifier
 from .outdir import output_folder, safe_name
 from .plugins import Registry, default_registry
 from .pointcloud import histogram_vector, histogram_vector_names, velocity_bins
-from .progress import note
+from .progress import note, progress_enabled
 from .settings import Seed, StrictModel, Workers
 
 #: every name an experiment writes in its folder (group names are made safe by ``safe_name``)
@@ -385,7 +385,13 @@ def within_source(
     mats, accs, optimistic, subsets = [], [], [], []
     from tqdm import tqdm
 
-    bar = tqdm(splits, desc=progress, unit="split", disable=progress is None, leave=False)
+    bar = tqdm(
+        splits,
+        desc=progress,
+        unit="split",
+        disable=progress is None or not progress_enabled(),
+        leave=False,
+    )
     for rep, (train, test) in enumerate(bar):
         sel = _select(cfg, factory, x[train], y[train], cfg.seed + rep)
         pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
@@ -598,8 +604,9 @@ def _report(
         f"{round(100 * cfg.evaluation.test_fraction)}.",
         "",
     ]
+    source = cfg.dataset.config.name if cfg.dataset.config is not None else Path(data_dir).name
     caption = (
-        f"dataset {Path(data_dir).name} ({len(data.labels)} records); classifier "
+        f"dataset {source} ({len(data.labels)} records); classifier "
         f"{json.dumps(cfg.classifier)}; selection {cfg.selection.method}"
     )
     for group in sorted(set(data.groups.tolist())):

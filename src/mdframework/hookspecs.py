@@ -32,8 +32,8 @@ from .interfaces import (
     Classifier,
     Effect,
     MotionSource,
-    RadarRecordingSource,
     RadarWaveform,
+    RecordingSource,
     ScattererModel,
 )
 
@@ -80,9 +80,19 @@ def mdframework_register_effects() -> list[type[Effect]]:  # type: ignore[empty-
 
 
 @hookspec
-def mdframework_register_recordings() -> list[type[RadarRecordingSource]]:  # type: ignore[empty-body]
-    """Return the :class:`~mdframework.interfaces.RadarRecordingSource` classes (readers of
-    real radar recordings) this plugin provides."""
+def mdframework_register_recording_sources() -> list[type[RecordingSource]]:  # type: ignore[empty-body]
+    """Return the :class:`~mdframework.interfaces.RecordingSource` classes (readers of real
+    radar recordings, the ``recording`` entry of a dataset source) this plugin provides."""
+
+
+@hookspec(
+    warn_on_impl=DeprecationWarning(
+        "the hook mdframework_register_recordings is deprecated: rename it to "
+        "mdframework_register_recording_sources"
+    )
+)
+def mdframework_register_recordings() -> list[type[RecordingSource]]:  # type: ignore[empty-body]
+    """Deprecated spelling of :func:`mdframework_register_recording_sources`."""
 
 
 # --------------------------------------------------------------------------- command line

@@ -24,6 +24,7 @@ must give the same output whether a record is processed as one block or as many
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -76,12 +77,16 @@ class Motion:
     bodies (point targets). ``point_rcs`` (n_joints,) [m^2] is set by sources whose joints are
     isotropic point scatterers. ``metadata`` holds subject, activity label, source file, frame rate
     and anything else worth recording with a run (JSON-serialisable values only).
+    ``linear_tracks`` is set by sources whose joints move exactly linearly in time between frames
+    (constant-velocity targets): the pipeline then resamples them linearly, which is exact and
+    needs no spline, unless conditioning changes the tracks.
     """
 
     skeleton: Skeleton
     metadata: Mapping[str, Any] = field(default_factory=dict)
     canonical_map: Mapping[str, str] | None = None
     point_rcs: FloatArray | None = None
+    linear_tracks: bool = False
 
     def canonical(self) -> Skeleton:
         """The skeleton mapped to the canonical 17 joints; ``ValueError`` if there is no map."""
@@ -328,8 +333,9 @@ class Recording:
     metadata: Mapping[str, Any] = field(default_factory=dict)
 
 
-class RadarRecordingSource(Plugin):
-    """Reads recordings of a real radar (point clouds), for datasets and experiments."""
+class RecordingSource(Plugin):
+    """Reads recordings of a real radar (point clouds), for datasets and experiments (the
+    ``recording`` entry of a dataset source)."""
 
     @abstractmethod
     def load(self) -> list[Recording]:
@@ -407,3 +413,21 @@ class Effect(Plugin):
     def describe(self) -> dict[str, Any]:
         """What this effect did, for the run's metadata (default: its config)."""
         return dict(self.config.model_dump())
+
+
+# --------------------------------------------------------------------------- old names
+
+#: old public name -> current one (each still importable, with a DeprecationWarning)
+OLD_NAMES = {"RadarRecordingSource": "RecordingSource"}
+
+
+def __getattr__(name: str) -> Any:
+    if name in OLD_NAMES:
+        new = OLD_NAMES[name]
+        warnings.warn(
+            f"{__name__}.{name} is deprecated: use {__name__}.{new}",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return globals()[new]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

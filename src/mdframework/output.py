@@ -53,6 +53,7 @@ from .figures import (
 from .outdir import OutputFolder, output_folder
 from .physics.spectrogram import power_to_db
 from .pipeline import RunResult
+from .progress import QUIET, Progress
 
 MAX_RANGE_TIME_ROWS = 2000
 #: every file a run may write
@@ -165,24 +166,62 @@ def write_run(
     out: Path | OutputFolder,
     *,
     force: bool = False,
+    progress: Progress = QUIET,
 ) -> list[Path]:
     """Write a run's files into ``out`` (a folder path, or a folder already opened with
-    :func:`run_folder`): staged inside it, then moved in. Returns the written paths."""
+    :func:`run_folder`): staged inside it, then moved in. Returns the written paths.
+    ``progress`` reports the files that take more than a second."""
     if not isinstance(out, OutputFolder):
         with run_folder(out, force=force) as folder:
-            return write_run(result, resolved_config, folder)
+            return write_run(result, resolved_config, folder, progress=progress)
     stage = out.stage()
-    stage_run(result, resolved_config, stage)
+    stage_run(result, resolved_config, stage, progress)
     return out.commit(stage)
 
 
-def stage_run(result: RunResult, resolved_config: dict[str, Any], stage: Path) -> None:
-    """Write a run's files into the staging folder ``stage`` (see :func:`write_run`)."""
+def stage_run(
+    result: RunResult, resolved_config: dict[str, Any], stage: Path, progress: Progress = QUIET
+) -> None:
+    """Write a run's files into the staging folder ``stage`` (see :func:`write_run`); the
+    figures only when ``[figures] enabled``."""
+    try:
+        _stage_run(result, resolved_config, stage, progress)
+    finally:
+        progress.end()
+
+
+def _stage_run(
+    result: RunResult, resolved_config: dict[str, Any], stage: Path, progress: Progress
+) -> None:
+    progress.stage("writing result.npz")
     arrays = result_arrays(result)
     np.savez_compressed(stage / "result.npz", **arrays)  # type: ignore[arg-type]
-    gate = (float(result.gate_range[0]), float(result.gate_range[-1]))
-    title, caption = run_caption(result.metadata, resolved_config, gate)
-    look = resolved_config.get("figures", {})
+    look = dict(resolved_config.get("figures", {}))
+    if look.pop("enabled", True):
+        gate = (float(result.gate_range[0]), float(result.gate_range[-1]))
+        title, caption = run_caption(result.metadata, resolved_config, gate)
+        _plot_run(stage, arrays, title, caption, look, progress)
+    products = "points" in arrays
+    progress.stage("writing features.json" + (" and points.csv" if products else ""))
+    (stage / "features.json").write_text(json.dumps(features_document(arrays), indent=2) + "\n")
+    if products:
+        write_points_csv(stage / "points.csv", arrays["points"])
+    (stage / "config.resolved.json").write_text(json.dumps(resolved_config, indent=2) + "\n")
+    (stage / "metadata.json").write_text(
+        json.dumps(result.metadata, indent=2, default=_jsonable) + "\n"
+    )
+
+
+def _plot_run(
+    stage: Path,
+    arrays: dict[str, np.ndarray],
+    title: str,
+    caption: str,
+    look: dict[str, Any],
+    progress: Progress,
+) -> None:
+    """A run's figures; ``look``: the ``[figures]`` options but ``enabled``."""
+    progress.stage("drawing spectrogram.png")
     plot_spectrogram(
         stage / "spectrogram.png",
         arrays["spectrogram_db"],
@@ -194,6 +233,7 @@ def stage_run(result: RunResult, resolved_config: dict[str, Any], stage: Path) -
         **look,
     )
     if "range_time_db" in arrays:
+        progress.stage("drawing range_time.png")
         plot_range_time(
             stage / "range_time.png",
             arrays["range_time_db"],
@@ -204,12 +244,9 @@ def stage_run(result: RunResult, resolved_config: dict[str, Any], stage: Path) -
             dynamic_range_db=look.get("dynamic_range_db", 40.0),
             colormap=look.get("colormap", "viridis"),
         )
-    (stage / "features.json").write_text(json.dumps(features_document(arrays), indent=2) + "\n")
-    write_point_products(stage, arrays, title)
-    (stage / "config.resolved.json").write_text(json.dumps(resolved_config, indent=2) + "\n")
-    (stage / "metadata.json").write_text(
-        json.dumps(result.metadata, indent=2, default=_jsonable) + "\n"
-    )
+    if "points" in arrays or "range_doppler" in arrays:
+        progress.stage("drawing the radar's products")
+        plot_point_products(stage, arrays, title)
 
 
 def run_folder(
@@ -233,13 +270,11 @@ def write_points_csv(path: Path, points: np.ndarray) -> None:
             f.write(f"{int(row[0])}," + ",".join(f"{v:.6g}" for v in row[1:]) + "\n")
 
 
-def write_point_products(stage: Path, arrays: dict[str, np.ndarray], title: str) -> None:
-    """Files of a waveform's range-Doppler maps and point clouds, when it made them:
-    ``points.csv``, and ``range_doppler.png`` / ``point_cloud.png`` of the frame with the most
-    points (the strongest map when there are none)."""
+def plot_point_products(stage: Path, arrays: dict[str, np.ndarray], title: str) -> None:
+    """Figures of a waveform's range-Doppler maps and point clouds, when it made them:
+    ``range_doppler.png`` / ``point_cloud.png`` of the frame with the most points (the strongest
+    map when there are none)."""
     points = arrays.get("points")
-    if points is not None:
-        write_points_csv(stage / "points.csv", points)
     maps = arrays.get("range_doppler")
     frame = None
     if points is not None and len(points):

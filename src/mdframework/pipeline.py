@@ -36,6 +36,7 @@ from .interfaces import (
 from .physics import interpolation, radar, scene
 from .physics.spectrogram import RecordTooShortError, Spectrogram, power_to_db, spectrogram
 from .plugins import PluginError, Registry, default_registry
+from .progress import QUIET, Progress
 from .settings import ConditioningConfig, PersonConfig, RunConfigBase, SanityConfig
 from .skeleton import Skeleton
 
@@ -162,13 +163,17 @@ def _is_default_placement(person: PersonConfig) -> bool:
     return person == PersonConfig()
 
 
-def simulate(config: RunConfigBase, registry: Registry | None = None) -> RunResult:
-    """Run one config end to end."""
+def simulate(
+    config: RunConfigBase, registry: Registry | None = None, progress: Progress = QUIET
+) -> RunResult:
+    """Run one config end to end; ``progress`` reports the steps that take more than a second
+    (:class:`~mdframework.progress.Progress`; silent by default)."""
     stages = build_stages(config, registry)
     t0 = time.perf_counter()
-    motion = load_motion(stages.source)
+    with progress.step(f"loading the motion ({stages.source.name})"):
+        motion = load_motion(stages.source)
     timings = {"load": time.perf_counter() - t0}
-    return simulate_motion(config, stages, motion, timings)
+    return simulate_motion(config, stages, motion, timings, progress)
 
 
 def load_motion(source: MotionSource) -> Motion:
@@ -183,22 +188,42 @@ def load_motion(source: MotionSource) -> Motion:
 
 
 def simulate_motion(
-    config: RunConfigBase, stages: Stages, motion: Motion, timings: dict[str, float] | None = None
+    config: RunConfigBase,
+    stages: Stages,
+    motion: Motion,
+    timings: dict[str, float] | None = None,
+    progress: Progress = QUIET,
 ) -> RunResult:
     """Run the stages after the motion source on an already loaded motion.
 
     The body is conditioned and placed over the whole recording (facing, drift and outlier
     statistics need it); only the record's window (plus a margin of frames) is resampled; then
     pulses stream through scatterers, effects, ranges and the receive chain in blocks of
-    ``processing.block_pulses``, and the slow-time signal goes to the spectrogram.
+    ``processing.block_pulses``, and the slow-time signal goes to the spectrogram. ``progress``
+    reports the steps (placing the body, the pulses, the spectrogram).
     """
-    timings = {} if timings is None else timings
+    try:
+        return _simulate_motion(
+            config, stages, motion, {} if timings is None else timings, progress
+        )
+    finally:
+        progress.end()
+
+
+def _simulate_motion(
+    config: RunConfigBase,
+    stages: Stages,
+    motion: Motion,
+    timings: dict[str, float],
+    progress: Progress,
+) -> RunResult:
     cfg: Any = config
     sc, proc, wf, model = config.scene, config.processing, stages.radar, stages.model
     radar_pos = np.asarray(sc.radar_position, dtype=np.float64)
     lam = radar.wavelength(wf.carrier_frequency)
 
     clock = time.perf_counter()
+    progress.stage("conditioning and placing the body")
     body, conditioning_report, placement = _place(config, stages, motion, radar_pos)
     t_start, t_end = _window(body, cfg.motion.start, cfg.motion.duration)
     limits.check_pulses(
@@ -211,9 +236,9 @@ def simulate_motion(
     t = wf.pulse_times(t_start, t_end)
     frames = interpolation.window_frames(body.time, float(t[0]), float(t[-1]))
     near = body.select_frames(frames)
-    resample = interpolation.TrackResampler(
-        near.time, near.positions, near.valid, proc.interpolation
-    )
+    exact_linear = motion.linear_tracks and body is motion.skeleton
+    method = "linear" if exact_linear else proc.interpolation
+    resample = interpolation.TrackResampler(near.time, near.positions, near.valid, method)
     record_body = near.select_frames(_inside(near.time, t_start, t_end))
     model.start_record(record_body)
     wf.start_record(t, _range_span(record_body, radar_pos))
@@ -226,7 +251,8 @@ def simulate_motion(
     rng = np.random.default_rng(seeds[0])
     stream = _Stream(n, proc.keep_scatterers, proc.aliasing, wf, sc.min_range, t)
     losses = emptiness.Losses()
-    for lo, hi in _blocks(n, proc.block_pulses, wf.block_multiple):
+    blocks = _blocks(n, proc.block_pulses, wf.block_multiple)
+    for lo, hi in progress.counted(blocks, n, "simulating the pulses", "pulse"):
         clock = time.perf_counter()
         tb = t[lo:hi]
         at_pulses = Skeleton(tb, resample(tb), body.joint_names)
@@ -252,6 +278,9 @@ def simulate_motion(
         timings["receive"] = timings.get("receive", 0.0) + time.perf_counter() - clock
 
     clock = time.perf_counter()
+    late = [e.name for e in stages.effects if e.stage == "received"]
+    if late:
+        progress.stage(f"effects on the received signal ({', '.join(late)})")
     stream.warn_aliasing()
     received = stream.received()
     if received.products:
@@ -264,6 +293,7 @@ def simulate_motion(
     timings["received_effects"] = time.perf_counter() - clock
 
     clock = time.perf_counter()
+    progress.stage("spectrogram")
     spec = wf.spectrogram(received.signal, t, proc)
     if spec is None:
         try:
@@ -328,7 +358,7 @@ def _check_empty(
     if proc.empty == "error":
         raise SceneError(f"{why} (processing.empty = 'error')")
     warnings.warn(
-        f"{why} (processing.empty = 'error' makes this an error)", EmptyResultWarning, stacklevel=3
+        f"{why} (processing.empty = 'error' makes this an error)", EmptyResultWarning, stacklevel=4
     )
 
 
@@ -439,7 +469,7 @@ class _Stream:
     def warn_aliasing(self) -> None:
         """Warn once when the record's fastest scatterer aliases."""
         if self.speed > self.v_max:
-            warnings.warn(self._aliasing_message(), AliasingWarning, stacklevel=3)
+            warnings.warn(self._aliasing_message(), AliasingWarning, stacklevel=4)
 
     def add(self, lo: int, gate: FloatArray, scat: Scatterers, rec: Received) -> None:
         """Store one block's received data."""

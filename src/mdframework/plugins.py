@@ -15,11 +15,12 @@ base class, the registration hook and the contract check follow :data:`INTERFACE
   ``check_radar_waveform``;
 - ``classifier``: ``Classifier``, ``mdframework_register_classifiers``, ``check_classifier``;
 - ``effects``: ``Effect``, ``mdframework_register_effects``, ``check_effect``;
-- ``recording`` (dataset configs): ``RadarRecordingSource``, ``mdframework_register_recordings``,
-  ``check_recording_source``.
+- ``recording`` (dataset configs): ``RecordingSource``,
+  ``mdframework_register_recording_sources``, ``check_recording_source``.
 
-Old spellings (the registry key ``effect``, the hook ``mdframework_register_waveforms``) keep
-working with a :class:`DeprecationWarning`.
+Old spellings (the registry key ``effect``, the hooks ``mdframework_register_waveforms`` and
+``mdframework_register_recordings``, the class name ``RadarRecordingSource``) keep working with
+a :class:`DeprecationWarning`.
 
 Switching plugins off (both read by every process, so dataset workers see them too):
 
@@ -52,8 +53,8 @@ from .interfaces import (
     Effect,
     MotionSource,
     Plugin,
-    RadarRecordingSource,
     RadarWaveform,
+    RecordingSource,
     ScattererModel,
 )
 
@@ -75,13 +76,16 @@ INTERFACES: dict[str, Interface] = {
     "radar": Interface("mdframework_register_radar_waveforms", RadarWaveform),
     "classifier": Interface("mdframework_register_classifiers", Classifier),
     "effects": Interface("mdframework_register_effects", Effect),
-    "recording": Interface("mdframework_register_recordings", RadarRecordingSource),
+    "recording": Interface("mdframework_register_recording_sources", RecordingSource),
 }
 
 #: old interface spelling -> current one
 OLD_INTERFACE_NAMES = {"effect": "effects"}
 #: old hook name -> the interface it registers for
-OLD_HOOKS = {"mdframework_register_waveforms": "radar"}
+OLD_HOOKS = {
+    "mdframework_register_waveforms": "radar",
+    "mdframework_register_recordings": "recording",
+}
 
 
 class PluginError(RuntimeError):

@@ -29,6 +29,7 @@ from numpy.typing import NDArray
 
 from .errors import MdfError
 from .figures import COLORMAP, DYNAMIC_RANGE_DB, draw_spectrogram, run_caption, save, style
+from .progress import QUIET, Progress
 from .skeleton import CANONICAL_JOINTS, CANONICAL_SEGMENTS, Skeleton
 
 if TYPE_CHECKING:
@@ -231,11 +232,14 @@ def animate(
     fps: int = 12,
     title: str = "",
     caption: str = "",
+    progress: Progress = QUIET,
 ) -> int:
     """Save the animated preview to ``path`` (``.gif`` or ``.mp4``); one frame every ``1/fps``
-    s of the record, played in real time. Returns the number of frames."""
+    s of the record, played in real time (``progress``: a bar over the frames). Returns the
+    number of frames."""
     fmt = Path(path).suffix.lower().lstrip(".")
     times = animation_times(body, fps)
+    progress.stage(f"laying out {Path(path).name}")
     with style() as plt:
         from matplotlib.animation import FFMpegWriter, PillowWriter
 
@@ -258,11 +262,16 @@ def animate(
         fig.canvas.draw()  # lay the figure out once; the frames only move artists
         fig.set_layout_engine("none")
 
-        with writer.saving(fig, str(path), dpi=ANIMATION_DPI):
+        label = f"drawing {Path(path).name}"
+        with (
+            writer.saving(fig, str(path), dpi=ANIMATION_DPI),
+            progress.bar(times.size, label, "frame") as advance,
+        ):
             for t in times:
                 scene.update(float(t))
                 cursor.set_xdata([t, t])
                 writer.grab_frame()
+                advance(1)
         plt.close(fig)
     return int(times.size)
 
@@ -331,11 +340,13 @@ def stage_preview(
     fmt: str = "gif",
     fps: int = 12,
     instants: Sequence[float] | None = None,
+    progress: Progress = QUIET,
 ) -> None:
     """Write ``motion.<fmt>`` (:func:`animate`) and ``skeleton.png`` (:func:`plot_stills`) of a
     run into the staging folder ``stage`` (``mdf show`` commits them with the run's files). The
     body is ``result.body`` (times from the first pulse); the figures carry the run's title and
-    caption and its ``[figures]`` options."""
+    caption and its ``[figures]`` options. ``progress`` reports the animation's frames and the
+    stills."""
     if fmt not in FORMATS:
         raise PreviewError(f"--format: {fmt!r} is not one of {', '.join(FORMATS)}")
     body = result.body
@@ -352,5 +363,18 @@ def stage_preview(
     )
     gate = (float(result.gate_range[0]), float(result.gate_range[-1]))
     title, caption = run_caption(result.metadata, resolved_config, gate)
-    animate(stage / f"motion.{fmt}", body, radar, spec, fps=fps, title=title, caption=caption)
-    plot_stills(stage / "skeleton.png", body, radar, spec, at, title=title, caption=caption)
+    try:
+        animate(
+            stage / f"motion.{fmt}",
+            body,
+            radar,
+            spec,
+            fps=fps,
+            title=title,
+            caption=caption,
+            progress=progress,
+        )
+        progress.stage("drawing skeleton.png")
+        plot_stills(stage / "skeleton.png", body, radar, spec, at, title=title, caption=caption)
+    finally:
+        progress.end()

@@ -1,13 +1,145 @@
-"""Progress notes on stderr for steps that take more than a second (interactive use only)."""
+"""Progress on stderr for steps that take more than a second (interactive use only).
+
+Shown when stderr is a terminal; a pipe or a log keeps the one-line-per-error rule of the
+command line. The environment variable ``MDF_PROGRESS`` overrides that: ``1`` shows every
+step, however short, even when stderr is not a terminal (for logs and tests); ``0`` shows
+nothing. A command's ``--no-progress`` hides it whatever the environment says.
+
+Two kinds of report, both on stderr:
+
+- a *step* (:meth:`Progress.step`): ``mdf: MESSAGE ...`` printed once the step has lasted
+  :data:`DELAY_S` (a step that ends sooner prints nothing);
+- a *bar* (:meth:`Progress.bar`) over counted work (pulses, animation frames), drawn by tqdm
+  once it has lasted :data:`DELAY_S`, and removed when the work is done.
+
+tqdm is imported only when a bar is shown.
+"""
 
 from __future__ import annotations
 
+import os
 import sys
+import threading
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
+from typing import Any
+
+#: Environment variable: ``1`` forces progress on (every step, no delay), ``0`` off.
+PROGRESS_ENV = "MDF_PROGRESS"
+#: A step or bar appears once it has lasted this long [s].
+DELAY_S = 1.0
+
+
+def _forced() -> bool | None:
+    value = os.environ.get(PROGRESS_ENV, "").strip()
+    if value == "1":
+        return True
+    if value == "0":
+        return False
+    return None
+
+
+def progress_enabled(wanted: bool = True) -> bool:
+    """Whether progress is shown: ``wanted`` (a command's ``--no-progress`` turns it off),
+    then ``MDF_PROGRESS`` (``1`` on, ``0`` off), else whether stderr is a terminal."""
+    if not wanted:
+        return False
+    forced = _forced()
+    if forced is not None:
+        return forced
+    return bool(sys.stderr.isatty())
 
 
 def note(message: str, enabled: bool = True) -> None:
-    """Print ``mdf: MESSAGE ...`` on stderr when ``enabled`` and stderr is a terminal (a pipe or
-    a log keeps the one-line-per-error rule of the command line)."""
-    stream = sys.stderr
-    if enabled and stream.isatty():
-        print(f"mdf: {message} ...", file=stream, flush=True)
+    """Print ``mdf: MESSAGE ...`` on stderr now, when progress is shown
+    (:func:`progress_enabled`)."""
+    if progress_enabled(enabled):
+        print(f"mdf: {message} ...", file=sys.stderr, flush=True)
+
+
+class Progress:
+    """Progress of one command's steps (see the module docstring). ``enabled=False`` (or
+    stderr not a terminal, without ``MDF_PROGRESS=1``) makes every report silent; ``delay``
+    [s]: how long a step or bar runs before it appears (default :data:`DELAY_S`, 0 with
+    ``MDF_PROGRESS=1``)."""
+
+    def __init__(self, enabled: bool = True, *, delay: float | None = None) -> None:
+        self.enabled = progress_enabled(enabled)
+        if delay is None:
+            delay = 0.0 if _forced() else DELAY_S
+        self.delay = float(delay)
+        self._timer: threading.Timer | None = None
+
+    def stage(self, message: str) -> None:
+        """Start a step (ending the previous one): ``mdf: MESSAGE ...`` appears if it lasts
+        :attr:`delay` seconds, i.e. if :meth:`stage` or :meth:`end` is not called sooner."""
+        self.end()
+        if not self.enabled:
+            return
+        if self.delay <= 0:
+            _print(message)
+            return
+        self._timer = threading.Timer(self.delay, _print, (message,))
+        self._timer.daemon = True
+        self._timer.start()
+
+    def end(self) -> None:
+        """End the current step (its message, if not shown yet, never is)."""
+        if self._timer is not None:
+            self._timer.cancel()
+            self._timer = None
+
+    @contextmanager
+    def step(self, message: str) -> Iterator[None]:
+        """The enclosed work as one step (:meth:`stage`), ended however it ends."""
+        self.stage(message)
+        try:
+            yield
+        finally:
+            self.end()
+
+    def counted(
+        self, blocks: Iterable[tuple[int, int]], total: int, label: str, unit: str
+    ) -> Iterator[tuple[int, int]]:
+        """The ``(lo, hi)`` blocks of ``total`` units of work, as given, with a :meth:`bar`
+        that advances by ``hi - lo`` as each block is done."""
+        with self.bar(total, label, unit) as advance:
+            for lo, hi in blocks:
+                yield lo, hi
+                advance(hi - lo)
+
+    @contextmanager
+    def bar(self, total: int, label: str, unit: str) -> Iterator[Callable[[int], None]]:
+        """A bar over ``total`` units of work labelled ``mdf: LABEL``; yields ``advance(n)``,
+        to call as ``n`` more units are done. Ends the current step."""
+        self.end()
+        if not self.enabled:
+            yield _ignore
+            return
+        from tqdm import tqdm
+
+        bar: Any = tqdm(
+            total=total,
+            desc=f"mdf: {label}",
+            unit=unit,
+            delay=self.delay,
+            leave=False,
+            file=sys.stderr,
+            dynamic_ncols=True,
+        )
+        try:
+            yield bar.update
+        finally:
+            bar.close()
+
+
+#: Progress that reports nothing (the default of library calls).
+QUIET = Progress(False)
+
+
+def _print(message: str) -> None:
+    print(f"mdf: {message} ...", file=sys.stderr, flush=True)
+
+
+def _ignore(n: int) -> None:
+    """``advance`` of a silent bar."""

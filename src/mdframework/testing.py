@@ -44,10 +44,10 @@ from .interfaces import (
     Plugin,
     PluginConfig,
     PulseBlock,
-    RadarRecordingSource,
     RadarWaveform,
     Received,
     Recording,
+    RecordingSource,
     ScattererModel,
     Scatterers,
     SceneContext,
@@ -559,7 +559,7 @@ def check_block_invariance(
     )
 
 
-def check_recording_source(source: RadarRecordingSource) -> list[Recording]:
+def check_recording_source(source: RecordingSource) -> list[Recording]:
     """``load()`` gives named recordings with consistent point clouds: unique names, frame
     indices within the recording, finite positions and velocities, a positive frame period and
     JSON metadata."""

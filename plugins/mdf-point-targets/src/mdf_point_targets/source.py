@@ -1,8 +1,10 @@
 """Point scatterers at constant velocity, for calibration and tests.
 
 The source places each target at ``position + velocity * t`` [m] for ``0 <= t <= length``,
-sampled at ``frame_rate`` (the motion is linear, so any interpolation of it is exact). The
-``points`` scatterer model turns each joint into an isotropic scatterer whose RCS is the target's.
+sampled at ``frame_rate``. The motion is linear, so any interpolation of it is exact; the
+source says so (``Motion.linear_tracks``) and the pipeline resamples it linearly, without a
+spline. The ``points`` scatterer model turns each joint into an isotropic scatterer whose RCS is
+the target's.
 """
 
 from __future__ import annotations
@@ -73,7 +75,7 @@ class PointTargets(MotionSource):
         names = tuple(f"target{i}" for i in range(len(c.targets)))
         meta = {"source": "point_targets", "activity": c.label, "n_targets": len(c.targets)}
         rcs = np.array([tg.rcs for tg in c.targets], dtype=np.float64)
-        return Motion(Skeleton(t, pos, names), meta, None, rcs)
+        return Motion(Skeleton(t, pos, names), meta, None, rcs, linear_tracks=True)
 
 
 class IsotropicPointsConfig(PluginConfig):

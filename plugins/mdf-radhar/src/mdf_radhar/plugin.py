@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-from mdframework import RadarRecordingSource, hookimpl
+from mdframework import RecordingSource, hookimpl
 
 from .source import RadharSource
 
 
 @hookimpl
-def mdframework_register_recordings() -> list[type[RadarRecordingSource]]:
+def mdframework_register_recording_sources() -> list[type[RecordingSource]]:
     """Register the RadHAR point-cloud reader (``kind = "radhar"``)."""
     return [RadharSource]

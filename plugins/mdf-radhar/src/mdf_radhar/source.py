@@ -43,8 +43,8 @@ from mdframework import (
     DataFileError,
     DataPath,
     PluginConfig,
-    RadarRecordingSource,
     Recording,
+    RecordingSource,
     limits,
 )
 from mdframework.pointcloud import PointCloud, frames_from_point_ids, range_rate_to_approaching
@@ -192,7 +192,7 @@ def npz_recordings(
     return out
 
 
-class RadharSource(RadarRecordingSource):
+class RadharSource(RecordingSource):
     """RadHAR point clouds of a TI IWR1443 radar (rostopic text, .txt.gz or compact NPZ)."""
 
     name = "radhar"
