@@ -334,22 +334,10 @@ def train_test(
             raise MdfError(f"train_test.{name}: no record matches {getattr(tt, name)}")
     if np.any(train & test):
         raise MdfError(f"train_test: {int(np.sum(train & test))} records are in both selections")
-    shared = sorted(set(labels[train].tolist()) & set(labels[test].tolist()))
-    if len(shared) < 2:
-        raise MdfError(f"train_test: the selections share fewer than two classes ({shared})")
-    train &= np.isin(labels, shared)
-    test &= np.isin(labels, shared)
-    x, y = (data.features if x is None else x), labels
-    sel = _select(cfg, factory, x[train], y[train], cfg.seed)
-    pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
-    return {
-        "classes": shared,
-        "confusion": confusion_matrix(y[test], pred, shared),
-        "balanced_accuracy": balanced_accuracy(y[test], pred),
-        "subset": [names[i] for i in sel.subset],
-        "train_counts": {c: int(np.sum(y[train] == c)) for c in shared},
-        "test_counts": {c: int(np.sum(y[test] == c)) for c in shared},
-    }
+    x = data.features if x is None else x
+    return _train_then_test(
+        cfg, factory, x, labels, train, test, names, "train_test: the selections"
+    )
 
 
 def within_source(
@@ -434,22 +422,39 @@ def cross_source(
     for name, mask in (("train", train), ("test", test)):
         if not np.any(mask):
             groups = ", ".join(sorted(set(data.groups.tolist())))
-            raise MdfError(f"cross_source.{name}: no records of group {name!r} (have {groups})")
+            group = getattr(cs, name)
+            raise MdfError(f"cross_source.{name}: no records of group {group!r} (have {groups})")
+    x = data.features if x is None else x
+    return _train_then_test(cfg, factory, x, labels, train, test, names, "cross_source: the groups")
+
+
+def _train_then_test(
+    cfg: ExperimentConfig,
+    factory: Callable[[], Classifier],
+    x: NDArray[np.float64],
+    labels: NDArray[Any],
+    train: NDArray[np.bool_],
+    test: NDArray[np.bool_],
+    names: Sequence[str],
+    who: str,
+) -> dict[str, Any]:
+    """Select features and fit on the ``train`` records (mask), predict the ``test`` records,
+    over the classes both hold (``who`` names the two sides in the error when they share
+    fewer than two). ``x`` (n_records, n_columns) named by ``names``; ``labels`` (n_records,)."""
     shared = sorted(set(labels[train].tolist()) & set(labels[test].tolist()))
     if len(shared) < 2:
-        raise MdfError(f"cross_source: the groups share fewer than two classes ({shared})")
-    train &= np.isin(labels, shared)
-    test &= np.isin(labels, shared)
-    x, y = (data.features if x is None else x), labels
-    sel = _select(cfg, factory, x[train], y[train], cfg.seed)
-    pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
+        raise MdfError(f"{who} share fewer than two classes ({shared})")
+    train = train & np.isin(labels, shared)
+    test = test & np.isin(labels, shared)
+    sel = _select(cfg, factory, x[train], labels[train], cfg.seed)
+    pred = _fit_predict(factory, x[train], labels[train], x[test], sel.subset)
     return {
         "classes": shared,
-        "confusion": confusion_matrix(y[test], pred, shared),
-        "balanced_accuracy": balanced_accuracy(y[test], pred),
+        "confusion": confusion_matrix(labels[test], pred, shared),
+        "balanced_accuracy": balanced_accuracy(labels[test], pred),
         "subset": [names[i] for i in sel.subset],
-        "train_counts": {c: int(np.sum(y[train] == c)) for c in shared},
-        "test_counts": {c: int(np.sum(y[test] == c)) for c in shared},
+        "train_counts": {c: int(np.sum(labels[train] == c)) for c in shared},
+        "test_counts": {c: int(np.sum(labels[test] == c)) for c in shared},
     }
 
 

@@ -144,6 +144,33 @@ def velocity_limits(
     return max(lo_axis, lo - pad), min(hi_axis, hi + pad)
 
 
+def _power_image(
+    ax: Any,
+    db: NDArray[np.floating[Any]],
+    across: NDArray[np.float64],
+    up: NDArray[np.float64],
+    dynamic_range_db: float,
+    colormap: str,
+) -> Any:
+    """Draw a dB map ``db`` (len(up), len(across)) into ``ax``, each cell centred on its
+    coordinates (``across``, ``up``: evenly spaced, ascending), the top ``dynamic_range_db``
+    in colour. Returns the image (for a colour bar)."""
+    da = float(across[1] - across[0]) if across.size > 1 else 1.0
+    du = float(up[1] - up[0]) if up.size > 1 else 1.0
+    extent = (across[0] - da / 2, across[-1] + da / 2, up[0] - du / 2, up[-1] + du / 2)
+    peak = float(np.max(db))
+    return ax.imshow(
+        db,
+        origin="lower",
+        aspect="auto",
+        extent=extent,
+        cmap=colormap,
+        vmin=peak - dynamic_range_db,
+        vmax=peak,
+        interpolation="nearest",
+    )
+
+
 def draw_spectrogram(
     ax: Any,
     spectrogram_db: NDArray[np.floating[Any]],
@@ -158,20 +185,7 @@ def draw_spectrogram(
     approaching), the top ``dynamic_range_db`` in colour. Returns the image (for a colour bar).
     ``spectrogram_db`` (n_doppler, n_frames) [dB re peak]; ``time`` (n_frames,) [s];
     ``velocity`` (n_doppler,) ascending [m/s]."""
-    dt = float(time[1] - time[0]) if time.size > 1 else 1.0
-    dv = float(velocity[1] - velocity[0]) if velocity.size > 1 else 1.0
-    extent = (time[0] - dt / 2, time[-1] + dt / 2, velocity[0] - dv / 2, velocity[-1] + dv / 2)
-    peak = float(np.max(spectrogram_db))
-    im = ax.imshow(
-        spectrogram_db,
-        origin="lower",
-        aspect="auto",
-        extent=extent,
-        cmap=colormap,
-        vmin=peak - dynamic_range_db,
-        vmax=peak,
-        interpolation="nearest",
-    )
+    im = _power_image(ax, spectrogram_db, time, velocity, dynamic_range_db, colormap)
     ax.set_ylim(*velocity_limits(spectrogram_db, velocity, velocity_span, dynamic_range_db))
     ax.set_xlabel("time [s]")
     ax.set_ylabel("radial velocity [m/s] (+ approaching)")
@@ -227,17 +241,7 @@ def plot_range_time(
     [m]."""
     with _rc_context():
         fig, ax = subplots(figsize=(8, 4), layout="constrained")
-        peak = float(np.max(range_time_db))
-        im = ax.imshow(
-            range_time_db.T,
-            origin="lower",
-            aspect="auto",
-            extent=(time[0], time[-1], ranges[0], ranges[-1]),
-            cmap=colormap,
-            vmin=peak - dynamic_range_db,
-            vmax=peak,
-            interpolation="nearest",
-        )
+        im = _power_image(ax, range_time_db.T, time, ranges, dynamic_range_db, colormap)
         ax.set_xlabel("time [s]")
         ax.set_ylabel("range [m]")
         fig.colorbar(im, ax=ax, label="compressed power [dB re peak]")
@@ -332,19 +336,9 @@ def plot_range_doppler(
     from .physics.spectrogram import power_to_db
 
     db = power_to_db(np.asarray(power, np.float64), -dynamic_range_db)
-    dr = range_m[1] - range_m[0] if range_m.size > 1 else 1.0
-    dv = velocity[1] - velocity[0] if velocity.size > 1 else 1.0
-    extent = (
-        range_m[0] - dr / 2,
-        range_m[-1] + dr / 2,
-        velocity[0] - dv / 2,
-        velocity[-1] + dv / 2,
-    )
     with _rc_context():
         fig, ax = subplots(figsize=(7, 4), layout="constrained")
-        im = ax.imshow(
-            db, origin="lower", aspect="auto", extent=extent, cmap=colormap, interpolation="nearest"
-        )
+        im = _power_image(ax, db, range_m, velocity, dynamic_range_db, colormap)
         ax.set_xlabel("range [m]")
         ax.set_ylabel("radial velocity [m/s] (+ approaching)")
         fig.colorbar(im, ax=ax, label="power [dB re peak]")

@@ -100,33 +100,12 @@ MSR_JOINTS: tuple[str, ...] = (
     "Head",
 )
 
-#: Kinect v2 joint order (NTU RGB+D).
+#: Kinect v2 joint order (NTU RGB+D): the v1 order with the spine renamed (base, mid, neck)
+#: and five joints appended.
 KINECT_V2_JOINTS: tuple[str, ...] = (
-    "SpineBase",
-    "SpineMid",
-    "Neck",
-    "Head",
-    "ShoulderLeft",
-    "ElbowLeft",
-    "WristLeft",
-    "HandLeft",
-    "ShoulderRight",
-    "ElbowRight",
-    "WristRight",
-    "HandRight",
-    "HipLeft",
-    "KneeLeft",
-    "AnkleLeft",
-    "FootLeft",
-    "HipRight",
-    "KneeRight",
-    "AnkleRight",
-    "FootRight",
-    "SpineShoulder",
-    "HandTipLeft",
-    "ThumbLeft",
-    "HandTipRight",
-    "ThumbRight",
+    ("SpineBase", "SpineMid", "Neck")
+    + KINECT_V1_JOINTS[3:]
+    + ("SpineShoulder", "HandTipLeft", "ThumbLeft", "HandTipRight", "ThumbRight")
 )
 
 
