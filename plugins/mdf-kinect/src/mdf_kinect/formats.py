@@ -103,9 +103,15 @@ MSR_JOINTS: tuple[str, ...] = (
 #: Kinect v2 joint order (NTU RGB+D): the v1 order with the spine renamed (base, mid, neck)
 #: and five joints appended.
 KINECT_V2_JOINTS: tuple[str, ...] = (
-    ("SpineBase", "SpineMid", "Neck")
-    + KINECT_V1_JOINTS[3:]
-    + ("SpineShoulder", "HandTipLeft", "ThumbLeft", "HandTipRight", "ThumbRight")
+    "SpineBase",
+    "SpineMid",
+    "Neck",
+    *KINECT_V1_JOINTS[3:],
+    "SpineShoulder",
+    "HandTipLeft",
+    "ThumbLeft",
+    "HandTipRight",
+    "ThumbRight",
 )
 
 
