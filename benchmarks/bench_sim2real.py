@@ -3,21 +3,24 @@
 The data: ``examples/datasets/sim2real.toml``, group ``radhar``: the shipped RadHAR recordings
 (12 recordings per activity, boxing, jump, walk, 2 s records of per-frame Doppler histograms);
 group ``sim``: CMU motions through the FMCW sensor model with the IWR1443 preset, point clouds,
-per-record random draws. It is built once per seed and per ablation variant, each variant
-changing one modelling choice of that config (the real records are the same in all).
+per-record random draws. It is built once per seed and per variant: ``full`` is the shipped
+config, every other variant changes one modelling choice of it (the real records are the same in
+all).
 
-The ``full`` variant is built for every seed, the other variants for the first seed only.
 For every variant, seed, classifier input (the seven features, the histogram vector) and
 classifier, a classifier is trained on ALL simulated records and tested on ALL real records:
-balanced accuracy and per-class rates. The real-to-real reference uses the same input and
-classifier, trained on real recordings and tested on held-out real recordings (10 random splits
-holding out 40 % of the recordings of every class).
+balanced accuracy and per-class rates, then mean and std over the seeds. The real-to-real
+reference uses the same input and classifier, trained on real recordings and tested on held-out
+real recordings (``--repeats`` random splits holding out 40 % of the recordings of every class).
 
     .venv/bin/python benchmarks/bench_sim2real.py [--seeds 0 1 2] [--variants full,...]
-        [--workers N] [--out out/bench_sim2real]
+        [--workers N] [--out out/bench_sim2real] [--docs]
 
-Writes ``results.json`` and ``results.md`` (the tables of ``docs/sim-to-real.md``) and
-``histograms.png`` (mean real and simulated per-frame histograms per class) under ``--out``.
+Writes ``results.json`` and ``results.md`` (the tables of ``docs/sim-to-real.md``, with the
+build times and the load average) and ``histograms.png`` (mean real and simulated per-frame
+histograms per class) under ``--out``; ``--docs`` also copies ``results.json`` to
+``docs/data/sim2real_results.json`` and the figure to ``docs/figures/``
+(``tests/test_sim2real_page.py`` checks the page against that file).
 """
 
 from __future__ import annotations
@@ -30,6 +33,8 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 import argparse  # noqa: E402
 import copy  # noqa: E402
 import json  # noqa: E402
+import shutil  # noqa: E402
+import sys  # noqa: E402
 import time  # noqa: E402
 from collections.abc import Callable  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -50,6 +55,8 @@ from mdframework.experiment import (  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = ROOT / "examples" / "datasets" / "sim2real.toml"
+DOCS_RESULTS = ROOT / "docs" / "data" / "sim2real_results.json"
+DOCS_FIGURE = ROOT / "docs" / "figures" / "sim2real_histograms.png"
 SIM, REAL = "sim", "radhar"
 CLASSIFIERS: dict[str, dict[str, Any]] = {
     "knn": {"kind": "knn", "k": 5},
@@ -62,15 +69,34 @@ CLASSIFIERS: dict[str, dict[str, Any]] = {
 INPUTS = ("features", "histogram")
 
 
+def _effect_index(cfg: dict[str, Any], kind: str) -> int:
+    return [e.get("kind") for e in cfg["base"]["effects"]].index(kind)
+
+
 def _drop_effect(kind: str) -> Callable[[dict[str, Any]], None]:
+    """Remove one effect and the draws of its fields (the later effects' draws renumbered)."""
+
     def change(cfg: dict[str, Any]) -> None:
-        effects = cfg["base"].get("effects", [])
-        cfg["base"]["effects"] = [e for e in effects if e.get("kind") != kind]
+        gone = _effect_index(cfg, kind)
+        cfg["base"]["effects"].pop(gone)
+        params = cfg.get("randomize", {}).get("params", {})
+        moved: dict[str, Any] = {}
+        for key, value in params.items():
+            parts = key.split(".")
+            if parts[0] == "effects":
+                n = int(parts[1])
+                if n == gone:
+                    continue
+                parts[1] = str(n - 1 if n > gone else n)
+            moved[".".join(parts)] = value
+        cfg["randomize"]["params"] = moved
 
     return change
 
 
 def _no_draw(*names: str) -> Callable[[dict[str, Any]], None]:
+    """Remove draws of the dataset and of every source (scene names or params paths)."""
+
     def change(cfg: dict[str, Any]) -> None:
         for table in [cfg.get("randomize", {})] + [
             s.get("randomize") or {} for s in cfg["sources"]
@@ -82,36 +108,90 @@ def _no_draw(*names: str) -> Callable[[dict[str, Any]], None]:
     return change
 
 
+def _middle(*names: str) -> Callable[[dict[str, Any]], None]:
+    """Fix uniform draws of the dataset and of every source at the middle of their range (so a
+    source keeps its own typical value: walks still walk away or toward, slowly)."""
+
+    def change(cfg: dict[str, Any]) -> None:
+        for table in [cfg.get("randomize", {})] + [
+            s.get("randomize") or {} for s in cfg["sources"]
+        ]:
+            for name in names:
+                if name in table:
+                    lo, hi = table[name]["uniform"]
+                    table[name] = {"uniform": [(lo + hi) / 2, (lo + hi) / 2]}
+
+    return change
+
+
+def _no_augmentation(cfg: dict[str, Any]) -> None:
+    _middle("speed")(cfg)
+    _no_draw("body_scale", "mirror", "time_warp")(cfg)
+
+
 def _fixed_height(cfg: dict[str, Any]) -> None:
     _no_draw("radar_height")(cfg)
     cfg["base"]["scene"]["radar_position"][2] = 0.8
 
 
+def _wide_elevation(cfg: dict[str, Any]) -> None:
+    """The antenna's elevation beam 120 deg wide (azimuth still drawn)."""
+    n = _effect_index(cfg, "antenna")
+    cfg["randomize"]["params"].pop(f"effects.{n}.beamwidth_el_deg")
+    cfg["base"]["effects"][n]["beamwidth_el_deg"] = 120.0
+
+
+def _fixed_sensor(cfg: dict[str, Any]) -> None:
+    """The preset's detection threshold and noise figure, one noise seed."""
+    params = cfg["randomize"]["params"]
+    for key in [k for k in params if k.startswith("radar.")]:
+        params.pop(key)
+
+
+def _source_draws_as(label: str, **draws: Any) -> Callable[[dict[str, Any]], None]:
+    """Replace the given draws of every source of one activity (None: remove the draw, so the
+    dataset's applies)."""
+
+    def change(cfg: dict[str, Any]) -> None:
+        for s in cfg["sources"]:
+            if s.get("label") == label and "motion" in s:
+                table = s.setdefault("randomize", {})
+                for name, value in draws.items():
+                    if value is None:
+                        table.pop(name, None)
+                    else:
+                        table[name] = value
+
+    return change
+
+
 def _one_gate(cfg: dict[str, Any]) -> None:
     """The project before the sensor model: a 77 GHz pulse-Doppler radar, one range gate, the
     spectrogram and its features (no point clouds, so no histogram input)."""
+    _drop_effect("static_scene")(cfg)
     cfg["representation"] = "spectrogram"
     cfg["base"]["radar"] = {"kind": "lfm", "carrier_frequency": 77e9, "prf": 6000.0}
-    cfg["base"]["effects"] = [e for e in cfg["base"]["effects"] if e["kind"] == "antenna"]
     params = cfg["randomize"]["params"]
-    for key in list(params):
-        if not key.startswith("effects.1."):
-            params.pop(key)
-    cfg["randomize"]["params"] = {
-        k.replace("effects.1.", "effects.0."): v for k, v in params.items()
-    }
+    for key in [k for k in params if k.startswith("radar.")]:
+        params.pop(key)
 
 
 #: variant name -> (what it changes, how)
 VARIANTS: dict[str, tuple[str, Callable[[dict[str, Any]], None]]] = {
     "full": ("the shipped config", lambda cfg: None),
     "no_static_scene": ("no static reflectors (room)", _drop_effect("static_scene")),
-    "no_augmentation": (
-        "no speed, body-size, mirror or time-warp augmentation",
-        _no_draw("speed", "body_scale", "mirror", "time_warp"),
-    ),
-    "fixed_aspect": ("aspect fixed at the base scene's", _no_draw("aspect_deg")),
+    "wide_elevation_beam": ("elevation beam 120 deg instead of 20-60 deg", _wide_elevation),
+    "fixed_aspect": ("aspect fixed at the middle of each source's range", _middle("aspect_deg")),
     "radar_at_0.8m": ("radar height fixed at 0.8 m", _fixed_height),
+    "fixed_sensor": ("no CFAR threshold, noise figure or noise draws", _fixed_sensor),
+    "no_augmentation": (
+        "speed fixed at the middle of each source's range; no body-size, mirror or time-warp draws",
+        _no_augmentation,
+    ),
+    "lively_jumps": (
+        "jumps at the dataset's speeds (0.8-1.25) instead of 0.3-0.6",
+        _source_draws_as("jump", speed=None),
+    ),
     "one_gate_spectrogram": ("no sensor model: 77 GHz one-gate spectrogram", _one_gate),
 }
 
@@ -171,6 +251,27 @@ def sim_to_real(path: Path, kind: str, clf: dict[str, Any]) -> dict[str, Any] | 
     }
 
 
+def point_stats(path: Path, group: str) -> dict[str, dict[str, float]]:
+    """Per class, over one group's records: points per frame within the histogram's range
+    gate, moving points per frame (outside the 0 m/s bin) and the share of points at 0 m/s."""
+    data = load_dataset(path, spectrograms=False, histograms=True)
+    out = {}
+    for label in sorted(set(data.labels.tolist())):
+        pick = (data.labels == label) & (data.groups == group)
+        hs = [h for h, p in zip(data.histograms or [], pick, strict=True) if p and h is not None]
+        if not hs:  # records without point clouds (a one-gate spectrogram)
+            continue
+        h = np.concatenate(hs)
+        centre = h.shape[1] // 2
+        total = h.sum(axis=1)
+        out[label] = {
+            "points": float(total.mean()),
+            "moving": float((total - h[:, centre]).mean()),
+            "static_share": float(h[:, centre].sum() / max(total.sum(), 1.0)),
+        }
+    return out
+
+
 def mean_histograms(path: Path, group: str) -> dict[str, np.ndarray]:
     """Per class, the mean over one group's records of the mean per-frame histogram shares
     (n_bins,)."""
@@ -218,6 +319,19 @@ def plot_histograms(path: Path, out: Path) -> None:
         save(fig, out, caption)
 
 
+def _summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
+    """Mean and population std over seeds of the scores, mean per-class rates and confusion."""
+    return {
+        "mean": float(np.mean([r["score"] for r in runs])),
+        "std": float(np.std([r["score"] for r in runs])),
+        "scores": [r["score"] for r in runs],
+        "per_class": {
+            c: float(np.mean([r["per_class"][c] for r in runs])) for c in runs[0]["per_class"]
+        },
+        "confusion": np.mean([r["confusion"] for r in runs], axis=0).tolist(),
+    }
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
@@ -226,21 +340,41 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=None)
     parser.add_argument("--repeats", type=int, default=10, help="real-to-real splits")
     parser.add_argument("--out", type=Path, default=Path("out/bench_sim2real"))
+    parser.add_argument(
+        "--docs",
+        action="store_true",
+        help=f"also copy results.json and the figure to {DOCS_RESULTS.relative_to(ROOT)} and "
+        f"{DOCS_FIGURE.relative_to(ROOT)} (the numbers of docs/sim-to-real.md)",
+    )
     args = parser.parse_args()
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
     clock = time.perf_counter()
     base = read_config_file(CONFIG)
     classifiers = {k: CLASSIFIERS[k] for k in args.classifiers.split(",")}
-    results: dict[str, Any] = {"real_to_real": {}, "sim_to_real": {}, "seeds": args.seeds}
+    results: dict[str, Any] = {
+        "command": "benchmarks/bench_sim2real.py " + " ".join(sys.argv[1:]),
+        "seeds": args.seeds,
+        "repeats": args.repeats,
+        "load_average_start": list(os.getloadavg()),
+        "real_to_real": {},
+        "sim_to_real": {},
+        "build_s": {},
+    }
     for variant in args.variants.split(","):
         what, change = VARIANTS[variant]
         per: dict[str, list[dict[str, Any]]] = {}
-        for seed in args.seeds if variant == "full" else args.seeds[:1]:
+        stats: list[dict[str, dict[str, float]]] = []
+        results["build_s"][variant] = []
+        for seed in args.seeds:
             cfg = copy.deepcopy(base)
             change(cfg)
             cfg["seed"] = seed
+            tick = time.perf_counter()
+            done = (out / f"{variant}_{seed}" / "index.csv").exists()
             path = _dataset(cfg, CONFIG.parent, out / f"{variant}_{seed}", args.workers)
+            if not done:  # a dataset of the same config in --out is reused, not timed
+                results["build_s"][variant].append(time.perf_counter() - tick)
             for name, clf in classifiers.items():  # the same real records in every dataset
                 for kind in INPUTS:
                     key = f"{name}/{kind}"
@@ -253,59 +387,152 @@ def main() -> None:
                             pass
             if variant == "full" and seed == args.seeds[0]:
                 plot_histograms(path, out / "histograms.png")
+            if "points" not in results:
+                results["points"] = {"real": point_stats(path, REAL)}
+            stats.append(point_stats(path, SIM))
             for name, clf in classifiers.items():
                 for kind in INPUTS:
                     res = sim_to_real(path, kind, clf)
                     if res is not None:
                         per.setdefault(f"{name}/{kind}", []).append(res)
+            print(
+                time.strftime("%H:%M:%S ")
+                + f"{variant} seed {seed}: "
+                + ", ".join(f"{k} {v[-1]['score']:.3f}" for k, v in per.items()),
+                flush=True,
+            )
         results["sim_to_real"][variant] = {
             "what": what,
-            **{
-                key: {
-                    "mean": float(np.mean([r["score"] for r in runs])),
-                    "std": float(np.std([r["score"] for r in runs])),
-                    "scores": [r["score"] for r in runs],
-                    "per_class": {
-                        c: float(np.mean([r["per_class"][c] for r in runs]))
-                        for c in runs[0]["per_class"]
-                    },
-                    "confusion": np.mean([r["confusion"] for r in runs], axis=0).tolist(),
-                }
-                for key, runs in per.items()
-            },
+            **{key: _summary(runs) for key, runs in per.items()},
         }
+        if stats[0]:
+            results["points"][variant] = {
+                label: {q: float(np.mean([st[label][q] for st in stats])) for q in stats[0][label]}
+                for label in stats[0]
+            }
+        (out / "partial.json").write_text(json.dumps(results, indent=2) + "\n")
     results["wall_s"] = time.perf_counter() - clock
+    results["load_average_end"] = list(os.getloadavg())
     (out / "results.json").write_text(json.dumps(results, indent=2) + "\n")
     (out / "results.md").write_text(markdown(results))
+    if args.docs:
+        DOCS_RESULTS.parent.mkdir(parents=True, exist_ok=True)
+        DOCS_RESULTS.write_text(json.dumps(results, indent=2) + "\n")
+        if (out / "histograms.png").exists():
+            shutil.copyfile(out / "histograms.png", DOCS_FIGURE)
     print(markdown(results))
 
 
+def goal(results: dict[str, Any]) -> dict[str, bool]:
+    """Per input/classifier: is the goal met by ``full``, its mean balanced accuracy on the real
+    recordings at least 0.80 and at most 10 points below the real-to-real mean?"""
+    full = results["sim_to_real"].get("full", {})
+    return {
+        k: full[k]["mean"] >= 0.80 and ref["mean"] - full[k]["mean"] <= 0.10
+        for k, ref in results["real_to_real"].items()
+        if k in full
+    }
+
+
+def goal_line(results: dict[str, Any]) -> str:
+    """One sentence: for which inputs and classifiers the goal is met."""
+    met = goal(results)
+    yes = [f"`{k}`" for k, v in met.items() if v]
+    no = [f"`{k}`" for k, v in met.items() if not v]
+    return (
+        "Goal (at least 0.80, and at most 10 points below real-to-real): "
+        f"met for {', '.join(yes) or 'none'}; not met for {', '.join(no) or 'none'}."
+    )
+
+
+def _table(caption: str, columns: list[str]) -> list[str]:
+    """A blank line, the caption, a blank line and a Markdown table's head."""
+    return ["", caption, "", "| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+
+
+def _cell(res: dict[str, Any] | None) -> str:
+    return "" if res is None else f"{res['mean']:.3f} ± {res['std']:.3f}"
+
+
 def markdown(results: dict[str, Any]) -> str:
-    """The result tables: real-to-real, then every variant, mean +- std over seeds."""
+    """The tables of docs/sim-to-real.md: the result, the ablation (every variant, mean ± std
+    over the seeds) and the per-class rates."""
     keys = list(results["real_to_real"])
+    seeds = results["seeds"]
+    head = ["| training data | " + " | ".join(keys) + " |", "|---|" + "---|" * len(keys)]
+    full = results["sim_to_real"].get("full", {})
     lines = [
-        f"Balanced accuracy on the real recordings, mean ± std over seeds {results['seeds']} "
-        "(other variants: the first seed; real-to-real: over 10 held-out-recording splits).",
+        f"Balanced accuracy on the real recordings; simulated: mean ± std over dataset seeds "
+        f"{', '.join(map(str, seeds))}; real-to-real: mean ± std over {results['repeats']} "
+        "splits holding out 40 % of the recordings of every class.",
         "",
-        "| training data | " + " | ".join(keys) + " |",
-        "|---|" + "---|" * len(keys),
+        *head,
         "| real (held-out recordings) | "
-        + " | ".join(
-            f"{results['real_to_real'][k]['mean']:.3f} ± {results['real_to_real'][k]['std']:.3f}"
-            for k in keys
-        )
+        + " | ".join(_cell(results["real_to_real"][k]) for k in keys)
         + " |",
+        "| simulated (`full`) | " + " | ".join(_cell(full.get(k)) for k in keys) + " |",
+        "",
+        goal_line(results),
+        *_table(
+            "Ablation: each variant changes one modelling choice of the shipped config (mean ± "
+            "std over the same seeds; difference to `full` in points of balanced accuracy).",
+            ["variant", "what it changes", *keys],
+        ),
     ]
     for variant, res in results["sim_to_real"].items():
-        cells = [f"{res[k]['mean']:.3f} ± {res[k]['std']:.3f}" if k in res else "" for k in keys]
-        lines.append(f"| simulated: {variant} ({res['what']}) | " + " | ".join(cells) + " |")
-    lines += ["", "Per-class rates (boxing / jump / walk), simulated `full` and real-to-real:", ""]
-    lines += ["| input | simulated full | real-to-real |", "|---|---|---|"]
+        cells = []
+        for k in keys:
+            if k not in res:
+                cells.append("(no histograms)" if k.endswith("histogram") else "")
+                continue
+            delta = 100 * (res[k]["mean"] - full[k]["mean"]) if k in full else None
+            extra = "" if variant == "full" or delta is None else f" ({delta:+.1f})"
+            cells.append(_cell(res[k]) + extra)
+        lines.append(f"| `{variant}` | {res['what']} | " + " | ".join(cells) + " |")
+    lines += _table(
+        "Per-class rates (boxing / jump / walk), simulated `full` (mean over seeds) and "
+        "real-to-real:",
+        ["input", "simulated `full`", "real-to-real"],
+    )
     for k in keys:
-        full = results["sim_to_real"].get("full", {}).get(k)
+        sim = full.get(k)
         ref = results["real_to_real"][k]["per_class"]
-        sim_cell = " / ".join(f"{v:.2f}" for v in full["per_class"].values()) if full else ""
+        sim_cell = " / ".join(f"{v:.2f}" for v in sim["per_class"].values()) if sim else ""
         lines.append(f"| {k} | {sim_cell} | " + " / ".join(f"{v:.2f}" for v in ref.values()) + " |")
+    shown = [v for v in ("real", "full", "lively_jumps") if v in results.get("points", {})]
+    if shown:
+        lines += _table(
+            "Points per frame within 0.5-3 m: all / moving (outside the 0 m/s bin) / share at "
+            "0 m/s; simulated: mean over the seeds.",
+            ["activity", *shown],
+        )
+        for label in results["points"]["real"]:
+            cells = []
+            for v in shown:
+                st = results["points"][v].get(label)
+                cells.append(
+                    f"{st['points']:.1f} / {st['moving']:.2f} / {st['static_share']:.2f}"
+                    if st
+                    else ""
+                )
+            lines.append(f"| {label} | " + " | ".join(cells) + " |")
+    builds = [t for ts in results["build_s"].values() for t in ts]
+    n_sets = len(results["sim_to_real"]) * len(seeds)
+    timing = (
+        f"{len(builds)} of the {n_sets} datasets built in this run, median "
+        f"{np.median(builds):.0f} s each (the others were complete in --out from an "
+        "earlier run of the same command and were reused); "
+        if builds and len(builds) < n_sets
+        else f"{len(builds)} datasets built, median {np.median(builds):.0f} s each; "
+        if builds
+        else f"all {n_sets} datasets reused from an earlier run of the same command; "
+    )
+    lines += [
+        "",
+        timing + f"{results['wall_s'] / 60:.0f} min in all; load average (5 min) "
+        f"{results['load_average_start'][1]:.1f} at the start, "
+        f"{results['load_average_end'][1]:.1f} at the end (2 cores shared).",
+    ]
     return "\n".join(lines) + "\n"
 
 

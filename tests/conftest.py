@@ -25,3 +25,11 @@ def project_distributions() -> set[str]:
         tomllib.loads(p.read_text())["project"]["name"]
         for p in (ROOT / "plugins").glob("*/pyproject.toml")
     }
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """The documented commands first (tests/test_docs.py): under ``--dist loadscope`` each is a
+    unit of its own that pytest-xdist sends to whichever worker is free, and the long ones
+    (experiments, dataset builds) finish last on one worker unless they start early. Every
+    other test keeps its order, and each file its worker."""
+    items.sort(key=lambda item: 0 if "::TestDocumentedCommand" in item.nodeid else 1)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -37,3 +38,68 @@ def peak_frequency_per_frame(result: RunResult) -> np.ndarray:
 def phase_increment_doppler(signal: np.ndarray, prf: float) -> float:
     """Mean Doppler [Hz] from the average pulse-to-pulse phase increment."""
     return float(np.angle(np.sum(signal[1:] * np.conj(signal[:-1]))) * prf / (2 * np.pi))
+
+
+# --------------------------------------------------------------------------- C3D files
+
+#: Plug-in Gait markers: name -> (canonical joint, offset from it [m]); the joint is the mean
+#: of its markers (offsets cancel), LUPA is a marker no joint uses.
+PIG = {
+    "LFHD": ("head", (0.05, 0.06, 0.0)),
+    "RFHD": ("head", (0.05, -0.06, 0.0)),
+    "LBHD": ("head", (-0.05, 0.06, 0.0)),
+    "RBHD": ("head", (-0.05, -0.06, 0.0)),
+    "C7": ("neck", (-0.06, 0.0, 0.0)),
+    "CLAV": ("neck", (0.06, 0.0, 0.0)),
+    "LASI": ("l_hip", (0.07, 0.0, 0.0)),
+    "LPSI": ("l_hip", (-0.07, 0.0, 0.0)),
+    "RASI": ("r_hip", (0.07, 0.0, 0.0)),
+    "RPSI": ("r_hip", (-0.07, 0.0, 0.0)),
+    "LWRA": ("l_hand", (0.0, 0.02, 0.0)),
+    "LWRB": ("l_hand", (0.0, -0.02, 0.0)),
+    "RWRA": ("r_hand", (0.0, 0.02, 0.0)),
+    "RWRB": ("r_hand", (0.0, -0.02, 0.0)),
+    **{
+        f"{s}{m}": (f"{s.lower()}_{j}", (0.0, 0.0, 0.0))
+        for s in "LR"
+        for m, j in (("SHO", "shoulder"), ("ELB", "elbow"), ("KNE", "knee"))
+    },
+    **{f"{s}ANK": (f"{s.lower()}_ankle", (0.0, 0.0, 0.0)) for s in "LR"},
+    **{f"{s}TOE": (f"{s.lower()}_toe", (0.0, 0.0, 0.0)) for s in "LR"},
+    "LUPA": ("l_elbow", (0.0, 0.05, 0.1)),
+}
+
+
+def write_c3d(
+    path: Path, markers: dict[str, np.ndarray], rate: float, units: str, scale: float
+) -> None:
+    """A C3D file of the given marker tracks [m], written through ezc3d in ``units``."""
+    import ezc3d
+
+    c = ezc3d.c3d()
+    labels = list(markers)
+    c["parameters"]["POINT"]["RATE"]["value"] = [rate]
+    c["parameters"]["POINT"]["LABELS"]["value"] = labels
+    c["parameters"]["POINT"]["UNITS"]["value"] = [units]
+    n = next(iter(markers.values())).shape[0]
+    pts = np.ones((4, len(labels), n))
+    pts[:3] = np.stack([markers[k] / scale for k in labels], axis=1).T
+    c["data"]["points"] = pts
+    c.write(str(path))
+
+
+def pig_markers(body: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Plug-in Gait marker tracks [m] around the given canonical joint tracks (:data:`PIG`)."""
+    return {m: body[j] + np.array(o) for m, (j, o) in PIG.items()}
+
+
+def walking_c3d(path: Path, seconds: float = 2.0, rate: float = 100.0) -> Path:
+    """A Plug-in Gait C3D file (mm) of :func:`mdframework.testing.walking_positions`."""
+    from mdframework import CANONICAL_JOINTS
+    from mdframework.testing import walking_positions
+
+    t = np.arange(round(seconds * rate)) / rate
+    pos = walking_positions(t)
+    body = {j: pos[:, k] for k, j in enumerate(CANONICAL_JOINTS)}
+    write_c3d(path, pig_markers(body), rate, "mm", 0.001)
+    return path

@@ -149,14 +149,67 @@ def skip_reason(where: str, command: str) -> str | None:
     return None
 
 
-@pytest.mark.parametrize(("where", "command"), COMMANDS, ids=[c for _, c in COMMANDS])
-def test_every_documented_command_runs(where: str, command: str, reader: Reader) -> None:
-    """Each command in its own process, from the repository root, as a reader runs it."""
+def out_folder(command: str) -> str | None:
+    """The ``--out`` folder of a command line, if it has one."""
+    words = shlex.split(command)
+    return words[words.index("--out") + 1] if "--out" in words[:-1] else None
+
+
+def split_commands() -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
+    """The commands that run with the rest of this file (those that share an output folder with
+    another command, as the dataset commands that resume one build, and those that make a file
+    a page's Python blocks read, whose result the blocks' test reuses), and the others, each of
+    which becomes a test class of its own (``TestDocumentedCommandNN``): under
+    ``--dist loadscope`` pytest-xdist sends each class to whichever worker is free, so the long
+    commands run side by side while every file keeps its own worker."""
+    code = "\n".join(b.text for b in blocks() if b.lang == "python")
+    read = set(re.findall(r"[\"'](out/[\w.-]+)", code))
+    outs = [out_folder(c) for _, c in COMMANDS]
+    together, alone = [], []
+    for (where, command), out in zip(COMMANDS, outs, strict=True):
+        keep = out is not None and (outs.count(out) > 1 or out in read)
+        (together if keep else alone).append((where, command))
+    return together, alone
+
+
+TOGETHER, ALONE = split_commands()
+
+
+def run_documented_command(where: str, command: str, reader: Reader) -> None:
+    """Run one documented command as a reader does (or skip it, saying why it cannot run)."""
     why = skip_reason(where, command)
     if why:
         pytest.skip(why)
     done = reader.run(command)
     assert done.returncode == 0, f"{where}: `{command}` exited {done.returncode}: {done.stderr}"
+
+
+@pytest.mark.parametrize(("where", "command"), TOGETHER, ids=[c for _, c in TOGETHER])
+def test_every_documented_command_runs(where: str, command: str, reader: Reader) -> None:
+    """Each command in its own process, from the repository root, as a reader runs it (the
+    commands of :func:`split_commands` that stay together; the others below)."""
+    run_documented_command(where, command, reader)
+
+
+def _command_class(index: int, where: str, command: str) -> type:
+    """A test class that runs one documented command (see :func:`split_commands`)."""
+
+    @pytest.mark.parametrize(("where", "command"), [(where, command)], ids=[command])
+    def test_every_documented_command_runs(
+        self: object, where: str, command: str, reader: Reader
+    ) -> None:
+        """The command in its own process, from the repository root, as a reader runs it."""
+        run_documented_command(where, command, reader)
+
+    name = f"TestDocumentedCommand{index:02d}"
+    return type(
+        name, (), {"test_every_documented_command_runs": test_every_documented_command_runs}
+    )
+
+
+for _index, (_where, _command) in enumerate(ALONE):
+    _cls = _command_class(_index, _where, _command)
+    globals()[_cls.__name__] = _cls
 
 
 def test_commands_that_cannot_run_here_are_still_documented() -> None:

@@ -125,6 +125,22 @@ def test_raw_and_analytic_range_profiles_are_identical() -> None:
             assert np.max(np.abs(raw - ana)) < 1e-12 * np.max(np.abs(raw))
 
 
+def test_closed_form_holds_for_targets_on_and_next_to_a_bin() -> None:
+    """Hard case: targets exactly on a range bin, 1e-13 .. 1e-6 of a bin beside one, at zero
+    range and one maximum range out (aliased onto bin 0): the closed form still equals the
+    sampled FFT to 1e-12 of the peak (a ratio of two small sines taken of differently rounded
+    arguments was off by 3.7e-6 of the peak here; now 2.4e-14)."""
+    k = np.array([0, 1, 37, 120, 239, 240])
+    offsets = np.array([0.0, 1e-13, -1e-11, 1e-9, -1e-7, 1e-6])
+    x = (k[:, None] + offsets[None, :]) / 240  # beat frequency [cycles per sample]
+    delays = x * SEQ.sample_rate / SEQ.slope
+    a = np.linspace(0.5, 1.0, delays.size).reshape(delays.shape)
+    for name in fmcw.WINDOWS:
+        raw = fmcw.range_profile(fmcw.if_samples(delays, a, SEQ), name, 240)  # type: ignore[arg-type]
+        ana = fmcw.analytic_range_profile(delays, a, SEQ, name, 240, np.arange(240))  # type: ignore[arg-type]
+        assert np.max(np.abs(raw - ana)) < 1e-12 * np.max(np.abs(raw)), name
+
+
 def test_target_beyond_max_range_aliases_in_the_if() -> None:
     """Hard case: at 1.3 x the maximum range the beat frequency exceeds fs and the target
     appears at 0.3 x, in the raw and the analytic path alike."""

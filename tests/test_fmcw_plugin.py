@@ -148,8 +148,9 @@ def test_absurd_settings_are_refused_before_any_frame(
 def test_scatterer_beyond_max_range_is_an_error_or_aliases() -> None:
     """Hard case: at 12 m the IWR1443's beat frequency (5.60 MHz) exceeds its 4.884 Msps ADC.
     Default: an error naming the field and the limit; ``beyond_max_range = "alias"``: the point
-    appears at 12 - 10.46 = 1.54 m, as on the sensor."""
-    target = [{"position": [12.0, 0.0, 0.0], "rcs": 1.0}]
+    appears at 12 - 10.46 = 1.54 m, as on the sensor (10 m^2: a 1 m^2 point at 12 m is 11 dB
+    over the noise with the preset's 12 dBm and isotropic antennas, under the 15 dB CFAR)."""
+    target = [{"position": [12.0, 0.0, 0.0], "rcs": 10.0}]
     with pytest.raises(SceneError, match=r"radar\.sample_rate.*12\.00 m.*4\.884 MHz.*10\.46 m"):
         fmcw_run(target, duration=0.2, **QUIET)
     res = fmcw_run(target, duration=0.2, beyond_max_range="alias")
@@ -183,6 +184,54 @@ def test_point_target_points_have_position_and_positive_approach_velocity() -> N
         assert best[2] / r == pytest.approx(np.sin(az) * np.cos(np.arcsin(true[2] / r)), abs=0.05)
         assert best[5] == pytest.approx(v, abs=1e-6)
         assert best[1] == pytest.approx(f * 33.333e-3)
+
+
+@pytest.mark.parametrize("preset", ["iwr1443_short_range_3d", "iwr6843isk_people_counting_6m"])
+def test_snr_of_a_point_target_follows_the_range_equation(preset: str) -> None:
+    """The presets' data-sheet transmit power and noise figure make the SNR a prediction: a
+    1 m^2 point on a range bin at boresight, static, peaks in the range-Doppler map (summed over
+    the virtual antennas) at ``1 + SNR`` times the map's mean noise, with
+    ``SNR = P_r / (k T0 F fs) x (sum w_r)^2 / sum w_r^2 x (sum w_d)^2 / sum w_d^2`` (the received
+    power of the range equation over the noise of one complex ADC sample, times the coherent
+    gain of the Hann-windowed range and Doppler FFTs), to 0.1 dB over 6 frames (0.03 dB
+    measured)."""
+    from mdframework.physics import fmcw
+
+    cfg = FmcwConfig(preset=preset)  # type: ignore[arg-type]
+    # the data sheets' values (docs/fmcw.md): 12 dBm; 16 dB (77-81 GHz) and 12 dB
+    assert 10 * np.log10(cfg.transmit_power / 1e-3) == pytest.approx(12.0, abs=1e-12)
+    assert cfg.noise_figure_db == {"iwr1443_short_range_3d": 16.0}.get(preset, 12.0)
+    assert cfg.gain_dbi == 0.0
+    wf = FmcwRadar(cfg)
+    seq = wf.sequence
+    r = 40 * seq.range_resolution  # on bin 40 (1.74 m and 3.37 m)
+    res = fmcw_run(
+        [{"position": [r, 0.0, 0.0], "rcs": 1.0}],
+        duration=6 * seq.frame_period,
+        preset=preset,
+        clutter_removal=False,
+    )
+    maps = res.received.products["range_doppler"].astype(np.float64)
+    assert maps.shape[0] == 6
+    amp = cfg.amplitudes(np.ones(1), np.array([r]), seq.wavelength)[0]
+    noise = wf.noise_power()
+    assert noise == pytest.approx(
+        1.380649e-23 * 290 * 10 ** (cfg.noise_figure_db / 10) * seq.sample_rate
+    )
+    w_r, w_d = fmcw.window("hann", seq.n_samples), fmcw.window("hann", seq.n_loops)
+    gain = np.sum(w_r) ** 2 / np.sum(w_r**2) * np.sum(w_d) ** 2 / np.sum(w_d**2)
+    snr = amp**2 / noise * gain
+    zero = seq.n_loops // 2
+    peak = maps[:, zero, 40]
+    assert np.all(np.argmax(maps.reshape(6, -1), axis=1) == zero * maps.shape[2] + 40)
+    floor = np.mean(maps[:, :, 80:])  # every Doppler row, 40 bins and more beyond the target
+    measured = 10 * np.log10(np.mean(peak) / floor)
+    assert measured == pytest.approx(10 * np.log10(1 + snr), abs=0.1)
+    # the figures of docs/fmcw.md: 44.3 and 44.9 dB here; 10.8 dB for 1 m^2 at 12 m (IWR1443)
+    documented = {"iwr1443_short_range_3d": 44.3, "iwr6843isk_people_counting_6m": 44.9}
+    assert round(10 * np.log10(1 + snr), 1) == documented[preset]
+    if preset == "iwr1443_short_range_3d":
+        assert round(10 * np.log10(snr * (r / 12.0) ** 4), 1) == 10.8
 
 
 def test_receive_is_block_invariant() -> None:

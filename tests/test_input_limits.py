@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from conftest import EXAMPLES
+from conftest import EXAMPLES, project_distributions
 from pydantic import BaseModel
 
 from mdframework import ConfigError, DataFileError, MdfError, SceneError, limits
@@ -37,9 +37,11 @@ INFINITE_ALLOWED = {("ShadowingConfig", "attenuation_db")}
 
 
 def _config_models() -> list[type[BaseModel]]:
-    reg = default_registry()
+    """The project's config models (a third party's plugins installed beside ours keep their
+    own rules)."""
+    reg = default_registry().provided_by(project_distributions())
     classifiers = [reg.plugins["classifier"][n].cls.Config for n in reg.names("classifier")]
-    return [run_config_model(), DatasetConfig, ExperimentConfig, *classifiers]
+    return [run_config_model(reg), DatasetConfig, ExperimentConfig, *classifiers]
 
 
 def _schemas() -> list[tuple[str, str, dict[str, Any]]]:

@@ -200,3 +200,49 @@ def test_short_clip_cadence_takes_the_first_period_not_the_highest() -> None:
     counted = 60.0 / np.median(np.diff(body.time[peaks]))
     assert spm == pytest.approx(counted, rel=0.1) and 100 < spm < 125
     assert msgs == []
+
+
+MSR_JOGS = sorted((EXAMPLES / "data" / "kinect" / "msr-action3d").glob("a16_*_skeleton3D.txt"))
+
+
+def test_jogging_in_place_cadence_from_the_alternation_of_knees_feet_or_hands() -> None:
+    """Running on the spot: the feet stay side by side, so the distance between the ankles has
+    no clear period; the left-right alternation of the knees, ankles or hands has one (a
+    stride, two steps). MSR Action3D's nine jogging recordings (15 frames per second)."""
+    found = {}
+    for f in MSR_JOGS:
+        section = {"kind": "kinect", "format": "msr-action3d", "activity": "jogging"}
+        motion, msgs = load({**section, "file": f"data/kinect/msr-action3d/{f.name}"})
+        cad = motion.metadata["sanity"]["cadence"]
+        found[f.name[:11]] = cad
+        assert not any("steps" in m for m in msgs)
+        body = motion.canonical()
+        # the ankle distance alone finds no step period in 8 of the 9
+        assert cadence_spm(body.time, body.joint("l_ankle"), body.joint("r_ankle")) is None or (
+            f.name.startswith("a16_s03_e03")
+        )
+    spm = {k: c["steps_per_min"] for k, c in found.items()}
+    # a brisk run on the spot: 168-227 steps a minute, each read off the arms' alternation
+    assert all(130 <= v <= 230 for v in spm.values() if v is not None)
+    assert min(v for v in spm.values() if v is not None) == pytest.approx(168, abs=1)
+    assert max(v for v in spm.values() if v is not None) == pytest.approx(227, abs=1)
+    assert {c["from"] for c in found.values() if c["from"]} == {"hands alternation"}
+    # the limit: one recording (subject 3's first) has no clear period at all, and is not
+    # judged (no warning, steps_per_min None)
+    assert [k for k, v in spm.items() if v is None] == ["a16_s03_e01"]
+
+
+def test_alternation_keeps_exposing_a_wrong_time_base() -> None:
+    """Every cadence candidate scales with the time base: jogging read at twice its rate steps
+    twice as fast and is flagged."""
+    section = {
+        "kind": "kinect",
+        "format": "msr-action3d",
+        "activity": "jogging",
+        "file": "data/kinect/msr-action3d/a16_s01_e01_skeleton3D.txt",
+    }
+    ok, _ = load(section)
+    fast, msgs = load({**section, "frame_rate": 30.0})
+    spm = ok.metadata["sanity"]["cadence"]["steps_per_min"]
+    assert fast.metadata["sanity"]["cadence"]["steps_per_min"] == pytest.approx(2 * spm, rel=1e-6)
+    assert any("labelled 'jogging' but steps" in m for m in msgs)

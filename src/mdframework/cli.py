@@ -583,6 +583,8 @@ def _main(argv: list[str], debug: bool) -> int:
         print(f"mdf: error: {message}", file=sys.stderr)
         return EXIT_USAGE
     except Exception as exc:
+        if _caused_by_interrupt(exc):
+            raise KeyboardInterrupt from exc
         if args.debug:
             raise
         retract()
@@ -592,6 +594,19 @@ def _main(argv: list[str], debug: bool) -> int:
             file=sys.stderr,
         )
         return 1
+
+
+def _caused_by_interrupt(exc: BaseException) -> bool:
+    """Whether Ctrl-C is behind ``exc``: Python wraps a KeyboardInterrupt raised at some points
+    (e.g. while a class is being created during an import) in another exception."""
+    seen: set[int] = set()
+    cause: BaseException | None = exc
+    while cause is not None and id(cause) not in seen:
+        if isinstance(cause, KeyboardInterrupt):
+            return True
+        seen.add(id(cause))
+        cause = cause.__cause__ or cause.__context__
+    return False
 
 
 if __name__ == "__main__":

@@ -307,6 +307,19 @@ def _toml_hint(parts: list[str], source: str) -> str:
     return f"; {parts[-1]!r} is a top-level field: move it out of {where}"
 
 
+def _with_default_kinds(data: Any) -> Any:
+    """A run config's data with the default ``kind`` of each section that gives none (as
+    validation fills it in), so that errors inside such a section name its fields."""
+    if not isinstance(data, dict):
+        return data
+    filled = dict(data)
+    for section, name in DEFAULT_KINDS.items():
+        value = filled.get(section)
+        if isinstance(value, dict) and "kind" not in value:
+            filled[section] = {"kind": name, **value}
+    return filled
+
+
 def _field_loc(raw: tuple[Any, ...], data: Any) -> list[Any]:
     """An error location without the tags pydantic inserts for the members of a union (a
     plugin's ``kind``, or ``literal['track']`` under a number)."""
@@ -338,6 +351,8 @@ def format_validation_error(
     (the model validated) lets it list the valid field names."""
     errors = exc.errors(include_url=False)
     first = errors[0]
+    if isinstance(model, type) and issubclass(model, RunConfigBase):
+        data = _with_default_kinds(data)
     loc = _field_loc(first["loc"], data)
     parts = [str(part) for part in loc]
     allowed = None

@@ -24,9 +24,11 @@ Checks, on the canonical 17-joint body:
    length over the valid frames. A rigid rig (BVH, ASF/AMC) gives 0 to rounding; optical and
    depth-camera tracks vary (a Kinect's limbs by several per cent); above ``bone_tolerance``
    (10 %) the motion is flagged.
-4. **Cadence** (:func:`cadence_spm`): for motions labelled walk or run/jog, steps per minute
-   from the period of the distance between the ankles; outside ``walk_cadence`` (70-150) or
-   ``run_cadence`` (130-230) the motion is flagged: usually a wrong frame rate.
+4. **Cadence** (:func:`cadence_estimate`): for motions labelled walk or run/jog, steps per
+   minute from the clearest period among the distance between the ankles (a step) and the
+   left-right height alternation of the ankles, knees and hands (a stride: what running on the
+   spot shows); outside ``walk_cadence`` (70-150) or ``run_cadence`` (130-230) the motion is
+   flagged: usually a wrong frame rate.
 """
 
 from __future__ import annotations
@@ -223,14 +225,12 @@ def bone_lengths(skeleton: Skeleton) -> dict[str, dict[str, float]]:
     return out
 
 
-def first_period(time: FloatArray, signal: FloatArray, min_strength: float = 0.3) -> float | None:
-    """The signal's shortest clear period [s]: the lag of the first local maximum of its
-    autocorrelation (after the first zero crossing) that reaches ``min_strength``; None if
-    there is none. The signal is resampled linearly to its mean rate first.
-
-    The first such peak rather than the highest one: in a short clip the autocorrelation at a
-    multiple of the period can be higher than at the period itself.
-    """
+def _period_strength(
+    time: FloatArray, signal: FloatArray, min_strength: float = 0.3
+) -> tuple[float, float] | None:
+    """(period [s], autocorrelation there) of the first clear period (see
+    :func:`first_period`), the lag refined to a fraction of a sample by a parabola through the
+    peak and its neighbours (at 15 frames per second a whole-sample lag is 10 % off)."""
     t = np.asarray(time, dtype=np.float64)
     n = t.shape[0]
     if n < 8 or t[-1] <= t[0]:
@@ -247,24 +247,83 @@ def first_period(time: FloatArray, signal: FloatArray, min_strength: float = 0.3
         return None
     for lag in range(int(neg[0]) + 1, n - 1):
         if ac[lag] >= min_strength and ac[lag] >= ac[lag - 1] and ac[lag] >= ac[lag + 1]:
-            return float(lag * dt)
+            curve = ac[lag - 1] - 2 * ac[lag] + ac[lag + 1]
+            shift = 0.5 * (ac[lag - 1] - ac[lag + 1]) / curve if curve < 0 else 0.0
+            return float((lag + shift) * dt), float(ac[lag])
     return None
 
 
-def cadence_spm(time: FloatArray, l_ankle: FloatArray, r_ankle: FloatArray) -> float | None:
-    """Steps per minute from the distance between the ankles, or None if it has no clear period.
+def first_period(time: FloatArray, signal: FloatArray, min_strength: float = 0.3) -> float | None:
+    """The signal's shortest clear period [s]: the lag of the first local maximum of its
+    autocorrelation (after the first zero crossing) that reaches ``min_strength``; None if
+    there is none. The signal is resampled linearly to its mean rate first, and the lag refined
+    to a fraction of a sample.
 
-    The distance peaks once per step (feet apart at double support for a walk; one foot raised
-    when jogging in place) whichever foot leads, so the cadence is ``60 / period``
+    The first such peak rather than the highest one: in a short clip the autocorrelation at a
+    multiple of the period can be higher than at the period itself.
+    """
+    found = _period_strength(time, signal, min_strength)
+    return None if found is None else found[0]
+
+
+def cadence_estimate(
+    time: FloatArray,
+    l_ankle: FloatArray,
+    r_ankle: FloatArray,
+    pairs: dict[str, tuple[FloatArray, FloatArray]] | None = None,
+) -> tuple[float, str] | None:
+    """Steps per minute and the signal it came from, or None if no signal has a clear period.
+
+    Candidates (positions (n_frames, 3) [m], z up):
+
+    - ``ankle distance``: the distance between the ankles peaks once per step (feet apart at
+      double support in a walk), so steps per minute = 60 / its period;
+    - ``<pair> alternation``: for each pair in ``pairs`` (e.g. knees, hands), the signed
+      height difference left minus right swings once per stride (two steps), so steps per
+      minute = 120 / its period. This is what a run on the spot shows: the feet stay side by
+      side (their distance has no clear period), while the knees and feet rise in turn and the
+      arms swing against them.
+
+    The candidate whose autocorrelation peak is strongest wins. Every candidate scales with the
+    time base, so a wrong frame rate still shows as an implausible cadence.
+    """
+    t = np.asarray(time, dtype=np.float64)
+    found: list[tuple[float, float, str]] = []  # (strength, steps/min, signal)
+    dist = np.linalg.norm(np.asarray(l_ankle, dtype=np.float64) - r_ankle, axis=1)
+    ok = np.isfinite(dist)
+    if ok.sum() >= 8:
+        ps = _period_strength(t[ok], dist[ok])
+        if ps is not None:
+            found.append((ps[1], 60.0 / ps[0], "ankle distance"))
+    for name, (left, right) in (pairs or {}).items():
+        dz = np.asarray(left, dtype=np.float64)[:, 2] - np.asarray(right, dtype=np.float64)[:, 2]
+        ok = np.isfinite(dz)
+        if ok.sum() < 8:
+            continue
+        ps = _period_strength(t[ok], dz[ok])
+        if ps is not None:
+            found.append((ps[1], 120.0 / ps[0], f"{name} alternation"))
+    if not found:
+        return None
+    best = max(found, key=lambda f: f[0])
+    return best[1], best[2]
+
+
+def cadence_spm(
+    time: FloatArray,
+    l_ankle: FloatArray,
+    r_ankle: FloatArray,
+    pairs: dict[str, tuple[FloatArray, FloatArray]] | None = None,
+) -> float | None:
+    """Steps per minute (:func:`cadence_estimate`), or None if nothing has a clear period.
+
+    With the ankles alone: the distance between them peaks once per step (feet apart at double
+    support for a walk) whichever foot leads, so the cadence is ``60 / period``
     (:func:`first_period`, strength 0.3 or more). A recording shorter than about two steps
     gives None.
     """
-    dist = np.linalg.norm(np.asarray(l_ankle, dtype=np.float64) - r_ankle, axis=1)
-    ok = np.isfinite(dist)
-    if ok.sum() < 8:
-        return None
-    period = first_period(np.asarray(time, dtype=np.float64)[ok], dist[ok])
-    return None if period is None else 60.0 / period
+    found = cadence_estimate(time, l_ankle, r_ankle, pairs)
+    return None if found is None else found[0]
 
 
 def _activity_kind(activity: str) -> str | None:
@@ -360,12 +419,18 @@ def check_motion(motion: Motion, config: SanityConfig) -> Motion:
     activity = str(motion.metadata.get("activity", ""))
     kind = _activity_kind(activity)
     if config.cadence and kind is not None:
-        spm = cadence_spm(body.time, body.joint("l_ankle"), body.joint("r_ankle"))
+        pairs = {
+            side: (body.joint(f"l_{side[:-1]}"), body.joint(f"r_{side[:-1]}"))
+            for side in ("ankles", "knees", "hands")
+        }
+        est = cadence_estimate(body.time, body.joint("l_ankle"), body.joint("r_ankle"), pairs)
+        spm = None if est is None else est[0]
         lo, hi = config.walk_cadence if kind == "walk" else config.run_cadence
         rate = motion.metadata.get("frame_rate_hz")
         report["cadence"] = {
             "activity": activity,
             "steps_per_min": spm,
+            "from": None if est is None else est[1],
             "plausible": [lo, hi],
             "ok": spm is None or lo <= spm <= hi,
         }

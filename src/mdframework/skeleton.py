@@ -198,3 +198,54 @@ def to_canonical(skeleton: Skeleton, mapping: Mapping[str, str]) -> Skeleton:
     if missing:
         raise KeyError(f"joint mapping lacks canonical joints: {', '.join(missing)}")
     return skeleton.select([mapping[j] for j in CANONICAL_JOINTS]).renamed(CANONICAL_JOINTS)
+
+
+def group_means(
+    positions: FloatArray,
+    names: Sequence[str],
+    groups: Mapping[str, Sequence[str]],
+    valid: BoolArray | None = None,
+) -> tuple[FloatArray, BoolArray]:
+    """Joints as the mean of groups of source points (markers or joints).
+
+    ``positions`` (n_frames, n_points, 3) [any length unit], ``names`` the n_points names,
+    ``groups`` output joint -> the source names to average (one name copies that point);
+    ``valid`` (n_frames, n_points) bool, default: where the positions are finite. Returns the
+    means (n_frames, len(groups), 3) in the same unit, in the order of ``groups``, NaN where a
+    member is invalid, and their validity (n_frames, len(groups)): a joint is valid in a frame
+    only when every member is (a mean of the markers that happen to be seen would jump).
+
+    Raises ``KeyError`` naming a group member that is not among ``names``.
+    """
+    p = np.asarray(positions, dtype=np.float64)
+    ok = np.asarray(np.isfinite(p).all(axis=2) if valid is None else valid, dtype=np.bool_)
+    index = {n: i for i, n in enumerate(names)}
+    out = np.full((p.shape[0], len(groups), 3), np.nan)
+    out_ok = np.zeros((p.shape[0], len(groups)), dtype=bool)
+    for j, members in enumerate(groups.values()):
+        missing = [m for m in members if m not in index]
+        if missing:
+            raise KeyError(", ".join(missing))
+        idx = [index[m] for m in members]
+        both = ok[:, idx].all(axis=1)
+        out[both, j] = p[both][:, idx].mean(axis=1)
+        out_ok[:, j] = both
+    return out, out_ok
+
+
+#: An axis of a file's frame with a sign, as config files name it.
+AXES = ("x", "y", "z", "-x", "-y", "-z")
+
+
+def reorient(positions: FloatArray, axes: Sequence[str]) -> FloatArray:
+    """Positions (..., 3) in the project frame from a file's frame: ``axes[i]`` names the file
+    axis (with a sign, one of :data:`AXES`) that becomes project axis i (x forward, y left,
+    z up). ``("x", "y", "z")`` keeps the positions; ``("z", "x", "y")`` turns a y-up file whose
+    subject faces +z into the project frame. ``ValueError`` unless the three name three
+    different axes."""
+    letters = [a.lstrip("-") for a in axes]
+    if len(axes) != 3 or sorted(letters) != ["x", "y", "z"] or any(a not in AXES for a in axes):
+        raise ValueError(f"axes must name x, y and z once each (with an optional '-'), got {axes}")
+    p = np.asarray(positions, dtype=np.float64)
+    cols = [p[..., "xyz".index(a[-1])] * (-1.0 if a.startswith("-") else 1.0) for a in axes]
+    return np.stack(cols, axis=-1)

@@ -34,6 +34,7 @@ PRECOG = DATA / "kinect" / "precog" / "Seq1_1.csv"
 ONI = DATA / "kinect" / "oni" / "test.oni"
 RADHAR_TEXT = DATA / "radhar" / "text" / "20_jump_1.txt.gz"
 RADHAR_NPZ = DATA / "radhar" / "radhar_walk_subset.npz"
+C3D = DATA / "c3d" / "treadmill_events.c3d"
 
 
 @dataclass(frozen=True)
@@ -1079,12 +1080,81 @@ def _dataset_cases(c: _Corpus) -> None:
     )
 
 
+def _reader_cases(c: _Corpus) -> None:
+    """C3D marker files (the real treadmill capture, damaged) and joint-track tables (the
+    real UTKinect table, damaged, and small written ones)."""
+    raw = C3D.read_bytes()
+    rng = np.random.default_rng(11)
+
+    def c3d_case(name: str, data: bytes, *expect: str) -> None:
+        d = c.folder(f"c3d-{name}")
+        (d / "walk.c3d").write_bytes(data)
+        motion = {"kind": "c3d", "file": "walk.c3d"}
+        c.run(f"c3d-{name}", _json_config(d, {"motion": motion}), "walk.c3d", *expect)
+
+    c3d_case("truncated", raw[:200_000], "truncated")
+    c3d_case("wrong-key", raw[:1] + b"\x51" + raw[2:], "not a C3D file")
+    huge = bytearray(raw)
+    huge[8:10] = (65535).to_bytes(2, "little")
+    c3d_case("last-frame-65535", bytes(huge), "65491 frames")
+    c3d_case("random-bytes", rng.integers(0, 256, 5000, dtype=np.uint8).tobytes(), "not a C3D")
+    c3d_case("too-short", raw[:100], "too short")
+    c3d_case("no-arm-markers", raw, "lacks head", "marker_map")
+
+    utk = _lines(UTK)
+    joints = [
+        "HipCenter", "Spine", "ShoulderCenter", "Head", "ShoulderLeft", "ElbowLeft",
+        "WristLeft", "HandLeft", "ShoulderRight", "ElbowRight", "WristRight", "HandRight",
+        "HipLeft", "KneeLeft", "AnkleLeft", "FootLeft", "HipRight", "KneeRight", "AnkleRight",
+        "FootRight",
+    ]  # fmt: skip
+    table = {
+        "kind": "table", "file": UTK.name, "header": False, "time_column": "frame",
+        "frame_rate": 60.0, "joints": joints, "joint_set": "kinect-v1",
+    }  # fmt: skip
+
+    def table_case(
+        name: str, fname: str, data: str | bytes, motion: dict[str, Any], *e: str
+    ) -> None:
+        d = c.folder(f"table-{name}")
+        (d / fname).write_bytes(data if isinstance(data, bytes) else data.encode("utf-8"))
+        c.run(f"table-{name}", _json_config(d, {"motion": {**motion, "file": fname}}), fname, *e)
+
+    table_case("truncated-line", UTK.name, "".join(utk[:30]) + utk[30][:40], table, ":31:")
+    table_case(
+        "coordinate-1e308",
+        UTK.name,
+        "".join([*utk[:9], _replace_field(utk[9], 4, "1e308"), *utk[10:]]),
+        table,
+        "beyond",
+    )
+    table_case(
+        "word",
+        UTK.name,
+        "".join([*utk[:4], _replace_field(utk[4], 2, "up"), *utk[5:]]),
+        table,
+        ":5:",
+    )
+    table_case("binary", UTK.name, "".join(utk[:5]).encode() + b"\x00\x01", table, "NUL")
+    long = {"kind": "table"}
+    rows = "time,joint,x,y,z\n0,head,0,0,1.7\n0,head,0,0,1.7\n"
+    table_case("joint-twice", "t.csv", rows, long, "t.csv:3:", "twice")
+    rows = "time,joint,x,y,z\n0,head,0,0,1.7\n0.1,head,0,0,1.7\n"
+    table_case("missing-joints", "t.csv", rows, long, "lacks base", "joint_map")
+    table_case("time-inf", "t.csv", "time,joint,x,y,z\ninf,head,0,0,1\n", long, "time")
+    d = c.folder("table-npz-objects")
+    np.savez(d / "t.npz", positions=np.array([object()]), joints=np.array(["head"]))
+    c.run("table-npz-objects", _json_config(d, {"motion": {"kind": "table", "file": "t.npz"}}),
+          "t.npz", "objects")  # fmt: skip
+
+
 def make_corpus(root: Path) -> list[Case]:
     """Write every case under ``root`` (an empty folder) and return them."""
     root.mkdir(parents=True, exist_ok=True)
     c = _Corpus(root)
     _motion_cases(c)
     _radhar_cases(c)
+    _reader_cases(c)
     _config_file_cases(c)
     _field_cases(c)
     _dataset_cases(c)

@@ -248,35 +248,63 @@ def window_transform(name: WindowName, n: int, nu: FloatArray) -> ComplexArray:
 
 
 def _window_transform_on_bins(
-    name: WindowName, n: int, x: FloatArray, bins: IntArray
+    n: int, x: FloatArray, ext: IntArray
+) -> tuple[ComplexArray, ComplexArray]:
+    """The Dirichlet kernel ``D_n(k / n - x)`` of an unpadded FFT at the integer bins ``ext``,
+    factored as ``D = f[..., None] * g`` with ``f`` (*x.shape) and ``g`` (*x.shape, n_ext), so
+    that the factor of each ``x`` multiplies the scatterer's coefficient instead of every bin.
+
+    On bins, ``D_n(k/n - x) = f(x) q_k / sin(pi (k/n - x))`` with ``f(x) = -sin(pi n x)
+    exp(-j pi (n-1) x)`` and ``q_k = (-1)^k exp(j pi (n-1) k / n)``; the sine of the difference
+    is expanded (``sin(pi k/n) cos(pi x) - cos(pi k/n) sin(pi x)``), so the only transcendental
+    functions are per bin and per ``x``. Within 1e-3 of a bin the ratio of two small sines
+    taken of differently rounded arguments loses precision: there ``D`` is evaluated directly
+    from ``nu = k/n - x`` (``n`` on the bin)."""
+    xe = np.asarray(x, np.float64)
+    arg = np.pi * xe
+    f = -np.sin(n * arg) * np.exp(-1j * (n - 1) * arg)
+    zero = f == 0  # x = 0 exactly: D is n on bin 0 and 0 elsewhere
+    f = np.where(zero, 1.0 + 0j, f)
+    e_arg = np.pi * ext / n
+    den = np.sin(e_arg) * np.cos(arg)[..., None] - np.cos(e_arg) * np.sin(arg)[..., None]
+    near = np.abs(den) < 1e-3
+    q = np.where(ext % 2 == 0, 1.0, -1.0) * np.exp(1j * (n - 1) * e_arg)
+    inv = 1.0 / np.where(near, 1.0, den)
+    if zero.any():
+        inv[zero] = 0.0
+    g = np.empty(den.shape, dtype=np.complex128)
+    np.multiply(inv, q.real, out=g.real)
+    np.multiply(inv, q.imag, out=g.imag)
+    if near.any():
+        idx = np.nonzero(near)
+        nu = ext[idx[-1]] / n - xe[idx[:-1]]
+        nu = nu - np.round(nu)  # D is periodic in nu with period 1
+        s_nu = np.sin(np.pi * nu)
+        on = s_nu == 0.0
+        ratio = np.where(on, float(n), np.sin(np.pi * n * nu) / np.where(on, 1.0, s_nu))
+        g[idx] = ratio * np.exp(1j * np.pi * (n - 1) * nu) / f[idx[:-1]]
+    return f, g
+
+
+def _window_bins(name: WindowName, n: int, bins: IntArray) -> IntArray:
+    """The bins a cosine-sum window's transform at ``bins`` needs (each bin and its neighbours
+    up to the window's order), sorted, (n_ext,)."""
+    reach = len(WINDOWS[name]) - 1
+    return np.unique((bins[:, None] + np.arange(-reach, reach + 1)[None, :]).ravel() % n)
+
+
+def _window_combine(
+    name: WindowName, n: int, values: ComplexArray, ext: IntArray, bins: IntArray
 ) -> ComplexArray:
-    """:func:`window_transform` at ``nu = k / n - x`` for integer bins ``k`` of an unpadded
-    FFT, (*x.shape, n_bins): the same values with one sine per element. On bins,
-    ``D_n(k/n - x) = -(-1)^k sin(pi n x) exp(j pi (n-1)(k/n - x)) / sin(pi (k/n - x))``, and a
-    cosine-sum window's shifts by ``c / n`` are shifts by ``c`` bins, so ``D`` is evaluated once
-    on the bins ``k - C .. k + C`` and combined."""
+    """Apply a cosine-sum window to Dirichlet-kernel values on the bins ``ext`` (last axis):
+    ``W(k/n - x) = sum_c (-1)^c a_c / 2 (D(k+c) + D(k-c))`` (``a_0`` once), at ``bins``."""
     coeffs = WINDOWS[name]
-    reach = len(coeffs) - 1
-    ext = np.unique((bins[:, None] + np.arange(-reach, reach + 1)[None, :]).ravel() % n)
-    pos = {int(k): i for i, k in enumerate(ext)}
-    xe = np.asarray(x, np.float64)[..., None]
-    den = np.sin(np.pi * (ext / n - xe))
-    near = np.abs(den) < 1e-12
-    num = -np.sin(np.pi * n * xe) * np.where(ext % 2 == 0, 1.0, -1.0)
-    ratio = np.where(near, float(n), num / np.where(near, 1.0, den))
-    # the phase factor exp(j pi (n-1) nu) is 1 where nu is an integer (D = n exactly there)
-    left = np.exp(1j * np.pi * (n - 1) * ext / n)
-    right = np.exp(-1j * np.pi * (n - 1) * np.asarray(x, np.float64))[..., None]
-    d = np.where(near, float(n) + 0j, ratio * (right * left))
-    out = np.zeros((*np.shape(x), bins.size), dtype=np.complex128)
-    for c, a in enumerate(coeffs):
-        if c == 0:
-            out += a * d[..., [pos[int(k)] for k in bins]]
-            continue
-        up = [pos[int(k)] for k in (bins + c) % n]
-        down = [pos[int(k)] for k in (bins - c) % n]
-        out += (-1) ** c * a / 2.0 * (d[..., up] + d[..., down])
-    return out
+    out = coeffs[0] * np.take(values, np.searchsorted(ext, bins), axis=-1)
+    for c in range(1, len(coeffs)):
+        up = np.take(values, np.searchsorted(ext, (bins + c) % n), axis=-1)
+        down = np.take(values, np.searchsorted(ext, (bins - c) % n), axis=-1)
+        out += (-1) ** c * coeffs[c] / 2.0 * (up + down)
+    return np.asarray(out, np.complex128)
 
 
 def _if_cycles0(delays: FloatArray, seq: ChirpSequence) -> FloatArray:
@@ -334,16 +362,26 @@ def analytic_range_profile(
     """
     c0 = _if_cycles0(delays, seq)
     x = seq.slope * delays / seq.sample_rate  # beat frequency in cycles per sample
-    if n_fft == seq.n_samples:
-        kern = _window_transform_on_bins(name, seq.n_samples, x, np.asarray(bins, np.int64))
-    else:
-        nu = np.asarray(bins, np.float64)[None, None, :] / n_fft - x[:, :, None]
-        kern = window_transform(name, seq.n_samples, nu)
     phase = (-2.0 * np.pi) * c0
     coef = np.empty(c0.shape, dtype=np.complex128)
     coef.real = amplitudes * np.cos(phase)
     coef.imag = amplitudes * np.sin(phase)
     scale = 1.0 / float(np.sum(window(name, seq.n_samples)))
+    if n_fft == seq.n_samples:
+        # the window is a combination of Dirichlet kernels on neighbouring bins, a linear map
+        # that commutes with the sum over scatterers: sum first, combine the bins after
+        sel = np.asarray(bins, np.int64)
+        ext = _window_bins(name, seq.n_samples, sel)
+        factor, dirichlet_ext = _window_transform_on_bins(seq.n_samples, x, ext)
+        coef = coef * factor
+        if phasors is None:
+            summed = np.einsum("cs,csk->ck", coef, dirichlet_ext)
+        else:
+            summed = np.matmul(phasors * coef[:, None, :], dirichlet_ext)
+        total = _window_combine(name, seq.n_samples, summed, ext, sel)
+        return np.asarray(total * scale, np.complex128)
+    nu = np.asarray(bins, np.float64)[None, None, :] / n_fft - x[:, :, None]
+    kern = window_transform(name, seq.n_samples, nu)
     if phasors is None:
         return np.asarray(np.einsum("cs,csk->ck", coef, kern) * scale, np.complex128)
     total = np.einsum("crs,csk->crk", phasors * coef[:, None, :], kern)

@@ -20,6 +20,7 @@ from __future__ import annotations
 import os
 import struct
 from collections.abc import Iterator
+from contextlib import closing, contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -205,91 +206,162 @@ def _sensor(openni2: Any, kind: str) -> Any:
     ]
 
 
+#: Linux system call numbers (x86-64 and arm64) of the sleeps an idle file player thread is in.
+_SLEEP_SYSCALLS = {"35", "230", "101", "115"}
+
+
+def _task_ids() -> set[str]:
+    """Ids of this process's threads (Linux ``/proc``; empty elsewhere)."""
+    try:
+        return set(os.listdir("/proc/self/task"))
+    except OSError:
+        return set()
+
+
+def _wait_until_sleeping(tids: set[str], timeout_s: float = 3.0) -> None:
+    """Wait until every thread in ``tids`` is in a sleep system call (or has ended), for at
+    most ``timeout_s``; without ``/proc``, wait 50 ms."""
+    import time
+
+    if not tids:
+        time.sleep(0.05)
+        return
+
+    def sleeping(tid: str) -> bool:
+        try:
+            with open(f"/proc/self/task/{tid}/syscall") as f:
+                return f.read().split(" ", 1)[0] in _SLEEP_SYSCALLS
+        except OSError:  # the thread has ended
+            return True
+
+    end = time.monotonic() + timeout_s
+    while not all(sleeping(t) for t in tids) and time.monotonic() < end:
+        time.sleep(0.001)
+
+
+@contextmanager
+def _playback(path: Path, stream: str | None) -> Iterator[tuple[Any, Any, Any, str]]:
+    """An ``.oni`` file opened through OpenNI2 with one stream created (not started):
+    ``(openni2, device, stream, kind)``, torn down in the only order that is safe.
+    ``stream`` None takes the first of depth, colour and IR that the recording holds.
+
+    Why the teardown waits: OpenNI2's file driver (``libOniFile``, ``PlayerDevice``) runs a
+    player thread per opened file. Between frames it walks the device's list of streams
+    without a lock (``MainLoop``: is any stream started?), busily once the file is at its end,
+    and it hands frames to streams from inside ``ReadNext``; destroying a stream
+    (``oniStreamDestroy`` -> ``PlayerDevice::destroyStream``) unlinks and frees it without that
+    lock, and closing the device while a stream exists frees objects the thread may still
+    deliver to. Both race the player thread and crash it now and then (a segfault while
+    ``oniDeviceClose`` waits for the thread). Here the stream is stopped and the playback
+    switched to full speed (so a thread waiting for the next frame's trigger runs through the
+    rest of the file), then the teardown waits until the player thread sleeps in its idle loop
+    (no stream started: it sleeps 10 ms between checks), and only then destroys the stream and
+    closes the device.
+    """
+    scan_oni(path)
+    openni2 = initialize_openni()
+    before = _task_ids()
+    dev = open_device(openni2, str(path))
+    player = _task_ids() - before  # the file player's thread, started by the open
+    s = None
+    try:
+        kinds = [stream] if stream is not None else ["depth", "color", "ir"]
+        kind = next((k for k in kinds if dev.has_sensor(_sensor(openni2, k))), None)
+        if kind is None:
+            raise DataFileError(path, f"no {' or '.join(kinds)} stream in this recording")
+        dev.playback.set_repeat_enabled(False)
+        dev.playback.set_speed(-1.0)  # manual: one frame per read, none dropped
+        s = dev.create_stream(_sensor(openni2, kind))
+        yield openni2, dev, s, kind
+    finally:
+        if s is not None:
+            s.stop()
+            dev.playback.set_speed(0.0)  # fastest: no more waiting for a read
+            _wait_until_sleeping(player)
+            s.close()
+        dev.close()
+
+
+def _frames(openni2: Any, s: Any, path: Path, kind: str, timeout_s: float) -> Iterator[Any]:
+    """Start ``s`` and yield its frames in order, each closed before the next is read."""
+    n = s.get_number_of_frames()
+    s.start()
+    for k in range(n):
+        if openni2.wait_for_any_stream([s], timeout_s) is None:
+            raise DataFileError(path, f"{kind} frame {k + 1} of {n}: OpenNI2 delivered no frame")
+        frame = s.read_frame()
+        try:
+            yield frame
+        finally:
+            frame.close()
+
+
 def iter_oni_frames(path: Path, stream: str = "depth", timeout_s: float = 2.0) -> Iterator[Any]:
     """Frames of one stream of an ``.oni`` file through OpenNI2, in order, as the binding's
-    ``VideoFrame`` objects (valid until the next one is read)."""
-    scan = scan_oni(path)
-    del scan
-    openni2 = initialize_openni()
-    dev = open_device(openni2, str(path))
-    try:
-        sensor = _sensor(openni2, stream)
-        if not dev.has_sensor(sensor):
-            raise DataFileError(path, f"no {stream} stream in this recording")
-        dev.playback.set_repeat_enabled(False)
-        dev.playback.set_speed(-1.0)  # as fast as frames are read
-        s = dev.create_stream(sensor)
-        n = s.get_number_of_frames()
-        s.start()
-        try:
-            for k in range(n):
-                if openni2.wait_for_any_stream([s], timeout_s) is None:
-                    raise DataFileError(
-                        path, f"{stream} frame {k + 1} of {n}: OpenNI2 delivered no frame"
-                    )
-                frame = s.read_frame()
-                try:
-                    yield frame
-                finally:
-                    frame.close()
-        finally:
-            s.stop()
-            s.close()
-    finally:
-        dev.close()
+    ``VideoFrame`` objects (valid until the next one is read).
+
+    Close the generator when stopping early (``contextlib.closing``): the recording stays open
+    until it is exhausted or closed."""
+    with _playback(path, stream) as (openni2, _dev, s, kind):
+        yield from _frames(openni2, s, path, kind, timeout_s)
 
 
 def read_oni_depth(path: Path) -> list[DepthFrame]:
     """Every depth frame of an ``.oni`` file, (height, width) uint16 [mm] with time stamps."""
     out: list[DepthFrame] = []
-    for f in iter_oni_frames(path, "depth"):
-        buf = np.frombuffer(bytes(f.get_buffer_as_uint8()), dtype="<u2")
-        depth = buf.reshape(f.height, f.stride // 2)[:, : f.width].copy()
-        out.append(DepthFrame(int(f.frameIndex), int(f.timestamp), depth))
+    with closing(iter_oni_frames(path, "depth")) as frames:
+        for f in frames:
+            buf = np.frombuffer(bytes(f.get_buffer_as_uint8()), dtype="<u2")
+            depth = buf.reshape(f.height, f.stride // 2)[:, : f.width].copy()
+            out.append(DepthFrame(int(f.frameIndex), int(f.timestamp), depth))
     return out
 
 
-def oni_info(path: Path) -> dict[str, Any]:
+def _stream_info(frames: Iterator[Any]) -> dict[str, Any]:
+    """Resolution, pixel format, frame count, time stamps and measured rate of one stream."""
+    stamps: list[int] = []
+    mode: dict[str, Any] = {}
+    for f in frames:
+        stamps.append(int(f.timestamp))
+        if not mode:
+            vm = f.videoMode
+            mode = {
+                "width": int(f.width),
+                "height": int(f.height),
+                "pixel_format": str(vm.pixelFormat).split(".")[-1].replace("ONI_PIXEL_FORMAT_", ""),
+                "nominal_fps": int(vm.fps),
+                "bytes_per_frame": int(f.dataSize),
+            }
+    rate = (len(stamps) - 1) / ((stamps[-1] - stamps[0]) * 1e-6) if len(stamps) > 1 else None
+    return {
+        **mode,
+        "frames": len(stamps),
+        "first_timestamp_us": stamps[0] if stamps else None,
+        "last_timestamp_us": stamps[-1] if stamps else None,
+        "measured_fps": rate,
+        "timestamps_increasing": bool(np.all(np.diff(stamps) > 0)),
+    }
+
+
+def oni_info(path: Path, timeout_s: float = 2.0) -> dict[str, Any]:
     """Streams of an ``.oni`` file: resolution, pixel format, frame count, first and last time
-    stamps [us] and measured frame rate [Hz], read through OpenNI2."""
+    stamps [us] and measured frame rate [Hz], read through OpenNI2.
+
+    The device is only ever opened with a stream to read (the first session also reads the
+    device's name and sensors): a file device closed before its player thread has started
+    would keep that thread spinning until the driver's 3 s join timeout kills it."""
     scan = scan_oni(path)
-    openni2 = initialize_openni()
-    dev = open_device(openni2, str(path))
-    try:
+    with _playback(path, None) as (openni2, dev, s, first):
         info = dev.get_device_info()
         device = {
             "name": info.name.decode(errors="replace"),
             "vendor": info.vendor.decode(errors="replace"),
         }
         has = {k: dev.has_sensor(_sensor(openni2, k)) for k in ("depth", "color", "ir")}
-    finally:
-        dev.close()
-    streams: dict[str, Any] = {}
-    for kind, present in has.items():
-        if not present:
-            continue
-        stamps: list[int] = []
-        mode: dict[str, Any] = {}
-        for f in iter_oni_frames(path, kind):
-            stamps.append(int(f.timestamp))
-            if not mode:
-                vm = f.videoMode
-                mode = {
-                    "width": int(f.width),
-                    "height": int(f.height),
-                    "pixel_format": str(vm.pixelFormat)
-                    .split(".")[-1]
-                    .replace("ONI_PIXEL_FORMAT_", ""),
-                    "nominal_fps": int(vm.fps),
-                    "bytes_per_frame": int(f.dataSize),
-                }
-        rate = (len(stamps) - 1) / ((stamps[-1] - stamps[0]) * 1e-6) if len(stamps) > 1 else None
-        streams[kind] = {
-            **mode,
-            "frames": len(stamps),
-            "first_timestamp_us": stamps[0] if stamps else None,
-            "last_timestamp_us": stamps[-1] if stamps else None,
-            "measured_fps": rate,
-            "timestamps_increasing": bool(np.all(np.diff(stamps) > 0)),
-        }
+        streams = {first: _stream_info(_frames(openni2, s, path, first, timeout_s))}
+    for kind in (k for k, present in has.items() if present and k != first):
+        with closing(iter_oni_frames(path, kind, timeout_s)) as frames:
+            streams[kind] = _stream_info(frames)
+    order = ("depth", "color", "ir")
+    streams = {k: streams[k] for k in order if k in streams}
     return {"file": str(path), "device": device, "records": scan.n_records, "streams": streams}

@@ -1,0 +1,254 @@
+"""The ``c3d`` plugin (``mdf-c3d``): C3D marker files through ezc3d.
+
+Physics on the real treadmill walk shipped in ``examples/data/c3d`` (see its PROVENANCE.md):
+the cadence from the markers against the gait events the lab marked in the file, the belt
+speed from the stance heel, stride length, and the shank's constant length. The mapping onto
+the canonical body is checked on files written here with ezc3d (the real file has no arm or
+head markers, and the source must say so), and the bad-input rules on damaged copies.
+"""
+
+from __future__ import annotations
+
+import struct
+from pathlib import Path
+
+import numpy as np
+import pytest
+from helpers import pig_markers, write_c3d
+from mdf_c3d import C3dConfig, C3dSource, read_c3d, read_c3d_header
+
+from mdframework import CANONICAL_JOINTS, DataFileError
+from mdframework.sanity import cadence_spm
+from mdframework.skeleton import group_means
+
+REAL = Path(__file__).parents[1] / "examples" / "data" / "c3d" / "treadmill_events.c3d"
+
+KNEES_ANKLES = {
+    "l_knee": ["LLEK", "LMEK"],
+    "r_knee": ["RLEK", "RMEK"],
+    "l_ankle": ["LLM", "LMM"],
+    "r_ankle": ["RLM", "RMM"],
+    "l_heel": ["LHEE"],
+    "r_heel": ["RHEE"],
+    "pelvis": ["LASIS", "RASIS", "LPSIS", "RPSIS"],
+}
+
+
+@pytest.fixture(scope="module")
+def real() -> tuple[np.ndarray, np.ndarray, object]:
+    m = read_c3d(REAL)
+    p, ok = group_means(m.positions * m.unit_m, m.labels, KNEES_ANKLES)
+    assert ok.all()
+    t = np.arange(m.n_frames) / m.rate_hz
+    return t, p, m
+
+
+def _j(name: str) -> int:
+    return list(KNEES_ANKLES).index(name)
+
+
+def test_real_file_header_units_and_events() -> None:
+    h = read_c3d_header(REAL)
+    assert (h.processor, h.floats, h.n_points, h.n_frames) == ("Intel", True, 124, 1206)
+    m = read_c3d(REAL)
+    assert m.rate_hz == 100.0 and m.units == "mm" and m.unit_m == 1e-3
+    assert m.subject == "SI02" and m.software == "Vicon Nexus"
+    assert m.positions.shape == (1206, 124, 3)
+    labels = {e[0] for e in m.events}
+    assert labels == {"Foot Strike", "Foot Off"} and len(m.events) == 43
+    # z up: the pelvis about a metre above the floor, the heels within 30 cm of it
+    z = m.positions[..., 2] * m.unit_m
+    assert 0.85 < np.nanmedian(z[:, m.labels.index("LASIS")]) < 1.1
+    assert np.nanmin(z[:, m.labels.index("LHEE")]) < 0.1
+
+
+def test_real_cadence_from_markers_matches_the_labs_gait_events(real) -> None:
+    t, p, m = real
+    strikes = np.array([e[2] for e in m.events if e[0] == "Foot Strike"])
+    # the lab's events: steps per minute over the span they cover
+    from_events = (strikes.size - 1) / (strikes.max() - strikes.min()) * 60
+    from_markers = cadence_spm(t, p[:, _j("l_ankle")], p[:, _j("r_ankle")])
+    assert from_markers is not None
+    assert from_markers == pytest.approx(from_events, rel=0.02)
+    assert from_events == pytest.approx(105.8, abs=0.05)  # an ordinary walking cadence
+
+
+def test_real_treadmill_belt_speed_and_stride_length(real) -> None:
+    t, p, m = real
+    speeds = {}
+    for side, ctx in (("l_heel", "Left"), ("r_heel", "Right")):
+        strikes = sorted(e[2] for e in m.events if e[0] == "Foot Strike" and e[1] == ctx)
+        offs = sorted(e[2] for e in m.events if e[0] == "Foot Off" and e[1] == ctx)
+        v = np.gradient(p[:, _j(side), 1], t)
+        mid = []
+        for a in strikes:
+            b = next((f for f in offs if f > a), None)
+            if b is None:
+                continue
+            # middle half of stance; event times count from the file's frame 1
+            i0 = round((a + 0.25 * (b - a)) * m.rate_hz) - (m.first_frame - 1)
+            i1 = round((a + 0.75 * (b - a)) * m.rate_hz) - (m.first_frame - 1)
+            mid.append(np.median(v[max(i0, 0) : i1]))
+        assert len(mid) >= 8
+        # the stance foot rides the belt: the same speed in every stride (within 2 %)
+        assert np.std(mid) < 0.02 * abs(np.mean(mid))
+        speeds[ctx] = abs(float(np.mean(mid)))
+        stride_s = float(np.median(np.diff(strikes)))
+        assert stride_s == pytest.approx(1.135, abs=0.01)
+        stride_m = speeds[ctx] * stride_s
+        assert stride_m == pytest.approx(1.24, abs=0.02)  # an ordinary walking stride
+    assert speeds["Left"] == pytest.approx(speeds["Right"], rel=0.02)
+    assert speeds["Left"] == pytest.approx(1.09, abs=0.01)  # a comfortable walking speed
+    # on a treadmill the pelvis stays put: its mean speed along the belt is under 1 % of it
+    pelvis_v = np.gradient(p[:, _j("pelvis"), 1], t)
+    assert abs(np.mean(pelvis_v)) < 0.01 * speeds["Left"]
+
+
+def test_real_shank_length_is_constant(real) -> None:
+    _, p, _ = real
+    for s in "lr":
+        shank = np.linalg.norm(p[:, _j(f"{s}_knee")] - p[:, _j(f"{s}_ankle")], axis=1)
+        # knee and ankle centres from medial and lateral markers: a rigid bone within 1 %
+        assert shank.mean() == pytest.approx(0.405, abs=0.005)
+        assert shank.std() / shank.mean() == pytest.approx(0.007, abs=0.001)
+
+
+def test_real_file_without_arms_is_refused_naming_its_markers() -> None:
+    with pytest.raises(DataFileError) as err:
+        C3dSource(C3dConfig(file=REAL)).load()
+    msg = str(err.value)
+    assert msg.startswith(str(REAL))
+    assert "lacks head (LFHD + RFHD + LBHD + RBHD), l_shoulder (LSHO)" in msg
+    assert "LASIS, RASIS, LPSIS" in msg and "marker_map" in msg and "\n" not in msg
+
+
+# --------------------------------------------------------------------------- written files
+
+
+def _body(n: int, rate: float) -> dict[str, np.ndarray]:
+    """Joint tracks [m] of a body stepping forward at 1.2 m/s with swinging limbs."""
+    t = np.arange(n) / rate
+    base = np.stack([1.2 * t, 0.0 * t, 1.0 + 0.02 * np.sin(2 * np.pi * 1.8 * t)], axis=1)
+    off = {
+        "neck": (0, 0, 0.5),
+        "head": (0, 0, 0.7),
+        "l_shoulder": (0, 0.2, 0.45),
+        "r_shoulder": (0, -0.2, 0.45),
+        "l_elbow": (0, 0.22, 0.15),
+        "r_elbow": (0, -0.22, 0.15),
+        "l_hand": (0, 0.22, -0.1),
+        "r_hand": (0, -0.22, -0.1),
+        "l_hip": (0, 0.1, -0.05),
+        "r_hip": (0, -0.1, -0.05),
+        "l_knee": (0, 0.1, -0.5),
+        "r_knee": (0, -0.1, -0.5),
+        "l_ankle": (0, 0.1, -0.92),
+        "r_ankle": (0, -0.1, -0.92),
+        "l_toe": (0.15, 0.1, -0.98),
+        "r_toe": (0.15, -0.1, -0.98),
+    }
+    out = {"base": base}
+    for j, o in off.items():
+        swing = (0.0 if j in ("neck", "head") else 0.2) * np.sin(2 * np.pi * 0.9 * t)
+        sign = 1 if j.startswith("l_") else -1
+        out[j] = base + np.array(o) + np.stack([sign * swing, 0 * t, 0 * t], axis=1)
+    return out
+
+
+def test_plug_in_gait_file_gives_the_joints_as_marker_means(tmp_path: Path) -> None:
+    body = _body(120, 60.0)
+    path = tmp_path / "walk.c3d"
+    write_c3d(path, pig_markers(body), 60.0, "cm", 0.01)
+    m = C3dSource(C3dConfig(file=path, activity="walk")).load()
+    assert m.metadata["marker_set"] == "plug-in-gait" and m.metadata["unit_m"] == 0.01
+    assert m.metadata["frame_rate_hz"] == 60.0 and m.metadata["frame_rate_from"] == "header"
+    c = m.canonical()
+    assert c.joint_names == CANONICAL_JOINTS
+    assert np.allclose(np.diff(c.time), 1 / 60)
+    # base: the mean of the four pelvis markers is the mean of the two hips here
+    truth = dict(body, base=(body["l_hip"] + body["r_hip"]) / 2)
+    for j in CANONICAL_JOINTS:
+        assert np.allclose(c.joint(j), truth[j], atol=1e-5), j  # ezc3d stores float32
+    assert m.metadata["markers"]["head"] == ["LFHD", "RFHD", "LBHD", "RBHD"]
+
+
+def test_axes_units_rate_and_marker_map_from_the_config(tmp_path: Path) -> None:
+    body = _body(60, 50.0)
+    markers = pig_markers(body)
+    markers["LMKNE"] = body["l_knee"] + np.array([0.0, -0.05, 0.0])
+    markers["LKNE"] = body["l_knee"] + np.array([0.0, 0.05, 0.0])
+    # a y-up lab: file (X, Y, Z) = project (y, z, x)
+    yup = {k: v[:, [1, 2, 0]] for k, v in markers.items()}
+    path = tmp_path / "yup.c3d"
+    write_c3d(path, yup, 50.0, "mm", 0.001)
+    m = C3dSource(
+        C3dConfig(
+            file=path,
+            axes=("z", "x", "y"),
+            frame_rate=100.0,
+            marker_map={"l_knee": ["LKNE", "LMKNE"]},
+        )
+    ).load()
+    c = m.canonical()
+    assert np.allclose(c.joint("l_knee"), body["l_knee"], atol=1e-4)
+    assert np.allclose(c.joint("head"), body["head"], atol=1e-4)
+    assert np.allclose(np.diff(c.time), 0.01) and m.metadata["frame_rate_from"] == "config"
+    assert m.metadata["markers"]["l_knee"] == ["LKNE", "LMKNE"]
+
+
+def test_unseen_markers_make_their_joints_invalid(tmp_path: Path) -> None:
+    body = _body(40, 50.0)
+    markers = pig_markers(body)
+    markers["LWRA"][10:15] = np.nan  # ezc3d writes NaN points as not seen (residual -1)
+    path = tmp_path / "gap.c3d"
+    write_c3d(path, markers, 50.0, "m", 1.0)
+    c = C3dSource(C3dConfig(file=path)).load().canonical()
+    hand = c.index("l_hand")
+    assert not c.valid[10:15, hand].any() and c.valid[:10, hand].all()
+    assert c.valid[:, c.index("r_hand")].all()
+
+
+# --------------------------------------------------------------------------- bad input
+
+
+def _patched(tmp_path: Path, name: str, offset: int, data: bytes) -> Path:
+    raw = bytearray(REAL.read_bytes())
+    raw[offset : offset + len(data)] = data
+    out = tmp_path / name
+    out.write_bytes(bytes(raw))
+    return out
+
+
+def test_bad_files_are_one_line_errors_naming_the_file(tmp_path: Path) -> None:
+    cut = tmp_path / "cut.c3d"
+    cut.write_bytes(REAL.read_bytes()[:200_000])
+    cut_msg = (
+        r"cut\.c3d: header declares 1206 frames of 124 points and 240 analog samples from block "
+        r"62 \(3,581,696 bytes\), but the file holds 200,000 bytes: the file is truncated"
+    )
+    with pytest.raises(DataFileError, match=cut_msg):
+        read_c3d(cut)
+    bad_key = _patched(tmp_path, "key.c3d", 1, b"\x51")
+    with pytest.raises(DataFileError, match=r"key\.c3d: not a C3D file: header byte 2 is 0x51"):
+        read_c3d(bad_key)
+    # a header claiming 65535 frames: refused from the header, before anything is allocated
+    huge = _patched(tmp_path, "huge.c3d", 8, struct.pack("<H", 65535))
+    with pytest.raises(DataFileError, match=r"huge\.c3d: header declares 65491 frames"):
+        read_c3d(huge)
+    short = tmp_path / "short.c3d"
+    short.write_bytes(b"\x02\x50" + bytes(100))
+    with pytest.raises(DataFileError, match=r"short\.c3d: 102 bytes: too short"):
+        read_c3d(short)
+    garbage = tmp_path / "garbage.c3d"
+    garbage.write_bytes(np.random.default_rng(3).integers(0, 256, 5000, dtype=np.uint8).tobytes())
+    with pytest.raises(DataFileError, match=r"garbage\.c3d: not a C3D file"):
+        read_c3d(garbage)
+
+
+def test_unknown_units_ask_for_unit_m(tmp_path: Path) -> None:
+    path = tmp_path / "feet.c3d"
+    write_c3d(path, pig_markers(_body(20, 50.0)), 50.0, "ft", 0.3048)
+    with pytest.raises(DataFileError, match=r"feet\.c3d: POINT:UNITS is 'ft'.*motion\.unit_m"):
+        C3dSource(C3dConfig(file=path)).load()
+    m = C3dSource(C3dConfig(file=path, unit_m=0.3048)).load()
+    assert m.metadata["unit_from"] == "config"

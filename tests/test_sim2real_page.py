@@ -1,0 +1,88 @@
+"""docs/sim-to-real.md against the numbers that benchmarks/bench_sim2real.py wrote.
+
+The benchmark (``--docs``) copies its ``results.json`` to ``docs/data/sim2real_results.json``;
+the page must show exactly the tables the script renders from it, quote the command that made
+it, and every other decimal number in its prose must be one of the script's figures.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import re
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PAGE = ROOT / "docs" / "sim-to-real.md"
+RESULTS = ROOT / "docs" / "data" / "sim2real_results.json"
+BEGIN = "<!-- bench_sim2real tables: generated, do not edit -->"
+END = "<!-- end of bench_sim2real tables -->"
+
+
+def _bench() -> ModuleType:
+    spec = importlib.util.spec_from_file_location(
+        "bench_sim2real", ROOT / "benchmarks" / "bench_sim2real.py"
+    )
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _results() -> dict[str, Any]:
+    data: dict[str, Any] = json.loads(RESULTS.read_text())
+    return data
+
+
+def _block(page: str) -> tuple[str, str]:
+    """The generated block and the rest of the page."""
+    start, end = page.index(BEGIN), page.index(END)
+    return page[start + len(BEGIN) : end].strip("\n") + "\n", page[:start] + page[end:]
+
+
+def test_the_page_shows_the_tables_the_script_renders() -> None:
+    pytest.importorskip("mdf_fmcw")  # the benchmark's config needs the FMCW radar
+    bench = _bench()
+    results = _results()
+    generated, _ = _block(PAGE.read_text())
+    assert generated == bench.markdown(results)
+    assert set(results["sim_to_real"]) <= set(bench.VARIANTS)
+    # three or more seeds for every variant: the spread is over seeds
+    assert len(results["seeds"]) >= 3
+    for variant, res in results["sim_to_real"].items():
+        for key, cell in res.items():
+            if key != "what":
+                assert len(cell["scores"]) == len(results["seeds"]), (variant, key)
+
+
+def test_the_page_quotes_the_command_and_only_the_scripts_numbers() -> None:
+    pytest.importorskip("mdf_fmcw")
+    bench = _bench()
+    results = _results()
+    page = PAGE.read_text()
+    generated, prose = _block(page)
+    assert ".venv/bin/python " + results["command"] in prose
+    # every accuracy-like number (0.xxx) and every signed difference in points in the prose is
+    # one the script printed
+    numbers = set(re.findall(r"(?<![\d.])0\.\d{3}(?!\d)", prose))
+    numbers |= set(re.findall(r"(?<![\w.])[+-]\d+\.\d(?!\d)", prose))
+    rendered = bench.markdown(results)
+    missing = sorted(n for n in numbers if n not in rendered)
+    assert not missing, f"numbers on the page that the script did not print: {missing}"
+    assert generated == rendered
+
+
+def test_the_goal_sentence_follows_the_numbers() -> None:
+    """The goal verdict is computed, not written: met exactly where the mean is >= 0.80 and
+    within 10 points of the real-to-real mean of the same input and classifier."""
+    bench = _bench()
+    results = {
+        "real_to_real": {"a": {"mean": 0.92}, "b": {"mean": 0.92}, "c": {"mean": 0.85}},
+        "sim_to_real": {"full": {"a": {"mean": 0.83}, "b": {"mean": 0.81}, "c": {"mean": 0.79}}},
+    }
+    assert bench.goal(results) == {"a": True, "b": False, "c": False}
+    assert bench.goal_line(results).endswith("met for `a`; not met for `b`, `c`.")

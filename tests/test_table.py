@@ -1,0 +1,214 @@
+"""The ``table`` plugin (``mdf-table``): plain joint-track tables, long or wide, CSV/TSV/text/NPZ.
+
+The real file is UTKinect-Action3D's s01_e01 joints file (``examples/data/kinect``, see its
+PROVENANCE.md), which is a plain whitespace table without a header: read through the generic
+table reader it must give exactly what the Kinect plugin's own UTKinect reader gives (an
+independent implementation), and its walk a plausible cadence. Layouts, units, axes, joint
+maps and bad input are checked on tables written here from known tracks.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from mdf_kinect import KINECT_V1_JOINTS, read_utkinect, to_project_frame
+from mdf_table import TableConfig, TableLayout, TableSource, read_table
+
+from mdframework import CANONICAL_JOINTS, DataFileError
+from mdframework.config import load_run_config
+from mdframework.pipeline import build_stages, load_motion
+
+ROOT = Path(__file__).parents[1]
+UT = ROOT / "examples" / "data" / "kinect" / "utkinect" / "joints_s01_e01.txt"
+EXAMPLE = ROOT / "examples" / "table_utkinect_walk.toml"
+
+
+def test_utkinect_file_as_a_plain_table_equals_the_kinect_reader() -> None:
+    spec = TableLayout(
+        header=False, joints=tuple(KINECT_V1_JOINTS), time_column="frame", frame_rate=60.0
+    )
+    table = read_table(UT, spec)
+    ref = read_utkinect(UT)
+    assert table.names == tuple(KINECT_V1_JOINTS) and table.layout == "wide"
+    assert np.array_equal(table.time, ref.time)
+    assert np.array_equal(table.positions, ref.positions)
+    # the file repeats some frame numbers: both readers keep the first and drop the rest
+    assert table.duplicates_dropped == ref.metadata["duplicate_frames_dropped"] == 15
+
+
+def test_example_walk_through_the_table_source_matches_the_kinect_source() -> None:
+    cfg = load_run_config(EXAMPLE)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the depth camera's bone-length warning
+        motion = load_motion(build_stages(cfg).source)
+    body = motion.canonical()
+    # the walk segment: frames 252..390 at 60 frame numbers per second
+    assert body.time[0] == 0.0 and body.time[-1] == pytest.approx((390 - 252) / 60, abs=1 / 30)
+    ref = read_utkinect(UT)
+    sel = (ref.frame_numbers >= 252) & (ref.frame_numbers <= 390)
+    want = to_project_frame(ref.positions[sel])
+    idx = [KINECT_V1_JOINTS.index(motion.metadata["joints"][j][0]) for j in CANONICAL_JOINTS]
+    assert np.allclose(body.positions, want[:, idx], equal_nan=True)
+    # a walk across the sensor's view: the pelvis covers 1.6 m at a slow walking speed, and
+    # the cadence found by the sanity checks is a walking one (about 102 steps a minute)
+    base = body.joint("base")
+    speed = np.linalg.norm(base[-1, :2] - base[0, :2]) / (body.time[-1] - body.time[0])
+    assert speed == pytest.approx(0.70, abs=0.01)
+    cad = motion.metadata["sanity"]["cadence"]
+    assert cad["ok"] and cad["steps_per_min"] == pytest.approx(102, abs=1)
+
+
+# --------------------------------------------------------------------------- written tables
+
+
+def _tracks(n: int = 30, rate: float = 50.0) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    t = np.arange(n) / rate
+    rng = np.random.default_rng(7)
+    out = {}
+    for k, j in enumerate(CANONICAL_JOINTS):
+        out[j] = np.stack(
+            [0.9 * t + 0.01 * k, 0.02 * k + 0 * t, 0.1 * k + 0.05 * np.sin(6 * t + k)], axis=1
+        ) + rng.normal(0, 1e-3, (n, 3))
+    return t, out
+
+
+def _long_csv(path: Path, t: np.ndarray, tracks: dict[str, np.ndarray], scale: float) -> None:
+    rows = ["time,joint,x,y,z,confidence"]
+    for i, ti in enumerate(t):
+        for j, p in tracks.items():
+            x, y, z = p[i] / scale
+            rows.append(f"{ti:.6f},{j},{x:.9g},{y:.9g},{z:.9g},1")
+    path.write_text("\n".join(rows) + "\n")
+
+
+def test_long_csv_in_millimetres(tmp_path: Path) -> None:
+    t, tracks = _tracks()
+    path = tmp_path / "long.csv"
+    _long_csv(path, t, tracks, 0.001)
+    m = TableSource(TableConfig(file=path, units="mm")).load()
+    body = m.canonical()
+    assert m.metadata["layout"] == "long" and m.metadata["joint_set"] == "canonical"
+    assert m.metadata["frame_rate_hz"] == pytest.approx(50.0)
+    for j in CANONICAL_JOINTS:
+        assert np.allclose(body.joint(j), tracks[j], atol=1e-6)
+
+
+def test_wide_tsv_with_time_in_ms_axes_and_mean_joints(tmp_path: Path) -> None:
+    t, tracks = _tracks()
+    names = {j: j.replace("l_", "Left").replace("r_", "Right") for j in CANONICAL_JOINTS}
+    # a y-up file: file (X, Y, Z) = project (y, z, x); the base is given as two hip markers
+    cols = ["ms"] + [f"{names[j]}.{a}" for j in CANONICAL_JOINTS if j != "base" for a in "XYZ"]
+    cols += [f"{h}.{a}" for h in ("PelvisL", "PelvisR") for a in "XYZ"]
+    lines = ["\t".join(cols)]
+    for i, ti in enumerate(t):
+        vals = [f"{ti * 1000:.3f}"]
+        for j in CANONICAL_JOINTS:
+            if j != "base":
+                vals += [f"{v:.9g}" for v in tracks[j][i][[1, 2, 0]]]
+        for d in (0.1, -0.1):
+            vals += [f"{v:.9g}" for v in (tracks["base"][i] + [0, d, 0])[[1, 2, 0]]]
+        lines.append("\t".join(vals))
+    path = tmp_path / "wide.tsv"
+    path.write_text("\n".join(lines) + "\n")
+    joint_map = {j: names[j] for j in CANONICAL_JOINTS if j != "base"}
+    cfg = TableConfig(
+        file=path,
+        time_column="ms",
+        time_unit_s=0.001,
+        axes=("z", "x", "y"),
+        joint_map={**joint_map, "base": ["PelvisL", "PelvisR"]},
+    )
+    m = TableSource(cfg).load()
+    body = m.canonical()
+    assert m.metadata["layout"] == "wide"
+    for j in CANONICAL_JOINTS:
+        assert np.allclose(body.joint(j), tracks[j], atol=1e-6), j
+    assert np.allclose(body.time, t - t[0], atol=1e-9)
+
+
+def test_npz_wide_and_long_agree(tmp_path: Path) -> None:
+    t, tracks = _tracks()
+    pos = np.stack([tracks[j] for j in CANONICAL_JOINTS], axis=1)
+    wide = tmp_path / "wide.npz"
+    np.savez(wide, time=t, positions=pos, joints=np.array(CANONICAL_JOINTS))
+    long = tmp_path / "long.npz"
+    n, nj = pos.shape[:2]
+    np.savez(
+        long,
+        time=np.repeat(t, nj),
+        joint=np.tile(np.array(CANONICAL_JOINTS), n),
+        x=pos[..., 0].ravel(),
+        y=pos[..., 1].ravel(),
+        z=pos[..., 2].ravel(),
+    )
+    a = TableSource(TableConfig(file=wide)).load().canonical()
+    b = TableSource(TableConfig(file=long)).load().canonical()
+    assert np.array_equal(a.positions, b.positions) and np.allclose(a.positions, pos)
+
+
+def test_missing_values_and_unsorted_rows(tmp_path: Path) -> None:
+    t, tracks = _tracks(10)
+    path = tmp_path / "gaps.csv"
+    _long_csv(path, t, tracks, 1.0)
+    lines = path.read_text().splitlines()
+    head, rows = lines[0], lines[1:]
+    # the head's row of frame 3 loses its coordinates; frames 5 and 6 swap places
+    k = 3 * 17 + CANONICAL_JOINTS.index("head")
+    rows[k] = ",".join([*rows[k].split(",")[:2], "", "", "", "0"])
+    rows[5 * 17 : 7 * 17] = rows[6 * 17 : 7 * 17] + rows[5 * 17 : 6 * 17]
+    path.write_text("\n".join([head, *rows]) + "\n")
+    body = TableSource(TableConfig(file=path)).load().canonical()
+    h = body.index("head")
+    assert not body.valid[3, h] and body.valid[[2, 4], h].all()
+    assert np.all(np.diff(body.time) > 0)
+    assert np.allclose(body.joint("l_knee")[5:7], tracks["l_knee"][5:7])
+
+
+# --------------------------------------------------------------------------- bad input
+
+
+@pytest.mark.parametrize(
+    "name,text,match",
+    [
+        (
+            "ragged.csv",
+            "time,joint,x,y,z\n0,head,1,2,3\n0.1,head,1,2\n",
+            r"ragged\.csv:3: 4 fields",
+        ),
+        ("word.csv", "time,joint,x,y,z\n0,head,1,two,3\n", r"word\.csv:2: coordinate: 'two'"),
+        ("inf.csv", "time,joint,x,y,z\n0,head,1,inf,3\n1,head,1,2,3\n", r"inf\.csv.*not finite"),
+        ("far.csv", "time,joint,x,y,z\n0,head,1,2,3e9\n1,head,1,2,3\n", r"far\.csv.*beyond"),
+        ("twice.csv", "time,joint,x,y,z\n0,head,1,2,3\n0,head,1,2,3\n", r"twice\.csv:3: joint"),
+        ("one.csv", "time,joint,x,y,z\n0,head,1,2,3\n", r"one\.csv.*two"),
+        ("nojoint.csv", "time,a,b\n0,1,2\n1,1,2\n", r"nojoint\.csv:1: no joint columns"),
+        ("empty.csv", "\n\n", r"empty\.csv: the file is empty"),
+    ],
+)
+def test_bad_tables_are_one_line_errors(tmp_path: Path, name: str, text: str, match: str) -> None:
+    path = tmp_path / name
+    path.write_text(text)
+    with pytest.raises(DataFileError, match=match) as err:
+        read_table(path)
+    assert "\n" not in str(err.value)
+
+
+def test_binary_files_and_missing_joints(tmp_path: Path) -> None:
+    binary = tmp_path / "bin.csv"
+    binary.write_bytes(b"time,joint,x,y,z\n\x00\x01")
+    with pytest.raises(DataFileError, match=r"bin\.csv:2: binary data"):
+        read_table(binary)
+    pickled = tmp_path / "obj.npz"
+    np.savez(pickled, positions=np.array([object()]), joints=np.array(["a"]))
+    with pytest.raises(DataFileError, match=r"obj\.npz: array 'positions' holds Python objects"):
+        read_table(pickled)
+    t, tracks = _tracks(5)
+    tracks.pop("l_toe")
+    path = tmp_path / "notoe.csv"
+    _long_csv(path, t, tracks, 1.0)
+    with pytest.raises(DataFileError, match=r"notoe\.csv: the joint set 'canonical' lacks l_toe"):
+        TableSource(TableConfig(file=path)).load()
+    with pytest.raises(DataFileError, match=r"joint_map names joints not in the file: LeftToe"):
+        TableSource(TableConfig(file=path, joint_map={"l_toe": "LeftToe"})).load()
