@@ -24,6 +24,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -237,15 +238,32 @@ def group_means(
 AXES = ("x", "y", "z", "-x", "-y", "-z")
 
 
+def check_axes(axes: Sequence[str]) -> None:
+    """``ValueError`` unless ``axes`` names x, y and z once each, each one of :data:`AXES`."""
+    letters = [a.lstrip("-") for a in axes]
+    if len(axes) != 3 or sorted(letters) != ["x", "y", "z"] or any(a not in AXES for a in axes):
+        raise ValueError(
+            f"axes must name x, y and z once each (with an optional '-'), got {list(axes)}"
+        )
+
+
+def check_canonical_keys(mapping: Mapping[str, Any] | None, field: str) -> None:
+    """``ValueError`` naming ``field`` unless every key of ``mapping`` (a user's joint or
+    marker map) is a canonical joint."""
+    bad = sorted(set(mapping or {}) - set(CANONICAL_JOINTS))
+    if bad:
+        raise ValueError(
+            f"{field}: {', '.join(bad)} are not canonical joints ({', '.join(CANONICAL_JOINTS)})"
+        )
+
+
 def reorient(positions: FloatArray, axes: Sequence[str]) -> FloatArray:
     """Positions (..., 3) in the project frame from a file's frame: ``axes[i]`` names the file
     axis (with a sign, one of :data:`AXES`) that becomes project axis i (x forward, y left,
     z up). ``("x", "y", "z")`` keeps the positions; ``("z", "x", "y")`` turns a y-up file whose
     subject faces +z into the project frame. ``ValueError`` unless the three name three
     different axes."""
-    letters = [a.lstrip("-") for a in axes]
-    if len(axes) != 3 or sorted(letters) != ["x", "y", "z"] or any(a not in AXES for a in axes):
-        raise ValueError(f"axes must name x, y and z once each (with an optional '-'), got {axes}")
+    check_axes(axes)
     p = np.asarray(positions, dtype=np.float64)
     cols = [p[..., "xyz".index(a[-1])] * (-1.0 if a.startswith("-") else 1.0) for a in axes]
     return np.stack(cols, axis=-1)

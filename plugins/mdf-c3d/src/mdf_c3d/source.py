@@ -24,7 +24,7 @@ from mdframework import (
     limits,
 )
 from mdframework.settings import FrameRate
-from mdframework.skeleton import group_means, reorient
+from mdframework.skeleton import check_axes, check_canonical_keys, group_means, reorient
 
 Axis = Literal["x", "y", "z", "-x", "-y", "-z"]
 
@@ -62,14 +62,8 @@ class C3dConfig(MotionConfig):
     def _check(self) -> C3dConfig:
         if Path(self.file).suffix.lower() != ".c3d":
             raise ValueError(f"file must be a .c3d file, got {Path(self.file).name!r}")
-        bad = sorted(set(self.marker_map or {}) - set(CANONICAL_JOINTS))
-        if bad:
-            raise ValueError(
-                f"marker_map: {', '.join(bad)} are not canonical joints "
-                f"({', '.join(CANONICAL_JOINTS)})"
-            )
-        if sorted(a[-1] for a in self.axes) != ["x", "y", "z"]:
-            raise ValueError(f"axes must name x, y and z once each, got {list(self.axes)}")
+        check_canonical_keys(self.marker_map, "marker_map")
+        check_axes(self.axes)
         return self
 
 

@@ -39,6 +39,7 @@ from mdframework import (
     Skeleton,
 )
 from mdframework.settings import FrameRate
+from mdframework.skeleton import check_canonical_keys
 
 from .bvh import bvh_forward_kinematics, read_bvh
 from .kinematics import to_project_frame
@@ -217,12 +218,7 @@ class BvhConfig(MotionConfig):
     def _check(self) -> BvhConfig:
         if Path(self.file).suffix.lower() != ".bvh":
             raise ValueError(f"file must be a .bvh file, got {Path(self.file).name!r}")
-        bad = sorted(set(self.joint_map or {}) - set(CANONICAL_JOINTS))
-        if bad:
-            raise ValueError(
-                f"joint_map: {', '.join(bad)} are not canonical joints "
-                f"({', '.join(CANONICAL_JOINTS)})"
-            )
+        check_canonical_keys(self.joint_map, "joint_map")
         return self
 
 

@@ -27,7 +27,7 @@ from mdframework import (
     limits,
 )
 from mdframework.settings import FrameRate
-from mdframework.skeleton import group_means, reorient
+from mdframework.skeleton import check_axes, check_canonical_keys, group_means, reorient
 
 Axis = Literal["x", "y", "z", "-x", "-y", "-z"]
 #: A value of a time column in its own unit (frame numbers, milliseconds, seconds).
@@ -113,14 +113,8 @@ class TableConfig(MotionConfig):
             raise ValueError(
                 f"file must be a .csv, .tsv, .txt, .dat or .npz table, got {Path(self.file).name!r}"
             )
-        bad = sorted(set(self.joint_map or {}) - set(CANONICAL_JOINTS))
-        if bad:
-            raise ValueError(
-                f"joint_map: {', '.join(bad)} are not canonical joints "
-                f"({', '.join(CANONICAL_JOINTS)})"
-            )
-        if sorted(a[-1] for a in self.axes) != ["x", "y", "z"]:
-            raise ValueError(f"axes must name x, y and z once each, got {list(self.axes)}")
+        check_canonical_keys(self.joint_map, "joint_map")
+        check_axes(self.axes)
         if self.time_range is not None and self.time_range[0] > self.time_range[1]:
             raise ValueError(f"time_range: first {self.time_range[0]:g} is after last")
         if not self.header and self.columns is None and self.joints is None:
