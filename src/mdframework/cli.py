@@ -248,6 +248,16 @@ def _version() -> str:
     return f"mdf (mdframework) {v}, Python {sys.version.split()[0]}"
 
 
+def _run_arguments(parser: argparse.ArgumentParser) -> None:
+    """The arguments `mdf run` and `mdf show` share: the config, the output folder and how it
+    is written, and progress."""
+    parser.add_argument("config", help="run config file (.toml, .yaml or .json)")
+    parser.add_argument("--out", required=True, help="output folder")
+    parser.add_argument("--force", action="store_true", help=FORCE_HELP)
+    parser.add_argument("--staging-dir", default=None, help=STAGING_HELP)
+    parser.add_argument("--no-progress", action="store_true", help=PROGRESS_HELP)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``mdf`` (with the commands installed plugins add)."""
     parser = argparse.ArgumentParser(
@@ -293,17 +303,13 @@ def build_parser() -> argparse.ArgumentParser:
             "mdf run examples/point_target.toml --out out/pt-arrays --no-figures",
         ],
     )
-    run.add_argument("config", help="run config file (.toml, .yaml or .json)")
-    run.add_argument("--out", required=True, help="output folder")
-    run.add_argument("--force", action="store_true", help=FORCE_HELP)
-    run.add_argument("--staging-dir", default=None, help=STAGING_HELP)
+    _run_arguments(run)
     run.add_argument(
         "--no-figures",
         action="store_true",
         help="write no figures, only the arrays and JSON/CSV files (as [figures] enabled = "
         "false; the run does not import matplotlib)",
     )
-    run.add_argument("--no-progress", action="store_true", help=PROGRESS_HELP)
     run.set_defaults(func=_cmd_run)
 
     show = add_command(
@@ -315,11 +321,7 @@ def build_parser() -> argparse.ArgumentParser:
         "the body at chosen instants above the spectrogram. See docs/figures.md.",
         ["mdf show examples/cmu_walk.toml --out out/walk --at 0.5 1.4 2.3 --fps 6"],
     )
-    show.add_argument("config", help="run config file (.toml, .yaml or .json)")
-    show.add_argument("--out", required=True, help="output folder")
-    show.add_argument("--force", action="store_true", help=FORCE_HELP)
-    show.add_argument("--staging-dir", default=None, help=STAGING_HELP)
-    show.add_argument("--no-progress", action="store_true", help=PROGRESS_HELP)
+    _run_arguments(show)
     show.add_argument("--format", choices=("gif", "mp4"), default="gif", help="animation format")
     show.add_argument("--fps", type=_positive_int, default=12, help="animation frames per second")
     show.add_argument(
