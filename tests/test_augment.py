@@ -179,3 +179,114 @@ def test_augmentation_factors_stay_within_their_ranges() -> None:
     page = " ".join((ROOT / "docs" / "datasets.md").read_text().split())
     assert "`speed` 0.1 .. 10 and `body_scale` 0.5 .. 2" in page
     assert "randomize.speed: draws 0.05 .. 1.3 (...), outside the factor's range 0.1 .. 10" in page
+
+
+# A drawn value that its field refuses is blamed on the [randomize] entry that drew it
+
+
+def _first_draws(randomize: dict, seed: int = 7) -> dict:
+    """Record 0's draws, as the planner makes them (its generator's seed)."""
+    rz = Randomization.model_validate(randomize)
+    return rz.sample(np.random.default_rng(np.random.SeedSequence([seed, 0, 1])))
+
+
+def _plan(tmp_path, source_extra: dict, randomize: dict, **top: object) -> None:
+    import json
+
+    from conftest import EXAMPLES
+
+    from mdframework.dataset import load_dataset_config, plan_records
+
+    bvh = EXAMPLES / "data" / "cmu" / "bvh" / "16_21.bvh"
+    source = {"label": "walk", "motion": {"kind": "cmu", "file": str(bvh)}}
+    source.update(record_length=1.0, max_records=1, **source_extra)
+    cfg = {"seed": 7, "sources": [source], "randomize": randomize, **top}
+    path = tmp_path / "ds.json"
+    path.write_text(json.dumps(cfg))
+    plan_records(*load_dataset_config(path))
+
+
+def test_a_drawn_height_on_a_source_without_height_names_the_randomize_entry(tmp_path) -> None:
+    """A CMU trial has no `height` (its body is the recorded one): the error used to name
+    `motion.height` only; it names `randomize.height`, the value drawn and the record."""
+    from mdframework.errors import ConfigError
+
+    randomize = {"height": {"uniform": [1.5, 1.9]}}
+    value = _first_draws(randomize)["height"]
+    with pytest.raises(ConfigError) as err:
+        _plan(tmp_path, {}, randomize)
+    msg = str(err.value)
+    assert msg.startswith(
+        f"sources[0] record 0: randomize.height drew {value:.6g} for motion.height"
+    )
+    assert "unknown field 'height'" in msg and "remove the draw" in msg
+    # the page's example is this message (seed 7)
+    from conftest import ROOT
+
+    page = " ".join((ROOT / "docs" / "datasets.md").read_text().split())
+    quoted = page.split("then the field's rule: `")[1].split(" (...)`")[0]
+    assert msg.startswith(quoted)
+
+
+def test_a_draw_beyond_its_fields_range_names_the_randomize_entry_and_its_section(
+    tmp_path,
+) -> None:
+    """The source's own [randomize] or the dataset's, and a `params` path, each named as
+    written; the field's own rule follows."""
+    from mdframework.errors import ConfigError
+
+    own = {"radar_height": {"uniform": [2e4, 3e4]}}
+    dataset_wide = {"aspect_deg": {"uniform": [0.0, 10.0]}}
+    value = _first_draws({**dataset_wide, **own})["radar_height"]
+    with pytest.raises(ConfigError) as err:
+        _plan(tmp_path, {"randomize": own}, dataset_wide)
+    assert str(err.value).startswith(
+        f"sources[0] record 0: sources[0].randomize.radar_height drew {value:.6g} for "
+        "scene.radar_position.2: must be at most 10000"
+    )
+    params = {"params": {"radar.prf": {"uniform": [2e7, 3e7]}}}
+    value = _first_draws(params)["radar.prf"]
+    with pytest.raises(ConfigError, match=r"^sources\[0\] record 0: randomize\.params\.") as err:
+        _plan(tmp_path, {}, params)
+    assert f'randomize.params."radar.prf" drew {value:.6g} for radar.prf: must be at most' in str(
+        err.value
+    )
+
+
+def test_a_record_skipped_for_a_bad_draw_says_which_draw(tmp_path) -> None:
+    """With on_error = "skip" the planner leaves records to the build; the skipped record's
+    cause names the draw too."""
+    import json
+
+    from conftest import EXAMPLES
+
+    from mdframework.dataset import build_record, load_dataset_config, plan_records
+
+    bvh = EXAMPLES / "data" / "cmu" / "bvh" / "16_21.bvh"
+    source = {"label": "walk", "motion": {"kind": "cmu", "file": str(bvh)}, "max_records": 1}
+    cfg = {
+        "seed": 7,
+        "on_error": "skip",
+        "sources": [{**source, "record_length": 1.0}],
+        "randomize": {"height": {"uniform": [1.5, 1.9]}},
+    }
+    path = tmp_path / "ds.json"
+    path.write_text(json.dumps(cfg))
+    (spec,) = plan_records(*load_dataset_config(path))
+    row = build_record(spec, str(tmp_path))
+    assert "randomize.height drew" in row["skipped"] and "motion.height" in row["skipped"]
+    assert not list(tmp_path.rglob("*.npz"))
+
+
+def test_blamed_draw_prefers_the_most_specific_field() -> None:
+    from mdframework.dataset import blamed_draw
+
+    draws = {"radar_range": 5.0, "radar_height": 1.2, "effects.0.snr_db": 3.0, "speed": 1.1}
+    assert blamed_draw("scene.radar_position.2", draws) == "radar_height"
+    assert blamed_draw("scene.radar_position.0", draws) == "radar_range"
+    assert blamed_draw("scene.radar_position", draws) == "radar_height"  # holds both
+    assert blamed_draw("effects.0.snr_db", draws) == "effects.0.snr_db"
+    assert blamed_draw("effects.0", draws) == "effects.0.snr_db"
+    assert blamed_draw("scene", draws) is None  # a check across the section blames no draw
+    assert blamed_draw("radar.prf", draws) is None
+    assert blamed_draw("motion.duration", {"speed": 2.0}) is None  # augmentations set no field

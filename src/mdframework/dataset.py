@@ -77,6 +77,7 @@ from .settings import (
     Distance,
     Point3,
     PositiveSeconds,
+    RunConfigBase,
     Seed,
     StrictModel,
     Workers,
@@ -293,6 +294,9 @@ class RecordSpec:
     recording: str = ""
     dataset: str = ""
     on_error: str = "stop"
+    #: the config section each draw's distribution comes from (``randomize`` or
+    #: ``sources[N].randomize``), to name it when a drawn value does not fit its field
+    draw_origins: dict[str, str] | None = None
 
 
 def load_dataset_config(path: str | Path) -> tuple[DatasetConfig, Path]:
@@ -431,6 +435,7 @@ def _spec(
     draws: dict[str, Any] | None,
     hist: dict[str, Any] | None,
     meta: tuple[str, str, str] = ("", "", ""),
+    draw_origins: dict[str, str] | None = None,
 ) -> RecordSpec:
     """A record's spec; its id ends with a digest of everything that makes the record.
     ``meta``: the record's subject, recording and dataset."""
@@ -449,6 +454,7 @@ def _spec(
         None if hist is None else {"histogram": hist},
         *meta,
         config.on_error,
+        draw_origins,
     )
 
 
@@ -467,6 +473,81 @@ def _apply_draws(
                 set_path(run, path, value)
             except KeyError as exc:
                 raise ConfigError(f"{where}: randomize.params: {exc.args[0]}") from None
+
+
+#: the run-config field that each named scene draw sets (``params`` draws name their own)
+DRAWN_FIELDS = {
+    "aspect_deg": "scene.person.aspect_deg",
+    "radar_range": "scene.radar_position",  # x and y
+    "radar_height": "scene.radar_position.2",
+    "height": "motion.height",
+}
+
+
+def _drawn_field(name: str) -> str | None:
+    """The run-config field a draw sets (None for the motion augmentations)."""
+    return DRAWN_FIELDS.get(name) or (name if "." in name else None)
+
+
+def blamed_draw(field: str, draws: dict[str, Any]) -> str | None:
+    """The draw that set the run-config ``field`` (dotted, as a config error names it), or
+    None: the draw whose field is ``field``, holds it or lies inside it, the most specific
+    first (``scene.radar_position.2`` is ``radar_height``'s, ``.0`` ``radar_range``'s)."""
+    best: str | None = None
+    for name in draws:
+        own = _drawn_field(name)
+        if own is None:
+            continue
+        inside = "." in field and own.startswith(field + ".")
+        if field == own or field.startswith(own + ".") or inside:
+            if best is None or len(own) > len(_drawn_field(best) or ""):
+                best = name
+    return best
+
+
+def _draw_origins(config: DatasetConfig, entry_no: int, entry: SourceEntry) -> dict[str, str]:
+    """The config section of each draw of a source: its own ``randomize`` for the fields it
+    gives, else the dataset's."""
+    own = set() if entry.randomize is None else entry.randomize.model_fields_set
+    rz = _randomize(config, entry)
+    names = [*DRAWN_FIELDS, *rz.params]
+    return {
+        name: f"sources[{entry_no}].randomize"
+        if (name if name in DRAWN_FIELDS else "params") in own
+        else "randomize"
+        for name in names
+    }
+
+
+def validate_record(
+    run: dict[str, Any],
+    source: str,
+    base_dir: Path | str,
+    draws: dict[str, Any] | None,
+    origins: dict[str, str] | None = None,
+) -> RunConfigBase:
+    """:func:`validate_run_config` of a record's run config; a field that a ``[randomize]``
+    draw set and that refuses the drawn value is blamed on the draw: the error names the
+    distribution (``randomize.height``), the drawn value, the record and the field's rule."""
+    try:
+        return validate_run_config(run, source=source, base_dir=Path(base_dir))
+    except ConfigError as exc:
+        text = str(exc)
+        rest = text.removeprefix(f"{source}: ")
+        field, _, problem = rest.partition(": ")
+        name = None if rest == text else blamed_draw(field, draws or {})
+        if name is None or draws is None:
+            raise
+        section = (origins or {}).get(name, "randomize")
+        what = f"{section}.{name}" if name in DRAWN_FIELDS else f'{section}.params."{name}"'
+        value = draws[name]
+        shown = f"{value:.6g}" if isinstance(value, float) else repr(value)
+        todo = (
+            "this source's config has no such field: remove the draw"
+            if problem.startswith("unknown field")
+            else "keep the distribution within the field's range"
+        )
+        raise ConfigError(f"{source}: {what} drew {shown} for {field}: {problem}; {todo}") from None
 
 
 def _randomize(config: DatasetConfig, entry: SourceEntry) -> Randomization:
@@ -535,6 +616,7 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
         )
         hop = entry.hop or length
         rz = _randomize(config, entry)
+        origins = _draw_origins(config, entry_no, entry)
         n_windows = int(np.ceil((duration - length + 1e-9) / hop))
         if entry.max_records is not None:
             n_windows = min(n_windows, entry.max_records)
@@ -564,23 +646,34 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
                     },
                 )
                 index = len(specs)
+                record = f"sources[{entry_no}] record {index}"
                 draws = None
                 if rz.active():
                     rng = np.random.default_rng(np.random.SeedSequence([config.seed, index, 1]))
                     draws = rz.sample(rng)
                     _apply_draws(run, section, draws, f"sources[{entry_no}]")
                 if config.place == "record":  # after the draws: it fixes the drawn aspect
-                    run["scene"] = _place_record(run, loaded, base_dir)
+                    placing = validate_record(run, record, base_dir, draws, origins)
+                    run["scene"] = _place_record(run, placing, loaded)
                 run["seed"] = _record_seed(config.seed, index)
                 specs.append(
-                    _spec(config, index, entry, motion["kind"], run, base_dir, draws, hist, meta)
+                    _spec(
+                        config,
+                        index,
+                        entry,
+                        motion["kind"],
+                        run,
+                        base_dir,
+                        draws,
+                        hist,
+                        meta,
+                        origins if draws else None,
+                    )
                 )
                 # every record's run config is valid before any file is written (with
                 # on_error = "skip" an invalid record is skipped by the build instead)
                 if config.on_error == "stop":
-                    validate_run_config(
-                        run, source=f"sources[{entry_no}] record {index}", base_dir=base_dir
-                    )
+                    validate_record(run, record, base_dir, draws, origins)
     if not specs:
         raise ConfigError(
             f"no records: every source is shorter than its record length ({', '.join(short)})"
@@ -588,14 +681,14 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
     return specs
 
 
-def _place_record(run: dict[str, Any], motion: Motion, base_dir: Path) -> dict[str, Any]:
+def _place_record(run: dict[str, Any], config: RunConfigBase, motion: Motion) -> dict[str, Any]:
     """The scene of a record placed at ``person.position`` (``place = "record"``): the position
     moved back by the placed recording's travel up to the record's start, and the heading the
-    recording's placement gives fixed, so that the record starts at the configured position."""
+    recording's placement gives fixed, so that the record starts at the configured position.
+    ``config``: ``run`` validated."""
     from .conditioning import condition
     from .pipeline import place_body
 
-    config = validate_run_config(run, source="record placement", base_dir=base_dir)
     scene: dict[str, Any] = json.loads(json.dumps(run.get("scene", {})))
     if motion.canonical_map is None:
         return scene
@@ -765,6 +858,9 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         k: v for k, v in run_config["motion"].items() if k not in ("start", "duration", "height")
     }
     motion_section.update({k: v for k, v in run_config["motion"].items() if k == "height"})
+    where = f"record {spec.record_id}"
+    # the record's config first: a drawn value its field refuses is named as the draw
+    config = validate_record(run_config, where, spec.base_dir, spec.draws, spec.draw_origins)
     motion = _load_motion(json.dumps(motion_section, sort_keys=True), spec.base_dir)
     draws = spec.draws or {}
     if any(k in draws for k in ("speed", "body_scale", "mirror", "time_warp")):
@@ -772,9 +868,7 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
             motion, draws, float(run_config["motion"]["start"]), run_config["motion"]["duration"]
         )
         run_config = {**run_config, "motion": {**run_config["motion"], "start": round(start, 9)}}
-    config = validate_run_config(
-        run_config, source=f"record {spec.record_id}", base_dir=Path(spec.base_dir)
-    )
+        config = validate_run_config(run_config, source=where, base_dir=Path(spec.base_dir))
     stages = build_stages(config)
     result = simulate_motion(config, stages, motion)
     fcfg = spec.features

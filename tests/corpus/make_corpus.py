@@ -991,10 +991,24 @@ def _dataset_cases(c: _Corpus) -> None:
     rz_case("mirror-probability-2", {"mirror": 2.0}, "randomize.mirror")
     rz_case("time-warp-1", {"time_warp": 1.0}, "randomize.time_warp")
     rz_case("time-warp-nan", {"time_warp": nan}, "randomize.time_warp")
-    rz_case("param-beyond-field", {"params": {"radar.prf": {"uniform": [1e9, 1e10]}}}, "prf")
+    rz_case(
+        "param-beyond-field",
+        {"params": {"radar.prf": {"uniform": [1e9, 1e10]}}},
+        'randomize.params."radar.prf" drew',
+        "record 0",
+    )
     rz_case("param-unknown-field", {"params": {"radar.nope": {"uniform": [1, 2]}}}, "nope")
     rz_case("param-no-list-item", {"params": {"effects.3.snr_db": {"uniform": [1, 2]}}}, "effects")
-    rz_case("radar-range-absurd", {"radar_range": {"normal": [0.0, 1e9]}}, "radar_position")
+    rz_case(
+        "radar-range-absurd",
+        {"radar_range": {"normal": [0.0, 1e9]}},
+        "randomize.radar_range drew",
+        "radar_position",
+    )
+    # a field the source does not have (a CMU trial's body is the recorded one)
+    rz_case(
+        "height-on-cmu", {"height": {"uniform": [1.5, 1.9]}}, "randomize.height drew", "record 0"
+    )
     ds_case(
         "source-randomize-speed-inf",
         {"sources": [{**one, "randomize": {"speed": {"uniform": [1.0, inf]}}}]},
