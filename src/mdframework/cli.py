@@ -20,7 +20,7 @@ import warnings
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 from .errors import DataFileError, MdfError, OutputError
 from .plugins import (
@@ -114,10 +114,25 @@ def _cmd_show(args: argparse.Namespace) -> int:
 
 
 def _positive_int(text: str) -> int:
-    value = int(text)
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
     if value <= 0:
-        raise argparse.ArgumentTypeError(f"must be a positive integer, got {text}")
+        raise argparse.ArgumentTypeError(f"must be a positive integer, got {text!r}")
     return value
+
+
+class UsageError(MdfError):
+    """The command line itself is wrong (an unknown option, a missing or malformed argument)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line (``mdf: error: ...``, exit code 2, like
+    every bad input) instead of the usage text and a second line; ``--help`` shows the usage."""
+
+    def error(self, message: str) -> NoReturn:
+        raise UsageError(f"{message} (see `{self.prog} --help`)")
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
@@ -260,7 +275,7 @@ def _run_arguments(parser: argparse.ArgumentParser) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``mdf`` (with the commands installed plugins add)."""
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="mdf",
         description=textwrap.fill(
             "Radar micro-Doppler signatures of people in motion, simulated from motion capture: "
@@ -371,7 +386,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     build.add_argument("config", help="dataset config file")
     build.add_argument("--out", required=True, help="dataset folder")
-    build.add_argument("--workers", type=int, default=None, help="local processes")
+    build.add_argument("--workers", type=_positive_int, default=None, help="local processes")
     build.add_argument(
         "--scheduler",
         default=None,
@@ -569,7 +584,13 @@ def _main(argv: list[str], debug: bool) -> int:
             raise
         print(f"mdf: error: {_one_line(str(exc))}", file=sys.stderr)
         return EXIT_USAGE
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except UsageError as exc:
+        if debug:
+            traceback.print_exc()
+        print(f"mdf: error: {_one_line(str(exc))}", file=sys.stderr)
+        return EXIT_USAGE
     args.debug = debug or args.debug
     try:
         return int(args.func(args))

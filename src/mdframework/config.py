@@ -134,11 +134,38 @@ def _check_depth(p: Path, data: Any) -> None:
             stack.extend((v, depth + 1) for v in node)
 
 
-def read_config_file(path: str | Path) -> dict[str, Any]:
+#: the kinds of config file: the top-level field that marks each, and the command that reads it
+CONFIG_KINDS = {
+    "run": ("motion", "mdf run {path} --out DIR"),
+    "dataset": ("sources", "mdf dataset build {path} --out DIR"),
+    "experiment": ("dataset", "mdf experiment {path} --out DIR"),
+}
+
+
+def _check_kind(path: Path, data: dict[str, Any], kind: str) -> None:
+    """Refuse a config of another kind than the command reads (a dataset config given to
+    ``mdf run``), naming the field that tells and the command that reads it."""
+    if CONFIG_KINDS[kind][0] in data:
+        return
+    for other, (key, command) in CONFIG_KINDS.items():
+        if other != kind and key in data:
+            raise ConfigError(
+                f"{path}: {_a(other)} config (it has `{key}`), not {_a(kind)} config: use "
+                f"`{command.format(path=path)}`"
+            )
+
+
+def _a(word: str) -> str:
+    return f"an {word}" if word[0] in "aeiou" else f"a {word}"
+
+
+def read_config_file(path: str | Path, kind: str | None = None) -> dict[str, Any]:
     """Parse a TOML, YAML or JSON file into a dict; errors name the file and line.
 
     The file must be UTF-8 (a byte-order mark is allowed), at most ``limits.MAX_CONFIG_BYTES``
-    long, with tables and lists nested at most ``limits.MAX_CONFIG_DEPTH`` deep.
+    long, with tables and lists nested at most ``limits.MAX_CONFIG_DEPTH`` deep. ``kind``
+    (``"run"``, ``"dataset"``, ``"experiment"``): a config of another kind is refused, naming
+    the command that reads it.
     """
     p = Path(path)
     suffix = p.suffix.lower()
@@ -181,6 +208,8 @@ def read_config_file(path: str | Path) -> dict[str, Any]:
     if not isinstance(data, dict):
         raise ConfigError(f"{p}: the top level must be a table of sections")
     _check_depth(p, data)
+    if kind is not None:
+        _check_kind(p, data, kind)
     return data
 
 
@@ -426,7 +455,7 @@ def _kinds(registry: Registry, interface: str) -> str:
 def load_run_config(path: str | Path, registry: Registry | None = None) -> RunConfigBase:
     """Read and validate a run config file."""
     p = Path(path)
-    data = read_config_file(p)
+    data = read_config_file(p, "run")
     return validate_run_config(data, source=str(p), base_dir=p.parent, registry=registry)
 
 

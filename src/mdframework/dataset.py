@@ -302,7 +302,7 @@ class RecordSpec:
 def load_dataset_config(path: str | Path) -> tuple[DatasetConfig, Path]:
     """Read and validate a dataset config; returns it and its folder (for relative paths)."""
     p = Path(path)
-    data = read_config_file(p)
+    data = read_config_file(p, "dataset")
     if "scheduler" in data:
         raise ConfigError(
             f"{p}: scheduler: a shared config cannot choose where records are computed; give "

@@ -180,7 +180,7 @@ class ExperimentConfig(StrictModel):
 def load_experiment_config(path: str | Path) -> ExperimentConfig:
     """Read and validate an experiment config; relative paths become relative to its folder."""
     p = Path(path)
-    data = read_config_file(p)
+    data = read_config_file(p, "experiment")
     ds = data.get("dataset")
     if isinstance(ds, dict):
         data["dataset"] = {

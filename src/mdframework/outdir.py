@@ -128,6 +128,23 @@ def atomic_savez(path: Path, **arrays: Any) -> None:
         raise
 
 
+def check_output_file(path: str | Path, option: str = "--out") -> Path:
+    """Check, before any work starts, that a command can write the single file ``path`` (given
+    with ``option``): not a folder, inside an existing folder it may write into. Write it with
+    :func:`atomic_write_bytes` (never half-written). Raises :class:`OutputError`."""
+    p = Path(path)
+    if p.is_dir():
+        raise OutputError(f"{option} {p}: is a folder; give the name of a file to write")
+    parent = p.parent
+    if not parent.exists():
+        raise OutputError(f"{option} {p}: the folder {parent} does not exist; create it first")
+    if not parent.is_dir():
+        raise OutputError(f"{option} {p}: {parent} is a file, not a folder; choose another path")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise OutputError(f"{option} {p}: cannot write into {parent}; choose another folder")
+    return p
+
+
 _UNSAFE = re.compile(r"[^A-Za-z0-9_-]+")
 
 
@@ -427,14 +444,20 @@ def output_folder(
             release_lock(out, lock)
 
 
+def _empty_folder(path: Path) -> bool:
+    """A folder (not a link to one) that holds nothing."""
+    return path.is_dir() and not path.is_symlink() and not any(path.iterdir())
+
+
 def _remove_if_empty(out: Path, made: list[Path]) -> None:
     """Remove a folder this command created (and the parents it made), if it holds nothing but
-    the command's internals."""
+    the command's internals and empty folders (a dataset's ``records/`` before its first
+    record)."""
     try:
-        names = [p.name for p in out.iterdir()]
+        entries = list(out.iterdir())
+        if any(not _INTERNAL.match(p.name) and not _empty_folder(p) for p in entries):
+            return
     except OSError:
-        return
-    if any(not _INTERNAL.match(n) for n in names):
         return
     shutil.rmtree(out, ignore_errors=True)
     for parent in made[1:]:

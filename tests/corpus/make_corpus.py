@@ -1162,6 +1162,104 @@ def _reader_cases(c: _Corpus) -> None:
           "t.npz", "objects")  # fmt: skip
 
 
+def _command_cases(c: _Corpus) -> None:
+    """Every command on the inputs any of them can be given by mistake: a config that is not
+    there, a folder, an empty file or a config of another kind; --out inside a file; malformed
+    options; and the plugin commands' files."""
+    run = {
+        "motion": {"kind": "point_targets", "length": 1.0, "targets": [{"position": [50, 0, 0]}]}
+    }
+    dataset = {"sources": [{"label": "walk", "motion": {"kind": "cmu", "file": str(BVH)}}]}
+    experiment = {"dataset": {"config": "dataset.json"}}
+    commands = {
+        "run": ("run", "--out"),
+        "show": ("show", "--out"),
+        "check": ("check",),
+        "dataset": ("dataset", "build", "--out"),
+        "experiment": ("experiment", "--out"),
+    }
+
+    def case(name: str, words: tuple[str, ...], config: str, *expect: str, **extra: str) -> None:
+        d = c.folder(f"command-{name}")
+        (d / "run.json").write_text(json.dumps(run))
+        (d / "dataset.json").write_text(json.dumps(dataset))
+        (d / "experiment.json").write_text(json.dumps(experiment))
+        (d / "folder.toml").mkdir()
+        (d / "empty.yaml").write_bytes(b"")
+        (d / "a-file").write_text("not a folder\n")
+        out = d / extra.get("out", "out")
+        argv = [w for w in words if w != "--out"] + [str(d / config)]
+        if "--out" in words:
+            argv += ["--out", str(out)]
+        argv += extra.get("options", "").split()
+        c.command(f"command-{name}", argv, d / "out", *expect)
+
+    for name, words in commands.items():
+        case(f"{name}-missing-config", words, "nope.toml", "nope.toml", "cannot read")
+        case(f"{name}-config-is-a-folder", words, "folder.toml", "folder.toml", "cannot read")
+        case(f"{name}-empty-yaml", words, "empty.yaml", "empty.yaml", "top level")
+    for name, words in commands.items():
+        kind = (
+            "dataset" if name in ("dataset",) else "experiment" if name == "experiment" else "run"
+        )
+        for other in ("run", "dataset", "experiment"):
+            if other != kind:
+                reader = commands["dataset" if other == "dataset" else other]
+                case(
+                    f"{name}-given-{other}-config",
+                    words,
+                    f"{other}.json",
+                    f"{other}.json: a",
+                    f"{other} config",
+                    f"use `mdf {' '.join(w for w in reader if w != '--out')}",
+                )
+    for name, words in commands.items():
+        if "--out" in words:
+            config = {"dataset": "dataset.json", "experiment": "experiment.json"}.get(
+                name, "run.json"
+            )
+            case(f"{name}-out-inside-a-file", words, config, "--out", "a-file", out="a-file/out")
+    build = commands["dataset"]
+    case("dataset-workers-negative", build, "dataset.json", "--workers", options="--workers -3")
+    case("dataset-workers-word", build, "dataset.json", "--workers", options="--workers two")
+    case(
+        "dataset-scheduler-malformed",
+        build,
+        "dataset.json",
+        "Dask scheduler 'nonsense'",
+        options="--scheduler nonsense",
+    )
+    case("show-fps-zero", commands["show"], "run.json", "--fps", options="--fps 0")
+    case("run-unknown-option", commands["run"], "run.json", "--bogus", options="--bogus")
+    d = c.folder("command-unknown")
+    c.command("command-unknown", ["simulate", str(d)], d / "out", "invalid choice", "mdf --help")
+    c.command("command-none", [], d / "out", "required: COMMAND")
+    c.command("command-plugins-extra", ["plugins", "all"], d / "out", "unrecognized", "all")
+    c.command("command-schema-extra", ["config", "schema", "x"], d / "out", "unrecognized")
+    # the Kinect plugin's commands: a folder or an empty file for a recording; --out of a
+    # capture checked before the device starts (no NiTE2 here: the check must come first)
+    d = c.folder("command-kinect-info-folder")
+    (d / "rec.oni").mkdir()
+    c.command("command-kinect-info-folder", ["kinect", "info", str(d / "rec.oni")], d / "out",
+              "rec.oni", "cannot read")  # fmt: skip
+    d = c.folder("command-kinect-info-empty")
+    (d / "rec.oni").write_bytes(b"")
+    c.command("command-kinect-info-empty", ["kinect", "info", str(d / "rec.oni")], d / "out",
+              "rec.oni", "too short")  # fmt: skip
+    d = c.folder("command-capture-out-folder")
+    c.command("command-capture-out-folder", ["capture", "--out", str(d)], d / "out",
+              f"--out {d}", "is a folder")  # fmt: skip
+    d = c.folder("command-capture-out-inside-a-file")
+    (d / "a-file").write_text("x\n")
+    c.command("command-capture-out-inside-a-file",
+              ["capture", "--out", str(d / "a-file" / "walk.nite.txt")], d / "out",
+              "a-file is a file")  # fmt: skip
+    d = c.folder("command-capture-duration-nan")
+    c.command("command-capture-duration-nan",
+              ["capture", "--out", str(d / "w.nite.txt"), "--duration", "nan"], d / "out",
+              "--duration")  # fmt: skip
+
+
 def make_corpus(root: Path) -> list[Case]:
     """Write every case under ``root`` (an empty folder) and return them."""
     root.mkdir(parents=True, exist_ok=True)
@@ -1172,6 +1270,7 @@ def make_corpus(root: Path) -> list[Case]:
     _config_file_cases(c)
     _field_cases(c)
     _dataset_cases(c)
+    _command_cases(c)
     names = [case.name for case in c.cases]
     assert len(names) == len(set(names)), "case names must be unique"
     return c.cases

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import io
 import json
+import math
 import signal
 import time
 from pathlib import Path
@@ -13,6 +15,7 @@ import numpy as np
 
 from mdframework import DataFileError
 from mdframework.cli import add_command
+from mdframework.outdir import atomic_write_text, check_output_file
 
 from .device import (
     DeviceError,
@@ -63,11 +66,25 @@ def add_commands(subparsers: argparse._SubParsersAction[Any]) -> None:
     )
     cap.add_argument("--out", required=True, help="skeleton recording to write (.nite.txt)")
     cap.add_argument(
-        "--duration", type=float, default=None, help="seconds to record (default: until Ctrl-C)"
+        "--duration",
+        type=_seconds,
+        default=None,
+        help="seconds to record (default: until Ctrl-C)",
     )
     cap.add_argument("--device", default=None, help="device URI or .oni file (default: first)")
     cap.add_argument("--nite2", default=None, help="NiTE2 Redist folder (else $NITE2_REDIST)")
     cap.set_defaults(func=cmd_capture)
+
+
+def _seconds(text: str) -> float:
+    """A recording length: a finite number of seconds > 0, at most a day."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0.0 < value <= 86400.0:  # NaN fails too
+        raise argparse.ArgumentTypeError(f"must be a number of seconds in (0, 86400], got {text!r}")
+    return value
 
 
 def cmd_info(args: argparse.Namespace) -> int:
@@ -91,7 +108,9 @@ def cmd_info(args: argparse.Namespace) -> int:
 
 
 def cmd_capture(args: argparse.Namespace) -> int:
-    """Record skeletons until the duration is over or Ctrl-C; write the NiTE file."""
+    """Record skeletons until the duration is over or Ctrl-C; write the NiTE file (checked
+    before the device starts, written whole or not at all)."""
+    out = check_output_file(args.out)
     nite2 = initialize_nite(args.nite2)
     openni2 = initialize_openni()
     dev = open_device(openni2, args.device)
@@ -132,9 +151,9 @@ def cmd_capture(args: argparse.Namespace) -> int:
         "units": "m; axes: Kinect SDK camera space (x to the sensor's left, y up, z away)",
         "started": time.strftime("%Y-%m-%dT%H:%M:%S%z", time.localtime(time.time() - wall)),
     }
-    out = Path(args.out)
-    with out.open("w", encoding="utf-8") as fh:
-        write_nite(fh, t, idx, user, pos, conf, info)
+    text = io.StringIO()
+    write_nite(text, t, idx, user, pos, conf, info)
+    atomic_write_text(out, text.getvalue())
     rate = (len(t) - 1) / t[-1] if t[-1] > 0 else float("nan")
     tracked = int(np.all(np.isfinite(pos), axis=(1, 2)).sum())
     print(
