@@ -24,6 +24,7 @@ from mdframework.dataset import (
     SCHEDULER_TIMEOUT_ENV,
     DatasetConfig,
     _connect,
+    check_scheduler_address,
     scheduler_address,
 )
 from mdframework.docgen import numeric_ranges
@@ -290,6 +291,26 @@ def test_an_unreachable_scheduler_is_a_clear_error_after_the_timeout(
     monkeypatch.setenv(SCHEDULER_TIMEOUT_ENV, "soon")
     with pytest.raises(MdfError, match=SCHEDULER_TIMEOUT_ENV):
         _connect(Client, None, f"tcp://127.0.0.1:{port}")
+
+
+def test_a_malformed_scheduler_address_is_refused_before_any_connection(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Hard case: `--scheduler nonsense` used to start a Dask client (and its event-loop
+    thread, left running) and fail inside it, after the output folder was made."""
+    import threading
+
+    before = set(threading.enumerate())
+    for good in (None, "local", "tcp://10.0.0.1:8786", "10.0.0.1:8786", "tcp://[::1]:8786"):
+        check_scheduler_address(good)
+    for bad in ("nonsense", "tcp://host", "tls://:x"):
+        with pytest.raises(MdfError, match="not an address"):
+            check_scheduler_address(bad)
+    assert set(threading.enumerate()) == before  # nothing was started
+    monkeypatch.setenv(SCHEDULER_TIMEOUT_ENV, "soon")
+    check_scheduler_address("local")  # no connection, no timeout
+    with pytest.raises(MdfError, match=SCHEDULER_TIMEOUT_ENV):
+        check_scheduler_address("tcp://10.0.0.1:8786")
 
 
 def test_a_server_that_is_not_a_dask_scheduler_is_a_clear_error(

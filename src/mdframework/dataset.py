@@ -1017,6 +1017,29 @@ def scheduler_address(given: str | None) -> str | None:
     return given or os.environ.get(SCHEDULER_ENV) or None
 
 
+def check_scheduler_address(address: str | None) -> None:
+    """Refuse a malformed scheduler address (``HOST:PORT``, ``SCHEME://HOST:PORT``,
+    ``inproc://...`` or ``local``), or a malformed connection timeout, before any folder is
+    made or process started; the timeout is for addresses that are well formed but do not
+    answer."""
+    if address is None or address == "local":
+        return
+    try:
+        from distributed.comm.addressing import parse_address, parse_host_port
+    except ImportError:
+        raise MdfError("a Dask scheduler needs `pip install mdframework[dask]`") from None
+    try:
+        scheme, location = parse_address(address)
+        if scheme != "inproc":
+            parse_host_port(location)
+    except ValueError as exc:
+        raise MdfError(
+            f"Dask scheduler {address!r}: not an address ({' '.join(str(exc).split())}); give "
+            f"HOST:PORT, tcp://HOST:PORT or 'local' with --scheduler or {SCHEDULER_ENV}"
+        ) from None
+    scheduler_timeout()
+
+
 def scheduler_timeout() -> float:
     """Connection timeout to a Dask scheduler [s]: :data:`SCHEDULER_TIMEOUT_ENV`, else
     :data:`SCHEDULER_TIMEOUT_S`."""
@@ -1186,6 +1209,7 @@ def build_dataset(
     """
     from tqdm import tqdm
 
+    check_scheduler_address(scheduler_address(scheduler))
     with dataset_folder(out_dir, force=force) as folder:
         note("planning the records (reading each recording once)", progress)
         specs = plan_records(config, base_dir)  # errors in the config stop before any file

@@ -1226,7 +1226,7 @@ def _command_cases(c: _Corpus) -> None:
         "dataset-scheduler-malformed",
         build,
         "dataset.json",
-        "Dask scheduler 'nonsense'",
+        "Dask scheduler 'nonsense': not an address",
         options="--scheduler nonsense",
     )
     case("show-fps-zero", commands["show"], "run.json", "--fps", options="--fps 0")
