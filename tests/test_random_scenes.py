@@ -11,6 +11,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from scenes import body_scenes, point_scenes, run_scene
 
+#: Fewest scenes of a run that must be simulated (not refused), as a fraction.
+MIN_SIMULATED = 0.25
+
 SETTINGS = settings(
     max_examples=150,
     deadline=None,
@@ -29,10 +32,15 @@ def test_random_valid_scenes_give_finite_outputs_or_a_user_error(kind: str) -> N
         outcomes.append(run_scene(cfg))
 
     check()
-    # most drawn scenes are simulated (the property is not vacuous)
     refused = [o for o in outcomes if o != "ok"]
     assert all(o.startswith("refused: ") for o in refused)
-    assert len(refused) <= 0.5 * len(outcomes), refused[:5]
+    # the property is not vacuous: many drawn scenes are simulated. About 60 % are (see
+    # docs/input-rules.md: 10,000 scenes), the rest are refused by design (a target inside
+    # min_range, a record shorter than the STFT window, clutter without a range resolution).
+    # Which 150 scenes are drawn depends on this test's source and on Hypothesis's version
+    # (derandomize), so the bound must lie far below the rate: at "half run" it sat within
+    # the spread between draws (78 of 150 point scenes refused after one edit of this file).
+    assert len(outcomes) - len(refused) >= MIN_SIMULATED * len(outcomes), refused[:5]
 
 
 # Hard cases the fuzzer found (each gave a numerical warning, and a NaN or -inf, before its fix)
