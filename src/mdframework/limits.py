@@ -152,6 +152,33 @@ def check_product_bytes(n_bytes: float, what: str, field: str) -> None:
         )
 
 
+def read_text_file(path: str | Path, what: str, max_bytes: int | None = None) -> str:
+    """The text of a file that must be UTF-8 (a byte-order mark is dropped), checked before it
+    is decoded: at most ``max_bytes`` long (when given), no NUL byte (binary data, or UTF-16).
+
+    ``what`` names what the file should be (``"a text table"``). Raises
+    :class:`~mdframework.errors.DataFileError` naming the file and the line of the first bad
+    byte.
+    """
+    p = Path(path)
+    try:
+        if max_bytes is not None and (size := p.stat().st_size) > max_bytes:
+            raise DataFileError(
+                p, f"{size:,} bytes is beyond the limit of {max_bytes:,} bytes for {what}"
+            )
+        raw = p.read_bytes()
+    except OSError as exc:
+        raise DataFileError(p, f"cannot read: {exc.strerror or exc}") from None
+    if b"\0" in raw:
+        line = raw[: raw.index(b"\0")].count(b"\n") + 1
+        raise DataFileError(p, f"binary data (a NUL byte): not {what}", line)
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        raise DataFileError(p, "not UTF-8 text: re-save the file as UTF-8", line) from None
+
+
 def check_declared_count(
     path: str | Path,
     line: int,
