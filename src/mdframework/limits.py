@@ -224,3 +224,27 @@ def check_time_stamps(path: str | Path, time: NDArray[np.float64], line: int | N
             "least two distinct time stamps",
             line,
         )
+
+
+def read_text(path: str | Path, what: str, latin1: bool = False) -> str:
+    """A text data file's contents, checked before any of it is parsed: readable, no NUL byte
+    (binary data, or UTF-16), UTF-8 (a byte-order mark is dropped). ``what`` names the format in
+    the message (``"a text table"``); ``latin1``: text that is not UTF-8 is read as Latin-1
+    instead of refused (formats whose old writers put Windows paths in a header line).
+
+    Raises :class:`~mdframework.errors.DataFileError` naming the file and the line."""
+    path = Path(path)
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise DataFileError(path, f"cannot read: {exc.strerror or exc}") from None
+    if b"\0" in raw:
+        line = raw[: raw.index(b"\0")].count(b"\n") + 1
+        raise DataFileError(path, f"binary data (a NUL byte): not {what}", line)
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        if latin1:
+            return raw.decode("latin-1")
+        line = raw[: exc.start].count(b"\n") + 1
+        raise DataFileError(path, f"not UTF-8 text: re-save {what} as UTF-8", line) from None

@@ -162,18 +162,7 @@ def read_table(path: Path, spec: TableLayout | None = None) -> Table:
 
 def _lines(path: Path) -> list[tuple[int, str]]:
     """Non-empty, non-comment lines with their 1-based numbers."""
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise DataFileError(path, f"cannot read: {exc.strerror or exc}") from None
-    if b"\0" in raw:
-        line = raw[: raw.index(b"\0")].count(b"\n") + 1
-        raise DataFileError(path, "binary data (a NUL byte): not a text table", line)
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = raw[: exc.start].count(b"\n") + 1
-        raise DataFileError(path, "not UTF-8 text: re-save the table as UTF-8", line) from None
+    text = limits.read_text(path, "a text table")
     out = [(i, s) for i, s in enumerate(text.splitlines(), start=1) if s.strip()]
     out = [(i, s) for i, s in out if not s.lstrip().startswith("#")]
     if not out:
