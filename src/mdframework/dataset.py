@@ -310,17 +310,34 @@ def load_dataset_config(path: str | Path) -> tuple[DatasetConfig, Path]:
         raise ConfigError(format_validation_error(exc, str(p), data, DatasetConfig)) from None
 
 
-@lru_cache(maxsize=64)
+_MOTIONS: dict[tuple[str, str], Motion] = {}  # this process's motions, oldest first
+_MAX_MOTIONS = 64  # far more recordings than a dataset config lists
+
+
 def _load_motion(motion_json: str, base_dir: str) -> Motion:
     """Load a motion once per process (records of one recording share it). Local worker
-    processes are forked after planning and inherit the motions the planner loaded; a Dask
-    worker loads each motion it meets once (the cache holds far more recordings than a dataset
-    config lists, so records scheduled in any order never evict one)."""
-    section = json.loads(motion_json)
-    config = validate_run_config(
-        {"motion": section}, source="dataset motion", base_dir=Path(base_dir)
-    )
-    return load_motion(build_stages(config).source)
+    processes are forked after planning and inherit the motions the planner loaded; Dask workers
+    are sent them when the build starts (:func:`_receive_motions`), and load any other motion
+    they meet once. The cache holds far more recordings than a dataset config lists, so records
+    scheduled in any order never evict one."""
+    key = (motion_json, base_dir)
+    motion = _MOTIONS.get(key)
+    if motion is None:
+        section = json.loads(motion_json)
+        config = validate_run_config(
+            {"motion": section}, source="dataset motion", base_dir=Path(base_dir)
+        )
+        motion = load_motion(build_stages(config).source)
+        while len(_MOTIONS) >= _MAX_MOTIONS:
+            del _MOTIONS[next(iter(_MOTIONS))]
+        _MOTIONS[key] = motion
+    return motion
+
+
+def _receive_motions(motions: dict[tuple[str, str], Motion]) -> None:
+    """Keep the motions the planner loaded (run on each Dask worker as a build starts)."""
+    for key, motion in motions.items():
+        _MOTIONS.setdefault(key, motion)
 
 
 def _record_seed(seed: int, index: int) -> int:
@@ -1001,9 +1018,18 @@ def _executor(
         raise MdfError("a Dask scheduler needs `pip install mdframework[dask]`") from None
     import dask
 
-    # the statistical profiler samples every worker thread every 10 ms and nothing reads its
-    # profiles; the workers started here inherit the setting
-    with dask.config.set({"distributed.worker.profile.enabled": False}):
+    # The statistical profiler samples every worker thread every 10 ms and nothing reads its
+    # profiles. Dask also starts its workers with MALLOC_TRIM_THRESHOLD_ set, which turns off
+    # glibc's adaptive mmap threshold: every array over 128 KiB is then mapped and unmapped
+    # afresh, and a record took 2.4 times as long as in a local worker. The workers started
+    # here inherit both settings; a cluster started elsewhere is configured by its owner
+    # (docs/datasets.md).
+    with dask.config.set(
+        {
+            "distributed.worker.profile.enabled": False,
+            "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+        }
+    ):
         cluster = (
             LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None)
             if address == "local"
@@ -1011,6 +1037,7 @@ def _executor(
         )
     client = _connect(Client, cluster, address)
     try:
+        client.run(_receive_motions, dict(_MOTIONS))  # each worker gets what planning loaded
 
         def run_dask(specs: list[RecordSpec], out: str) -> Iterator[dict[str, Any]]:
             futures = client.map(build_record, specs, out_dir=out, pure=False)

@@ -255,7 +255,7 @@ def _simulate_motion(
     for lo, hi in progress.counted(blocks, n, "simulating the pulses", "pulse"):
         clock = time.perf_counter()
         tb = t[lo:hi]
-        at_pulses = Skeleton(tb, resample(tb), body.joint_names)
+        at_pulses = Skeleton.resampled(tb, resample(tb), body.joint_names)
         timings["resample"] = timings.get("resample", 0.0) + time.perf_counter() - clock
 
         clock = time.perf_counter()

@@ -129,6 +129,28 @@ class Skeleton:
         object.__setattr__(self, "joint_names", names)
         object.__setattr__(self, "valid", valid)
 
+    @classmethod
+    def resampled(
+        cls, time: FloatArray, positions: FloatArray, joint_names: tuple[str, ...]
+    ) -> Skeleton:
+        """A skeleton resampled from a checked one, every joint valid (the pipeline's pulse
+        blocks): ``time`` (n,) [s] strictly increasing and ``positions`` (n, n_joints, 3)
+        float64 [m] finite by construction (interpolation within a checked skeleton's frames
+        never extrapolates), so they are not checked again; the checks would cost a pass over
+        every block."""
+        skeleton = object.__new__(cls)
+        valid = np.ones(positions.shape[:2], dtype=bool)
+        for name, value in (
+            ("time", time),
+            ("positions", positions),
+            ("joint_names", joint_names),
+            ("valid", valid),
+        ):
+            if isinstance(value, np.ndarray):
+                value.flags.writeable = False
+            object.__setattr__(skeleton, name, value)
+        return skeleton
+
     @property
     def n_frames(self) -> int:
         """Number of frames."""
