@@ -36,6 +36,7 @@ SOURCE_EXAMPLES = {
     "boulic": "boulic_walk.toml",
     "bvh": "bvh_mixamo.toml",
     "cmu": "cmu_walk.toml",
+    "deepmimic": "deepmimic_walk.toml",
     "kinect": "kinect_utkinect_walk.toml",
     "point_targets": "point_target.toml",
     "table": "table_utkinect_walk.toml",

@@ -152,6 +152,39 @@ def check_product_bytes(n_bytes: float, what: str, field: str) -> None:
         )
 
 
+def read_text_file(
+    path: str | Path, what: str, max_bytes: int | None = None, latin1: bool = False
+) -> str:
+    """The text of a file that must be UTF-8 (a byte-order mark is dropped), checked before it
+    is decoded: at most ``max_bytes`` long (when given), no NUL byte (binary data, or UTF-16).
+    ``latin1``: text that is not UTF-8 is read as Latin-1 instead of refused (formats whose old
+    writers put Windows paths in a header line).
+
+    ``what`` names what the file should be (``"a text table"``). Raises
+    :class:`~mdframework.errors.DataFileError` naming the file and the line of the first bad
+    byte.
+    """
+    p = Path(path)
+    try:
+        if max_bytes is not None and (size := p.stat().st_size) > max_bytes:
+            raise DataFileError(
+                p, f"{size:,} bytes is beyond the limit of {max_bytes:,} bytes for {what}"
+            )
+        raw = p.read_bytes()
+    except OSError as exc:
+        raise DataFileError(p, f"cannot read: {exc.strerror or exc}") from None
+    if b"\0" in raw:
+        line = raw[: raw.index(b"\0")].count(b"\n") + 1
+        raise DataFileError(p, f"binary data (a NUL byte): not {what}", line)
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        if latin1:
+            return raw.decode("latin-1")
+        line = raw[: exc.start].count(b"\n") + 1
+        raise DataFileError(p, "not UTF-8 text: re-save the file as UTF-8", line) from None
+
+
 def check_declared_count(
     path: str | Path,
     line: int,
@@ -225,26 +258,3 @@ def check_time_stamps(path: str | Path, time: NDArray[np.float64], line: int | N
             line,
         )
 
-
-def read_text(path: str | Path, what: str, latin1: bool = False) -> str:
-    """A text data file's contents, checked before any of it is parsed: readable, no NUL byte
-    (binary data, or UTF-16), UTF-8 (a byte-order mark is dropped). ``what`` names the format in
-    the message (``"a text table"``); ``latin1``: text that is not UTF-8 is read as Latin-1
-    instead of refused (formats whose old writers put Windows paths in a header line).
-
-    Raises :class:`~mdframework.errors.DataFileError` naming the file and the line."""
-    path = Path(path)
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise DataFileError(path, f"cannot read: {exc.strerror or exc}") from None
-    if b"\0" in raw:
-        line = raw[: raw.index(b"\0")].count(b"\n") + 1
-        raise DataFileError(path, f"binary data (a NUL byte): not {what}", line)
-    try:
-        return raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        if latin1:
-            return raw.decode("latin-1")
-        line = raw[: exc.start].count(b"\n") + 1
-        raise DataFileError(path, f"not UTF-8 text: re-save {what} as UTF-8", line) from None

@@ -36,6 +36,8 @@ RADHAR_TEXT = DATA / "radhar" / "text" / "20_jump_1.txt.gz"
 RADHAR_NPZ = DATA / "radhar" / "radhar_walk_subset.npz"
 C3D = DATA / "c3d" / "treadmill_events.c3d"
 TRC = DATA / "trc" / "opensim_subject01_walk.trc"
+DEEPMIMIC_WALK = DATA / "deepmimic" / "humanoid3d_walk.txt"
+DEEPMIMIC_PUNCH = DATA / "deepmimic" / "humanoid3d_punch.txt"
 
 
 @dataclass(frozen=True)
@@ -1176,6 +1178,62 @@ def _reader_cases(c: _Corpus) -> None:
           "t.npz", "objects")  # fmt: skip
 
 
+def _clip_frame(line: str, index: int, value: str | None) -> str:
+    """A DeepMimic clip's frame line (``[v0, v1, ...],``) with value ``index`` replaced, or
+    dropped when ``value`` is None."""
+    head, body = line.split("[", 1)
+    body, tail = body.rsplit("]", 1)
+    values = body.split(",")
+    if value is None:
+        del values[index]
+    else:
+        values[index] = f" {value}"
+    return head + "[" + ",".join(values) + "]" + tail
+
+
+def _deepmimic_cases(c: _Corpus) -> None:
+    """DeepMimic clips: the real walk (frame i on line i + 5) damaged, and a clip that does not
+    loop asked to repeat."""
+    walk = _lines(DEEPMIMIC_WALK)
+
+    def clip_case(name: str, data: str | bytes, *expect: str, **motion: Any) -> None:
+        d = c.folder(f"deepmimic-{name}")
+        (d / "walk.txt").write_bytes(data if isinstance(data, bytes) else data.encode("utf-8"))
+        cfg = {"motion": {"kind": "deepmimic", "file": "walk.txt", **motion}}
+        c.run(f"deepmimic-{name}", _json_config(d, cfg), "walk.txt", *expect)
+
+    def frame(i: int, index: int, value: str | None) -> str:
+        lines = list(walk)
+        lines[i + 4] = _clip_frame(lines[i + 4], index, value)
+        return "".join(lines)
+
+    clip_case("truncated", "".join(walk)[:20_000], "not valid JSON", "truncated")
+    clip_case("frame-width", frame(10, 7, None), "walk.txt:15:", "frame 10 has 43 values")
+    clip_case("nan", frame(5, 12, "NaN"), "walk.txt:10:", "not finite")
+    clip_case("zero-duration", frame(3, 0, "0.0"), "walk.txt:8:", "duration 0.0")
+    clip_case("negative-duration", frame(3, 0, "-0.0333"), "walk.txt:8:", "duration")
+    clip_case("position-1e300", frame(7, 1, "1e300"), "walk.txt:12:", "root position")
+    clip_case("quaternion-zero", frame(2, 8, "0"), "walk.txt:7:", "chest quaternion")
+    clip_case("word", frame(4, 3, '"up"'), "walk.txt:9:", "not a number")
+    clip_case("loop", "".join(walk).replace('"wrap"', '"mirror"'), "walk.txt:2:", "Loop")
+    clip_case("not-a-clip", "[1, 2, 3]", "Frames")
+    clip_case("binary", "".join(walk[:6]).encode() + b"\x00", "NUL")
+    clip_case("one-frame", "".join(walk[:4]) + walk[4].rstrip().rstrip(",") + "\n]\n}\n", "1 frame")
+    d = c.folder("deepmimic-huge")
+    with open(d / "walk.txt", "wb") as f:  # sparse: huge on paper, nothing read or allocated
+        f.truncate(200 * 1024 * 1024)
+    c.run("deepmimic-huge", _json_config(d, {"motion": {"kind": "deepmimic", "file": "walk.txt"}}),
+          "walk.txt", "beyond the limit")  # fmt: skip
+    d = c.folder("deepmimic-cycles-of-a-punch")
+    (d / "punch.txt").write_bytes(DEEPMIMIC_PUNCH.read_bytes())
+    motion = {"kind": "deepmimic", "file": "punch.txt", "cycles": 2}
+    c.run("deepmimic-cycles-of-a-punch", _json_config(d, {"motion": motion}), "punch.txt", "Loop")
+    d = c.folder("deepmimic-mirrored-axes")
+    (d / "walk.txt").write_bytes(DEEPMIMIC_WALK.read_bytes())
+    motion = {"kind": "deepmimic", "file": "walk.txt", "axes": ["x", "z", "y"]}
+    c.run("deepmimic-mirrored-axes", _json_config(d, {"motion": motion}), "motion.axes", "mirror")
+
+
 def make_corpus(root: Path) -> list[Case]:
     """Write every case under ``root`` (an empty folder) and return them."""
     root.mkdir(parents=True, exist_ok=True)
@@ -1183,6 +1241,7 @@ def make_corpus(root: Path) -> list[Case]:
     _motion_cases(c)
     _radhar_cases(c)
     _reader_cases(c)
+    _deepmimic_cases(c)
     _config_file_cases(c)
     _field_cases(c)
     _dataset_cases(c)

@@ -182,20 +182,9 @@ class Recording:
 
 def read_text(path: Path) -> list[str]:
     """The file's lines; clear errors for unreadable, empty or binary files."""
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise DataFileError(path, f"cannot read: {exc.strerror or exc}") from None
-    if not raw.strip():
+    text = limits.read_text_file(path, "a text skeleton file")
+    if not text.strip():
         raise DataFileError(path, "the file is empty")
-    if b"\0" in raw:
-        line = raw[: raw.index(b"\0")].count(b"\n") + 1
-        raise DataFileError(path, "binary data (a NUL byte): not a text skeleton file", line)
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        line = raw[: exc.start].count(b"\n") + 1
-        raise DataFileError(path, "not a text file (invalid UTF-8 bytes)", line) from None
     return text.splitlines()
 
 

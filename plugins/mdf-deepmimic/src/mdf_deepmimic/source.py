@@ -1,0 +1,154 @@
+"""The ``deepmimic`` motion source: a DeepMimic motion clip of the ``humanoid3d`` character.
+
+The clip (:mod:`mdf_deepmimic.reader`) gives the root's position and rotation and each joint's
+rotation per frame; forward kinematics over the character's joint tree
+(:mod:`mdf_deepmimic.character`, :mod:`mdf_deepmimic.kinematics`) gives every joint's position.
+Axes: DeepMimic's world is y up and the character faces +x with its right side at +z in the
+rest pose; ``axes = ["x", "-z", "y"]`` (the default) maps that onto the project's x forward,
+y left, z up (a rotation, not a mirror). Time: the frames' durations summed (the last frame's
+is not used). A ``"wrap"`` clip can be played ``cycles`` times, each cycle shifted by the
+clip's root displacement, as DeepMimic plays it.
+
+The canonical body takes the character's joints where it has them (root as the base, neck,
+shoulders, elbows, hips, knees, ankles) and, where it has none, points of its body shapes: the
+head is the centre of the head sphere, each hand the wrist joint (the centre of the hand
+sphere), each toe the front of the foot box (the metadata's ``estimated`` lists them).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import Field, field_validator
+
+from mdframework import (
+    DataFileError,
+    DataPath,
+    Motion,
+    MotionConfig,
+    MotionSource,
+    Skeleton,
+    limits,
+)
+from mdframework.skeleton import check_axes, reorient
+
+Axis = Literal["x", "y", "z", "-x", "-y", "-z"]
+
+#: Most cycles a ``"wrap"`` clip may be played.
+MAX_CYCLES = 10_000
+
+
+class DeepMimicConfig(MotionConfig):
+    """A DeepMimic motion clip (JSON text) of the humanoid3d character."""
+
+    kind: Literal["deepmimic"] = Field("deepmimic", description="Selects this source: 'deepmimic'.")
+    file: DataPath = Field(
+        description="The clip (DeepMimic's data/motions/*.txt, JSON); relative to the config file."
+    )
+    cycles: int = Field(
+        1,
+        ge=1,
+        le=MAX_CYCLES,
+        description='Play a cyclic clip ("Loop": "wrap") this many times, each cycle '
+        'shifted by the clip\'s root displacement; a clip with "Loop": "none" plays once.',
+    )
+    axes: tuple[Axis, Axis, Axis] = Field(
+        ("x", "-z", "y"),
+        description="The clip's axis (with sign) that becomes x (forward), y (left) and z (up); "
+        "DeepMimic's world is y up with the character facing +x and its right at +z.",
+    )
+    activity: str | None = Field(
+        None,
+        description="Activity label recorded in the metadata. Default: the file name without "
+        "'humanoid3d_' ('humanoid3d_walk.txt': 'walk').",
+    )
+    subject: str | None = Field(None, description="Subject id for the metadata.")
+
+    @field_validator("axes")
+    @classmethod
+    def _axes(cls, v: tuple[str, str, str]) -> tuple[str, str, str]:
+        check_axes(v)
+        m = np.zeros((3, 3))
+        for row, a in enumerate(v):
+            m[row, "xyz".index(a[-1])] = -1.0 if a.startswith("-") else 1.0
+        if np.linalg.det(m) < 0:
+            raise ValueError(
+                f"axes {list(v)} mirror the body (its left would become its right); "
+                "DeepMimic's clips are y up with the right at +z: ['x', '-z', 'y']"
+            )
+        return v
+
+
+class DeepMimicSource(MotionSource):
+    """A DeepMimic clip as the character's joints in metres, z up, with the canonical map."""
+
+    name = "deepmimic"
+    Config = DeepMimicConfig
+    config: DeepMimicConfig
+
+    def load(self) -> Motion:
+        """Read the clip and run forward kinematics.
+
+        Returns
+        -------
+        Motion
+            ``skeleton``: time (n_frames,) [s] from 0; positions (n_frames, 18, 3) [m], z up:
+            the 15 joints of ``humanoid3d`` and the points ``head_centre``, ``right_toe_tip``,
+            ``left_toe_tip``. ``canonical_map`` maps all 17 canonical joints. ``metadata``:
+            source, format, file, character, loop, cycles, activity, subject, frame_rate_hz
+            (median), n_frames, clip_frames, clip_duration_s, loop_closure_m, axes, estimated
+            (canonical joints placed from body shapes), quaternions_renormalised,
+            quaternion_norm_range.
+
+        Raises
+        ------
+        mdframework.DataFileError
+            A malformed clip (see :func:`mdf_deepmimic.read_clip`), or ``cycles`` above 1 for
+            a clip that does not loop.
+        """
+        from .character import CANONICAL_MAP, ESTIMATED, HUMANOID3D
+        from .kinematics import forward_kinematics, repeat_cycles
+        from .reader import read_clip
+
+        c = self.config
+        path = Path(c.file)
+        clip = read_clip(path, HUMANOID3D)
+        if c.cycles > 1 and clip.loop != "wrap":
+            raise DataFileError(
+                path,
+                f'motion.cycles = {c.cycles}, but the clip\'s "Loop" is "{clip.loop}": it is '
+                "not a cycle; set cycles = 1",
+            )
+        names, pos_file = forward_kinematics(HUMANOID3D, clip.root_position, clip.rotations)
+        pos = reorient(pos_file, c.axes)
+        time, pos, closure = repeat_cycles(clip.time, pos, c.cycles, names.index("root"))
+        limits.check_time_stamps(path, time)
+        limits.check_values(
+            path, pos, limits.MAX_COORDINATE_M, "a joint coordinate after forward kinematics",
+            unit=" m",
+        )  # fmt: skip
+        activity = c.activity
+        if activity is None:
+            activity = path.stem.removeprefix("humanoid3d_") or "unknown"
+        meta: dict[str, Any] = {
+            "source": "deepmimic",
+            "format": "DeepMimic clip (JSON)",
+            "file": path.name,
+            "character": HUMANOID3D.name,
+            "loop": clip.loop,
+            "cycles": c.cycles,
+            "activity": activity,
+            "subject": c.subject,
+            "frame_rate_hz": float(1.0 / np.median(clip.durations[:-1])),
+            "n_frames": int(time.shape[0]),
+            "clip_frames": clip.n_frames,
+            "clip_duration_s": float(clip.time[-1]),
+            "loop_closure_m": closure,
+            "axes": list(c.axes),
+            "estimated": dict(ESTIMATED),
+            "quaternions_renormalised": clip.renormalised,
+            "quaternion_norm_range": [clip.min_norm, clip.max_norm],
+        }
+        return Motion(Skeleton(time, pos, names), meta, dict(CANONICAL_MAP))
