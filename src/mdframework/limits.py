@@ -257,4 +257,3 @@ def check_time_stamps(path: str | Path, time: NDArray[np.float64], line: int | N
             "least two distinct time stamps",
             line,
         )
-
