@@ -62,7 +62,7 @@ def _child(config: str, scheduler: str, workers: int, out: str, start_only: bool
             )
         )
         return
-    specs = plan_records(cfg, base)
+    specs = plan_records(cfg, base, workers=workers)
     t_plan = time.perf_counter() - t1
     serial_cpu = time.process_time()  # since the interpreter started: imports and planning
     t2 = time.perf_counter()

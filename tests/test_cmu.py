@@ -456,6 +456,58 @@ def test_amc_value_count_and_frame_numbers(tmp_path: Path) -> None:
         load(write(tmp_path / "02_01.amc", amc_sample(3)[:3]))
 
 
+def _bits(a: np.ndarray) -> np.ndarray:
+    return np.ascontiguousarray(a, dtype=np.float64).view(np.int64)
+
+
+@pytest.mark.parametrize("trial", ["02_01", "09_06", "13_18"])
+def test_amc_whole_file_parse_is_the_line_by_line_parse(trial: str, tmp_path: Path) -> None:
+    """CMU files (every frame the same bones in the same order) are parsed in one pass over the
+    whole file; a comment between two frames makes a file irregular, so the line-by-line parse
+    reads it. Both give the same values bit for bit, in degrees and in radians."""
+    from mdf_cmu.asfamc import _read_regular_amc, read_amc, read_lines
+
+    asf = read_asf(AMC / f"{trial.split('_')[0]}.asf")
+    lines = (AMC / f"{trial}.amc").read_text().split("\n")
+    second = next(i for i, ln in enumerate(lines) if ln.strip() == "2")
+    for unit in (":DEGREES", ":RADIANS"):
+        text = [unit if ln.strip() == ":DEGREES" else ln for ln in lines]
+        regular = write(tmp_path / f"r{trial}.amc", text)
+        irregular = write(
+            tmp_path / f"i{trial}.amc", [*text[:second], "# a comment", *text[second:]]
+        )
+        assert _read_regular_amc(regular, read_lines(regular), asf) is not None
+        assert _read_regular_amc(irregular, read_lines(irregular), asf) is None
+        whole, by_line = read_amc(regular, asf), read_amc(irregular, asf)
+        assert list(whole.values) == list(by_line.values)
+        for bone, values in whole.values.items():
+            assert np.array_equal(_bits(values), _bits(by_line.values[bone])), bone
+        assert np.array_equal(whole.frame_numbers, by_line.frame_numbers)
+
+
+def test_amc_errors_late_in_a_regular_file_name_their_line(tmp_path: Path) -> None:
+    """A bad number, an angle beyond the limit, a missing value or a repeated bone deep inside
+    13_18.amc: the same one-line error naming the line as the line-by-line parse gives."""
+    lines = (AMC / "13_18.amc").read_text().split("\n")
+    (tmp_path / "13.asf").write_bytes((AMC / "13.asf").read_bytes())
+    frame = next(i for i, ln in enumerate(lines) if ln.strip() == "2500")
+    k = next(i for i in range(frame, len(lines)) if lines[i].startswith("lfemur"))
+    fields = lines[k].split()
+    after = lines[k + 1].split()
+    cases = [
+        (k, [fields[0], fields[1], "1.2.3", fields[3]], "bad number '1.2.3'"),
+        (k, [fields[0], fields[1], "5e5", fields[3]], "angle of bone 'lfemur': 500000.0"),
+        (k, [fields[0], fields[1], "inf", fields[3]], "non-finite number"),
+        (k, fields[:3], "needs 3 numbers, found 2"),
+        (k + 1, ["lfemur", *after[1:]], "bone 'lfemur' appears twice in frame 2500"),
+    ]
+    for at, bad, message in cases:
+        path = write(tmp_path / "13_18.amc", [*lines[:at], " ".join(bad), *lines[at + 1 :]])
+        with pytest.raises(DataFileError, match=re.escape(message)) as err:
+            load(path)
+        assert err.value.path == path and err.value.line == at + 1, (bad, err.value)
+
+
 def test_crlf_asf_amc_parse(tmp_path: Path) -> None:
     """02.asf and 02_01.amc have LF endings; the same content with CRLF gives the same motion."""
     lf = (AMC / "02.asf").read_text().split("\n")

@@ -7,12 +7,15 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
 from conftest import EXAMPLES
 
+from mdframework import dataset
 from mdframework.dataset import (
     RECORDS,
     DatasetWarning,
@@ -22,8 +25,9 @@ from mdframework.dataset import (
     plan_records,
     read_record,
 )
-from mdframework.errors import ConfigError
+from mdframework.errors import ConfigError, DataFileError
 from mdframework.features import FEATURE_NAMES
+from mdframework.sanity import MotionSanityWarning
 
 CMU = EXAMPLES / "data" / "cmu"
 
@@ -91,14 +95,115 @@ def test_plan_and_load(tmp_path: Path) -> None:
     assert meta["units"]["features"] == "m/s" and meta["label"] == "walk"
 
 
-def test_same_result_with_one_and_two_workers_and_dask(tmp_path: Path) -> None:
+def test_same_result_with_one_and_two_workers_and_dask(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Each build starts without the motions an earlier one loaded: with 2 workers the planner
+    loads them in 2 processes."""
     cfg, base = load_dataset_config(write_config(tmp_path / "d.toml"))
     build_dataset(cfg, base, tmp_path / "one", workers=1, progress=False)
+    monkeypatch.setattr(dataset, "_MOTIONS", {})
     build_dataset(cfg, base, tmp_path / "two", workers=2, progress=False)
     assert_same(tmp_path / "one", tmp_path / "two")
     pytest.importorskip("distributed")
+    monkeypatch.setattr(dataset, "_MOTIONS", {})
     build_dataset(cfg, base, tmp_path / "dask", workers=2, scheduler="local", progress=False)
     assert_same(tmp_path / "one", tmp_path / "dask")
+
+
+def _mixed_sources(tmp_path: Path, *extra: str) -> Path:
+    """Sources of every loader: ASF/AMC and BVH (both warn about glitches), the Boulic walker,
+    and ``extra`` sources."""
+    path = tmp_path / "mixed.toml"
+    path.write_text(
+        "\n".join(
+            [
+                "[record_lengths]\nwalk = 1.0\nboxing = 1.0",
+                *(
+                    f'[[sources]]\nlabel = "{label}"\nmax_records = 2\nmotion = {motion}'
+                    for label, motion in [
+                        ("boxing", f'{{ kind = "cmu", file = "{CMU / "asf-amc" / "13_18.amc"}" }}'),
+                        ("walk", '{ kind = "boulic", n_cycles = 2 }'),
+                        ("boxing", f'{{ kind = "cmu", file = "{CMU / "bvh" / "80_10.bvh"}" }}'),
+                        ("walk", f'{{ kind = "cmu", file = "{CMU / "asf-amc" / "02_01.amc"}" }}'),
+                    ]
+                ),
+                *extra,
+            ]
+        )
+        + "\n"
+    )
+    return path
+
+
+def _plan_fresh(
+    cfg: dataset.DatasetConfig, base: Path, workers: int, monkeypatch: pytest.MonkeyPatch
+) -> tuple[list[dataset.RecordSpec], dict[tuple[str, str], Any], list[tuple[type, str]], int]:
+    """Plan with an empty motion cache: specs, motions, warnings shown (category, text) and how
+    many motions this process loaded itself."""
+    monkeypatch.setattr(dataset, "_MOTIONS", {})
+    calls = []
+    real = dataset.load_motion
+    monkeypatch.setattr(dataset, "load_motion", lambda src: calls.append(src) or real(src))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        specs = plan_records(cfg, base, workers=workers)
+    shown = [(w.category, str(w.message)) for w in caught]
+    return specs, dict(dataset._MOTIONS), shown, len(calls)
+
+
+def test_motions_loaded_in_parallel_plan_the_same_records(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With 2 workers the planner's process loads none of the motions itself; the motions are
+    the same to the bit, the specs equal, and every warning of their loading is shown once, in
+    source order, as when one process loads them all."""
+    cfg, base = load_dataset_config(_mixed_sources(tmp_path))
+    specs1, motions1, shown1, loaded1 = _plan_fresh(cfg, base, 1, monkeypatch)
+    specs2, motions2, shown2, loaded2 = _plan_fresh(cfg, base, 2, monkeypatch)
+    assert (loaded1, loaded2) == (4, 0)
+    assert specs1 == specs2 and len(specs1) == 8
+    assert list(motions1) == list(motions2)
+    for key, m1 in motions1.items():
+        m2 = motions2[key]
+        assert type(m1) is type(m2)
+        for name in ("time", "positions", "valid"):
+            a, b = getattr(m1.skeleton, name), getattr(m2.skeleton, name)
+            assert a.dtype == b.dtype and a.tobytes() == b.tobytes(), (key, name)
+        assert m1.metadata == m2.metadata and m1.canonical_map == m2.canonical_map
+    assert shown1 == shown2
+    glitches = [text for category, text in shown2 if category is MotionSanityWarning]
+    assert [t.split(":")[0] for t in glitches] == ["13_18.amc", "80_10.bvh"], shown2
+
+
+def test_parallel_loading_keeps_errors_and_warning_filters(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A motion that fails to load, or whose warning the filters turn into an error, stops
+    planning with the same error whether it was loaded in another process or not."""
+    (tmp_path / "02.asf").write_bytes((CMU / "asf-amc" / "02.asf").read_bytes())
+    amc = (CMU / "asf-amc" / "02_01.amc").read_text().split("\n")
+    (tmp_path / "02_01.amc").write_text("\n".join(amc[:60]) + "\n")  # ends inside frame 3
+    motion = f'{{ kind = "cmu", file = "{tmp_path / "02_01.amc"}" }}'
+    broken = f'[[sources]]\nlabel = "walk"\nmotion = {motion}'
+    cfg, base = load_dataset_config(_mixed_sources(tmp_path, broken))
+    errors = []
+    for workers in (1, 2):
+        monkeypatch.setattr(dataset, "_MOTIONS", {})
+        with pytest.raises(DataFileError, match="lacks bone") as err, warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            plan_records(cfg, base, workers=workers)
+        errors.append(str(err.value))
+    assert errors[0] == errors[1]
+    cfg, base = load_dataset_config(_mixed_sources(tmp_path))
+    errors = []
+    for workers in (1, 2):
+        monkeypatch.setattr(dataset, "_MOTIONS", {})
+        with pytest.raises(MotionSanityWarning) as warn, warnings.catch_warnings():
+            warnings.simplefilter("error", MotionSanityWarning)
+            plan_records(cfg, base, workers=workers)
+        errors.append(str(warn.value))
+    assert errors[0] == errors[1] and errors[0].startswith("13_18.amc: 3 single-frame glitch")
 
 
 def test_corrupt_and_partial_records_are_redone(tmp_path: Path) -> None:

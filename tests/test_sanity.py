@@ -189,6 +189,53 @@ def test_cadence_needs_a_period() -> None:
     assert cadence_spm(t, still, still + np.array([0.0, 0.2, 0.0])) is None
 
 
+def _whole_autocorrelation_period(t: np.ndarray, signal: np.ndarray) -> tuple[float, float] | None:
+    """The first clear period and its strength (0.3) from the whole autocorrelation at once
+    (``np.correlate``), written independently of the lag-by-lag search of the module."""
+    n = t.shape[0]
+    dt = (t[-1] - t[0]) / (n - 1)
+    x = np.interp(t[0] + dt * np.arange(n), t, signal)
+    x = x - x.mean()
+    ac = np.correlate(x, x, mode="full")[n - 1 :] / float(x @ x)
+    neg = np.flatnonzero(ac < 0)
+    if not neg.size:
+        return None
+    peaks = [
+        k
+        for k in range(int(neg[0]) + 1, n - 1)
+        if ac[k] >= 0.3 and ac[k] >= ac[k - 1] and ac[k] >= ac[k + 1]
+    ]
+    if not peaks:
+        return None
+    k = peaks[0]
+    curve = ac[k - 1] - 2 * ac[k] + ac[k + 1]
+    shift = 0.5 * (ac[k - 1] - ac[k + 1]) / curve if curve < 0 else 0.0
+    return float((k + shift) * dt), float(ac[k])
+
+
+def test_lag_by_lag_autocorrelation_is_the_whole_one_bit_for_bit() -> None:
+    """The period search reads the autocorrelation lag by lag, only as far as its first clear
+    peak; every value it reads, and so the period and strength, are those of the whole
+    ``np.correlate`` (noisy sines at uneven and even sampling, some without any period)."""
+    from mdframework.sanity import _Autocorrelation, _period_strength
+
+    rng = np.random.default_rng(5)
+    found = 0
+    for case in range(120):
+        n = int(rng.integers(8, 4000))
+        t = np.arange(n) / 120.0 if case % 2 else np.sort(rng.uniform(0, 20, n))
+        signal = rng.uniform(0.1, 3) * np.sin(2 * np.pi * rng.uniform(0.2, 4) * t)
+        signal = signal + rng.normal(0, rng.uniform(0, 2), n)
+        expected = _whole_autocorrelation_period(t, signal)
+        assert _period_strength(t, signal) == expected, case
+        found += expected is not None
+        x = signal - signal.mean()
+        whole = np.correlate(x, x, mode="full")[n - 1 :] / float(x @ x)
+        lagged = _Autocorrelation(x, float(x @ x))
+        assert np.array_equal([lagged[k] for k in range(n)], whole), case
+    assert 30 < found < 120  # both kinds of signal were met
+
+
 def test_short_clip_cadence_takes_the_first_period_not_the_highest() -> None:
     # Mixamo walk cycle, 69 frames at 30 Hz, forward then back: the ankle distance peaks every
     # ~17 frames (0.53 s per step), while its autocorrelation is highest at 3 steps (1.67 s)

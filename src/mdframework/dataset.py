@@ -40,7 +40,7 @@ import json
 import os
 import warnings
 from collections.abc import Callable, Generator, Iterator
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from contextlib import AbstractContextManager, closing
 from dataclasses import dataclass
 from functools import lru_cache
@@ -312,14 +312,25 @@ def load_dataset_config(path: str | Path) -> tuple[DatasetConfig, Path]:
 
 _MOTIONS: dict[tuple[str, str], Motion] = {}  # this process's motions, oldest first
 _MAX_MOTIONS = 64  # far more recordings than a dataset config lists
+#: A warning raised while loading a motion: message, category, file name, line.
+_Caught = tuple[str, type[Warning], str, int]
+#: warnings raised while motions were loaded in other processes, to be shown here
+_PENDING: dict[tuple[str, str], list[_Caught]] = {}
+
+
+def build_workers(config: DatasetConfig, workers: int | None = None) -> int:
+    """The number of workers of a build: ``workers`` (the command line), else the config's,
+    else the CPU count."""
+    return workers or config.workers or os.cpu_count() or 1
 
 
 def _load_motion(motion_json: str, base_dir: str) -> Motion:
     """Load a motion once per process (records of one recording share it). Local worker
-    processes are forked after planning and inherit the motions the planner loaded; Dask workers
-    are sent them when the build starts (:func:`_receive_motions`), and load any other motion
-    they meet once. The cache holds far more recordings than a dataset config lists, so records
-    scheduled in any order never evict one."""
+    processes are forked after planning and inherit the motions the planner loaded (in
+    parallel, :func:`_preload_motions`); Dask workers are sent them when the build starts
+    (:func:`_receive_motions`), and load any other motion they meet once. The cache holds far
+    more recordings than a dataset config lists, so records scheduled in any order never evict
+    one. A motion loaded by another process shows its warnings here, when first asked for."""
     key = (motion_json, base_dir)
     motion = _MOTIONS.get(key)
     if motion is None:
@@ -328,10 +339,69 @@ def _load_motion(motion_json: str, base_dir: str) -> Motion:
             {"motion": section}, source="dataset motion", base_dir=Path(base_dir)
         )
         motion = load_motion(build_stages(config).source)
-        while len(_MOTIONS) >= _MAX_MOTIONS:
-            del _MOTIONS[next(iter(_MOTIONS))]
-        _MOTIONS[key] = motion
+        _keep_motion(key, motion)
+    for text, category, filename, lineno in _PENDING.pop(key, ()):
+        # shown, not warned again: the loading process has applied this process's filters
+        warnings.showwarning(_warning(text, category), category, filename, lineno)
     return motion
+
+
+def _warning(text: str, category: type[Warning]) -> Warning | str:
+    """The warning ``category(text)`` (as raised), or its text for a class made otherwise."""
+    try:
+        return category(text)
+    except Exception:
+        return text
+
+
+def _keep_motion(key: tuple[str, str], motion: Motion) -> None:
+    while len(_MOTIONS) >= _MAX_MOTIONS:
+        del _MOTIONS[next(iter(_MOTIONS))]
+    _MOTIONS[key] = motion
+
+
+def _motion_key(section: dict[str, Any]) -> str:
+    """The cache key of a source's motion: its section without the span that records are cut
+    from (``start``, ``duration``)."""
+    return json.dumps(
+        {k: v for k, v in section.items() if k not in ("start", "duration")}, sort_keys=True
+    )
+
+
+def _load_elsewhere(key: tuple[str, str]) -> tuple[Motion | None, list[_Caught]]:
+    """Load a motion in a planning worker: the motion and the warnings that the filters (the
+    planner's, inherited) let through, or (None, []) if it fails (a warning filtered as an
+    error included): the planner then loads it itself and raises the error there."""
+    with warnings.catch_warnings(record=True) as caught:
+        try:
+            motion = _load_motion(*key)
+        except Exception:
+            return None, []
+    return motion, [(str(w.message), w.category, w.filename, w.lineno) for w in caught]
+
+
+def _preload_motions(config: DatasetConfig, base_dir: Path, workers: int) -> None:
+    """Load the distinct motions of the sources in up to ``workers`` processes at once (at most
+    one per CPU), so that planning takes the time of the slowest share rather than of all.
+    Every result is the motion the planner would load itself; the warnings raised while
+    loading one are shown once, when the planner comes to its source (in source order)."""
+    keys = [
+        (_motion_key(e.motion), str(base_dir))
+        for e in config.sources
+        if e.motion is not None and "kind" in e.motion
+    ]
+    todo = [k for k in dict.fromkeys(keys) if k not in _MOTIONS]
+    n = min(workers, len(todo), os.cpu_count() or 1)
+    if n < 2:
+        return
+    from .workers import worker_pool
+
+    default_registry()  # once, before the workers fork (they would each load it)
+    with worker_pool(n) as pool:
+        for key, (motion, caught) in zip(todo, pool.map(_load_elsewhere, todo), strict=True):
+            if motion is not None:
+                _keep_motion(key, motion)
+                _PENDING[key] = caught
 
 
 def _receive_motions(motions: dict[tuple[str, str], Motion]) -> None:
@@ -494,9 +564,10 @@ def _randomize(config: DatasetConfig, entry: SourceEntry) -> Randomization:
     return config.randomize.model_copy(update=own)
 
 
-def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
+def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> list[RecordSpec]:
     """Expand sources x windows x variations x random draws into record specs, in a fixed
-    order."""
+    order. With ``workers`` > 1 the sources' motions are first loaded in that many processes
+    (:func:`_preload_motions`); the specs are the same."""
     v = config.variations
     for rz in [config.randomize] + [_randomize(config, e) for e in config.sources]:
         for name in ("aspect_deg", "radar_range", "radar_height", "height"):
@@ -515,6 +586,8 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
         )
     )
     hist = config.histogram.model_dump() if config.representation == "histogram" else None
+    if workers > 1:
+        _preload_motions(config, base_dir, workers)
     specs: list[RecordSpec] = []
     short: list[str] = []
     for entry_no, entry in enumerate(config.sources):
@@ -525,8 +598,7 @@ def plan_records(config: DatasetConfig, base_dir: Path) -> list[RecordSpec]:
         if "kind" not in motion:
             raise ConfigError(f"sources[{entry_no}].motion: a kind is required")
         # a source's own start/duration limit the span that records are cut from
-        whole = {k: v for k, v in motion.items() if k not in ("start", "duration")}
-        loaded = _load_motion(json.dumps(whole, sort_keys=True), str(base_dir))
+        loaded = _load_motion(_motion_key(motion), str(base_dir))
         span_start = float(motion.get("start", 0.0))
         span_end = loaded.skeleton.duration
         if motion.get("duration") is not None:
@@ -987,18 +1059,16 @@ def _executor(
     are closed afterwards). Local worker processes end when this process ends, however it ends
     (:func:`mdframework.workers.die_with_parent` for the process pool; a local Dask cluster's
     workers watch their parent themselves; both tested by killing the parent)."""
-    from .workers import die_with_parent, stop_pool
+    from .workers import worker_pool
 
     address = scheduler_address(scheduler)
-    n = workers or config.workers or os.cpu_count() or 1
+    n = build_workers(config, workers)
     if address is None:
         if n == 1:
             yield lambda specs, out: (build_record(s, out) for s in specs)
             return
-        pool = ProcessPoolExecutor(
-            max_workers=n, initializer=die_with_parent, initargs=(os.getpid(),)
-        )
-        try:
+        # Ctrl-C or an error (the generator closed): the queued records are dropped
+        with worker_pool(n) as pool:
 
             def run_local(specs: list[RecordSpec], out: str) -> Iterator[dict[str, Any]]:
                 futures = [pool.submit(build_record, s, out) for s in specs]
@@ -1006,10 +1076,6 @@ def _executor(
                     yield fut.result()
 
             yield run_local
-        except BaseException:
-            stop_pool(pool)  # Ctrl-C or an error: do not wait for the queued records
-            raise
-        pool.shutdown()
         return
     try:
         from distributed import Client, LocalCluster
@@ -1121,7 +1187,8 @@ def build_dataset(
 
     with dataset_folder(out_dir, force=force) as folder:
         note("planning the records (reading each recording once)", progress)
-        specs = plan_records(config, base_dir)  # errors in the config stop before any file
+        # errors in the config stop before any file
+        specs = plan_records(config, base_dir, workers=build_workers(config, workers))
         out = folder.path
         wanted = _comparable(config)
         built = _built_from(folder)

@@ -132,9 +132,14 @@ def find_glitches(
     local_ratio: float = 5.0,
 ) -> BoolArray:
     """Single-frame glitches, (n_frames, n_joints) bool (see the module docstring)."""
+    e, _ = deviations(time, positions, valid)
+    return _glitch_mask(e, min_m, ratio, local_ratio)
+
+
+def _glitch_mask(e: FloatArray, min_m: float, ratio: float, local_ratio: float) -> BoolArray:
+    """:func:`find_glitches` from the deviations ``e`` (n_frames, n_joints) [m]."""
     from scipy.ndimage import median_filter
 
-    e, _ = deviations(time, positions, valid)
     if e.shape[0] < 3:
         return np.zeros(e.shape, dtype=bool)
     zero = np.zeros((1, e.shape[1]))
@@ -175,13 +180,23 @@ def limit_violations(
     ``joint``, ``quantity`` ('speed' [m/s] or 'acceleration' [m/s^2]), ``max``, ``limit``,
     ``frames`` (count over the limit) and ``first_time_s``.
     """
+    if skeleton.n_frames < 3:
+        return []
+    _, acc = deviations(skeleton.time, skeleton.positions, skeleton.valid)
+    return _limit_violations(skeleton, acc, scale, exclude)
+
+
+def _limit_violations(
+    skeleton: Skeleton, acc: FloatArray, scale: float, exclude: BoolArray | None
+) -> list[dict[str, Any]]:
+    """:func:`limit_violations` with the implied accelerations ``acc`` (n_frames, n_joints)
+    [m/s^2] of :func:`deviations`."""
     t, p, valid = skeleton.time, skeleton.positions, skeleton.valid
     out: list[dict[str, Any]] = []
     if skeleton.n_frames < 3:
         return out
     speed = joint_speeds(t, p)
     speed = np.where(valid[1:] & valid[:-1], np.nan_to_num(speed, nan=0.0), 0.0)
-    _, acc = deviations(t, p, valid)
     if exclude is not None:
         acc = np.where(exclude, 0.0, acc)
     for j, name in enumerate(skeleton.joint_names):
@@ -241,16 +256,35 @@ def _period_strength(
     denom = float(x @ x)
     if denom <= 0:
         return None
-    ac = np.correlate(x, x, mode="full")[n - 1 :] / denom
-    neg = np.flatnonzero(ac < 0)
-    if neg.size == 0:
+    ac = _Autocorrelation(x, denom)
+    neg = next((lag for lag in range(n) if ac[lag] < 0), None)
+    if neg is None:
         return None
-    for lag in range(int(neg[0]) + 1, n - 1):
+    for lag in range(neg + 1, n - 1):
         if ac[lag] >= min_strength and ac[lag] >= ac[lag - 1] and ac[lag] >= ac[lag + 1]:
             curve = ac[lag - 1] - 2 * ac[lag] + ac[lag + 1]
             shift = 0.5 * (ac[lag - 1] - ac[lag + 1]) / curve if curve < 0 else 0.0
             return float((lag + shift) * dt), float(ac[lag])
     return None
+
+
+class _Autocorrelation:
+    """The autocorrelation of ``x`` (n,) at lags 0 .. n-1 divided by ``denom``, computed lag by
+    lag as far as it is read: the first clear period of a long recording lies within its
+    first few hundred lags, while the whole (``np.correlate``) costs n^2. Each lag is the dot
+    product of the overlapping parts, the value ``np.correlate(x, x, "full")`` gives there."""
+
+    def __init__(self, x: FloatArray, denom: float) -> None:
+        self.x = x
+        self.denom = denom
+        self.values: list[float] = []
+
+    def __getitem__(self, lag: int) -> float:
+        x, n, values = self.x, self.x.shape[0], self.values
+        while len(values) <= lag:
+            k = len(values)
+            values.append(float(x[k:] @ x[: n - k]) / self.denom)
+        return values[lag]
 
 
 def first_period(time: FloatArray, signal: FloatArray, min_strength: float = 0.3) -> float | None:
@@ -353,15 +387,8 @@ def check_motion(motion: Motion, config: SanityConfig) -> Motion:
     report: dict[str, Any] = {}
     notes: list[tuple[str, str]] = []  # (option, message)
 
-    mask = find_glitches(
-        body.time,
-        body.positions,
-        body.valid,
-        min_m=config.glitch_min_m,
-        ratio=config.glitch_ratio,
-        local_ratio=config.glitch_local_ratio,
-    )
-    e, _ = deviations(body.time, body.positions, body.valid)
+    e, acc = deviations(body.time, body.positions, body.valid)  # once for the checks below
+    mask = _glitch_mask(e, config.glitch_min_m, config.glitch_ratio, config.glitch_local_ratio)
     frames, joints = np.nonzero(mask)
     items = [
         {
@@ -389,7 +416,7 @@ def check_motion(motion: Motion, config: SanityConfig) -> Motion:
             )
         )
 
-    over = limit_violations(body, config.speed_scale, exclude=mask)
+    over = _limit_violations(body, acc, config.speed_scale, mask)
     report["limits"] = over
     if over:
         worst = over[0]

@@ -18,7 +18,9 @@ import signal
 import sys
 import threading
 import time
+from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
 from typing import Any
 
 _PR_SET_PDEATHSIG = 1
@@ -74,3 +76,17 @@ def stop_pool(pool: ProcessPoolExecutor) -> None:
         proc.terminate()
     for proc in processes.values():
         proc.join(timeout=5)
+
+
+@contextmanager
+def worker_pool(n: int) -> Iterator[ProcessPoolExecutor]:
+    """A process pool of ``n`` workers that end with this process (:func:`die_with_parent`).
+    Leaving the block normally waits for the work submitted; an error, Ctrl-C or a closed
+    generator around it stops the workers at once (:func:`stop_pool`)."""
+    pool = ProcessPoolExecutor(max_workers=n, initializer=die_with_parent, initargs=(os.getpid(),))
+    try:
+        yield pool
+    except BaseException:
+        stop_pool(pool)
+        raise
+    pool.shutdown()

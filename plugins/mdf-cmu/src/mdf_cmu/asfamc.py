@@ -23,6 +23,7 @@ Every problem raises :class:`mdframework.DataFileError` with the file and 1-base
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -170,10 +171,10 @@ def _check_amc_angles(
     vals: FloatArray,
     order: tuple[str, ...],
     degrees: bool,
-    lines: list[int],
+    lines: Callable[[int], int] | Sequence[int],
 ) -> None:
     """Rotation values of one AMC bone (n_frames, n_values) within +-``limits.MAX_ANGLE_DEG``;
-    ``lines``: the file line of each frame's values."""
+    ``lines``: the file line of each frame's values (a sequence, or a function of the frame)."""
     rot = [k for k, c in enumerate(order) if c.upper().startswith("R")]
     limit = limits.MAX_ANGLE_DEG if degrees else np.deg2rad(limits.MAX_ANGLE_DEG)
     unit = " deg" if degrees else " rad"
@@ -424,8 +425,10 @@ def read_amc(path: str | Path, asf: AsfSkeleton) -> AmcMotion:
     """
     p = Path(path)
     lines = read_lines(p)
-    counts = {"root": 6, **{b.name: len(b.dof) for b in asf.bones}}
-    orders = {"root": asf.root_order, **{b.name: b.dof for b in asf.bones}}
+    regular = _read_regular_amc(p, lines, asf)
+    if regular is not None:
+        return regular
+    counts, _ = _amc_layout(asf)
     bone_lines: dict[str, list[int]] = {}
     degrees = asf.angles_in_degrees
     rows: dict[str, list[list[float]]] = {}
@@ -487,10 +490,34 @@ def read_amc(path: str | Path, asf: AsfSkeleton) -> AmcMotion:
     if not numbers:
         raise DataFileError(p, "the file holds zero frames", max(len(lines), 1))
     close_frame(len(lines))
+    arrays = {
+        name: np.asarray(r, dtype=np.float64).reshape(len(numbers), counts[name])
+        for name, r in rows.items()
+    }
+    return _amc_motion(p, asf, arrays, degrees, bone_lines.__getitem__, numbers)
+
+
+def _amc_layout(asf: AsfSkeleton) -> tuple[dict[str, int], dict[str, tuple[str, ...]]]:
+    """The number of AMC values of the root and of each bone, and their order."""
+    counts = {"root": 6, **{b.name: len(b.dof) for b in asf.bones}}
+    orders = {"root": asf.root_order, **{b.name: b.dof for b in asf.bones}}
+    return counts, orders
+
+
+def _amc_motion(
+    p: Path,
+    asf: AsfSkeleton,
+    arrays: dict[str, FloatArray],
+    degrees: bool,
+    lines_of: Callable[[str], Callable[[int], int] | Sequence[int]],
+    numbers: list[int],
+) -> AmcMotion:
+    """The motion of parsed AMC values (bone -> (n_frames, n_values)), with the angle limits
+    checked (``lines_of(bone)`` gives each frame's line of that bone) and radians converted."""
+    _, orders = _amc_layout(asf)
     values: dict[str, FloatArray] = {}
-    for name, r in rows.items():
-        arr = np.asarray(r, dtype=np.float64).reshape(len(numbers), counts[name])
-        _check_amc_angles(p, name, arr, orders[name], degrees, bone_lines[name])
+    for name, arr in arrays.items():
+        _check_amc_angles(p, name, arr, orders[name], degrees, lines_of(name))
         if not degrees:
             if name == "root":
                 rot = [k for k, c in enumerate(asf.root_order) if c.startswith("R")]
@@ -499,6 +526,90 @@ def read_amc(path: str | Path, asf: AsfSkeleton) -> AmcMotion:
                 arr = np.rad2deg(arr)
         values[name] = arr
     return AmcMotion(p, values, np.asarray(numbers, dtype=np.int64))
+
+
+#: Token put between the lines of an AMC file for the whole-file parse (not in any valid file)
+_EOL = "|"
+
+
+def _read_regular_amc(p: Path, lines: list[str], asf: AsfSkeleton) -> AmcMotion | None:
+    """Parse an AMC file whose frames all list the same bones in the same order on consecutive
+    lines (as every CMU file does) in one pass over the whole file: the values are converted by
+    numpy with Python's own ``float`` (an object array's cast), so they are the line-by-line
+    parse's bit for bit. Returns None for any other file (comments or blank lines among the
+    frames, a bone missing or moved, a bad or out-of-range number, ...): the line-by-line parse
+    then reads it, or names the file and line of its first problem."""
+    counts, _ = _amc_layout(asf)
+    degrees = asf.angles_in_degrees
+    first = None
+    for i, raw in enumerate(lines):
+        toks = raw.split()
+        if not toks or toks[0].startswith("#"):
+            continue
+        if toks[0].isdigit():
+            first = i
+            break
+        k = toks[0].upper()
+        if len(toks) != 1 or k not in (":FULLY-SPECIFIED", ":DEGREES", ":RADIANS"):
+            return None
+        if k != ":FULLY-SPECIFIED":
+            degrees = k == ":DEGREES"
+    if first is None or len(lines[first].split()) != 1:
+        return None
+    # the bones of the first frame, in file order, give every frame's layout
+    names: list[str] = []
+    for raw in lines[first + 1 :]:
+        toks = raw.split()
+        if not toks or toks[0].isdigit():
+            break
+        if toks[0] not in counts or toks[0] in names or len(toks) != 1 + counts[toks[0]]:
+            return None
+        names.append(toks[0])
+    if not {name for name, c in counts.items() if c > 0} <= set(names):
+        return None
+    end = len(lines)
+    while end > first and not lines[end - 1].strip():
+        end -= 1
+    text = f" {_EOL} ".join(lines[first:end])
+    if text.count(_EOL) != end - first - 1:  # the file has one of its own
+        return None
+    # per frame: number, EOL, then per bone: name, values, EOL
+    tokens = np.array((text + f" {_EOL}").split(), dtype=object)
+    width = 2 + sum(2 + counts[name] for name in names)
+    if tokens.size % width:
+        return None
+    frames = tokens.reshape(-1, width)
+    cols: dict[str, slice] = {}
+    col = 2
+    for name in names:
+        cols[name] = slice(col + 1, col + 1 + counts[name])
+        if not (np.all(frames[:, col] == name) and np.all(frames[:, cols[name].stop] == _EOL)):
+            return None
+        col = cols[name].stop + 1
+    if not np.all(frames[:, 1] == _EOL):
+        return None
+    heads = frames[:, 0].tolist()
+    if not all(h.isascii() and h.isdigit() for h in heads):
+        return None
+    numbers = [int(h) for h in heads]
+    if numbers != list(range(numbers[0], numbers[0] + len(numbers))):
+        return None
+    arrays: dict[str, FloatArray] = {}
+    for name in names:
+        try:
+            arr = frames[:, cols[name]].astype(np.float64)  # Python's float() of each token
+        except ValueError:
+            return None
+        if not np.all(np.abs(arr) <= limits.MAX_FILE_COORDINATE):  # NaN fails too
+            return None
+        arrays[name] = arr
+    step = 1 + len(names)
+
+    def lines_of(name: str) -> Callable[[int], int]:
+        line = first + 2 + names.index(name)  # 1-based line of the bone in the first frame
+        return lambda k: line + k * step
+
+    return _amc_motion(p, asf, arrays, degrees, lines_of, numbers)
 
 
 def asf_forward_kinematics(asf: AsfSkeleton, amc: AmcMotion) -> tuple[tuple[str, ...], FloatArray]:

@@ -283,26 +283,34 @@ class WalkerBody:
 
         m, d = self.model, self.data
         n = qpos.shape[0]
-        joints = np.empty((n, len(CANONICAL_JOINTS), 3))
-        centres = np.empty((n, len(PART_NAMES), 3))
-        rot = np.empty((n, len(PART_NAMES), 9))
-        sites, geoms = self._site_ids, self._geom_ids
-        thorax = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "thorax")
+        # MjData's arrays are views of the buffers mj_kinematics fills in place: take the views
+        # once, copy them whole every frame (plain copies: a third of the time of picking the
+        # sites and geoms frame by frame) and pick the sites and geoms once for all frames
+        site_xpos, geom_xpos, geom_xmat, d_qpos = d.site_xpos, d.geom_xpos, d.geom_xmat, d.qpos
+        all_sites = np.empty((n, *site_xpos.shape))
+        all_pos = np.empty((n, *geom_xpos.shape))
+        all_mat = np.empty((n, *geom_xmat.shape))
         quirk = self.gait.chen_compatible
-        thorax_pos = np.empty((n, 3)) if quirk else None
-        thorax_mat = np.empty((n, 9)) if quirk else None
+        body_xpos, body_xmat = d.xpos, d.xmat
+        all_bpos = np.empty((n, *body_xpos.shape)) if quirk else None
+        all_bmat = np.empty((n, *body_xmat.shape)) if quirk else None
+        kinematics = mujoco.mj_kinematics
         for i in range(n):
-            d.qpos[:] = qpos[i]
-            mujoco.mj_kinematics(m, d)
-            joints[i] = d.site_xpos[sites]
-            centres[i] = d.geom_xpos[geoms]
-            rot[i] = d.geom_xmat[geoms]
-            if thorax_pos is not None and thorax_mat is not None:
-                thorax_pos[i] = d.xpos[thorax]
-                thorax_mat[i] = d.xmat[thorax]
-        if thorax_pos is not None and thorax_mat is not None:
-            joints = self._freeze_elbows(joints, thorax_pos, thorax_mat.reshape(n, 3, 3))
-        return Frames(joints, centres, rot.reshape(n, len(PART_NAMES), 3, 3), self.semi_axes)
+            d_qpos[:] = qpos[i]
+            kinematics(m, d)
+            all_sites[i] = site_xpos
+            all_pos[i] = geom_xpos
+            all_mat[i] = geom_xmat
+            if all_bpos is not None and all_bmat is not None:
+                all_bpos[i] = body_xpos
+                all_bmat[i] = body_xmat
+        joints = all_sites[:, self._site_ids]
+        rot = all_mat[:, self._geom_ids].reshape(n, len(PART_NAMES), 3, 3)
+        if all_bpos is not None and all_bmat is not None:
+            thorax = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "thorax")
+            mat = all_bmat[:, thorax].reshape(n, 3, 3)
+            joints = self._freeze_elbows(joints, all_bpos[:, thorax], mat)
+        return Frames(joints, all_pos[:, self._geom_ids], rot, self.semi_axes)
 
     def _freeze_elbows(self, joints: FloatArray, pos: FloatArray, mat: FloatArray) -> FloatArray:
         out = joints.copy()
