@@ -422,3 +422,20 @@ def test_a_mirror_clip_plays_once(tmp_path: Path) -> None:
     assert load(path).metadata["loop"] == "mirror"
     with pytest.raises(DataFileError, match="mirror image"):
         load(path, cycles=2)
+
+
+def test_cycles_beyond_the_limits_are_refused_before_anything_is_built(tmp_path: Path) -> None:
+    """1001 frames played 10,000 times would be 10,000,001 frames: refused, naming the field."""
+    frames = raw_frames(WALK)
+    long = np.concatenate([frames[:-1]] * 27)[:1001]
+    long[:, 0] = 0.001
+    path = tmp_path / "long.txt"
+    path.write_text(json.dumps({"Loop": "wrap", "Frames": long.tolist()}))
+    with pytest.raises(DataFileError, match=r"motion.cycles = 10000 .* 10,000,001 frames"):
+        load(path, cycles=10_000)
+    assert load(path, cycles=2).skeleton.n_frames == 2001
+    from mdframework import limits
+
+    assert (limits.MAX_FRAMES, limits.MAX_DURATION_S) == (10_000_000, 86_400)
+    with pytest.raises(ValidationError, match="less than or equal to 10000"):
+        DeepMimicConfig(file=WALK, cycles=10_001)

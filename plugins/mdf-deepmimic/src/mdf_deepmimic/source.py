@@ -126,6 +126,15 @@ class DeepMimicSource(MotionSource):
                 f'motion.cycles = {c.cycles}, but the clip\'s "Loop" is "{clip.loop}": {why}; '
                 "set cycles = 1",
             )
+        total = c.cycles * (clip.n_frames - 1) + 1
+        if total > limits.MAX_FRAMES or c.cycles * clip.time[-1] > limits.MAX_DURATION_S:
+            raise DataFileError(
+                path,
+                f"motion.cycles = {c.cycles} of this {clip.n_frames}-frame, "
+                f"{clip.time[-1]:.4g} s clip is {total:,} frames and "
+                f"{c.cycles * clip.time[-1]:.4g} s, beyond the limits of {limits.MAX_FRAMES:,} "
+                f"frames and {limits.MAX_DURATION_S:g} s: play fewer cycles",
+            )
         names, pos_file = forward_kinematics(HUMANOID3D, clip.root_position, clip.rotations)
         pos = reorient(pos_file, c.axes)
         time, pos, closure = repeat_cycles(clip.time, pos, c.cycles, names.index("root"))
