@@ -201,6 +201,8 @@ def test_walk_speed_and_cadence_from_the_raw_root_track_and_the_feet() -> None:
     assert speed == pytest.approx(0.9779, abs=1e-4)
     assert raw[-1, 1] - raw[0, 1] == pytest.approx(1.239, abs=1e-3)
     assert raw[-1, 3] == pytest.approx(raw[0, 3], abs=1e-12)  # no sideways drift
+    assert raw.shape == (39, 44) and raw[-1, 0] == 0.0
+    assert 0.845 < raw[:, 2].min() and raw[:, 2].max() < 0.875  # root height
     bob = np.abs(np.fft.rfft(raw[:-1, 2] - raw[:-1, 2].mean()))
     assert np.argmax(bob) == 2 and bob[1] < 1e-3 * bob[2]
     spm = 2 * 60 / period
@@ -233,6 +235,7 @@ def test_run_speed_and_cadence() -> None:
     """The run clip: one running cycle of 0.8 s, the root covering 2.845 m (3.56 m/s), 150
     steps a minute by the raw clip and by the core's estimate on four cycles."""
     raw = raw_frames(RUN)
+    assert raw.shape == (25, 44)
     period = raw[:-1, 0].sum()
     assert period == pytest.approx(0.79997, abs=1e-5)
     assert raw[-1, 1] - raw[0, 1] == pytest.approx(2.845, abs=1e-3)
@@ -268,6 +271,16 @@ def test_punch_is_a_right_hand_punch() -> None:
     heading = np.degrees(np.arctan2(-across[:, 0], across[:, 1]))
     assert heading.max() == pytest.approx(110, abs=3) and abs(heading[-1]) < 3
     assert m.metadata["quaternions_renormalised"] == 10
+    raw = raw_frames(PUNCH)
+    norms = {
+        j: np.linalg.norm(raw[:, c : c + 4], axis=1)
+        for k, j, c, _ in HUMANOID3D.layout()
+        if k == "spherical"
+    }
+    off = {j for j, n in norms.items() if np.any(np.abs(n - 1) > 1e-3)}
+    assert off == {"neck"}
+    neck = norms["neck"][np.abs(norms["neck"] - 1) > 1e-3]
+    assert neck.size == 10 and 0.91 < neck.min() < 0.92 and 0.98 < neck.max() < 0.99
     assert m.metadata["quaternion_norm_range"][0] == pytest.approx(0.917, abs=1e-3)
 
 
@@ -386,3 +399,43 @@ def test_frame_durations_are_bounded(tmp_path: Path, duration: float, ok: bool) 
     else:
         with pytest.raises(DataFileError, match="frame 3: duration"):
             read_clip(path)
+
+
+@pytest.mark.parametrize(("norm", "ok"), [(0.05, False), (0.5, True), (9.0, True), (11.0, False)])
+def test_quaternion_norms_are_bounded(tmp_path: Path, norm: float, ok: bool) -> None:
+    frames = raw_frames(WALK)
+    frames[6, 8:12] *= norm / np.linalg.norm(frames[6, 8:12])
+    path = tmp_path / "clip.txt"
+    path.write_text(json.dumps({"Loop": "wrap", "Frames": frames.tolist()}))
+    if ok:  # normalised: the same pose as the file's own
+        clip = read_clip(path)
+        np.testing.assert_allclose(clip.rotations["chest"], read_clip(WALK).rotations["chest"])
+        assert clip.renormalised == 1
+    else:
+        with pytest.raises(DataFileError, match="frame 6: the chest quaternion"):
+            read_clip(path)
+
+
+def test_a_mirror_clip_plays_once(tmp_path: Path) -> None:
+    path = tmp_path / "walk.txt"
+    path.write_text(WALK.read_text().replace('"wrap"', '"mirror"'))
+    assert load(path).metadata["loop"] == "mirror"
+    with pytest.raises(DataFileError, match="mirror image"):
+        load(path, cycles=2)
+
+
+def test_cycles_beyond_the_limits_are_refused_before_anything_is_built(tmp_path: Path) -> None:
+    """1001 frames played 10,000 times would be 10,000,001 frames: refused, naming the field."""
+    frames = raw_frames(WALK)
+    long = np.concatenate([frames[:-1]] * 27)[:1001]
+    long[:, 0] = 0.001
+    path = tmp_path / "long.txt"
+    path.write_text(json.dumps({"Loop": "wrap", "Frames": long.tolist()}))
+    with pytest.raises(DataFileError, match=r"motion.cycles = 10000 .* 10,000,001 frames"):
+        load(path, cycles=10_000)
+    assert load(path, cycles=2).skeleton.n_frames == 2001
+    from mdframework import limits
+
+    assert (limits.MAX_FRAMES, limits.MAX_DURATION_S) == (10_000_000, 86_400)
+    with pytest.raises(ValidationError, match="less than or equal to 10000"):
+        DeepMimicConfig(file=WALK, cycles=10_001)

@@ -1187,7 +1187,7 @@ def _deepmimic_cases(c: _Corpus) -> None:
     clip_case("position-1e300", frame(7, 1, "1e300"), "walk.txt:12:", "root position")
     clip_case("quaternion-zero", frame(2, 8, "0"), "walk.txt:7:", "chest quaternion")
     clip_case("word", frame(4, 3, '"up"'), "walk.txt:9:", "not a number")
-    clip_case("loop", "".join(walk).replace('"wrap"', '"mirror"'), "walk.txt:2:", "Loop")
+    clip_case("loop", "".join(walk).replace('"wrap"', '"bounce"'), "walk.txt:2:", "Loop")
     clip_case("not-a-clip", "[1, 2, 3]", "Frames")
     clip_case("binary", "".join(walk[:6]).encode() + b"\x00", "NUL")
     clip_case("one-frame", "".join(walk[:4]) + walk[4].rstrip().rstrip(",") + "\n]\n}\n", "1 frame")

@@ -11,7 +11,9 @@ A clip (DeepMimic's ``data/motions/*.txt``) is one JSON object::
     ]
     }
 
-``Loop`` is ``"wrap"`` (a cycle: the clip may be repeated) or ``"none"`` (absent: ``"none"``).
+``Loop`` is ``"wrap"`` (a cycle: the clip may be repeated), ``"mirror"`` (a cycle whose every
+other repetition DeepMimic plays mirrored left for right) or ``"none"`` (also when absent).
+Other keys (``VelFilterCutoff``, ``RightJoints``, ...) are not used.
 Each frame is, for the character's joints in file order: the duration of the frame [s], the
 root position (3) [m] and rotation (4, a quaternion w, x, y, z) in the world, then each joint's
 rotation relative to its parent: a quaternion (w, x, y, z) for a spherical joint, an angle
@@ -58,7 +60,7 @@ MAX_CLIP_BYTES = 128 * 1024 * 1024
 MIN_QUATERNION_NORM = 0.1
 MAX_QUATERNION_NORM = 10.0
 #: Loop modes of a clip.
-LOOPS = ("wrap", "none")
+LOOPS = ("wrap", "mirror", "none")
 
 
 @dataclass(frozen=True)
@@ -167,7 +169,9 @@ def read_clip(path: Path, character: Character = HUMANOID3D) -> Clip:
     loop = doc.get("Loop", "none")
     if loop not in LOOPS:
         raise DataFileError(
-            path, f'"Loop" is {loop!r}; a clip\'s loop is "wrap" or "none"', lines.key_line("Loop")
+            path,
+            f'"Loop" is {loop!r}; a clip\'s loop is "wrap", "mirror" or "none"',
+            lines.key_line("Loop"),
         )
     frames: list[Any] = doc["Frames"]
     n = len(frames)

@@ -52,7 +52,7 @@ class DeepMimicConfig(MotionConfig):
         ge=1,
         le=MAX_CYCLES,
         description='Play a cyclic clip ("Loop": "wrap") this many times, each cycle '
-        'shifted by the clip\'s root displacement; a clip with "Loop": "none" plays once.',
+        "shifted by the clip's root displacement; other clips play once.",
     )
     axes: tuple[Axis, Axis, Axis] = Field(
         ("x", "-z", "y"),
@@ -116,10 +116,24 @@ class DeepMimicSource(MotionSource):
         path = Path(c.file)
         clip = read_clip(path, HUMANOID3D)
         if c.cycles > 1 and clip.loop != "wrap":
+            why = {
+                "none": "it is not a cycle",
+                "mirror": "its repetitions alternate with their mirror image, which this "
+                "source does not play",
+            }[clip.loop]
             raise DataFileError(
                 path,
-                f'motion.cycles = {c.cycles}, but the clip\'s "Loop" is "{clip.loop}": it is '
-                "not a cycle; set cycles = 1",
+                f'motion.cycles = {c.cycles}, but the clip\'s "Loop" is "{clip.loop}": {why}; '
+                "set cycles = 1",
+            )
+        total = c.cycles * (clip.n_frames - 1) + 1
+        if total > limits.MAX_FRAMES or c.cycles * clip.time[-1] > limits.MAX_DURATION_S:
+            raise DataFileError(
+                path,
+                f"motion.cycles = {c.cycles} of this {clip.n_frames}-frame, "
+                f"{clip.time[-1]:.4g} s clip is {total:,} frames and "
+                f"{c.cycles * clip.time[-1]:.4g} s, beyond the limits of {limits.MAX_FRAMES:,} "
+                f"frames and {limits.MAX_DURATION_S:g} s: play fewer cycles",
             )
         names, pos_file = forward_kinematics(HUMANOID3D, clip.root_position, clip.rotations)
         pos = reorient(pos_file, c.axes)
