@@ -94,8 +94,11 @@ def keep_freed_memory() -> None:
     did not (the planner, when the motions were loaded in other processes) mapped and faulted
     in about 14 MB afresh for every 6 s record: 3,600 page faults and up to a third more CPU.
     Allocating and freeing one block of :data:`FREED_BLOCK_BYTES` raises the thresholds at
-    once. Elsewhere than glibc it allocates and frees one block."""
-    block = bytearray(FREED_BLOCK_BYTES)
+    once (numpy's ``empty`` asks malloc for it and touches no page of it). Elsewhere than glibc
+    it allocates and frees one block."""
+    import numpy as np
+
+    block = np.empty(FREED_BLOCK_BYTES, dtype=np.uint8)
     del block
 
 
