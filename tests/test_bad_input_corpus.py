@@ -27,6 +27,7 @@ def _files(folder: Path) -> set[Path]:
 def test_the_corpus_covers_every_format_and_config_section() -> None:
     prefixes = {name.split("-")[0] for name in NAMES}
     assert {"bvh", "amc", "utkinect", "msr", "precog", "ntu", "nite", "oni", "radhar"} <= prefixes
+    assert {"c3d", "trc", "table"} <= prefixes
     assert {"config", "field", "dataset", "experiment"} <= prefixes
     fields = " ".join(NAMES)
     for section in ("prf", "carrier", "target", "gate", "window", "gap", "seed", "noise"):

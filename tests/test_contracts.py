@@ -40,6 +40,7 @@ SOURCE_EXAMPLES = {
     "kinect": "kinect_utkinect_walk.toml",
     "point_targets": "point_target.toml",
     "table": "table_utkinect_walk.toml",
+    "trc": "trc_walk.toml",
 }
 #: motion sources checked on a file the test writes, because no real recording recorded by
 #: others that they can map onto the whole body is shipped: the one public C3D file in

@@ -152,9 +152,13 @@ def check_product_bytes(n_bytes: float, what: str, field: str) -> None:
         )
 
 
-def read_text_file(path: str | Path, what: str, max_bytes: int | None = None) -> str:
+def read_text_file(
+    path: str | Path, what: str, max_bytes: int | None = None, latin1: bool = False
+) -> str:
     """The text of a file that must be UTF-8 (a byte-order mark is dropped), checked before it
     is decoded: at most ``max_bytes`` long (when given), no NUL byte (binary data, or UTF-16).
+    ``latin1``: text that is not UTF-8 is read as Latin-1 instead of refused (formats whose old
+    writers put Windows paths in a header line).
 
     ``what`` names what the file should be (``"a text table"``). Raises
     :class:`~mdframework.errors.DataFileError` naming the file and the line of the first bad
@@ -175,6 +179,8 @@ def read_text_file(path: str | Path, what: str, max_bytes: int | None = None) ->
     try:
         return raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
+        if latin1:
+            return raw.decode("latin-1")
         line = raw[: exc.start].count(b"\n") + 1
         raise DataFileError(p, "not UTF-8 text: re-save the file as UTF-8", line) from None
 

@@ -35,6 +35,7 @@ ONI = DATA / "kinect" / "oni" / "test.oni"
 RADHAR_TEXT = DATA / "radhar" / "text" / "20_jump_1.txt.gz"
 RADHAR_NPZ = DATA / "radhar" / "radhar_walk_subset.npz"
 C3D = DATA / "c3d" / "treadmill_events.c3d"
+TRC = DATA / "trc" / "opensim_subject01_walk.trc"
 DEEPMIMIC_WALK = DATA / "deepmimic" / "humanoid3d_walk.txt"
 DEEPMIMIC_PUNCH = DATA / "deepmimic" / "humanoid3d_punch.txt"
 
@@ -1083,8 +1084,8 @@ def _dataset_cases(c: _Corpus) -> None:
 
 
 def _reader_cases(c: _Corpus) -> None:
-    """C3D marker files (the real treadmill capture, damaged) and joint-track tables (the
-    real UTKinect table, damaged, and small written ones)."""
+    """C3D and TRC marker files (the real treadmill captures, damaged) and joint-track tables
+    (the real UTKinect table, damaged, and small written ones)."""
     raw = C3D.read_bytes()
     rng = np.random.default_rng(11)
 
@@ -1102,6 +1103,33 @@ def _reader_cases(c: _Corpus) -> None:
     c3d_case("random-bytes", rng.integers(0, 256, 5000, dtype=np.uint8).tobytes(), "not a C3D")
     c3d_case("too-short", raw[:100], "too short")
     c3d_case("no-arm-markers", raw, "lacks head", "marker_map")
+
+    trc = _lines(TRC)
+
+    def trc_header(key: str, value: str) -> str:
+        keys = [k.strip() for k in trc[1].split("\t")]
+        values = trc[2].rstrip("\n").split("\t")
+        values[keys.index(key)] = value
+        return "".join([*trc[:2], "\t".join(values) + "\n", *trc[3:]])
+
+    def trc_case(name: str, text: str, *expect: str) -> None:
+        d = c.folder(f"trc-{name}")
+        (d / "walk.trc").write_text(text, encoding="utf-8")
+        motion = {"kind": "trc", "file": "walk.trc"}
+        c.run(f"trc-{name}", _json_config(d, {"motion": motion}), "walk.trc", *expect)
+
+    trc_case("truncated", "".join(trc[:60]), "walk.trc:3:", "truncated")
+    trc_case("row-cut-short", "".join([*trc[:59], trc[59][:300] + "\n", *trc[60:]]), ":60:")
+    trc_case("num-frames-1e9", trc_header("NumFrames", "1000000000"), "walk.trc:3:", "NumFrames")
+    trc_case("num-markers-1e12", trc_header("NumMarkers", "1e12"), "walk.trc:3:", "NumMarkers")
+    trc_case("num-markers-wrong", trc_header("NumMarkers", "40"), "walk.trc:4:", "NumMarkers")
+    trc_case("data-rate-nan", trc_header("DataRate", "nan"), "walk.trc:3:", "DataRate")
+    trc_case("data-rate-wrong", trc_header("DataRate", "120"), "walk.trc:8:", "DataRate")
+    trc_case("units-furlongs", trc_header("Units", "furlongs"), "walk.trc:3:", "unit_m")
+    for bad in ("1e308", "inf", "nan-word"):
+        row = trc[9].replace("621.540410", bad, 1)
+        trc_case(f"value-{bad}", "".join([*trc[:9], row, *trc[10:]]), "walk.trc:10:")
+    trc_case("not-a-trc", "".join(["Hello\n", *trc[1:]]), "walk.trc:1:", "not a TRC")
 
     utk = _lines(UTK)
     joints = [

@@ -1,11 +1,12 @@
-"""mdf-c3d: C3D marker files, read through ezc3d, with a marker-to-joint map onto the canonical
-body. See ``docs/motion-formats.md``."""
+"""mdf-c3d: marker files, C3D (read through ezc3d) and TRC (OpenSim's text format), with a
+marker-to-joint map onto the canonical body. See ``docs/motion-formats.md``."""
 
 from __future__ import annotations
 
 from .markersets import MARKER_SETS, detect_marker_set
 from .reader import C3dHeader, C3dMarkers, read_c3d, read_c3d_header
-from .source import C3dConfig, C3dSource
+from .source import C3dConfig, C3dSource, TrcConfig, TrcSource
+from .trc import TrcMarkers, read_trc
 
 __all__ = [
     "MARKER_SETS",
@@ -13,7 +14,11 @@ __all__ = [
     "C3dHeader",
     "C3dMarkers",
     "C3dSource",
+    "TrcConfig",
+    "TrcMarkers",
+    "TrcSource",
     "detect_marker_set",
     "read_c3d",
     "read_c3d_header",
+    "read_trc",
 ]

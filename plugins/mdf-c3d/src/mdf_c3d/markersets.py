@@ -14,11 +14,20 @@ plug-in-gait       Vicon Plug-in Gait full body: head ``LFHD RFHD LBHD RBHD``, n
                    ``LTOE``; and the same on the right.
 cmu                The CMU database's 41-marker set: as Plug-in Gait with the waist markers
                    ``LFWT RFWT LBWT RBWT`` for the pelvis.
+opensim-gait       The 41 markers of OpenSim's gait examples (Gait2354/Gait2392 subject01,
+                   Hamner's running subjects): head ``R.Temple L.Temple Top.Head``, neck
+                   ``R.Acromium L.Acromium``, shoulders ``L.Acromium``, elbows ``L.Elbow``,
+                   hands ``L.Wrist.Med L.Wrist.Lat``, pelvis ``R.ASIS L.ASIS V.Sacral``, hips
+                   ``L.ASIS V.Sacral``, knees ``L.Thigh.Rear L.Shank.Upper`` (the thigh
+                   cluster's lowest marker and the shank cluster's highest: the set has no knee
+                   marker), ankles ``L.Heel L.Midfoot.Sup L.Midfoot.Lat``, toes
+                   ``L.Toe.Lat L.Toe.Med``; and the same on the right.
 =================  ============================================================================
 
 A mean of skin markers is not the joint centre: the knee and ankle markers sit on the lateral
 side (about 5 cm off the joint axis), the hip from the pelvis markers lies a few centimetres
-above and outside the hip joint. For the radar signature (body parts tens of centimetres long,
+above and outside the hip joint; the OpenSim set's knee lies between two cluster markers about
+10 cm above and below the joint. For the radar signature (body parts tens of centimetres long,
 speeds of metres per second) these offsets are small; a ``marker_map`` with medial and lateral
 markers (``l_knee = ["LKNE", "LMKNE"]``) gives the joint centre.
 """
@@ -44,10 +53,13 @@ class MarkerSet:
 
 
 def _mirror(left: dict[str, Groups]) -> dict[str, Groups]:
-    """Left-side entries plus their right-side mirror (a leading L -> R)."""
+    """Left-side entries plus their right-side mirror (a leading L -> R; markers on the
+    midline, such as ``SACR`` or ``V.Sacral``, stay)."""
     out = dict(left)
     for key, groups in left.items():
-        out["r_" + key[2:]] = tuple(tuple("R" + m[1:] for m in g) for g in groups)
+        out["r_" + key[2:]] = tuple(
+            tuple("R" + m[1:] if m.startswith("L") else m for m in g) for g in groups
+        )
     return out
 
 
@@ -93,6 +105,27 @@ MARKER_SETS: dict[str, MarkerSet] = {
             ),
         },
         ("LFWT", "RFWT", "LBWT", "RBWT", "LSHN", "LMT5"),
+    ),
+    "opensim-gait": MarkerSet(
+        "opensim-gait",
+        "OpenSim gait example markers (Gait2354/Gait2392 subject01, Hamner running)",
+        {
+            "base": (("R.ASIS", "L.ASIS", "V.Sacral"),),
+            "neck": (("R.Acromium", "L.Acromium"),),
+            "head": (("R.Temple", "L.Temple", "Top.Head"),),
+            **_mirror(
+                {
+                    "l_shoulder": (("L.Acromium",),),
+                    "l_elbow": (("L.Elbow",),),
+                    "l_hand": (("L.Wrist.Med", "L.Wrist.Lat"),),
+                    "l_hip": (("L.ASIS", "V.Sacral"),),
+                    "l_knee": (("L.Thigh.Rear", "L.Shank.Upper"),),
+                    "l_ankle": (("L.Heel", "L.Midfoot.Sup", "L.Midfoot.Lat"),),
+                    "l_toe": (("L.Toe.Lat", "L.Toe.Med"),),
+                }
+            ),
+        },
+        ("V.Sacral", "R.Thigh.Upper", "R.Shank.Upper", "Top.Head", "R.Temple"),
     ),
 }
 

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from mdframework import MotionSource, hookimpl
 
-from .source import C3dSource
+from .source import C3dSource, TrcSource
 
 
 @hookimpl
 def mdframework_register_motion_sources() -> list[type[MotionSource]]:
-    """Register the C3D marker-file source (``kind = "c3d"``)."""
-    return [C3dSource]
+    """Register the marker-file sources (``kind = "c3d"`` and ``kind = "trc"``)."""
+    return [C3dSource, TrcSource]

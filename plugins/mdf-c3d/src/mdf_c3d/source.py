@@ -1,16 +1,18 @@
-"""The ``c3d`` motion source: a C3D marker file mapped onto the canonical 17-joint body.
+"""The ``c3d`` and ``trc`` motion sources: marker files mapped onto the canonical 17-joint body.
 
-Units from the file's ``POINT:UNITS`` (or ``unit_m``), frame rate from its header (or
-``frame_rate``), axes as the file's (C3D labs are usually z up; ``axes`` reorients), canonical
-joints as means of markers (:mod:`mdf_c3d.markersets`, or ``marker_map``).
+Units from the file (C3D ``POINT:UNITS``, TRC ``Units``; or ``unit_m``), frame rate from its
+header (or ``frame_rate``), axes as the file's (``axes`` reorients: C3D labs are usually z up,
+TRC files from OpenSim y up), canonical joints as means of markers (:mod:`mdf_c3d.markersets`,
+or ``marker_map``).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
+from numpy.typing import NDArray
 from pydantic import Field, model_validator
 
 from mdframework import (
@@ -29,14 +31,17 @@ from mdframework.skeleton import check_axes, check_canonical_keys, group_means, 
 Axis = Literal["x", "y", "z", "-x", "-y", "-z"]
 
 
-class C3dConfig(MotionConfig):
-    """A C3D marker file (Vicon, Qualisys, Motion Analysis, ...), mapped onto the body."""
+MarkerSetName = Literal["auto", "plug-in-gait", "cmu", "opensim-gait"]
 
-    kind: Literal["c3d"] = Field("c3d", description="Selects this source: 'c3d'.")
-    file: DataPath = Field(description="The .c3d file; relative to the config file's folder.")
-    marker_set: Literal["auto", "plug-in-gait", "cmu"] = Field(
+
+class MarkerFileConfig(MotionConfig):
+    """Fields shared by the marker-file sources (``c3d``, ``trc``)."""
+
+    file: DataPath = Field(description="The marker file; relative to the config file's folder.")
+    marker_set: MarkerSetName = Field(
         "auto",
-        description="Marker names: auto (detected from the labels), plug-in-gait or cmu.",
+        description="Marker names: auto (detected from the labels), plug-in-gait, cmu or "
+        "opensim-gait.",
     )
     marker_map: dict[str, str | list[str]] | None = Field(
         None,
@@ -44,27 +49,112 @@ class C3dConfig(MotionConfig):
         "['LKNE', 'LMKNE']}): overrides the set's, or maps all 17 joints of another set.",
     )
     unit_m: float | None = Field(
-        None, gt=0, le=1000, description="Metres per file unit; default: from POINT:UNITS."
+        None, gt=0, le=1000, description="Metres per file unit; default: from the file's units."
     )
     frame_rate: FrameRate | None = Field(
         None, description="Capture rate [Hz]; default: the file header's."
     )
+    activity: str = Field("unknown", description="Activity label recorded in the metadata.")
+
+    #: the file name's extension this source reads
+    suffix: ClassVar[str] = ""
+
+    @model_validator(mode="after")
+    def _check_marker_file(self) -> MarkerFileConfig:
+        if Path(self.file).suffix.lower() != self.suffix:
+            raise ValueError(f"file must be a {self.suffix} file, got {Path(self.file).name!r}")
+        check_canonical_keys(self.marker_map, "marker_map")
+        check_axes(getattr(self, "axes", ("x", "y", "z")))
+        return self
+
+
+class C3dConfig(MarkerFileConfig):
+    """A C3D marker file (Vicon, Qualisys, Motion Analysis, ...), mapped onto the body."""
+
+    kind: Literal["c3d"] = Field("c3d", description="Selects this source: 'c3d'.")
     axes: tuple[Axis, Axis, Axis] = Field(
         ("x", "y", "z"),
         description="The file axis (with sign) that becomes x (forward), y (left) and z (up).",
     )
-    activity: str = Field("unknown", description="Activity label recorded in the metadata.")
     subject: str | None = Field(
         None, description="Subject id for the metadata; default: the file's SUBJECTS:NAMES."
     )
 
-    @model_validator(mode="after")
-    def _check(self) -> C3dConfig:
-        if Path(self.file).suffix.lower() != ".c3d":
-            raise ValueError(f"file must be a .c3d file, got {Path(self.file).name!r}")
-        check_canonical_keys(self.marker_map, "marker_map")
-        check_axes(self.axes)
-        return self
+    suffix: ClassVar[str] = ".c3d"
+
+
+class TrcConfig(MarkerFileConfig):
+    """A TRC marker file (OpenSim's track-row-column text), mapped onto the body."""
+
+    kind: Literal["trc"] = Field("trc", description="Selects this source: 'trc'.")
+    axes: tuple[Axis, Axis, Axis] = Field(
+        ("x", "-z", "y"),
+        description="The file axis (with sign) that becomes x (forward), y (left) and z (up); "
+        "default: OpenSim's lab frame (X forward, Y up, Z right).",
+    )
+    subject: str | None = Field(None, description="Subject id for the metadata.")
+
+    suffix: ClassVar[str] = ".trc"
+
+
+def markers_motion(
+    path: Path,
+    config: C3dConfig | TrcConfig,
+    labels: tuple[str, ...],
+    positions: NDArray[np.float64],
+    unit_m: float,
+    rate: float,
+    meta: dict[str, Any],
+) -> Motion:
+    """The canonical body from a marker file's tracks.
+
+    ``positions`` (n_frames, n_markers, 3) in the file's unit (``unit_m`` metres each), NaN
+    where a marker is not seen; ``labels`` their names; ``rate`` [Hz] the frames' rate. The
+    marker set is detected (or taken from ``config``), each canonical joint is the mean of its
+    markers, the frame is turned by ``config.axes``. ``meta`` (the format's own entries) is
+    completed with the marker set and the markers of each joint.
+
+    Raises
+    ------
+    mdframework.DataFileError
+        Markers that do not make the body (the message lists the file's markers and what is
+        missing); fewer than two frames with a marker seen; joints beyond the limits.
+    """
+    from .markersets import MarkerMismatch, detect_marker_set, user_groups
+
+    c = config
+    try:
+        set_name, mapping = detect_marker_set(labels, user_groups(c.marker_map or {}), c.marker_set)
+    except MarkerMismatch as exc:
+        raise DataFileError(path, str(exc)) from None
+    try:
+        means, valid = group_means(positions, labels, mapping)
+    except KeyError as exc:  # pragma: no cover - resolve() only maps present labels
+        raise DataFileError(path, f"marker(s) {exc} not in the file") from None
+    pos = reorient(means * unit_m, c.axes)
+    if valid.any(axis=1).sum() < 2:
+        raise DataFileError(
+            path, "fewer than two frames where any mapped marker is seen: nothing to move"
+        )
+    time = np.arange(pos.shape[0], dtype=np.float64) / rate
+    limits.check_time_stamps(path, time)
+    limits.check_values(
+        path, pos, limits.MAX_COORDINATE_M, "a joint coordinate", unit=" m", allow_nan=True
+    )
+    meta = {
+        **meta,
+        "file": path.name,
+        "activity": c.activity,
+        "frame_rate_hz": rate,
+        "frame_rate_from": "config" if c.frame_rate is not None else "header",
+        "unit_m": unit_m,
+        "axes": list(c.axes),
+        "marker_set": set_name,
+        "markers": {j: list(m) for j, m in mapping.items()},
+        "n_frames": int(pos.shape[0]),
+    }
+    skeleton = Skeleton(time, np.where(valid[..., None], pos, np.nan), CANONICAL_JOINTS, valid)
+    return Motion(skeleton, meta, {j: j for j in CANONICAL_JOINTS})
 
 
 class C3dSource(MotionSource):
@@ -83,61 +173,84 @@ class C3dSource(MotionSource):
             ``skeleton``: time (n_frames,) [s] from 0 at the header's rate; positions
             (n_frames, 17, 3) [m] of the canonical joints (each the mean of its markers, NaN
             and invalid where one of them is not seen). ``metadata``: source, format, file,
-            subject, activity, frame_rate_hz and frame_rate_from, units, unit_m, marker_set,
-            markers (joint -> markers), n_frames, first_frame, software, events.
+            subject, activity, frame_rate_hz and frame_rate_from, units, unit_m, unit_from,
+            axes, marker_set, markers (joint -> markers), n_frames, first_frame, software,
+            events.
 
         Raises
         ------
         mdframework.DataFileError
             Malformed file (see :func:`mdf_c3d.read_c3d`); markers that do not make the body
-            (the message lists the file's markers and what is missing).
+            (see :func:`markers_motion`).
         """
-        from .markersets import MarkerMismatch, detect_marker_set, user_groups
         from .reader import read_c3d
 
         c = self.config
         path = Path(c.file)
         data = read_c3d(path, c.unit_m)
-        try:
-            set_name, mapping = detect_marker_set(
-                data.labels, user_groups(c.marker_map or {}), c.marker_set
-            )
-        except MarkerMismatch as exc:
-            raise DataFileError(path, str(exc)) from None
-        try:
-            means, valid = group_means(data.positions, data.labels, mapping)
-        except KeyError as exc:  # pragma: no cover - resolve() only maps present labels
-            raise DataFileError(path, f"marker(s) {exc} not in the file") from None
-        unit_m = data.unit_m
-        pos = reorient(means * unit_m, c.axes)
-        if valid.any(axis=1).sum() < 2:
-            raise DataFileError(
-                path, "fewer than two frames where any mapped marker is seen: nothing to move"
-            )
-        rate = float(c.frame_rate) if c.frame_rate is not None else data.rate_hz
-        time = np.arange(pos.shape[0], dtype=np.float64) / rate
-        limits.check_time_stamps(path, time)
-        limits.check_values(
-            path, pos, limits.MAX_COORDINATE_M, "a joint coordinate", unit=" m", allow_nan=True
-        )
         meta: dict[str, Any] = {
             "source": "c3d",
             "format": "c3d",
-            "file": path.name,
             "subject": c.subject if c.subject is not None else data.subject,
-            "activity": c.activity,
-            "frame_rate_hz": rate,
-            "frame_rate_from": "config" if c.frame_rate is not None else "header",
             "units": data.units,
-            "unit_m": unit_m,
             "unit_from": "config" if c.unit_m is not None else "POINT:UNITS",
-            "axes": list(c.axes),
-            "marker_set": set_name,
-            "markers": {j: list(m) for j, m in mapping.items()},
-            "n_frames": int(pos.shape[0]),
             "first_frame": data.first_frame,
             "software": data.software,
             "events": len(data.events),
         }
-        skeleton = Skeleton(time, np.where(valid[..., None], pos, np.nan), CANONICAL_JOINTS, valid)
-        return Motion(skeleton, meta, {j: j for j in CANONICAL_JOINTS})
+        rate = float(c.frame_rate) if c.frame_rate is not None else data.rate_hz
+        return markers_motion(path, c, data.labels, data.positions, data.unit_m, rate, meta)
+
+
+class TrcSource(MotionSource):
+    """A TRC marker file as the canonical 17-joint body, in metres, z up."""
+
+    name = "trc"
+    Config = TrcConfig
+    config: TrcConfig
+
+    def load(self) -> Motion:
+        """Read the file and average markers into joints.
+
+        Returns
+        -------
+        Motion
+            ``skeleton``: time (n_frames,) [s] from 0 at ``DataRate`` (the frame numbers
+            counted at the header's rate, or at ``frame_rate``); positions (n_frames, 17, 3) [m]
+            of the canonical joints (each the mean of its markers, NaN and invalid where one of
+            them is not seen). ``metadata``: source, format, file, subject, activity,
+            frame_rate_hz and frame_rate_from, units, unit_m, unit_from, axes, marker_set,
+            markers (joint -> markers), n_frames, first_frame (the first ``Frame#``),
+            camera_rate_hz (``CameraRate``, when given).
+
+        Raises
+        ------
+        mdframework.DataFileError
+            Malformed file (see :func:`mdf_c3d.read_trc`); markers that do not make the body
+            (see :func:`markers_motion`).
+        """
+        from .trc import read_trc
+
+        c = self.config
+        path = Path(c.file)
+        data = read_trc(path, c.unit_m, c.frame_rate)
+        camera = data.header.get("CameraRate")
+        meta: dict[str, Any] = {
+            "source": "trc",
+            "format": "trc",
+            "subject": c.subject,
+            "units": data.units,
+            "unit_from": "config" if c.unit_m is not None else "Units",
+            "first_frame": int(data.frames[0]),
+            "camera_rate_hz": _number(camera),
+        }
+        return markers_motion(path, c, data.labels, data.positions, data.unit_m, data.rate_hz, meta)
+
+
+def _number(text: str | None) -> float | None:
+    """A header value as a finite number, or None."""
+    try:
+        value = float(text) if text is not None else float("nan")
+    except ValueError:
+        return None
+    return value if np.isfinite(value) else None
