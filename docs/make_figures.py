@@ -31,3 +31,4 @@ if __name__ == "__main__":
     run_example("cmu_walk_raw", "range_time.png", "cmu_walk_range_time.png")
     run_example("point_target", "spectrogram.png", "point_target_spectrogram.png")
     run_example("deepmimic_walk", "spectrogram.png", "deepmimic_walk_spectrogram.png")
+    run_example("trc_walk", "spectrogram.png", "trc_walk_spectrogram.png")

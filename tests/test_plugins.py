@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import synthetic
 
-from mdframework import cli
+from mdframework import cli, errors
 from mdframework.plugins import (
     DISABLE_ENV,
     DISABLE_PLUGINS_ENV,
@@ -177,6 +177,35 @@ def test_a_broken_plugin_disables_only_itself_with_one_warning(
     assert len(lines) == 1 and lines[0].startswith("mdf: warning: plugin 'broken' is disabled")
     disabled = out.split("disabled:")[1]
     assert "broken" in disabled and BROKEN_WHY[how] in disabled
+
+
+def test_ctrl_c_while_a_plugin_loads_ends_the_command_instead_of_disabling_it(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    clean_modules: object,
+    fresh_default_registry: object,
+) -> None:
+    """pydantic turns a KeyboardInterrupt raised while it builds a plugin's schema into a
+    SchemaError that does not chain it; once Ctrl-C has reached the process, a plugin that
+    fails to load is the interrupt, not a broken plugin."""
+    _make_distribution(
+        tmp_path, "mdf-test-broken", "mdf_test_broken_late", BROKEN["import"], "broken"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setattr(errors, "_interrupt_seen", True)
+    with pytest.raises(KeyboardInterrupt):
+        build_registry(autoload=True)
+
+
+def test_an_interrupt_is_found_behind_wrapping_exceptions() -> None:
+    try:
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as inner:
+            raise RuntimeError("while creating a class") from inner
+    except RuntimeError as exc:
+        assert errors.caused_by_interrupt(exc)
+    assert not errors.caused_by_interrupt(RuntimeError("a plain failure"))
 
 
 def test_duplicate_names_are_rejected() -> None:

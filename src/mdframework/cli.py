@@ -22,7 +22,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from .errors import DataFileError, MdfError, OutputError
+from .errors import DataFileError, MdfError, OutputError, caused_by_interrupt, note_interrupt
 from .plugins import (
     DISABLE_ENV,
     DISABLE_PLUGINS_ENV,
@@ -525,6 +525,7 @@ def _catch_interrupts() -> Any:
 
     def first(signum: int, frame: Any) -> None:
         signal.signal(signal.SIGINT, again)
+        note_interrupt()
         raise KeyboardInterrupt
 
     return signal.signal(signal.SIGINT, first)
@@ -585,7 +586,7 @@ def _main(argv: list[str], debug: bool) -> int:
         print(f"mdf: error: {message}", file=sys.stderr)
         return EXIT_USAGE
     except Exception as exc:
-        if _caused_by_interrupt(exc):
+        if caused_by_interrupt(exc):
             raise KeyboardInterrupt from exc
         if args.debug:
             raise
@@ -596,19 +597,6 @@ def _main(argv: list[str], debug: bool) -> int:
             file=sys.stderr,
         )
         return 1
-
-
-def _caused_by_interrupt(exc: BaseException) -> bool:
-    """Whether Ctrl-C is behind ``exc``: Python wraps a KeyboardInterrupt raised at some points
-    (e.g. while a class is being created during an import) in another exception."""
-    seen: set[int] = set()
-    cause: BaseException | None = exc
-    while cause is not None and id(cause) not in seen:
-        if isinstance(cause, KeyboardInterrupt):
-            return True
-        seen.add(id(cause))
-        cause = cause.__cause__ or cause.__context__
-    return False
 
 
 if __name__ == "__main__":

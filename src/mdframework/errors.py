@@ -31,3 +31,29 @@ class SceneError(MdfError):
 class OutputError(MdfError):
     """An output folder cannot be used as given (a file, not writable, another command's or the
     user's files, in use by another command); the message names ``--out`` and what to do."""
+
+
+_interrupt_seen = False
+
+
+def note_interrupt() -> None:
+    """Record that Ctrl-C reached this process (the CLI's SIGINT handler calls it)."""
+    global _interrupt_seen
+    _interrupt_seen = True
+
+
+def caused_by_interrupt(exc: BaseException) -> bool:
+    """Whether Ctrl-C is behind ``exc``: a KeyboardInterrupt in its chain (Python wraps one
+    raised at some points, e.g. while a class is being created during an import, in another
+    exception), or any exception after Ctrl-C reached the process (pydantic turns one raised
+    while it builds a schema into a ``SchemaError`` that does not chain it)."""
+    if _interrupt_seen:
+        return True
+    seen: set[int] = set()
+    cause: BaseException | None = exc
+    while cause is not None and id(cause) not in seen:
+        if isinstance(cause, KeyboardInterrupt):
+            return True
+        seen.add(id(cause))
+        cause = cause.__cause__ or cause.__context__
+    return False

@@ -48,6 +48,7 @@ from typing import Any, NamedTuple
 import pluggy
 
 from . import hookspecs
+from .errors import caused_by_interrupt
 from .interfaces import (
     Classifier,
     Effect,
@@ -259,6 +260,7 @@ def _load_entry_points(pm: pluggy.PluginManager) -> None:
         try:
             plugin = ep.load()
         except Exception as exc:
+            _reraise_interrupt(exc)
             _warn_disabled(pm, ep.name, f"{dist} failed to load: {type(exc).__name__}: {exc}")
             continue
         bad = _unknown_hooks(plugin)
@@ -272,6 +274,12 @@ def _load_entry_points(pm: pluggy.PluginManager) -> None:
         _DISTRIBUTIONS[ep.name] = dist
 
 
+def _reraise_interrupt(exc: Exception) -> None:
+    """Ctrl-C while a plugin loads ends the command; it does not disable the plugin."""
+    if caused_by_interrupt(exc):
+        raise KeyboardInterrupt from exc
+
+
 def _hook_classes(
     pm: pluggy.PluginManager, hook_name: str
 ) -> Iterable[tuple[object, str, list[Any] | None]]:
@@ -281,6 +289,7 @@ def _hook_classes(
         try:
             classes = impl.function()
         except Exception as exc:
+            _reraise_interrupt(exc)
             name = pm.get_name(impl.plugin) or provider
             _warn_disabled(pm, name, f"{provider}: {hook_name} raised {type(exc).__name__}: {exc}")
             yield impl.plugin, provider, None
@@ -375,6 +384,7 @@ def add_cli_commands(subparsers: Any) -> None:
         try:
             impl.function(subparsers=subparsers)
         except Exception as exc:
+            _reraise_interrupt(exc)
             provider = _provider_name(pm, impl.plugin)
             name = pm.get_name(impl.plugin) or provider
             _warn_disabled(
