@@ -111,6 +111,37 @@ def test_same_result_with_one_and_two_workers_and_dask(
     assert_same(tmp_path / "one", tmp_path / "dask")
 
 
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's malloc")
+def test_workers_reuse_freed_memory_for_large_arrays() -> None:
+    """A fresh process maps a 10 MiB array afresh each time it is made (and faults its pages
+    in); after ``keep_freed_memory`` (what every local worker runs first) it reuses the freed
+    block: no page faults. Workers forked from a planner that had not freed large arrays took
+    3,600 page faults and up to a third more CPU per record without it."""
+    script = """
+import resource, sys
+import numpy as np
+from mdframework.workers import keep_freed_memory
+if sys.argv[1] == "1":
+    keep_freed_memory()
+a = np.ones(10 << 17)
+del a
+before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+for _ in range(20):
+    a = np.ones(10 << 17)
+    del a
+print(resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before)
+"""
+    faults = [
+        int(
+            subprocess.run(
+                [sys.executable, "-c", script, flag], capture_output=True, text=True, check=True
+            ).stdout
+        )
+        for flag in ("0", "1")
+    ]
+    assert faults[0] >= 20 and faults[1] <= faults[0] / 10, faults
+
+
 def _mixed_sources(tmp_path: Path, *extra: str) -> Path:
     """Sources of every loader: ASF/AMC and BVH (both warn about glitches), the Boulic walker,
     and ``extra`` sources."""

@@ -394,9 +394,14 @@ def _preload_motions(config: DatasetConfig, base_dir: Path, workers: int) -> Non
     n = min(workers, len(todo), os.cpu_count() or 1)
     if n < 2:
         return
+    import scipy.interpolate  # noqa: F401  # heavy: imported when used
+
     from .workers import worker_pool
 
-    default_registry()  # once, before the workers fork (they would each load it)
+    # Once, before the workers fork, what they would each load or import: the plugins, and the
+    # splines that make the Boulic walkers and resample every body motion in every record (the
+    # build's workers fork from this process later and inherit it too).
+    default_registry()
     with worker_pool(n) as pool:
         for key, (motion, caught) in zip(todo, pool.map(_load_elsewhere, todo), strict=True):
             if motion is not None:
