@@ -15,6 +15,7 @@ import hashlib
 import itertools
 import json
 import math
+import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Any
@@ -28,6 +29,7 @@ from mdf_deepmimic import (
     DeepMimicConfig,
     DeepMimicSource,
     forward_kinematics,
+    read_character,
     read_clip,
 )
 from pydantic import ValidationError
@@ -439,3 +441,68 @@ def test_cycles_beyond_the_limits_are_refused_before_anything_is_built(tmp_path:
     assert (limits.MAX_FRAMES, limits.MAX_DURATION_S) == (10_000_000, 86_400)
     with pytest.raises(ValidationError, match="less than or equal to 10000"):
         DeepMimicConfig(file=WALK, cycles=10_001)
+
+
+# ----------------------------------------------------------------------------- character files
+
+
+def character_file(path: Path, scale: float = 1.0, **change: Any) -> Path:
+    """A DeepMimic character file written here from the humanoid3d numbers (the format of
+    DeepMimic's data/characters/humanoid3d.txt), lengths times ``scale``; ``change`` replaces
+    fields of joints by name ({"left_knee": {"Type": "planar"}})."""
+    c = HUMANOID3D
+    joints = []
+    for k, name in enumerate(c.names):
+        x, y, z = (float(v) * scale for v in c.offsets[k])
+        joint = {"ID": k, "Name": name, "Type": c.types[k], "Parent": c.parents[k],
+                 "AttachX": x, "AttachY": y, "AttachZ": z,
+                 "AttachThetaX": 0, "AttachThetaY": 0, "AttachThetaZ": 0}  # fmt: skip
+        joints.append({**joint, **change.get(name, {})})
+    bodies = [{"ID": 2, "Name": "neck", "Shape": "sphere", "AttachX": 0, "AttachY": 0.175 * scale,
+               "AttachZ": 0, "Param0": 0.205 * scale}]  # fmt: skip
+    for k, side in ((5, "right"), (11, "left")):
+        bodies.append({"ID": k, "Name": f"{side}_ankle", "Shape": "box", "AttachX": 0.045 * scale,
+                       "AttachY": -0.0225 * scale, "AttachZ": 0, "Param0": 0.177 * scale,
+                       "Param1": 0.055 * scale, "Param2": 0.09 * scale})  # fmt: skip
+    path.write_text(json.dumps({"Skeleton": {"Joints": joints}, "BodyDefs": bodies}, indent=1))
+    return path
+
+
+def test_a_character_file_gives_its_own_lengths(tmp_path: Path) -> None:
+    """The humanoid3d numbers written as a character file give the built-in character's poses;
+    the same character 10 % larger gives every bone, head and toe point 10 % longer."""
+    same = read_character(character_file(tmp_path / "humanoid3d.txt"))
+    assert same.names == HUMANOID3D.names and same.types == HUMANOID3D.types
+    np.testing.assert_allclose(same.offsets, HUMANOID3D.offsets, atol=1e-15)
+    for (n1, j1, p1), (n2, j2, p2) in zip(same.points, HUMANOID3D.points, strict=True):
+        assert (n1, j1) == (n2, j2) and np.allclose(p1, p2, atol=1e-15)
+    built_in = load(WALK).skeleton.positions
+    np.testing.assert_allclose(
+        load(WALK, character=tmp_path / "humanoid3d.txt").skeleton.positions, built_in, atol=1e-12
+    )
+    m = load(WALK, character=character_file(tmp_path / "big.txt", scale=1.1))
+    assert m.metadata["character"] == "big" and m.metadata["character_file"] == "big.txt"
+    sk = m.skeleton
+    for j in range(1, len(HUMANOID3D.names)):
+        parent = HUMANOID3D.names[HUMANOID3D.parents[j]]
+        bone = np.linalg.norm(sk.joint(HUMANOID3D.names[j]) - sk.joint(parent), axis=1)
+        np.testing.assert_allclose(bone, 1.1 * np.linalg.norm(HUMANOID3D.offsets[j]), atol=1e-12)
+    head = np.linalg.norm(sk.joint("head_centre") - sk.joint("neck"), axis=1)
+    np.testing.assert_allclose(head, 1.1 * 0.175, atol=1e-12)
+    assert "(0.1469, -0.02475, 0) m in the left_ankle" in m.metadata["estimated"]["l_toe"]
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"left_knee": {"Type": "planar"}}, "joint 10 (left_knee): type 'planar'"),
+        ({"neck": {"AttachThetaZ": 0.3}}, "turned attachment"),
+        ({"left_elbow": {"Name": "l_elbow"}}, "lacks left_elbow"),
+        ({"chest": {"Parent": 5}}, "must be an earlier joint"),
+        ({"right_hip": {"AttachY": float("nan")}}, "not a finite number"),
+    ],
+)
+def test_bad_character_files(tmp_path: Path, change: dict[str, Any], message: str) -> None:
+    path = character_file(tmp_path / "c.txt", **change)
+    with pytest.raises(DataFileError, match=re.escape(message)):
+        load(WALK, character=path)

@@ -415,3 +415,26 @@ def test_an_effect_returning_none_is_named_in_one_line(
     }
     with pytest.raises(PluginError, match=r"effect 'forgetful' \(.*Forgetful\) returned NoneType"):
         simulate(validate_run_config(cfg, registry=reg), reg)
+
+
+def test_an_interrupt_python_could_not_raise_ends_the_command_as_interrupted(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Ctrl-C arriving in a finaliser or a C callback is reported by Python as 'Exception
+    ignored in ...' and the command goes on: the hook records it quietly, and the command ends
+    with the one interrupted line and exit 130."""
+    monkeypatch.setattr(errors, "_interrupt_seen", False)
+    passed_on: list[object] = []
+    handle = cli._quiet_unraisable_interrupt(passed_on.append)
+
+    class Unraisable:
+        def __init__(self, exc: BaseException) -> None:
+            self.exc_value = exc
+
+    other = Unraisable(RuntimeError("in a finaliser"))
+    handle(other)
+    assert passed_on == [other] and not errors.interrupt_seen()
+    handle(Unraisable(KeyboardInterrupt()))
+    assert passed_on == [other] and errors.interrupt_seen()
+    assert cli.main(["plugins"]) == 130
+    assert capsys.readouterr().err.strip().splitlines()[-1] == "mdf: interrupted"

@@ -125,3 +125,23 @@ def test_surface_points_all_facing_away_share_the_part_rcs() -> None:
         )
     assert pts.shape == (1, 1, 3) and pts[0, 0, 0] > 0  # the point faces +x, the radar is at -x
     assert rcs[0, 0] == 0.5
+
+
+def test_a_target_at_the_radar_with_multipath_is_refused_before_the_effect() -> None:
+    """A point target at the radar's position, with the ground-bounce effect: the direct range
+    is 0 and the effect divided by it (a numerical warning) before the scene's minimum range
+    was checked. The body is now checked against ``scene.min_range`` before any scatterer
+    effect."""
+    cfg = {
+        "motion": {
+            "kind": "point_targets",
+            "length": 0.5,
+            "targets": [{"position": [0.0, 0.0, 1.5], "velocity": [0.0, 0.0, 0.0]}],
+        },
+        "scatterers": {"kind": "points"},
+        "radar": {"kind": "lfm"},
+        "scene": {"radar_position": [0.0, 0.0, 1.5]},
+        "effects": [{"kind": "multipath", "ground_height": -8e-277}],
+    }
+    outcome = run_scene(cfg)
+    assert outcome.startswith("refused: ") and "scene.min_range" in outcome, outcome

@@ -22,7 +22,14 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, NoReturn
 
-from .errors import DataFileError, MdfError, OutputError, caused_by_interrupt, note_interrupt
+from .errors import (
+    DataFileError,
+    MdfError,
+    OutputError,
+    caused_by_interrupt,
+    interrupt_seen,
+    note_interrupt,
+)
 from .plugins import (
     DISABLE_ENV,
     DISABLE_PLUGINS_ENV,
@@ -510,13 +517,32 @@ def main(argv: Sequence[str] | None = None) -> int:
     one line and returns 130."""
     try:
         previous = _catch_interrupts()
+        hook = sys.unraisablehook
+        sys.unraisablehook = _quiet_unraisable_interrupt(hook)
         try:
-            return _main_with_options(argv)
+            code = _main_with_options(argv)
         finally:
+            sys.unraisablehook = hook
             if previous is not None:
                 signal.signal(signal.SIGINT, previous)
+        # a Ctrl-C that Python could not raise (it arrived in a finaliser or a callback and
+        # was reported as unraisable) still ends the command as interrupted
+        return _interrupted() if interrupt_seen() else code
     except KeyboardInterrupt:
         return _interrupted()
+
+
+def _quiet_unraisable_interrupt(hook: Any) -> Any:
+    """A ``sys.unraisablehook``: a KeyboardInterrupt that could not be raised is recorded (the
+    command ends as interrupted) instead of printed; anything else goes to ``hook``."""
+
+    def handle(unraisable: Any) -> None:
+        if isinstance(unraisable.exc_value, KeyboardInterrupt):
+            note_interrupt()
+            return
+        hook(unraisable)
+
+    return handle
 
 
 def _interrupted() -> int:

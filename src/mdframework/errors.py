@@ -42,6 +42,11 @@ def note_interrupt() -> None:
     _interrupt_seen = True
 
 
+def interrupt_seen() -> bool:
+    """Whether Ctrl-C has reached this process (see :func:`note_interrupt`)."""
+    return _interrupt_seen
+
+
 def caused_by_interrupt(exc: BaseException) -> bool:
     """Whether Ctrl-C is behind ``exc``: a KeyboardInterrupt in its chain (Python wraps one
     raised at some points, e.g. while a class is being created during an import, in another

@@ -252,6 +252,7 @@ def _simulate_motion(
     stream = _Stream(n, proc.keep_scatterers, proc.aliasing, wf, sc.min_range, t)
     losses = emptiness.Losses()
     blocks = _blocks(n, proc.block_pulses, wf.block_multiple)
+    early_effects = any(e.stage == "scatterers" for e in stages.effects)
     for lo, hi in progress.counted(blocks, n, "simulating the pulses", "pulse"):
         clock = time.perf_counter()
         tb = t[lo:hi]
@@ -265,6 +266,8 @@ def _simulate_motion(
         context = SceneContext(
             radar_pos, wf.prf, wf.carrier_frequency, tb, gate, at_pulses, wf, rng, lo
         )
+        if early_effects:  # the body itself within scene.min_range: refused before any effect
+            stream.check_near(lo, scat, scat.ranges(radar_pos))
         scat = _apply_effects(stages, "scatterers", scat, context)
         ranges = scat.ranges(radar_pos)
         stream.check(lo, scat, ranges)
@@ -434,8 +437,8 @@ class _Stream:
         self._rt_axis: FloatArray | None = None
         self._products: dict[str, list[NDArray[Any]]] = {}
 
-    def check(self, lo: int, scat: Scatterers, ranges: FloatArray) -> None:
-        """Finite ranges above ``scene.min_range``; the fastest radial speed so far."""
+    def check_near(self, lo: int, scat: Scatterers, ranges: FloatArray) -> None:
+        """Finite ranges (n_block, n_scatterers) [m] above ``scene.min_range``."""
         nearest = float(ranges.min())
         if not (np.isfinite(nearest) and np.isfinite(ranges.max())):
             raise SceneError("a scatterer position is not finite")
@@ -446,6 +449,10 @@ class _Stream:
                 f"at t = {self.t[lo + p] - self.t[0]:.3f} s (scene.min_range = "
                 f"{self.min_range:g} m): the range equation and far-field RCS do not hold there"
             )
+
+    def check(self, lo: int, scat: Scatterers, ranges: FloatArray) -> None:
+        """Finite ranges above ``scene.min_range``; the fastest radial speed so far."""
+        self.check_near(lo, scat, ranges)
         tb = self.t[lo : lo + ranges.shape[0]]
         if ranges.shape[0] > 1:
             step = np.diff(ranges, axis=0)

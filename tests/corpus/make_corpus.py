@@ -1340,6 +1340,13 @@ def _deepmimic_cases(c: _Corpus) -> None:
     (d / "punch.txt").write_bytes(DEEPMIMIC_PUNCH.read_bytes())
     motion = {"kind": "deepmimic", "file": "punch.txt", "cycles": 2}
     c.run("deepmimic-cycles-of-a-punch", _json_config(d, {"motion": motion}), "punch.txt", "Loop")
+    d = c.folder("deepmimic-character-without-arms")
+    (d / "walk.txt").write_bytes(DEEPMIMIC_WALK.read_bytes())
+    joints = [{"ID": 0, "Name": "root", "Type": "none", "Parent": -1}]
+    (d / "legs.txt").write_text(json.dumps({"Skeleton": {"Joints": joints}}), encoding="utf-8")
+    motion = {"kind": "deepmimic", "file": "walk.txt", "character": "legs.txt"}
+    c.run("deepmimic-character-without-arms", _json_config(d, {"motion": motion}), "legs.txt",
+          "lacks neck, left_shoulder")  # fmt: skip
     d = c.folder("deepmimic-mirrored-axes")
     (d / "walk.txt").write_bytes(DEEPMIMIC_WALK.read_bytes())
     motion = {"kind": "deepmimic", "file": "walk.txt", "axes": ["x", "z", "y"]}

@@ -13,6 +13,9 @@ frame). The pybullet port of DeepMimic ships the same character as ``humanoid/hu
 scaled by 4 (``examples/data/deepmimic/humanoid.urdf``); ``tests/test_deepmimic.py`` checks the
 offsets here against that file.
 
+:func:`read_character` reads another character file of that format whose joints carry the
+humanoid3d names (a resized humanoid).
+
 Frames: the character's frame is y up; in the rest pose (every rotation the identity) it faces
 +x and its right side is +z (the right hip is at z = +0.0849 m). Spherical joints turn by a
 quaternion, revolute joints (knees, elbows) by an angle about their own z axis (the knee's range
@@ -22,11 +25,15 @@ positive angle lifts the forearm forwards), fixed joints (wrists) not at all.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
-from typing import Literal
+from pathlib import Path
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
+
+from mdframework import DataFileError, limits
 
 FloatArray = NDArray[np.float64]
 
@@ -165,11 +172,136 @@ CANONICAL_MAP: dict[str, str] = {
     "r_toe": "right_toe_tip",
 }
 
-#: What the canonical body gets that the character's joints do not mark, recorded in the metadata.
-ESTIMATED: dict[str, str] = {
-    "head": "centre of the head sphere (diameter 0.205 m), 0.175 m above the neck joint",
-    "l_toe": "front of the foot box, 0.1335 m ahead of and 0.0225 m below the ankle",
-    "r_toe": "front of the foot box, 0.1335 m ahead of and 0.0225 m below the ankle",
-    "l_hand": "the wrist joint, the centre of the hand sphere (diameter 0.08 m)",
-    "r_hand": "the wrist joint, the centre of the hand sphere (diameter 0.08 m)",
-}
+
+def estimated(character: Character) -> dict[str, str]:
+    """What the canonical body takes from the character's body shapes rather than its joints
+    (recorded in the metadata as ``estimated``)."""
+    at = {name: (joint, p) for name, joint, p in character.points}
+
+    def where(point: str) -> str:
+        joint, p = at[point]
+        return f"({p[0]:.4g}, {p[1]:.4g}, {p[2]:.4g}) m in the {joint} joint's frame"
+
+    out = {"head": f"centre of the head (the neck body), {where('head_centre')}"}
+    for side, name in (("l", "left"), ("r", "right")):
+        out[f"{side}_hand"] = f"the {name} wrist joint (the centre of the hand; no hand joint)"
+        out[f"{side}_toe"] = f"front of the {name} foot box, {where(f'{name}_toe_tip')}"
+    return out
+
+
+#: Joints a character file must name for the canonical body (the humanoid3d names).
+REQUIRED_JOINTS = tuple(
+    j for j in CANONICAL_MAP.values() if j not in ("head_centre", "left_toe_tip", "right_toe_tip")
+)
+
+
+def _number(path: Path, item: dict[str, Any], key: str, where: str) -> float:
+    value = item.get(key, 0.0)
+    if not isinstance(value, int | float) or isinstance(value, bool) or not math.isfinite(value):
+        raise DataFileError(path, f"{where}: {key} {value!r} is not a finite number")
+    if abs(value) > limits.MAX_COORDINATE_M:
+        raise DataFileError(
+            path, f"{where}: {key} {value!r} is beyond +-{limits.MAX_COORDINATE_M:g}"
+        )
+    return float(value)
+
+
+def read_json(path: Path, what: str, max_bytes: int) -> tuple[str, Any]:
+    """The text of a JSON file and what it holds; ``DataFileError`` naming the file (and line)
+    for a file beyond ``max_bytes``, binary, not UTF-8, empty or not JSON (a truncated file is
+    said to end early)."""
+    import json
+
+    text = limits.read_text_file(path, what, max_bytes)
+    if not text.strip():
+        raise DataFileError(path, "the file is empty")
+    try:
+        return text, json.loads(text)
+    except json.JSONDecodeError as exc:
+        end = exc.pos >= len(text.rstrip())
+        hint = ": the file ends early (truncated?)" if end else ""
+        raise DataFileError(
+            path, f"not valid JSON: {exc.msg} at column {exc.colno}{hint}", exc.lineno
+        ) from None
+    except RecursionError:
+        raise DataFileError(path, f"JSON nested too deeply: not {what}") from None
+
+
+def read_character(path: Path) -> Character:
+    """A DeepMimic character file (``data/characters/*.txt``, JSON) whose joints carry the
+    humanoid3d names (a resized humanoid, for instance).
+
+    Reads ``Skeleton.Joints`` (``Name``, ``Type``: none for the root, spherical, revolute or
+    fixed; ``Parent``; ``AttachX/Y/Z`` [m]; every ``AttachTheta`` must be 0) and, from
+    ``BodyDefs``, the ``neck`` body (its centre: the head centre) and the ``right_ankle`` and
+    ``left_ankle`` boxes (the middle of their front faces: the toe tips).
+
+    Raises
+    ------
+    mdframework.DataFileError
+        Not a character file, a joint of another type or with a turned attachment, parents
+        after their children, missing joints or bodies (the message lists what is missing).
+    """
+    _, doc = read_json(path, "a DeepMimic character file", 16 * 1024 * 1024)
+    joints = doc.get("Skeleton", {}).get("Joints") if isinstance(doc, dict) else None
+    if not isinstance(joints, list) or not joints or not all(isinstance(j, dict) for j in joints):
+        raise DataFileError(path, 'not a DeepMimic character: no "Skeleton": {"Joints": [...]}')
+    names: list[str] = []
+    types: list[JointType] = []
+    parents: list[int] = []
+    offsets = []
+    for k, j in enumerate(joints):
+        name = str(j.get("Name", f"joint {k}"))
+        where = f"joint {k} ({name})"
+        kind, parent = j.get("Type"), j.get("Parent")
+        if kind not in DOF:
+            raise DataFileError(
+                path, f"{where}: type {kind!r} is not one of {', '.join(DOF)}: not supported"
+            )
+        if not isinstance(parent, int) or not -1 <= parent < k or (parent == -1) != (k == 0):
+            raise DataFileError(
+                path, f"{where}: Parent {parent!r} must be an earlier joint (-1 for the first)"
+            )
+        if (kind == "none") != (k == 0):
+            raise DataFileError(path, f"{where}: only the root (the first joint) has type none")
+        for axis in "XYZ":
+            if _number(path, j, f"AttachTheta{axis}", where) != 0.0:
+                raise DataFileError(
+                    path, f"{where}: a turned attachment (AttachTheta{axis}) is not supported"
+                )
+        names.append(name)
+        types.append(kind)
+        parents.append(parent)
+        offsets.append([_number(path, j, f"Attach{a}", where) for a in "XYZ"])
+    bodies = {str(b.get("Name")): b for b in doc.get("BodyDefs", []) if isinstance(b, dict)}
+    missing = [n for n in REQUIRED_JOINTS if n not in names]
+    shapes = {"neck": "sphere", "right_ankle": "box", "left_ankle": "box"}
+    missing += [
+        f"a {shape} body {n!r}"
+        for n, shape in shapes.items()
+        if bodies.get(n, {}).get("Shape") != shape
+    ]
+    if missing:
+        raise DataFileError(
+            path,
+            f"the character lacks {', '.join(missing)} (the humanoid3d joints and bodies the "
+            f"canonical body needs); its joints are {', '.join(names)}",
+        )
+
+    def attach(name: str) -> tuple[float, float, float]:
+        x, y, z = (_number(path, bodies[name], f"Attach{a}", f"body {name}") for a in "XYZ")
+        return x, y, z
+
+    points = [("head_centre", "neck", attach("neck"))]
+    for side in ("right", "left"):
+        x, y, z = attach(f"{side}_ankle")
+        length = _number(path, bodies[f"{side}_ankle"], "Param0", f"body {side}_ankle")
+        points.append((f"{side}_toe_tip", f"{side}_ankle", (x + length / 2.0, y, z)))
+    return Character(
+        name=path.stem,
+        names=tuple(names),
+        types=tuple(types),
+        parents=tuple(parents),
+        offsets=np.array(offsets, dtype=np.float64),
+        points=tuple(points),
+    )

@@ -36,7 +36,6 @@ the file, the line of the frame, the frame's number (from 0) and the joint.
 
 from __future__ import annotations
 
-import json
 import math
 import re
 import sys
@@ -49,7 +48,7 @@ from numpy.typing import NDArray
 
 from mdframework import DataFileError, limits
 
-from .character import HUMANOID3D, Character
+from .character import HUMANOID3D, Character, read_json
 
 FloatArray = NDArray[np.float64]
 
@@ -128,22 +127,6 @@ class _FrameLines:
         return starts
 
 
-def _read_json(path: Path) -> tuple[str, Any]:
-    text = limits.read_text_file(path, "a DeepMimic clip", MAX_CLIP_BYTES)
-    if not text.strip():
-        raise DataFileError(path, "the file is empty")
-    try:
-        return text, json.loads(text)
-    except json.JSONDecodeError as exc:
-        end = exc.pos >= len(text.rstrip())
-        hint = ": the file ends early (truncated?)" if end else ""
-        raise DataFileError(
-            path, f"not valid JSON: {exc.msg} at column {exc.colno}{hint}", exc.lineno
-        ) from None
-    except RecursionError:
-        raise DataFileError(path, "JSON nested too deeply: not a DeepMimic clip") from None
-
-
 def _is_number(v: object) -> bool:
     return isinstance(v, int | float) and not isinstance(v, bool)
 
@@ -158,7 +141,7 @@ def read_clip(path: Path, character: Character = HUMANOID3D) -> Clip:
         many frames, a frame of the wrong width or with a value that is not a number, a
         duration, position, angle or quaternion out of range (names the line and frame).
     """
-    text, doc = _read_json(path)
+    text, doc = read_json(path, "a DeepMimic clip", MAX_CLIP_BYTES)
     lines = _FrameLines(text)
     if not isinstance(doc, dict) or not isinstance(doc.get("Frames"), list):
         raise DataFileError(

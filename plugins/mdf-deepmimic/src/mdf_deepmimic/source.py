@@ -47,6 +47,11 @@ class DeepMimicConfig(MotionConfig):
     file: DataPath = Field(
         description="The clip (DeepMimic's data/motions/*.txt, JSON); relative to the config file."
     )
+    character: DataPath | None = Field(
+        None,
+        description="A DeepMimic character file (JSON) whose joints carry humanoid3d's names, "
+        "for clips of a resized humanoid; default: DeepMimic's humanoid3d.",
+    )
     cycles: int = Field(
         1,
         ge=1,
@@ -94,27 +99,30 @@ class DeepMimicSource(MotionSource):
         Returns
         -------
         Motion
-            ``skeleton``: time (n_frames,) [s] from 0; positions (n_frames, 18, 3) [m], z up:
-            the 15 joints of ``humanoid3d`` and the points ``head_centre``, ``right_toe_tip``,
-            ``left_toe_tip``. ``canonical_map`` maps all 17 canonical joints. ``metadata``:
-            source, format, file, character, loop, cycles, activity, subject, frame_rate_hz
-            (median), n_frames, clip_frames, clip_duration_s, loop_closure_m, axes, estimated
+            ``skeleton``: time (n_frames,) [s] from 0; positions (n_frames, n_joints + 3, 3)
+            [m], z up: the character's joints (15 for ``humanoid3d``) and the points
+            ``head_centre``, ``right_toe_tip``, ``left_toe_tip``. ``canonical_map`` maps all
+            17 canonical joints. ``metadata``: source, format, file, character,
+            character_file, loop, cycles, activity, subject, frame_rate_hz (median),
+            n_frames, clip_frames, clip_duration_s, loop_closure_m, axes, estimated
             (canonical joints placed from body shapes), quaternions_renormalised,
             quaternion_norm_range.
 
         Raises
         ------
         mdframework.DataFileError
-            A malformed clip (see :func:`mdf_deepmimic.read_clip`), or ``cycles`` above 1 for
-            a clip that does not loop.
+            A malformed clip (see :func:`mdf_deepmimic.read_clip`) or character file (see
+            :func:`mdf_deepmimic.read_character`), or ``cycles`` above 1 for a clip that does
+            not loop.
         """
-        from .character import CANONICAL_MAP, ESTIMATED, HUMANOID3D
+        from .character import CANONICAL_MAP, HUMANOID3D, estimated, read_character
         from .kinematics import forward_kinematics, repeat_cycles
         from .reader import read_clip
 
         c = self.config
         path = Path(c.file)
-        clip = read_clip(path, HUMANOID3D)
+        character = HUMANOID3D if c.character is None else read_character(Path(c.character))
+        clip = read_clip(path, character)
         if c.cycles > 1 and clip.loop != "wrap":
             why = {
                 "none": "it is not a cycle",
@@ -135,7 +143,7 @@ class DeepMimicSource(MotionSource):
                 f"{c.cycles * clip.time[-1]:.4g} s, beyond the limits of {limits.MAX_FRAMES:,} "
                 f"frames and {limits.MAX_DURATION_S:g} s: play fewer cycles",
             )
-        names, pos_file = forward_kinematics(HUMANOID3D, clip.root_position, clip.rotations)
+        names, pos_file = forward_kinematics(character, clip.root_position, clip.rotations)
         pos = reorient(pos_file, c.axes)
         time, pos, closure = repeat_cycles(clip.time, pos, c.cycles, names.index("root"))
         limits.check_time_stamps(path, time)
@@ -150,7 +158,8 @@ class DeepMimicSource(MotionSource):
             "source": "deepmimic",
             "format": "DeepMimic clip (JSON)",
             "file": path.name,
-            "character": HUMANOID3D.name,
+            "character": character.name,
+            "character_file": None if c.character is None else Path(c.character).name,
             "loop": clip.loop,
             "cycles": c.cycles,
             "activity": activity,
@@ -161,7 +170,7 @@ class DeepMimicSource(MotionSource):
             "clip_duration_s": float(clip.time[-1]),
             "loop_closure_m": closure,
             "axes": list(c.axes),
-            "estimated": dict(ESTIMATED),
+            "estimated": estimated(character),
             "quaternions_renormalised": clip.renormalised,
             "quaternion_norm_range": [clip.min_norm, clip.max_norm],
         }
