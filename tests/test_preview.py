@@ -53,6 +53,8 @@ def test_animation_frames_run_in_real_time() -> None:
     assert times.size == 13 and times[-1] == pytest.approx(1.0)
     with pytest.raises(PreviewError, match="--fps"):
         animation_times(body, 0)
+    with pytest.raises(PreviewError, match=r"--fps: must be 1 \.\. 100"):
+        animation_times(body, 10**6)  # a million frames a second: hours of drawing before
 
 
 def test_the_scene_shows_the_nearest_frame_and_the_line_of_sight() -> None:

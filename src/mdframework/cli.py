@@ -130,6 +130,16 @@ def _positive_int(text: str) -> int:
     return value
 
 
+def _fps(text: str) -> int:
+    """Frames per second of ``mdf show``'s animation: 1 .. ``limits.MAX_ANIMATION_FPS``."""
+    from .limits import MAX_ANIMATION_FPS
+
+    value = _positive_int(text)
+    if value > MAX_ANIMATION_FPS:
+        raise argparse.ArgumentTypeError(f"must be at most {MAX_ANIMATION_FPS}, got {text!r}")
+    return value
+
+
 class UsageError(MdfError):
     """The command line itself is wrong (an unknown option, a missing or malformed argument)."""
 
@@ -345,7 +355,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _run_arguments(show)
     show.add_argument("--format", choices=("gif", "mp4"), default="gif", help="animation format")
-    show.add_argument("--fps", type=_positive_int, default=12, help="animation frames per second")
+    show.add_argument("--fps", type=_fps, default=12, help="animation frames per second (1 .. 100)")
     show.add_argument(
         "--at", type=float, nargs="+", default=None, metavar="T",
         help="instants of skeleton.png [s from the record's start]; default: five spread over it",

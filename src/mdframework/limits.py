@@ -65,6 +65,9 @@ MAX_RECORDS = 1_000_000
 #: Largest |value| of a random distribution's parameters in a dataset config (what is drawn
 #: must then lie in the range of the field it is drawn into).
 MAX_DRAWN_NUMBER = 1e12
+#: Most frames per second of ``mdf show``'s animation (a GIF's frame delays are whole hundredths
+#: of a second; one frame a millisecond of a long record would render for hours).
+MAX_ANIMATION_FPS = 100
 
 #: Most complex values in one radar frame's largest array (an FMCW radar's IF samples or
 #: range profiles of every chirp and receive antenna, or its range-Doppler cube): 2**24, that is

@@ -78,8 +78,10 @@ def frame_at(time: FloatArray, instants: FloatArray) -> NDArray[np.intp]:
 def animation_times(body: Skeleton, fps: int) -> FloatArray:
     """Times [s] of the animation frames: every ``1/fps`` s from the body's first frame to its
     last, in real time."""
-    if fps <= 0:
-        raise PreviewError(f"--fps: must be positive, got {fps}")
+    from .limits import MAX_ANIMATION_FPS
+
+    if not 0 < fps <= MAX_ANIMATION_FPS:
+        raise PreviewError(f"--fps: must be 1 .. {MAX_ANIMATION_FPS}, got {fps}")
     n = int(np.floor(body.duration * fps + 1e-9)) + 1
     return np.asarray(body.time[0] + np.arange(n) / fps, dtype=np.float64)
 

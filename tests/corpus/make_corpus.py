@@ -1260,6 +1260,8 @@ def _command_cases(c: _Corpus) -> None:
         options="--scheduler nonsense",
     )
     case("show-fps-zero", commands["show"], "run.json", "--fps", options="--fps 0")
+    # a frame every microsecond of the record would render for hours
+    case("show-fps-1e6", commands["show"], "run.json", "--fps", "100", options="--fps 1000000")
     case("run-unknown-option", commands["run"], "run.json", "--bogus", options="--bogus")
     d = c.folder("command-unknown")
     c.command("command-unknown", ["simulate", str(d)], d / "out", "invalid choice", "mdf --help")
