@@ -297,9 +297,9 @@ def _simulate_motion(
 
     clock = time.perf_counter()
     progress.stage("spectrogram")
-    spec = wf.spectrogram(received.signal, t, proc)
-    if spec is None:
-        try:
+    try:
+        spec = wf.spectrogram(received.signal, t, proc)  # a waveform's own slow time (FMCW)
+        if spec is None:
             spec = spectrogram(
                 received.signal,
                 wf.prf,
@@ -309,8 +309,8 @@ def _simulate_motion(
                 nfft=proc.nfft,
                 precision=proc.precision,
             )
-        except RecordTooShortError as exc:
-            raise SceneError(f"processing.window_length: {exc}") from None
+    except RecordTooShortError as exc:
+        raise SceneError(f"processing.window_length: {exc}") from None
     spec_db = power_to_db(spec.power, proc.floor_db)
     velocity = radar.doppler_to_velocity(spec.doppler, wf.carrier_frequency)
     timings["spectrogram"] = time.perf_counter() - clock
