@@ -24,7 +24,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -258,6 +258,10 @@ def group_means(
 
 #: An axis of a file's frame with a sign, as config files name it.
 AXES = ("x", "y", "z", "-x", "-y", "-z")
+
+
+#: A file axis as a signed world axis, for source configs' ``axes`` (see :func:`reorient`).
+Axis = Literal["x", "y", "z", "-x", "-y", "-z"]
 
 
 def check_axes(axes: Sequence[str]) -> None:

@@ -26,10 +26,7 @@ from mdframework import (
     limits,
 )
 from mdframework.settings import FrameRate
-from mdframework.skeleton import check_axes, check_canonical_keys, group_means, reorient
-
-Axis = Literal["x", "y", "z", "-x", "-y", "-z"]
-
+from mdframework.skeleton import Axis, check_axes, check_canonical_keys, group_means, reorient
 
 MarkerSetName = Literal["auto", "plug-in-gait", "cmu", "opensim-gait"]
 

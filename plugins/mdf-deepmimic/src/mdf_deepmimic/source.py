@@ -32,9 +32,7 @@ from mdframework import (
     Skeleton,
     limits,
 )
-from mdframework.skeleton import check_axes, reorient
-
-Axis = Literal["x", "y", "z", "-x", "-y", "-z"]
+from mdframework.skeleton import Axis, check_axes, reorient
 
 #: Most cycles a ``"wrap"`` clip may be played.
 MAX_CYCLES = 10_000

@@ -27,9 +27,8 @@ from mdframework import (
     limits,
 )
 from mdframework.settings import FrameRate
-from mdframework.skeleton import check_axes, check_canonical_keys, group_means, reorient
+from mdframework.skeleton import Axis, check_axes, check_canonical_keys, group_means, reorient
 
-Axis = Literal["x", "y", "z", "-x", "-y", "-z"]
 #: A value of a time column in its own unit (frame numbers, milliseconds, seconds).
 ColumnTime = Annotated[float, Field(ge=-limits.MAX_FRAME_NUMBER, le=limits.MAX_FRAME_NUMBER)]
 
