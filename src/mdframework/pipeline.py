@@ -404,10 +404,27 @@ def _inside(time_s: FloatArray, t_first: float, t_last: float) -> slice:
 
 def _range_span(body: Skeleton, radar_pos: FloatArray) -> tuple[float, float]:
     """Smallest and largest distance [m] of the record's valid joints to the radar."""
-    d = np.linalg.norm(body.positions - radar_pos, axis=-1)[body.valid]
+    d = body.positions - radar_pos
+    r2 = d[..., 0] ** 2
+    r2 += d[..., 1] ** 2
+    r2 += d[..., 2] ** 2
+    d = np.sqrt(r2[body.valid])
     if d.size == 0 or not np.all(np.isfinite(d)):
         raise SceneError("the record has no valid, finite joint positions")
     return float(d.min()), float(d.max())
+
+
+def _fastest(ranges: FloatArray, t: FloatArray) -> float:
+    """The fastest radial speed [m/s] between consecutive pulses: ``ranges`` (n, n_scatterers)
+    [m] at times ``t`` (n,) [s], n >= 2. Pulses evenly spaced to 1e-9 (every waveform's) take
+    the largest range step over the shortest interval (at most 1e-9 above the exact value,
+    without a pass per pulse); others divide each pulse's largest step by its interval."""
+    step = ranges[1:] - ranges[:-1]
+    dt = np.diff(t)
+    dt_min, dt_max = float(dt.min()), float(dt.max())
+    if dt_max - dt_min <= 1e-9 * dt_min:
+        return max(float(step.max()), -float(step.min())) / dt_min
+    return float(np.max(np.maximum(step.max(axis=1), -step.min(axis=1)) / dt))
 
 
 class _Stream:
@@ -455,9 +472,7 @@ class _Stream:
         self.check_near(lo, scat, ranges)
         tb = self.t[lo : lo + ranges.shape[0]]
         if ranges.shape[0] > 1:
-            step = np.diff(ranges, axis=0)
-            fastest = np.maximum(step.max(axis=1), -step.min(axis=1))
-            self.speed = max(self.speed, float(np.max(fastest / np.diff(tb))))
+            self.speed = max(self.speed, _fastest(ranges, tb))
         if self._last is not None and self._last[1].shape == ranges[0].shape:
             jump = float(np.max(np.abs(ranges[0] - self._last[1])))
             self.speed = max(self.speed, jump / (float(tb[0]) - self._last[0]))
@@ -526,7 +541,10 @@ def _gate(gate: str | float, at_pulses: Skeleton, radar_pos: FloatArray) -> Floa
     if gate == "track":
         ref = at_pulses.index("base") if "base" in at_pulses.joint_names else 0
         d = at_pulses.positions[:, ref, :] - radar_pos
-        return np.asarray(np.sqrt(np.sum(d * d, axis=1)), dtype=np.float64)
+        r = d[:, 0] ** 2
+        r += d[:, 1] ** 2
+        r += d[:, 2] ** 2
+        return np.asarray(np.sqrt(r, out=r), dtype=np.float64)
     return np.full(at_pulses.time.shape, float(gate))
 
 
