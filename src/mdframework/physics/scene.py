@@ -7,6 +7,8 @@ clockwise (seen from above) from its right-hip -> left-hip vector.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -60,49 +62,76 @@ def body_heading(
     return facing_heading(left_hip, right_hip)
 
 
-def linear_drift(time: FloatArray, track: FloatArray) -> FloatArray:
-    """Least-squares straight-line fit of a horizontal track: (n_frames, 2) [m], evaluated at
-    ``time`` and zero at the first frame (the translation a treadmill removes)."""
+def linear_drift_rate(time: FloatArray, track: FloatArray) -> FloatArray:
+    """Slope (2,) [m/s] of the least-squares straight-line fit of a horizontal track
+    (n_frames, 2) [m] over ``time`` (n_frames,) [s]: the velocity a treadmill removes."""
     t = time - time[0]
     a = np.stack([np.ones_like(t), t], axis=1)
     coef, *_ = np.linalg.lstsq(a, track, rcond=None)
-    return np.asarray(np.outer(t, coef[1]), dtype=np.float64)
+    return np.asarray(coef[1], dtype=np.float64)
 
 
-def place(
+@dataclass(frozen=True)
+class Placement:
+    """A recording's placement in the scene, affine in time (see :func:`placement`): joints
+    at time ``t`` [s] go to ``R (x - origin) + offset + (t - t0) travel - (t - t0) drift``, the
+    last three horizontal. ``rotation`` (3, 3); ``origin`` (3,) [m]; ``offset`` (2,) [m];
+    ``drift`` and ``travel`` (2,) [m/s] or None; ``t0`` [s], the recording's first frame."""
+
+    rotation: FloatArray
+    origin: FloatArray
+    offset: FloatArray
+    t0: float
+    drift: FloatArray | None = None
+    travel: FloatArray | None = None
+
+    def apply(self, time: FloatArray, joints: FloatArray) -> FloatArray:
+        """Joints (n_frames, n_joints, 3) [m] at ``time`` (n_frames,) [s], any frames of the
+        recording (a window alone gives the same positions as the whole, sliced), placed."""
+        n, k = joints.shape[:2]
+        moved = ((joints - self.origin).reshape(-1, 3) @ self.rotation.T).reshape(n, k, 3)
+        since = (time - self.t0)[:, None, None]
+        if self.drift is not None:
+            moved[:, :, :2] -= since * self.drift
+        if self.travel is not None:
+            moved[:, :, :2] += since * self.travel
+        moved[:, :, :2] += self.offset
+        return np.asarray(moved, dtype=np.float64)
+
+
+def placement(
     time: FloatArray,
-    joints: FloatArray,
-    *,
     base: FloatArray,
+    *,
     heading_now: float,
     heading: float,
     position: FloatArray,
     mode: str,
     speed: float = 0.0,
-) -> FloatArray:
-    """Rotate and translate joints (n_frames, n_joints, 3) [m] into the scene.
+) -> Placement:
+    """How to rotate and translate a recording into the scene.
 
-    ``base`` (n_frames, 3) is the body's reference track (hip centre). The body is rotated about
-    the vertical through its first base position so that ``heading_now`` becomes ``heading``;
-    then, by ``mode``:
+    ``time`` (n_frames,) [s] and ``base`` (n_frames, 3) [m]: the whole recording's reference
+    track (hip centre). The body is rotated about the vertical through its first base position
+    so that ``heading_now`` becomes ``heading``; then, by ``mode``:
 
     - ``recorded``: its own translation is kept; the first base position moves to ``position``
       (x, y) [m] (its height is kept).
     - ``treadmill``: the straight-line horizontal drift of the base is removed (sway remains),
       and the base stays at ``position``.
     - ``straight``: as ``treadmill``, then the body moves along ``heading`` at ``speed`` [m/s].
+
+    The drift is fitted to the whole recording, so any window of it is placed as the whole is.
     """
+    if mode not in ("recorded", "treadmill", "straight"):
+        raise ValueError(f"unknown motion mode {mode!r}")
     rot = rotation_z(heading - heading_now)
     origin = np.array([base[0, 0], base[0, 1], 0.0])
-    moved = (joints - origin) @ rot.T
-    base_r = (base - origin) @ rot.T
+    drift = travel = None
     if mode in ("treadmill", "straight"):
-        drift = linear_drift(time, base_r[:, :2])
-        moved[:, :, :2] -= drift[:, None, :]
+        base_r = (base - origin) @ rot.T
+        drift = linear_drift_rate(time, base_r[:, :2])
         if mode == "straight":
-            direction = np.array([np.cos(heading), np.sin(heading)])
-            moved[:, :, :2] += ((time - time[0]) * speed)[:, None, None] * direction
-    elif mode != "recorded":
-        raise ValueError(f"unknown motion mode {mode!r}")
-    moved[:, :, :2] += np.asarray(position, dtype=np.float64)[:2]
-    return np.asarray(moved, dtype=np.float64)
+            travel = speed * np.array([np.cos(heading), np.sin(heading)])
+    offset = np.asarray(position, dtype=np.float64)[:2]
+    return Placement(rot, origin, offset, float(time[0]), drift, travel)
