@@ -121,3 +121,16 @@ def test_a_window_is_placed_as_the_whole_recording(mode: str) -> None:
         before = np.linalg.norm(joints[:, k] - base, axis=1)
         after = np.linalg.norm(whole[:, k] - where.apply(time, base[:, None, :])[:, 0], axis=1)
         assert np.max(np.abs(after - before)) < 1e-12
+
+
+def test_drift_rate_is_the_least_squares_slope() -> None:
+    """The treadmill's drift rate against numpy's polynomial fit (an independent least-squares
+    solver) on uneven frame times, to 1e-12 m/s; a single frame has no drift."""
+    from mdframework.physics import scene
+
+    rng = np.random.default_rng(11)
+    time = 3.0 + np.cumsum(rng.uniform(0.005, 0.02, 300))
+    track = np.column_stack([0.9 * time, -0.2 * time]) + rng.normal(0.0, 0.05, (300, 2))
+    expected = [np.polyfit(time, track[:, k], 1)[0] for k in range(2)]
+    assert np.max(np.abs(scene.linear_drift_rate(time, track) - expected)) < 1e-12
+    assert np.array_equal(scene.linear_drift_rate(time[:1], track[:1]), np.zeros(2))

@@ -15,12 +15,6 @@ from numpy.typing import NDArray
 FloatArray = NDArray[np.float64]
 
 
-def rotation_z(angle: float) -> FloatArray:
-    """Active rotation by ``angle`` [rad] about ``+z``, (3, 3)."""
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
 def facing_heading(left_hip: FloatArray, right_hip: FloatArray) -> float:
     """Mean facing heading [rad] of a body from hip tracks (n_frames, 3) [m]."""
     left = np.nanmean(left_hip - right_hip, axis=0)
@@ -64,39 +58,43 @@ def body_heading(
 
 def linear_drift_rate(time: FloatArray, track: FloatArray) -> FloatArray:
     """Slope (2,) [m/s] of the least-squares straight-line fit of a horizontal track
-    (n_frames, 2) [m] over ``time`` (n_frames,) [s]: the velocity a treadmill removes."""
-    t = time - time[0]
-    a = np.stack([np.ones_like(t), t], axis=1)
-    coef, *_ = np.linalg.lstsq(a, track, rcond=None)
-    return np.asarray(coef[1], dtype=np.float64)
+    (n_frames, 2) [m] over ``time`` (n_frames,) [s]: the velocity a treadmill removes (zero
+    for a single frame). The closed form ``sum(dt dy) / sum(dt^2)`` about the means."""
+    dt = time - np.mean(time)
+    denom = float(np.sum(dt * dt))
+    if denom <= 0.0:
+        return np.zeros(track.shape[1])
+    return np.asarray(np.sum(dt[:, None] * (track - np.mean(track, axis=0)), axis=0) / denom)
 
 
 @dataclass(frozen=True)
 class Placement:
-    """A recording's placement in the scene, affine in time (see :func:`placement`): joints
-    at time ``t`` [s] go to ``R (x - origin) + offset + (t - t0) travel - (t - t0) drift``, the
-    last three horizontal. ``rotation`` (3, 3); ``origin`` (3,) [m]; ``offset`` (2,) [m];
-    ``drift`` and ``travel`` (2,) [m/s] or None; ``t0`` [s], the recording's first frame."""
+    """A recording's placement in the scene, affine in time (see :func:`placement`): a joint
+    ``x`` at time ``t`` [s] goes to ``Rz(turn) (x - origin) + offset + (t - t0) velocity``,
+    the last two horizontal. ``turn`` [rad] about +z; ``origin`` (3,) [m]; ``offset`` (2,)
+    [m]; ``velocity`` (2,) [m/s] (the treadmill's drift removed and a straight path's travel
+    added; zero for a recorded path); ``t0`` [s], the recording's first frame."""
 
-    rotation: FloatArray
+    turn: float
     origin: FloatArray
     offset: FloatArray
     t0: float
-    drift: FloatArray | None = None
-    travel: FloatArray | None = None
+    velocity: FloatArray
 
     def apply(self, time: FloatArray, joints: FloatArray) -> FloatArray:
-        """Joints (n_frames, n_joints, 3) [m] at ``time`` (n_frames,) [s], any frames of the
-        recording (a window alone gives the same positions as the whole, sliced), placed."""
-        n, k = joints.shape[:2]
-        moved = ((joints - self.origin).reshape(-1, 3) @ self.rotation.T).reshape(n, k, 3)
-        since = (time - self.t0)[:, None, None]
-        if self.drift is not None:
-            moved[:, :, :2] -= since * self.drift
-        if self.travel is not None:
-            moved[:, :, :2] += since * self.travel
-        moved[:, :, :2] += self.offset
-        return np.asarray(moved, dtype=np.float64)
+        """Joints (n_frames, ..., 3) [m] at ``time`` (n_frames,) [s], any frames of the
+        recording (a window alone gives the same positions as the whole, sliced), placed.
+        Written out per coordinate (a turn about z leaves z alone): no BLAS call, whose threads
+        would contend with other work on a busy machine."""
+        c, s = np.cos(self.turn), np.sin(self.turn)
+        x = joints[..., 0] - self.origin[0]
+        y = joints[..., 1] - self.origin[1]
+        since = (time - self.t0).reshape(time.shape + (1,) * (joints.ndim - 2))
+        out = np.empty(joints.shape, dtype=np.float64)
+        out[..., 0] = c * x - s * y + (self.offset[0] + since * self.velocity[0])
+        out[..., 1] = s * x + c * y + (self.offset[1] + since * self.velocity[1])
+        out[..., 2] = joints[..., 2]
+        return out
 
 
 def placement(
@@ -125,13 +123,12 @@ def placement(
     """
     if mode not in ("recorded", "treadmill", "straight"):
         raise ValueError(f"unknown motion mode {mode!r}")
-    rot = rotation_z(heading - heading_now)
     origin = np.array([base[0, 0], base[0, 1], 0.0])
-    drift = travel = None
+    velocity = np.zeros(2)
+    turned = Placement(heading - heading_now, origin, np.zeros(2), float(time[0]), velocity)
     if mode in ("treadmill", "straight"):
-        base_r = (base - origin) @ rot.T
-        drift = linear_drift_rate(time, base_r[:, :2])
+        velocity = -linear_drift_rate(time, turned.apply(time, base)[:, :2])
         if mode == "straight":
-            travel = speed * np.array([np.cos(heading), np.sin(heading)])
+            velocity += speed * np.array([np.cos(heading), np.sin(heading)])
     offset = np.asarray(position, dtype=np.float64)[:2]
-    return Placement(rot, origin, offset, float(time[0]), drift, travel)
+    return Placement(heading - heading_now, origin, offset, float(time[0]), velocity)
