@@ -229,6 +229,24 @@ print(resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before)
     assert faults[0] >= 20 and faults[1] <= faults[0] / 10, faults
 
 
+def _blas_threads() -> list[int]:
+    from threadpoolctl import threadpool_info
+
+    return [int(lib["num_threads"]) for lib in threadpool_info() if lib["user_api"] == "blas"]
+
+
+def test_pool_workers_share_the_cpus_blas_threads() -> None:
+    """Each of n local workers runs its BLAS with cpu_count // n threads (at least one), so
+    that n workers side by side never start more BLAS threads than there are CPUs."""
+    from mdframework.workers import worker_pool
+
+    n_cpu = os.cpu_count() or 1
+    for n in (1, 2, n_cpu + 1):
+        with worker_pool(n) as pool:
+            threads = pool.submit(_blas_threads).result()
+        assert threads and all(t == max(1, n_cpu // n) for t in threads), (n, threads)
+
+
 def _mixed_sources(tmp_path: Path, *extra: str) -> Path:
     """Sources of every loader: ASF/AMC and BVH (both warn about glitches), the Boulic walker,
     and ``extra`` sources."""

@@ -134,3 +134,18 @@ def test_chen16_positions_follow_the_table() -> None:
     assert np.allclose(pos[0, names.index("r_lower_arm")], j["r_hand"])
     assert np.allclose(pos[0, names.index("l_foot")], j["l_toe"])
     assert np.allclose(axes[0, names.index("l_upper_leg")], j["l_knee"] - j["l_hip"])
+
+
+@pytest.mark.parametrize("placement", ["chen16", "joints17"])
+def test_part_geometry_in_coordinate_planes(placement: str) -> None:
+    """Coordinates first ((3, n, 17), joints along the last axis) gives the same positions
+    and axes as the (n, 17, 3) layout, transposed, for weighted and identity placements."""
+    rng = np.random.default_rng(3)
+    joints = _standing_body() + rng.normal(0.0, 0.05, (40, 17, 3))
+    parts = body.body_parts(placement)  # type: ignore[arg-type]
+    pos, axes = body.part_geometry(parts, joints)
+    planes = np.ascontiguousarray(np.moveaxis(joints, -1, 0))
+    pos_t, axes_t = body.part_geometry(parts, planes, joint_axis=-1)
+    assert pos_t.shape == axes_t.shape == (3, 40, len(parts))
+    assert np.allclose(np.moveaxis(pos_t, 0, -1), pos, rtol=0, atol=1e-15)
+    assert np.array_equal(np.moveaxis(axes_t, 0, -1), axes)

@@ -89,3 +89,26 @@ def test_float32_defaults_match_float64_within_the_ladder() -> None:
     f64 = run(radar={"kind": "lfm", "precision": "float64"}, processing={"precision": "float64"})
     support = f64.spectrogram_db > -40.0
     assert np.max(np.abs(f32.spectrogram_db - f64.spectrogram_db)[support]) < 0.01
+
+
+def test_fastest_radial_speed_against_a_per_pulse_reference() -> None:
+    """The aliasing check's radial speed: for evenly spaced pulses, the largest range step
+    over the shortest interval is the per-pulse maximum of |step| / interval to 1e-9; for
+    uneven pulse times it is that maximum exactly."""
+    from mdframework.pipeline import _fastest
+
+    rng = np.random.default_rng(7)
+    ranges = 10.0 + np.cumsum(rng.normal(0.0, 1e-3, (500, 5)), axis=0)
+
+    def reference(t: np.ndarray) -> float:
+        return max(
+            abs(ranges[i + 1, j] - ranges[i, j]) / (t[i + 1] - t[i])
+            for i in range(len(t) - 1)
+            for j in range(ranges.shape[1])
+        )
+
+    even = interpolation.pulse_times(0.3, 0.3 + 499 / 2400.0, 2400.0)
+    assert even.size == 500
+    assert _fastest(ranges, even) == pytest.approx(reference(even), rel=1e-9)
+    uneven = np.cumsum(rng.uniform(1e-4, 1e-3, 500))
+    assert _fastest(ranges, uneven) == reference(uneven)

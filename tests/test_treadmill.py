@@ -92,3 +92,45 @@ def test_treadmill_stance_foot_gives_negative_doppler(source: str) -> None:
     share_o = spec_o.power[band].sum() / spec_o.power.sum()
     assert share_t > 5 * share_o
     assert share_t > 1e-3
+
+
+@pytest.mark.parametrize("mode", ["recorded", "treadmill", "straight"])
+def test_a_window_is_placed_as_the_whole_recording(mode: str) -> None:
+    """Records place only their window's frames, with the placement found from the whole
+    recording (facing, drift): the window's placed joints equal the whole recording placed and
+    then cut, to 1e-12 m, in every motion mode."""
+    from mdframework.physics import scene
+
+    rng = np.random.default_rng(5)
+    time = np.cumsum(rng.uniform(0.005, 0.01, 400))
+    base = np.column_stack([1.2 * time, 0.1 * np.sin(time), 1.0 + 0.02 * np.cos(3 * time)])
+    joints = base[:, None, :] + rng.normal(0.0, 0.3, (400, 5, 3))
+    where = scene.placement(
+        time,
+        base,
+        heading_now=0.3,
+        heading=2.0,
+        position=np.array([4.0, -1.0]),
+        mode=mode,
+        speed=1.4,
+    )
+    whole = where.apply(time, joints)
+    assert np.max(np.abs(where.apply(time[150:260], joints[150:260]) - whole[150:260])) < 1e-12
+    # the rotation keeps every joint's distance to the base (a rigid motion per frame)
+    for k in range(5):
+        before = np.linalg.norm(joints[:, k] - base, axis=1)
+        after = np.linalg.norm(whole[:, k] - where.apply(time, base[:, None, :])[:, 0], axis=1)
+        assert np.max(np.abs(after - before)) < 1e-12
+
+
+def test_drift_rate_is_the_least_squares_slope() -> None:
+    """The treadmill's drift rate against numpy's polynomial fit (an independent least-squares
+    solver) on uneven frame times, to 1e-12 m/s; a single frame has no drift."""
+    from mdframework.physics import scene
+
+    rng = np.random.default_rng(11)
+    time = 3.0 + np.cumsum(rng.uniform(0.005, 0.02, 300))
+    track = np.column_stack([0.9 * time, -0.2 * time]) + rng.normal(0.0, 0.05, (300, 2))
+    expected = [np.polyfit(time, track[:, k], 1)[0] for k in range(2)]
+    assert np.max(np.abs(scene.linear_drift_rate(time, track) - expected)) < 1e-12
+    assert np.array_equal(scene.linear_drift_rate(time[:1], track[:1]), np.zeros(2))

@@ -113,7 +113,9 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
     proc = config.processing
 
     motion = load_motion(stages.source)
-    body, _, _ = _place(config, stages, motion, radar_pos)
+    body, _, _, where = _place(config, stages, motion, radar_pos)
+    if where is not None:
+        body = body.with_positions(where.apply(body.time, body.positions))
     t_start, t_end = _window(body, cfg.motion.start, cfg.motion.duration)
     limits.check_pulses(
         t_end - t_start, wf.pulse_rate, body.n_joints, "motion.duration", proc.keep_scatterers

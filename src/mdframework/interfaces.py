@@ -24,6 +24,7 @@ must give the same output whether a record is processed as one block or as many
 from __future__ import annotations
 
 import dataclasses
+import functools
 import warnings
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
@@ -95,6 +96,13 @@ class Motion:
                 "this motion has no mapping to the canonical 17-joint body "
                 f"(source: {self.metadata.get('source', 'unknown')})"
             )
+        return self._canonical
+
+    @functools.cached_property
+    def _canonical(self) -> Skeleton:
+        """The canonical skeleton, mapped once per motion (records cut from one recording
+        share it)."""
+        assert self.canonical_map is not None
         return to_canonical(self.skeleton, self.canonical_map)
 
 

@@ -128,7 +128,17 @@ def _describe(stages: Stages, stage: str) -> list[dict[str, Any]]:
 
 
 def place_body(body: Skeleton, person: PersonConfig, radar_position: FloatArray) -> Skeleton:
-    """Put a canonical body into the scene as ``person`` says (see :func:`physics.scene.place`)."""
+    """Put a canonical body into the scene as ``person`` says (the whole recording; see
+    :func:`body_placement`)."""
+    where = body_placement(body, person, radar_position)
+    return body.with_positions(where.apply(body.time, body.positions))
+
+
+def body_placement(
+    body: Skeleton, person: PersonConfig, radar_position: FloatArray
+) -> scene.Placement:
+    """How ``person`` places a canonical body (the whole recording) in the scene: apply it to
+    any of its frames (:meth:`physics.scene.Placement.apply`)."""
     base = body.joint("base")
     try:
         heading_now = scene.body_heading(
@@ -146,17 +156,15 @@ def place_body(body: Skeleton, person: PersonConfig, radar_position: FloatArray)
                 "give heading_deg instead"
             )
         heading = np.arctan2(to_radar[1], to_radar[0]) + np.deg2rad(person.aspect_deg or 0.0)
-    positions = scene.place(
+    return scene.placement(
         body.time,
-        body.positions,
-        base=base,
+        base,
         heading_now=heading_now,
         heading=float(heading),
         position=np.asarray(person.position),
         mode=person.motion,
         speed=person.speed or 0.0,
     )
-    return body.with_positions(positions)
 
 
 def _is_default_placement(person: PersonConfig) -> bool:
@@ -224,7 +232,7 @@ def _simulate_motion(
 
     clock = time.perf_counter()
     progress.stage("conditioning and placing the body")
-    body, conditioning_report, placement = _place(config, stages, motion, radar_pos)
+    body, conditioning_report, placement, where = _place(config, stages, motion, radar_pos)
     t_start, t_end = _window(body, cfg.motion.start, cfg.motion.duration)
     limits.check_pulses(
         t_end - t_start,
@@ -236,6 +244,8 @@ def _simulate_motion(
     t = wf.pulse_times(t_start, t_end)
     frames = interpolation.window_frames(body.time, float(t[0]), float(t[-1]))
     near = body.select_frames(frames)
+    if where is not None:  # placed from the whole recording, applied to the window alone
+        near = near.with_positions(where.apply(near.time, near.positions))
     exact_linear = motion.linear_tracks and body is motion.skeleton
     method = "linear" if exact_linear else proc.interpolation
     resample = interpolation.TrackResampler(near.time, near.positions, near.valid, method)
@@ -367,9 +377,10 @@ def _check_empty(
 
 def _place(
     config: RunConfigBase, stages: Stages, motion: Motion, radar_pos: FloatArray
-) -> tuple[Skeleton, dict[str, Any], dict[str, Any]]:
-    """The conditioned body placed in the scene (whole recording), the conditioning report and
-    the placement recorded in the metadata."""
+) -> tuple[Skeleton, dict[str, Any], dict[str, Any], scene.Placement | None]:
+    """The conditioned body (whole recording, not yet placed), the conditioning report, the
+    placement recorded in the metadata, and the placement to apply to the body's frames (None:
+    the body is used as given)."""
     sc = config.scene
     if stages.model.needs_canonical and motion.canonical_map is None:
         raise SceneError(
@@ -379,13 +390,14 @@ def _place(
     body = motion.canonical() if stages.model.needs_canonical else motion.skeleton
     body, conditioning_report = _condition(body, config.conditioning)
     if stages.model.needs_canonical:
-        return place_body(body, sc.person, radar_pos), conditioning_report, sc.person.model_dump()
+        where = body_placement(body, sc.person, radar_pos)
+        return body, conditioning_report, sc.person.model_dump(), where
     if not _is_default_placement(sc.person):
         raise SceneError(
             "scene.person: placement applies to human bodies only; this motion "
             f"({motion.metadata.get('source', 'unknown')}) is used as recorded"
         )
-    return body, conditioning_report, {"motion": "as given"}
+    return body, conditioning_report, {"motion": "as given"}, None
 
 
 def _blocks(n: int, size: int, multiple: int) -> list[tuple[int, int]]:
@@ -404,10 +416,27 @@ def _inside(time_s: FloatArray, t_first: float, t_last: float) -> slice:
 
 def _range_span(body: Skeleton, radar_pos: FloatArray) -> tuple[float, float]:
     """Smallest and largest distance [m] of the record's valid joints to the radar."""
-    d = np.linalg.norm(body.positions - radar_pos, axis=-1)[body.valid]
+    d = body.positions - radar_pos
+    r2 = d[..., 0] ** 2
+    r2 += d[..., 1] ** 2
+    r2 += d[..., 2] ** 2
+    d = np.sqrt(r2[body.valid])
     if d.size == 0 or not np.all(np.isfinite(d)):
         raise SceneError("the record has no valid, finite joint positions")
     return float(d.min()), float(d.max())
+
+
+def _fastest(ranges: FloatArray, t: FloatArray) -> float:
+    """The fastest radial speed [m/s] between consecutive pulses: ``ranges`` (n, n_scatterers)
+    [m] at times ``t`` (n,) [s], n >= 2. Pulses evenly spaced to 1e-9 (every waveform's) take
+    the largest range step over the shortest interval (at most 1e-9 above the exact value,
+    without a pass per pulse); others divide each pulse's largest step by its interval."""
+    step = ranges[1:] - ranges[:-1]
+    dt = np.diff(t)
+    dt_min, dt_max = float(dt.min()), float(dt.max())
+    if dt_max - dt_min <= 1e-9 * dt_min:
+        return max(float(step.max()), -float(step.min())) / dt_min
+    return float(np.max(np.maximum(step.max(axis=1), -step.min(axis=1)) / dt))
 
 
 class _Stream:
@@ -455,9 +484,7 @@ class _Stream:
         self.check_near(lo, scat, ranges)
         tb = self.t[lo : lo + ranges.shape[0]]
         if ranges.shape[0] > 1:
-            step = np.diff(ranges, axis=0)
-            fastest = np.maximum(step.max(axis=1), -step.min(axis=1))
-            self.speed = max(self.speed, float(np.max(fastest / np.diff(tb))))
+            self.speed = max(self.speed, _fastest(ranges, tb))
         if self._last is not None and self._last[1].shape == ranges[0].shape:
             jump = float(np.max(np.abs(ranges[0] - self._last[1])))
             self.speed = max(self.speed, jump / (float(tb[0]) - self._last[0]))
@@ -526,7 +553,10 @@ def _gate(gate: str | float, at_pulses: Skeleton, radar_pos: FloatArray) -> Floa
     if gate == "track":
         ref = at_pulses.index("base") if "base" in at_pulses.joint_names else 0
         d = at_pulses.positions[:, ref, :] - radar_pos
-        return np.asarray(np.sqrt(np.sum(d * d, axis=1)), dtype=np.float64)
+        r = d[:, 0] ** 2
+        r += d[:, 1] ** 2
+        r += d[:, 2] ** 2
+        return np.asarray(np.sqrt(r, out=r), dtype=np.float64)
     return np.full(at_pulses.time.shape, float(gate))
 
 

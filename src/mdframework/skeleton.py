@@ -138,8 +138,19 @@ class Skeleton:
         float64 [m] finite by construction (interpolation within a checked skeleton's frames
         never extrapolates), so they are not checked again; the checks would cost a pass over
         every block."""
+        return cls._trusted(time, positions, joint_names, np.ones(positions.shape[:2], dtype=bool))
+
+    @classmethod
+    def _trusted(
+        cls,
+        time: FloatArray,
+        positions: FloatArray,
+        joint_names: tuple[str, ...],
+        valid: BoolArray,
+    ) -> Skeleton:
+        """A skeleton whose arrays hold every invariant by construction (made from a checked
+        one), not checked again."""
         skeleton = object.__new__(cls)
-        valid = np.ones(positions.shape[:2], dtype=bool)
         for name, value in (
             ("time", time),
             ("positions", positions),
@@ -197,8 +208,11 @@ class Skeleton:
         return Skeleton(self.time[keep], self.positions[keep], self.joint_names, self.valid[keep])
 
     def select_frames(self, frames: slice) -> Skeleton:
-        """The frames ``frames`` (a slice of frame indices)."""
-        return Skeleton(
+        """The frames ``frames`` (a slice of frame indices, a positive step). The frames of a
+        checked skeleton are not checked again."""
+        if frames.step is not None and frames.step < 1:
+            raise ValueError("select_frames needs a slice with a positive step")
+        return Skeleton._trusted(
             self.time[frames], self.positions[frames], self.joint_names, self.valid[frames]
         )
 

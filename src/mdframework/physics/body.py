@@ -201,24 +201,30 @@ def _part_index(
     return index, weight, tail, tip, identity
 
 
-def part_geometry(parts: tuple[BodyPart, ...], joints: FloatArray) -> tuple[FloatArray, FloatArray]:
+def part_geometry(
+    parts: tuple[BodyPart, ...], joints: FloatArray, joint_axis: int = 1
+) -> tuple[FloatArray, FloatArray]:
     """Positions and axis vectors of the parts from canonical joints.
 
-    ``joints`` (n_pulses, 17, 3) [m]. Returns ``positions`` and ``axes``, both
-    (n_pulses, n_parts, 3) [m]; axes are not normalised and may be zero for coincident joints.
-    Positions may share memory with ``joints`` (when the parts are the joints themselves).
+    ``joints`` (n_pulses, 17, 3) [m], or any layout with the 17 joints along ``joint_axis``:
+    e.g. coordinates first, (3, n_pulses, 17) with ``joint_axis=-1``, where every later
+    product over the coordinates runs over whole contiguous planes. Returns ``positions`` and
+    ``axes`` in the same layout with the parts along ``joint_axis`` [m]; axes are not
+    normalised and may be zero for coincident joints. Positions may share memory with
+    ``joints`` (when the parts are the joints themselves).
     """
     index, weight, tail, tip, identity = _part_index(parts)
-    axes = np.take(joints, tip, axis=1)
-    axes -= np.take(joints, tail, axis=1)
+    axes = np.take(joints, tip, axis=joint_axis)
+    axes -= np.take(joints, tail, axis=joint_axis)
     if identity:
         return joints, axes
-    n_terms = index.shape[0]
-    positions = np.take(joints, index[0], axis=1)
+    shape = [1] * joints.ndim
+    shape[joint_axis] = len(parts)
+    positions = np.take(joints, index[0], axis=joint_axis)
     if not np.all(weight[0] == 1.0):
-        positions *= weight[0][None, :, None]
-    for k in range(1, n_terms):
-        positions += weight[k][None, :, None] * np.take(joints, index[k], axis=1)
+        positions *= weight[0].reshape(shape)
+    for k in range(1, index.shape[0]):
+        positions += weight[k].reshape(shape) * np.take(joints, index[k], axis=joint_axis)
     return positions, axes
 
 

@@ -79,17 +79,36 @@ def spheroid_rcs(
     los_norm2: FloatArray | None = None,
 ) -> FloatArray:
     """RCS of a prolate/oblate spheroid (``a = b``) whose symmetry axis is ``axis`` (..., 3),
-    seen along ``line_of_sight`` (..., 3) (part -> radar). Neither vector needs unit length but
-    the aspect uses ``cos^2 theta = (A.B)^2/(|A|^2 |B|^2)`` and ``sin^2 = 1 - cos^2`` (no
-    arccos, no azimuth: it does not matter when ``a = b``). Where either vector is zero the aspect
-    is undefined and broadside is used, so the result is always finite; callers that can have
-    zero axes should hold the last valid orientation instead. ``axis_norm2`` and ``los_norm2``:
-    ``|axis|^2`` and ``|line_of_sight|^2`` when the caller has them already."""
-    dot = np.asarray(_dot(axis, line_of_sight), dtype=np.float64)
-    dot *= dot
-    n2 = np.asarray(_dot(axis, axis) if axis_norm2 is None else axis_norm2.copy(), np.float64)
-    n2 *= _dot(line_of_sight, line_of_sight) if los_norm2 is None else los_norm2
-    cos2 = np.divide(dot, n2, out=dot, where=n2 > 0)
+    seen along ``line_of_sight`` (..., 3) (part -> radar). Neither vector needs unit length (see
+    :func:`spheroid_rcs_from_products`). ``axis_norm2`` and ``los_norm2``: ``|axis|^2`` and
+    ``|line_of_sight|^2`` when the caller has them already."""
+    return spheroid_rcs_from_products(
+        a,
+        c,
+        _dot(axis, line_of_sight),
+        _dot(axis, axis) if axis_norm2 is None else axis_norm2,
+        _dot(line_of_sight, line_of_sight) if los_norm2 is None else los_norm2,
+    )
+
+
+def spheroid_rcs_from_products(
+    a: ArrayLike,
+    c: ArrayLike,
+    dot: FloatArray,
+    axis_norm2: FloatArray,
+    los_norm2: FloatArray,
+) -> FloatArray:
+    """RCS of a spheroid (``a = b``, semi-axis ``c`` along its symmetry axis ``A``) seen along
+    ``B``, from the products ``dot = A.B``, ``axis_norm2 = |A|^2`` and ``los_norm2 = |B|^2``
+    (arrays of one shape, in any layout): ``sigma = pi a^4 c^2 / (a^2 sin^2 + c^2 cos^2)^2``
+    with ``cos^2 theta = (A.B)^2/(|A|^2 |B|^2)`` and ``sin^2 = 1 - cos^2`` (no arccos, no
+    azimuth: it does not matter when ``a = b``). Where either vector is zero the aspect is
+    undefined and broadside is used, so the result is always finite; callers that can have
+    zero axes should hold the last valid orientation instead. The inputs are not modified."""
+    cos2 = np.array(dot, dtype=np.float64)  # a copy: written below
+    cos2 *= cos2
+    n2 = np.asarray(np.multiply(axis_norm2, los_norm2, dtype=np.float64))
+    np.divide(cos2, n2, out=cos2, where=n2 > 0)
     cos2[~(n2 > 0)] = 0.0
     np.clip(cos2, 0.0, 1.0, out=cos2)
     a2 = np.asarray(a, dtype=np.float64) ** 2

@@ -7,16 +7,12 @@ clockwise (seen from above) from its right-hip -> left-hip vector.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numpy.typing import NDArray
 
 FloatArray = NDArray[np.float64]
-
-
-def rotation_z(angle: float) -> FloatArray:
-    """Active rotation by ``angle`` [rad] about ``+z``, (3, 3)."""
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 def facing_heading(left_hip: FloatArray, right_hip: FloatArray) -> float:
@@ -60,49 +56,79 @@ def body_heading(
     return facing_heading(left_hip, right_hip)
 
 
-def linear_drift(time: FloatArray, track: FloatArray) -> FloatArray:
-    """Least-squares straight-line fit of a horizontal track: (n_frames, 2) [m], evaluated at
-    ``time`` and zero at the first frame (the translation a treadmill removes)."""
-    t = time - time[0]
-    a = np.stack([np.ones_like(t), t], axis=1)
-    coef, *_ = np.linalg.lstsq(a, track, rcond=None)
-    return np.asarray(np.outer(t, coef[1]), dtype=np.float64)
+def linear_drift_rate(time: FloatArray, track: FloatArray) -> FloatArray:
+    """Slope (2,) [m/s] of the least-squares straight-line fit of a horizontal track
+    (n_frames, 2) [m] over ``time`` (n_frames,) [s]: the velocity a treadmill removes (zero
+    for a single frame). The closed form ``sum(dt dy) / sum(dt^2)`` about the means."""
+    dt = time - np.mean(time)
+    denom = float(np.sum(dt * dt))
+    if denom <= 0.0:
+        return np.zeros(track.shape[1])
+    return np.asarray(np.sum(dt[:, None] * (track - np.mean(track, axis=0)), axis=0) / denom)
 
 
-def place(
+@dataclass(frozen=True)
+class Placement:
+    """A recording's placement in the scene, affine in time (see :func:`placement`): a joint
+    ``x`` at time ``t`` [s] goes to ``Rz(turn) (x - origin) + offset + (t - t0) velocity``,
+    the last two horizontal. ``turn`` [rad] about +z; ``origin`` (3,) [m]; ``offset`` (2,)
+    [m]; ``velocity`` (2,) [m/s] (the treadmill's drift removed and a straight path's travel
+    added; zero for a recorded path); ``t0`` [s], the recording's first frame."""
+
+    turn: float
+    origin: FloatArray
+    offset: FloatArray
+    t0: float
+    velocity: FloatArray
+
+    def apply(self, time: FloatArray, joints: FloatArray) -> FloatArray:
+        """Joints (n_frames, ..., 3) [m] at ``time`` (n_frames,) [s], any frames of the
+        recording (a window alone gives the same positions as the whole, sliced), placed.
+        Written out per coordinate (a turn about z leaves z alone): no BLAS call, whose threads
+        would contend with other work on a busy machine."""
+        c, s = np.cos(self.turn), np.sin(self.turn)
+        x = joints[..., 0] - self.origin[0]
+        y = joints[..., 1] - self.origin[1]
+        since = (time - self.t0).reshape(time.shape + (1,) * (joints.ndim - 2))
+        out = np.empty(joints.shape, dtype=np.float64)
+        out[..., 0] = c * x - s * y + (self.offset[0] + since * self.velocity[0])
+        out[..., 1] = s * x + c * y + (self.offset[1] + since * self.velocity[1])
+        out[..., 2] = joints[..., 2]
+        return out
+
+
+def placement(
     time: FloatArray,
-    joints: FloatArray,
-    *,
     base: FloatArray,
+    *,
     heading_now: float,
     heading: float,
     position: FloatArray,
     mode: str,
     speed: float = 0.0,
-) -> FloatArray:
-    """Rotate and translate joints (n_frames, n_joints, 3) [m] into the scene.
+) -> Placement:
+    """How to rotate and translate a recording into the scene.
 
-    ``base`` (n_frames, 3) is the body's reference track (hip centre). The body is rotated about
-    the vertical through its first base position so that ``heading_now`` becomes ``heading``;
-    then, by ``mode``:
+    ``time`` (n_frames,) [s] and ``base`` (n_frames, 3) [m]: the whole recording's reference
+    track (hip centre). The body is rotated about the vertical through its first base position
+    so that ``heading_now`` becomes ``heading``; then, by ``mode``:
 
     - ``recorded``: its own translation is kept; the first base position moves to ``position``
       (x, y) [m] (its height is kept).
     - ``treadmill``: the straight-line horizontal drift of the base is removed (sway remains),
       and the base stays at ``position``.
     - ``straight``: as ``treadmill``, then the body moves along ``heading`` at ``speed`` [m/s].
+
+    The drift is fitted to the whole recording, so any window of it is placed as the whole is.
     """
-    rot = rotation_z(heading - heading_now)
-    origin = np.array([base[0, 0], base[0, 1], 0.0])
-    moved = (joints - origin) @ rot.T
-    base_r = (base - origin) @ rot.T
-    if mode in ("treadmill", "straight"):
-        drift = linear_drift(time, base_r[:, :2])
-        moved[:, :, :2] -= drift[:, None, :]
-        if mode == "straight":
-            direction = np.array([np.cos(heading), np.sin(heading)])
-            moved[:, :, :2] += ((time - time[0]) * speed)[:, None, None] * direction
-    elif mode != "recorded":
+    if mode not in ("recorded", "treadmill", "straight"):
         raise ValueError(f"unknown motion mode {mode!r}")
-    moved[:, :, :2] += np.asarray(position, dtype=np.float64)[:2]
-    return np.asarray(moved, dtype=np.float64)
+    origin = np.array([base[0, 0], base[0, 1], 0.0])
+    velocity = np.zeros(2)
+    turned = Placement(heading - heading_now, origin, np.zeros(2), float(time[0]), velocity)
+    if mode in ("treadmill", "straight"):
+        velocity = -linear_drift_rate(time, turned.apply(time, base)[:, :2])
+        if mode == "straight":
+            velocity += speed * np.array([np.cos(heading), np.sin(heading)])
+    offset = np.asarray(position, dtype=np.float64)[:2]
+    return Placement(heading - heading_now, origin, offset, float(time[0]), velocity)

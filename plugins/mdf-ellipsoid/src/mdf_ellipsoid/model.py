@@ -65,10 +65,18 @@ class EllipsoidConfig(PluginConfig):
     )
 
 
-def _usable(axes: np.ndarray, semi_c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(n, n_parts) bool: segments long enough to give an orientation; and their |axis|^2."""
-    length2 = axes[..., 0] ** 2 + axes[..., 1] ** 2 + axes[..., 2] ** 2
-    return np.asarray(length2 > (MIN_SEGMENT_FRACTION * 2.0 * semi_c) ** 2), length2
+def _usable(length2: np.ndarray, semi_c: np.ndarray) -> np.ndarray:
+    """Segments long enough to give an orientation, from their squared lengths |axis|^2 (any
+    shape ending in n_parts) and the parts' semi-axes c (n_parts,): bool, the same shape."""
+    return np.asarray(length2 > (MIN_SEGMENT_FRACTION * 2.0 * semi_c) ** 2)
+
+
+def _plane_dot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Dot products of vectors stored coordinates first, (3, ...) -> (...)."""
+    out = x[0] * y[0]
+    out += x[1] * y[1]
+    out += x[2] * y[2]
+    return out
 
 
 def hold_last_valid(axes: np.ndarray, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -164,10 +172,11 @@ class EllipsoidBody(ScattererModel):
         height = c.height if c.height is not None else bodymodel.estimate_height(body.positions)
         self._a, self._semi_c = bodymodel.part_semi_axes(self._parts, height)
         _, axes = bodymodel.part_geometry(self._parts, body.positions)
-        ok, _ = _usable(axes, self._semi_c)
+        ok = _usable(np.sum(axes * axes, axis=-1), self._semi_c)
         self._carry = axes[np.argmax(ok, axis=0), np.arange(axes.shape[1])]
         self._never = ~np.any(ok, axis=0)
-        self._helper = helper_directions(axes)
+        # the surface points' roll about each segment (their frames only)
+        self._helper = helper_directions(axes) if c.surface_points > 0 else None
 
     def scatterers(
         self, motion: Motion, skeleton: Skeleton, radar_position: np.ndarray, wavelength: float
@@ -177,21 +186,24 @@ class EllipsoidBody(ScattererModel):
         if not hasattr(self, "_carry"):  # used without a record (a one-off block)
             self.start_record(skeleton)
         parts, a, semi_c = self._parts, self._a, self._semi_c
-        pos, axes = bodymodel.part_geometry(parts, skeleton.positions)
-        ok, norm2 = _usable(axes, semi_c)
+        # coordinates first, (3, n_pulses, n_parts): every product runs over contiguous planes
+        joint_planes = np.ascontiguousarray(np.moveaxis(skeleton.positions, -1, 0))
+        pos_t, axes_t = bodymodel.part_geometry(parts, joint_planes, joint_axis=-1)
+        norm2 = _plane_dot(axes_t, axes_t)
+        ok = _usable(norm2, semi_c)
         if not np.all(ok):
-            ext = np.concatenate((self._carry[None], axes))
+            ext = np.concatenate((self._carry[None], np.moveaxis(axes_t, 0, -1)))
             ok_ext = np.concatenate((~self._never[None], ok))
             filled, _ = hold_last_valid(ext, ok_ext)
-            axes = filled[1:]
+            axes_t = np.ascontiguousarray(np.moveaxis(filled[1:], -1, 0))
             semi_c = np.where(self._never, a, semi_c)
-            _, norm2 = _usable(axes, semi_c)
+            norm2 = _plane_dot(axes_t, axes_t)
+        axes = np.moveaxis(axes_t, 0, -1)  # (n_pulses, n_parts, 3), a view
         self._carry = axes[-1].copy()
-        los = np.asarray(radar_position, dtype=np.float64) - pos
-        los2 = los[..., 0] ** 2
-        los2 += los[..., 1] ** 2
-        los2 += los[..., 2] ** 2
-        sigma = rcs.spheroid_rcs(a, semi_c, axes, los, norm2, los2)
+        rp = np.asarray(radar_position, dtype=np.float64)
+        los_t = rp[:, None, None] - pos_t
+        los2 = _plane_dot(los_t, los_t)
+        sigma = rcs.spheroid_rcs_from_products(a, semi_c, _plane_dot(axes_t, los_t), norm2, los2)
         spheres = np.array([p.sphere for p in parts])
         if np.any(spheres):
             if c.sphere_rcs == "mie":
@@ -200,6 +212,11 @@ class EllipsoidBody(ScattererModel):
                 value = rcs.sphere_rcs_optical(a[spheres])
             sigma[:, spheres] = value
         names = tuple(p.name for p in parts)
+        pos = (
+            skeleton.positions
+            if pos_t is joint_planes
+            else np.ascontiguousarray(np.moveaxis(pos_t, 0, -1))
+        )
         if c.surface_points > 0:
             n = c.surface_points
             pts, sig = surface_scatterers(
@@ -207,6 +224,6 @@ class EllipsoidBody(ScattererModel):
             )
             return Scatterers(pts, sig, tuple(f"{m}#{j}" for m in names for j in range(n)))
         semi_axes = np.stack([a, a, semi_c], axis=1)
-        key = tuple(float(v) for v in radar_position)
+        key = tuple(float(v) for v in rp)
         cache = (key, np.sqrt(los2, out=los2))
         return Scatterers(pos, sigma, names, semi_axes, axes, cache)  # type: ignore[arg-type]
