@@ -18,8 +18,21 @@ parallel part spread evenly over n cores), which captures every cost that more w
 The per-record cost is ``(total - serial) / n_records`` CPU seconds, and Dask's is compared with
 the local pool's at the same worker count.
 
+Where the CPU goes, per build: the planning workers (with more than one worker the planner
+loads the motions in other processes: planning, though it runs in parallel), the main process
+during the build (for Dask: the client, the scheduler and the nannies of the local cluster,
+importing Dask, sending the motions), and the worker processes (for Dask: starting a fresh
+interpreter each, their event loops, the records). "Records only" is the per-record cost
+without the planning workers.
+
+``--repeat N`` runs every build N times, alternating (1 and 2 workers, local and Dask, then
+again), and reports medians: the load of a shared machine drifts, so figures taken minutes
+apart are not comparable, and alternation pairs them. ``--idle S`` also measures what an idle
+local Dask cluster costs per second of wall time (its periodic monitors), with the build's
+settings (``LOCAL_DASK_CONFIG``) and with Dask's defaults (the profiler off in both).
+
     .venv/bin/python benchmarks/bench_dataset.py [--config PATH] [--workers 1 2]
-        [--schedulers local dask] [--json OUT.json]
+        [--schedulers local dask] [--repeat N] [--idle SECONDS] [--json OUT.json]
 """
 
 from __future__ import annotations
@@ -28,6 +41,7 @@ import argparse
 import json
 import os
 import resource
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -65,6 +79,7 @@ def _child(config: str, scheduler: str, workers: int, out: str, start_only: bool
     specs = plan_records(cfg, base, workers=workers)
     t_plan = time.perf_counter() - t1
     serial_cpu = time.process_time()  # since the interpreter started: imports and planning
+    plan_workers_cpu = _cpu(resource.RUSAGE_CHILDREN)  # the planning workers, ended by now
     t2 = time.perf_counter()
     rows = build_dataset(cfg, base, Path(out), workers=workers, scheduler=address, progress=False)
     t_build = time.perf_counter() - t2
@@ -76,20 +91,63 @@ def _child(config: str, scheduler: str, workers: int, out: str, start_only: bool
                 "plan_s": t_plan,
                 "build_s": t_build,
                 "serial_cpu_s": serial_cpu,
+                "plan_workers_cpu_s": plan_workers_cpu,
+                # the build planned again (cheap: the motions are loaded) and ran the records
+                "main_build_cpu_s": time.process_time() - serial_cpu,
+                "workers_cpu_s": _cpu(resource.RUSAGE_CHILDREN) - plan_workers_cpu,
                 "n_records": len(rows),
             }
         )
     )
 
 
-def _children_cpu() -> float:
-    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+def _idle_child(settings: str, workers: int, seconds: float) -> None:
+    """Run in a fresh process: the CPU an idle local Dask cluster costs per second of wall
+    time, in this process (scheduler, nannies, client) and in its workers."""
+    import dask
+    from distributed import Client, LocalCluster
+
+    from mdframework.dataset import LOCAL_DASK_CONFIG
+
+    config = dict(LOCAL_DASK_CONFIG)
+    if settings == "dask":  # Dask's defaults, but for the profiler and the malloc setting
+        config = {k: v for k, v in config.items() if "profile" in k or "MALLOC" in k}
+    with dask.config.set(config):
+        cluster = LocalCluster(
+            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None
+        )
+    client = Client(cluster)
+    time.sleep(2.0)  # past the start
+    worker0 = client.run(_self_cpu)
+    main0, t0 = time.process_time(), time.perf_counter()
+    time.sleep(seconds)
+    worker1 = client.run(_self_cpu)
+    main1, wall = time.process_time(), time.perf_counter() - t0
+    client.close()
+    cluster.close()
+    workers_cpu = sum(worker1[w] - worker0[w] for w in worker1)
+    print(
+        json.dumps(
+            {
+                "main_ms_per_s": 1e3 * (main1 - main0) / wall,
+                "workers_ms_per_s": 1e3 * workers_cpu / wall,
+            }
+        )
+    )
+
+
+def _self_cpu() -> float:
+    return _cpu(resource.RUSAGE_SELF)
+
+
+def _cpu(who: int) -> float:
+    usage = resource.getrusage(who)
     return usage.ru_utime + usage.ru_stime
 
 
 def _run_child(args: list[str]) -> tuple[dict[str, Any], float, float]:
     """The child's JSON line, its wall time and the CPU time of its whole process tree."""
-    cpu0 = _children_cpu()
+    cpu0 = _cpu(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     proc = subprocess.run(
         [sys.executable, __file__, "--child", *args],
@@ -100,7 +158,97 @@ def _run_child(args: list[str]) -> tuple[dict[str, Any], float, float]:
     if proc.returncode:
         raise SystemExit(f"child {args} failed:\n{proc.stderr}")
     wall = time.perf_counter() - t0
-    return json.loads(proc.stdout.strip().splitlines()[-1]), wall, _children_cpu() - cpu0
+    return (
+        json.loads(proc.stdout.strip().splitlines()[-1]),
+        wall,
+        _cpu(resource.RUSAGE_CHILDREN) - cpu0,
+    )
+
+
+def _build(config: str, sched: str, n: int) -> dict[str, float]:
+    """One build (and, for Dask, one start of the cluster alone) in fresh processes."""
+    load = os.getloadavg()[0]
+    with tempfile.TemporaryDirectory() as tmp:
+        info, wall, cpu = _run_child([config, sched, str(n), str(Path(tmp) / "ds")])
+    start_wall = start_cpu = 0.0
+    if sched == "dask":
+        s_info, _, s_cpu = _run_child([config, sched, str(n), "-", "--start-only"])
+        start_wall, start_cpu = s_info["start_s"], s_cpu - s_info["serial_cpu_s"]
+    serial, parallel = info["serial_cpu_s"], cpu - info["serial_cpu_s"]
+    records = info["n_records"]
+    r = {
+        "wall_s": wall,
+        "cpu_s": cpu,
+        "serial_cpu_s": serial,
+        "parallel_cpu_s": parallel,
+        "predicted_wall_s": serial + parallel / n,
+        "plan_wall_s": info["plan_s"],
+        "import_wall_s": info["import_s"],
+        "dask_start_wall_s": start_wall,
+        "dask_start_cpu_s": start_cpu,
+        "per_record_cpu_ms": 1e3 * parallel / records,
+        "per_record_cpu_ms_after_start": 1e3 * (parallel - start_cpu) / records,
+        "plan_workers_cpu_s": info["plan_workers_cpu_s"],
+        "main_build_cpu_s": info["main_build_cpu_s"],
+        "workers_cpu_s": info["workers_cpu_s"],
+        # after the build: the process's exit, and processes reaped only then
+        "other_cpu_s": parallel
+        - info["plan_workers_cpu_s"]
+        - info["main_build_cpu_s"]
+        - info["workers_cpu_s"],
+        "records_only_cpu_ms": 1e3 * (parallel - info["plan_workers_cpu_s"]) / records,
+        "n_records": records,
+        "load_before": load,
+    }
+    print(
+        f"{sched:5s} workers={n}: wall {wall:6.1f} s, CPU {cpu:6.1f} s, of which serial "
+        f"{serial:4.1f} s (imports and planning); per record {r['per_record_cpu_ms']:.0f} "
+        f"ms CPU ({r['per_record_cpu_ms_after_start']:.0f} ms after the workers' start); "
+        f"predicted wall on {n} idle core(s) {r['predicted_wall_s']:.1f} s",
+        flush=True,
+    )
+    print(
+        f"      planning workers {r['plan_workers_cpu_s']:.2f} s; during the build: main "
+        f"process {r['main_build_cpu_s']:.2f} s, workers {r['workers_cpu_s']:.2f} s, other "
+        f"{r['other_cpu_s']:.2f} s; records only {r['records_only_cpu_ms']:.1f} ms a record; "
+        f"load average before {load:.2f}",
+        flush=True,
+    )
+    return r
+
+
+def _idle(seconds: float, workers: list[int]) -> dict[str, dict[int, dict[str, float]]]:
+    """What an idle local Dask cluster costs per second, with Dask's monitors and with the
+    build's."""
+    out: dict[str, dict[int, dict[str, float]]] = {}
+    for settings in ("dask", "build"):
+        out[settings] = {}
+        for n in workers:
+            proc = subprocess.run(
+                [sys.executable, __file__, "--idle-child", settings, str(n), str(seconds)],
+                capture_output=True,
+                text=True,
+                env={**os.environ, "PYTHONWARNINGS": "ignore"},
+            )
+            if proc.returncode:
+                raise SystemExit(f"idle child failed:\n{proc.stderr}")
+            res = json.loads(proc.stdout.strip().splitlines()[-1])
+            out[settings][n] = res
+            print(
+                f"idle local Dask cluster, {settings + ' settings':14s} workers={n}: "
+                f"{res['main_ms_per_s']:.1f} ms CPU a second in the main process, "
+                f"{res['workers_ms_per_s']:.1f} ms in the workers",
+                flush=True,
+            )
+    return out
+
+
+def _spread(values: list[float], scale: float = 1.0, fmt: str = ".2f") -> str:
+    """The median of ``values`` (times ``scale``), with their range when there are several."""
+    med = format(scale * statistics.median(values), fmt)
+    if len(values) == 1:
+        return med
+    return f"{med} (range {scale * min(values):{fmt}} to {scale * max(values):{fmt}})"
 
 
 def main() -> None:
@@ -109,77 +257,104 @@ def main() -> None:
     ap.add_argument("--config", default=str(DEFAULT_CONFIG))
     ap.add_argument("--workers", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--schedulers", nargs="+", default=["local", "dask"])
+    ap.add_argument("--repeat", type=int, default=1, help="Rounds of alternating builds.")
+    ap.add_argument("--idle", type=float, default=0.0, help="Seconds of idle Dask cluster.")
     ap.add_argument("--json", type=Path, default=None, help="Also write the results here.")
     ap.add_argument("--child", nargs=4, metavar=("CONFIG", "SCHED", "N", "OUT"), default=None)
     ap.add_argument("--start-only", action="store_true")
+    ap.add_argument("--idle-child", nargs=3, metavar=("SETTINGS", "N", "SECONDS"), default=None)
     a = ap.parse_args()
     if a.child is not None:
         config, sched, n, out = a.child
         _child(config, sched, int(n), out, a.start_only)
         return
+    if a.idle_child is not None:
+        settings, n, seconds = a.idle_child
+        _idle_child(settings, int(n), float(seconds))
+        return
 
     print(f"load average before: {os.getloadavg()}, cores: {os.cpu_count()}", flush=True)
-    results: dict[str, dict[int, dict[str, float]]] = {}
-    for sched in a.schedulers:
-        results[sched] = {}
-        for n in a.workers:
-            with tempfile.TemporaryDirectory() as tmp:
-                info, wall, cpu = _run_child([a.config, sched, str(n), str(Path(tmp) / "ds")])
-            start_wall = start_cpu = 0.0
-            if sched == "dask":
-                s_info, _, s_cpu = _run_child([a.config, sched, str(n), "-", "--start-only"])
-                start_wall, start_cpu = s_info["start_s"], s_cpu - s_info["serial_cpu_s"]
-            serial, parallel = info["serial_cpu_s"], cpu - info["serial_cpu_s"]
-            r = {
-                "wall_s": wall,
-                "cpu_s": cpu,
-                "serial_cpu_s": serial,
-                "parallel_cpu_s": parallel,
-                "predicted_wall_s": serial + parallel / n,
-                "plan_wall_s": info["plan_s"],
-                "import_wall_s": info["import_s"],
-                "dask_start_wall_s": start_wall,
-                "dask_start_cpu_s": start_cpu,
-                "per_record_cpu_ms": 1e3 * parallel / info["n_records"],
-                "per_record_cpu_ms_after_start": 1e3 * (parallel - start_cpu) / info["n_records"],
-                "n_records": info["n_records"],
-            }
-            results[sched][n] = r
-            print(
-                f"{sched:5s} workers={n}: wall {wall:6.1f} s, CPU {cpu:6.1f} s, of which serial "
-                f"{serial:4.1f} s (imports and planning); per record {r['per_record_cpu_ms']:.0f} "
-                f"ms CPU ({r['per_record_cpu_ms_after_start']:.0f} ms after the workers' start); "
-                f"predicted wall on {n} idle core(s) {r['predicted_wall_s']:.1f} s",
-                flush=True,
-            )
+    rounds: list[dict[str, dict[int, dict[str, float]]]] = []
+    for k in range(a.repeat):
+        if a.repeat > 1:
+            print(f"round {k + 1} of {a.repeat}", flush=True)
+        rounds.append(
+            {sched: {n: _build(a.config, sched, n) for n in a.workers} for sched in a.schedulers}
+        )
     print(f"load average after: {os.getloadavg()}")
-    summary: dict[str, Any] = {"results": results, "load_after": os.getloadavg()}
+    results = (
+        rounds[0]
+        if a.repeat == 1
+        else {
+            sched: {
+                n: {
+                    key: statistics.median(r[sched][n][key] for r in rounds)
+                    for key in rounds[0][sched][n]
+                }
+                for n in a.workers
+            }
+            for sched in a.schedulers
+        }
+    )
+    if a.repeat > 1:
+        print(f"medians of {a.repeat} rounds (ranges over the rounds; ratios paired by round):")
+        for sched, res in results.items():
+            for n, r in res.items():
+                print(
+                    f"{sched:5s} workers={n}: serial {r['serial_cpu_s']:.2f} s, per record "
+                    f"{r['per_record_cpu_ms']:.1f} ms ({r['per_record_cpu_ms_after_start']:.1f} "
+                    f"after the workers' start; records only {r['records_only_cpu_ms']:.1f}), "
+                    f"predicted wall {r['predicted_wall_s']:.2f} s"
+                )
+    summary: dict[str, Any] = {
+        "results": results,
+        "rounds": rounds,
+        "load_after": os.getloadavg(),
+    }
     for sched, res in results.items():
         if 1 in res and 2 in res:
-            eff = res[1]["wall_s"] / (2 * res[2]["wall_s"])
-            eff_pred = res[1]["predicted_wall_s"] / (2 * res[2]["predicted_wall_s"])
+            eff = [r[sched][1]["wall_s"] / (2 * r[sched][2]["wall_s"]) for r in rounds]
+            eff_pred = [
+                r[sched][1]["predicted_wall_s"] / (2 * r[sched][2]["predicted_wall_s"])
+                for r in rounds
+            ]
             serial_fraction = res[1]["serial_cpu_s"] / res[1]["predicted_wall_s"]
             summary[sched] = {
-                "efficiency_wall": eff,
-                "efficiency_predicted": eff_pred,
+                "efficiency_wall": statistics.median(eff),
+                "efficiency_predicted": statistics.median(eff_pred),
+                "efficiency_predicted_rounds": eff_pred,
                 "serial_fraction": serial_fraction,
             }
             print(
-                f"{sched}: efficiency 1 -> 2 workers: {100 * eff_pred:.0f} % predicted from CPU "
-                f"times, {100 * eff:.0f} % in wall time on this machine now; serial part "
-                f"{res[1]['serial_cpu_s']:.1f} s CPU = {100 * serial_fraction:.1f} % of one "
-                f"worker's build"
+                f"{sched}: efficiency 1 -> 2 workers: {_spread(eff_pred, 100, '.0f')} % predicted "
+                f"from CPU times, {_spread(eff, 100, '.0f')} % in wall time on this machine now; "
+                f"serial part {res[1]['serial_cpu_s']:.1f} s CPU = {100 * serial_fraction:.1f} % "
+                f"of one worker's build (with 2 workers: {res[2]['serial_cpu_s']:.1f} s, and "
+                f"{res[2]['plan_workers_cpu_s']:.1f} s of planning in 2 processes)"
             )
     if "local" in results and "dask" in results:
         for n in sorted(set(results["local"]) & set(results["dask"])):
-            loc, dsk = results["local"][n], results["dask"][n]
-            ratio = dsk["per_record_cpu_ms"] / loc["per_record_cpu_ms"]
-            ratio_run = dsk["per_record_cpu_ms_after_start"] / loc["per_record_cpu_ms"]
-            summary[f"dask_over_local_{n}"] = {"with_start": ratio, "after_start": ratio_run}
+            ratios = {
+                key: [r["dask"][n][key] / r["local"][n]["per_record_cpu_ms"] for r in rounds]
+                for key in ("per_record_cpu_ms", "per_record_cpu_ms_after_start")
+            }
+            records_only = [
+                r["dask"][n]["records_only_cpu_ms"] / r["local"][n]["records_only_cpu_ms"]
+                for r in rounds
+            ]
+            summary[f"dask_over_local_{n}"] = {
+                "with_start": statistics.median(ratios["per_record_cpu_ms"]),
+                "after_start": statistics.median(ratios["per_record_cpu_ms_after_start"]),
+                "records_only": statistics.median(records_only),
+            }
             print(
-                f"Dask / local per-record CPU, {n} worker(s): {ratio:.2f} with the cluster's "
-                f"start, {ratio_run:.2f} after it"
+                f"Dask / local per-record CPU, {n} worker(s): "
+                f"{_spread(ratios['per_record_cpu_ms'])} with the cluster's start, "
+                f"{_spread(ratios['per_record_cpu_ms_after_start'])} after it; records only "
+                f"{_spread(records_only)}"
             )
+    if a.idle > 0:
+        summary["idle_cluster"] = _idle(a.idle, a.workers)
     if a.json is not None:
         a.json.write_text(json.dumps(summary, indent=2) + "\n")
 

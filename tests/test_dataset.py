@@ -111,6 +111,93 @@ def test_same_result_with_one_and_two_workers_and_dask(
     assert_same(tmp_path / "one", tmp_path / "dask")
 
 
+@pytest.mark.parametrize("n_records", [0, 1, 5, 64, 480, 1001])
+@pytest.mark.parametrize("threads", [1, 2, 7])
+def test_record_chunks_keep_order_and_shrink_to_single_records(
+    n_records: int, threads: int
+) -> None:
+    """Worker tasks hold consecutive records, all of them once, in order; at most
+    MAX_RECORDS_PER_TASK each; each takes at most its share of the records left, so the
+    tasks shrink and the last ``threads`` tasks are single records."""
+    specs: list[Any] = list(range(n_records))
+    chunks = dataset.record_chunks(specs, threads)
+    assert [i for chunk in chunks for i in chunk] == specs
+    sizes = [len(chunk) for chunk in chunks]
+    assert all(1 <= size <= dataset.MAX_RECORDS_PER_TASK for size in sizes)
+    assert sizes == sorted(sizes, reverse=True)
+    share = threads * dataset.TASKS_PER_THREAD
+    left = n_records
+    for size in sizes:
+        assert size == 1 or size <= left / share
+        left -= size
+    assert sizes[-threads:] == [1] * min(threads, len(sizes))
+    if n_records >= 480:  # a long build: tasks of several records
+        assert max(sizes) == dataset.MAX_RECORDS_PER_TASK and len(chunks) < n_records / 3
+
+
+def test_tasks_of_several_records_keep_errors_and_skips(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Records built several to a worker task (forced here: 3 a task) give the rows and
+    skipped records of a build in one process; with on_error = "stop" the build stops on a
+    failing record (with 2 workers the first to fail, not always the first in order)."""
+    monkeypatch.setattr(dataset, "TASKS_PER_THREAD", 1)
+    monkeypatch.setattr(dataset, "MAX_RECORDS_PER_TASK", 3)
+    cfg, base = load_dataset_config(write_config(tmp_path / "d.toml", boxing_records=4))
+    specs = plan_records(cfg, base)
+    assert max(len(c) for c in dataset.record_chunks(specs, 2)) == 3
+    build_dataset(cfg, base, tmp_path / "one", workers=1, progress=False)
+    build_dataset(cfg, base, tmp_path / "two", workers=2, progress=False)
+    assert_same(tmp_path / "one", tmp_path / "two")
+    # a radar 2 m ahead: the walk and run records reach it (fail), the boxing ones do not
+    near = write_config(tmp_path / "near.toml", boxing_records=4)
+    near.write_text(near.read_text() + "[base.scene]\nradar_position = [2.0, 0.0, 1.2]\n")
+    text = near.read_text()
+    cfg, base = load_dataset_config(near)
+    for workers in (1, 2):
+        with pytest.raises(dataset.MdfError, match=r"^record \S+ \((walk|run); .* comes within "):
+            build_dataset(cfg, base, tmp_path / f"stop{workers}", workers=workers, progress=False)
+    near.write_text('on_error = "skip"\n' + text)
+    cfg, base = load_dataset_config(near)
+    for workers in (1, 2):
+        with pytest.warns(DatasetWarning, match="skipped: "):
+            build_dataset(cfg, base, tmp_path / f"skip{workers}", workers=workers, progress=False)
+    assert_same(tmp_path / "skip1", tmp_path / "skip2")
+    skipped = [(tmp_path / f"skip{w}" / dataset.SKIPPED).read_text() for w in (1, 2)]
+    assert skipped[0] == skipped[1] and len(skipped[0].splitlines()) > 2
+    assert len(records(tmp_path / "skip1")) >= 4  # the boxing records
+
+
+def test_local_dask_workers_run_with_the_build_settings(tmp_path: Path) -> None:
+    """The local Dask cluster a build starts: its workers run without Dask's
+    MALLOC_TRIM_THRESHOLD_, without the statistical profiler and with the slower monitors
+    (LOCAL_DASK_CONFIG), and they hold the motions the planner loaded."""
+    pytest.importorskip("distributed")
+    import dask
+    from distributed import default_client
+
+    cfg, base = load_dataset_config(write_config(tmp_path / "d.toml"))
+    plan_records(cfg, base)
+    executor = dataset._executor(cfg, 1, "local")
+    next(executor)
+    try:
+        client = default_client()
+        keys = list(dataset.LOCAL_DASK_CONFIG)
+
+        def settings() -> tuple[dict[str, Any], bool, int]:
+            return (
+                {key: dask.config.get(key) for key in keys},
+                "MALLOC_TRIM_THRESHOLD_" in os.environ,
+                len(dataset._MOTIONS),
+            )
+
+        (seen,) = client.run(settings).values()
+    finally:
+        executor.close()
+    assert seen == (dataset.LOCAL_DASK_CONFIG, False, len(dataset._MOTIONS))
+    assert len(dataset._MOTIONS) >= 3
+
+
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's malloc")
 def test_workers_reuse_freed_memory_for_large_arrays() -> None:
     """A fresh process maps a 10 MiB array afresh each time it is made (and faults its pages

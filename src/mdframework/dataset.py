@@ -101,6 +101,10 @@ SCHEDULER_ENV = "MDF_DASK_SCHEDULER"
 SCHEDULER_TIMEOUT_ENV = "MDF_DASK_TIMEOUT"
 #: Default connection timeout to a Dask scheduler [s].
 SCHEDULER_TIMEOUT_S = 10.0
+#: Records a worker task builds at most, and the share of the records left that a task takes
+#: (``1 / (threads * TASKS_PER_THREAD)``): see :func:`record_chunks`.
+MAX_RECORDS_PER_TASK = 8
+TASKS_PER_THREAD = 4
 
 #: A percentile (0 .. 100).
 Percent = Annotated[float, Field(ge=0, le=100)]
@@ -1174,6 +1178,47 @@ def _connect(client_cls: Any, cluster: Any, address: str) -> Any:
         ) from None
 
 
+#: Dask settings of the local cluster a build starts (its scheduler and nannies run in this
+#: process; its workers inherit the settings; a cluster started elsewhere is configured by its
+#: owner, docs/datasets.md). The statistical profiler samples every worker thread every 10 ms
+#: and nothing reads its profiles. Dask starts its workers with MALLOC_TRIM_THRESHOLD_ set,
+#: which turns off glibc's adaptive mmap threshold: every array over 128 KiB is then mapped and
+#: unmapped afresh, and a record took 2.4 times as long as in a local worker. The event-loop
+#: health check (every 20 ms), the system monitor (500 ms; it feeds the dashboard, which is
+#: off), the memory monitor (100 ms) and the cluster's widget text (500 ms) cost an idle
+#: one-worker cluster 38 ms CPU a second between its two processes; at the intervals below,
+#: 7 ms. The memory limits still hold (checked every 0.5 s instead of 0.1 s), and an event
+#: loop blocked for over 3 s is still reported.
+LOCAL_DASK_CONFIG: dict[str, Any] = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+    "distributed.admin.tick.interval": "1s",
+    "distributed.admin.system-monitor.interval": "5s",
+    "distributed.worker.memory.monitor-interval": "500ms",
+    "distributed.deploy.cluster-repr-interval": "10s",
+}
+
+
+def build_records(specs: list[RecordSpec], out_dir: str) -> list[dict[str, Any]]:
+    """Build several records in one task, in order (:func:`build_record` each); their rows."""
+    return [build_record(spec, out_dir) for spec in specs]
+
+
+def record_chunks(specs: list[RecordSpec], threads: int) -> list[list[RecordSpec]]:
+    """Consecutive records grouped into tasks for ``threads`` worker threads, in order. Each
+    task takes a share of the records still left: ``1 / (threads * TASKS_PER_THREAD)`` of
+    them, at most :data:`MAX_RECORDS_PER_TASK` and at least one, so that tasks shrink to single
+    records towards the end and the workers finish together (guided self-scheduling)."""
+    share = max(threads, 1) * TASKS_PER_THREAD
+    chunks: list[list[RecordSpec]] = []
+    start = 0
+    while start < len(specs):
+        size = max(1, min(MAX_RECORDS_PER_TASK, (len(specs) - start) // share))
+        chunks.append(specs[start : start + size])
+        start += size
+    return chunks
+
+
 def _executor(
     config: DatasetConfig, workers: int | None, scheduler: str | None
 ) -> Generator[Callable[[list[RecordSpec], str], Iterator[dict[str, Any]]], None, None]:
@@ -1193,9 +1238,10 @@ def _executor(
         with worker_pool(n) as pool:
 
             def run_local(specs: list[RecordSpec], out: str) -> Iterator[dict[str, Any]]:
-                futures = [pool.submit(build_record, s, out) for s in specs]
+                chunks = record_chunks(specs, n)
+                futures = [pool.submit(build_records, chunk, out) for chunk in chunks]
                 for fut in as_completed(futures):
-                    yield fut.result()
+                    yield from fut.result()
 
             yield run_local
         return
@@ -1206,18 +1252,7 @@ def _executor(
         raise MdfError("a Dask scheduler needs `pip install mdframework[dask]`") from None
     import dask
 
-    # The statistical profiler samples every worker thread every 10 ms and nothing reads its
-    # profiles. Dask also starts its workers with MALLOC_TRIM_THRESHOLD_ set, which turns off
-    # glibc's adaptive mmap threshold: every array over 128 KiB is then mapped and unmapped
-    # afresh, and a record took 2.4 times as long as in a local worker. The workers started
-    # here inherit both settings; a cluster started elsewhere is configured by its owner
-    # (docs/datasets.md).
-    with dask.config.set(
-        {
-            "distributed.worker.profile.enabled": False,
-            "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
-        }
-    ):
+    with dask.config.set(LOCAL_DASK_CONFIG):
         cluster = (
             LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None)
             if address == "local"
@@ -1228,9 +1263,11 @@ def _executor(
         client.run(_receive_motions, dict(_MOTIONS))  # each worker gets what planning loaded
 
         def run_dask(specs: list[RecordSpec], out: str) -> Iterator[dict[str, Any]]:
-            futures = client.map(build_record, specs, out_dir=out, pure=False)
+            threads = sum(client.nthreads().values()) or n
+            chunks = record_chunks(specs, threads)
+            futures = client.map(build_records, chunks, out_dir=out, pure=False)
             for fut in dask_completed(futures):
-                yield fut.result()
+                yield from fut.result()
 
         yield run_dask
     finally:
