@@ -37,7 +37,7 @@ from typing import Any  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 from hypothesis import HealthCheck, given, seed, settings  # noqa: E402
-from scenes import body_scenes, point_scenes, run_scene  # noqa: E402
+from scenes import body_scenes, load_project_modules, point_scenes, run_scene  # noqa: E402
 
 #: a number in an error message (grouping refusals by their words)
 NUMBER = re.compile(r"[-+]?\d[\d.,]*(?:e[-+]?\d+)?")
@@ -76,6 +76,7 @@ def main(argv: list[str] | None = None) -> int:
             reasons[" ".join(text.split()[:6])] += 1
 
     half = args.examples // 2
+    load_project_modules()  # the same scenes for a seed (see its docstring)
     for strategy in (point_scenes(), body_scenes()):
         run = settings(
             max_examples=half,

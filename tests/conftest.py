@@ -38,9 +38,28 @@ def project_distributions() -> set[str]:
     }
 
 
+#: Units of ``--dist loadscope`` (a test class, else a file) that take longest, in the order they
+#: start: the random-scene classes (20-60 s of CPU each), the documented commands (each a class of
+#: its own; the experiments take 5-25 s) and the files that start many `mdf` processes. pytest-xdist
+#: hands the next unit to whichever worker is free, so the long ones must come first or one of
+#: them ends the run alone on one worker while the other waits (it did: the last 57 s of a
+#: 215 s run). pyproject.toml turns off xdist's own reordering (by tests per unit), which put
+#: these one-test units last.
+LONG_UNITS = (
+    "test_random_scenes.py::TestRandomBodyScenes",
+    "test_random_scenes.py::TestRandomPointScenes",
+    "::TestDocumentedCommand",
+    "test_outputs.py",
+    "test_cli.py",
+    "test_docs.py",
+)
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """The documented commands first (tests/test_docs.py): under ``--dist loadscope`` each is a
-    unit of its own that pytest-xdist sends to whichever worker is free, and the long ones
-    (experiments, dataset builds) finish last on one worker unless they start early. Every
-    other test keeps its order, and each file its worker."""
-    items.sort(key=lambda item: 0 if "::TestDocumentedCommand" in item.nodeid else 1)
+    """The :data:`LONG_UNITS` first, in that order; every other test keeps its order, and each
+    file its worker."""
+
+    def rank(item: pytest.Item) -> int:
+        return next((i for i, u in enumerate(LONG_UNITS) if u in item.nodeid), len(LONG_UNITS))
+
+    items.sort(key=rank)

@@ -9,7 +9,7 @@ from typing import Any
 
 from hypothesis import HealthCheck, given, seed, settings
 from hypothesis import strategies as st
-from scenes import body_scenes, point_scenes, run_scene
+from scenes import body_scenes, load_project_modules, point_scenes, run_scene
 
 #: Random scenes per test: points are cheap, bodies are split in classes of their own so that
 #: pytest-xdist (``--dist loadscope``: one class or module per worker) runs them side by side.
@@ -26,6 +26,7 @@ def check_random_scenes(
     outputs or are refused with a one-line user error, and many are simulated (the property is
     not vacuous)."""
     outcomes: list[str] = []
+    load_project_modules()  # the same scenes whatever ran before (see its docstring)
 
     @seed(draw_seed)
     @settings(
