@@ -2,10 +2,21 @@
 
 from __future__ import annotations
 
-from pathlib import Path
+import os
 
-import numpy as np
-import pytest
+# One BLAS/OpenMP thread per process, set before numpy loads OpenBLAS (workers and the `mdf`
+# processes that tests start inherit it): pytest-xdist already runs one worker per core, and a
+# second BLAS thread per worker only contends for the same cores. On a loaded 2-core machine
+# the FMCW angle scans (small complex matmuls) of one random scene took 100-120 s of CPU with
+# OpenBLAS's threads against 23 s with one. The benchmarks set the same. An explicit setting
+# in the environment wins.
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"

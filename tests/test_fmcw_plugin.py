@@ -236,7 +236,7 @@ def test_snr_of_a_point_target_follows_the_range_equation(preset: str) -> None:
 
 def test_receive_is_block_invariant() -> None:
     """Four frames in one block or in two give the same signal, maps and points (the receiver
-    noise is seeded per frame)."""
+    noise is seeded per frame); ``receive_signal`` gives the same signal without them."""
     wf = FmcwRadar(IWR1443)
     t = wf.pulse_times(0.0, 4 * 33.333e-3)
     assert t.size == 4 * 48
@@ -260,6 +260,9 @@ def test_receive_is_block_invariant() -> None:
             whole.products[key], np.concatenate([h.products[key] for h in halves])
         )
     assert whole.products["points"].shape[0] > 4
+    # the signal alone (clutter patches: no maps, no angle scans) is the same signal
+    alone = [wf.receive_signal(block(0, 96)), wf.receive_signal(block(96, 192))]
+    np.testing.assert_array_equal(whole.signal, np.concatenate(alone))
 
 
 def test_spectrogram_follows_the_frame_timing() -> None:

@@ -290,6 +290,13 @@ class RadarWaveform(Plugin):
     def receive(self, block: PulseBlock) -> Received:
         """Received, pulse-compressed data of one block: ``signal`` (block.n_pulses,)."""
 
+    def receive_signal(self, block: PulseBlock) -> ComplexArray:
+        """Only the slow-time signal of one block, (block.n_pulses,) complex128: what one-off
+        receives such as clutter patches use. It must equal ``receive(block).signal``.
+        Default: exactly that; a radar whose ``products`` cost much (FMCW range-Doppler maps
+        and point clouds) overrides it to skip them."""
+        return self.receive(block).signal
+
     def spectrogram(
         self, signal: ComplexArray, times: FloatArray, processing: ProcessingConfig
     ) -> Spectrogram | None:
@@ -313,10 +320,13 @@ def receive_points(
     gate_range: FloatArray,
     radar_position: FloatArray | None = None,
     times: FloatArray | None = None,
+    signal_only: bool = False,
 ) -> Received:
     """One-off receive of point scatterers given by their ranges, e.g. clutter patches or
     contract checks: ``ranges``, ``rcs`` (n_pulses, K) [m], [m^2]; ``gate_range`` (n_pulses,)
-    [m]. The scatterers are put on the +x axis of the radar; ``times`` default to ``n / prf``."""
+    [m]. The scatterers are put on the +x axis of the radar; ``times`` default to ``n / prf``.
+    With ``signal_only`` the result holds only the signal
+    (:meth:`RadarWaveform.receive_signal`: no products)."""
     r = np.asarray(ranges, dtype=np.float64)
     origin = np.zeros(3) if radar_position is None else np.asarray(radar_position, np.float64)
     positions = np.zeros((*r.shape, 3))
@@ -327,6 +337,8 @@ def receive_points(
         positions, np.asarray(rcs, dtype=np.float64), tuple(map(str, range(r.shape[1])))
     )
     block = PulseBlock(0, t, scat, r, np.asarray(gate_range, dtype=np.float64), origin)
+    if signal_only:
+        return Received(waveform.receive_signal(block))
     return waveform.receive(block)
 
 

@@ -308,7 +308,8 @@ def check_scatterer_model(
 def check_radar_waveform(waveform: RadarWaveform) -> None:
     """Positive carrier and PRF; increasing ``pulse_times``; ``receive`` returns one finite
     complex sample per pulse; an approaching scatterer (5 m away, at a quarter of the radar's
-    unambiguous velocity) has positive Doppler (the project's sign convention); two scatterers
+    unambiguous velocity) has positive Doppler (the project's sign convention);
+    ``receive_signal`` gives the same signal; two scatterers
     give the sum of their separate returns (superposition). The pulses are the radar's own
     ``pulse_times`` and the Doppler is read from the phase steps between consecutive pulses at
     most 1.5 / prf apart, so radars whose slow time has gaps (FMCW frames) are checked too."""
@@ -325,6 +326,10 @@ def check_radar_waveform(waveform: RadarWaveform) -> None:
     y = received.signal
     assert y.shape == (n,) and np.iscomplexobj(y), f"{who}: signal must be (n_pulses,) complex"
     assert np.all(np.isfinite(y)), f"{who}: the signal must be finite"
+    only = receive_points(
+        waveform, ranges, np.ones_like(ranges), ranges[:, 0], times=t, signal_only=True
+    ).signal
+    assert np.array_equal(only, y), f"{who}: receive_signal() must equal receive().signal"
     dt = np.diff(t)
     near = dt <= 1.5 / prf
     steps = np.angle(y[1:] * np.conj(y[:-1]))[near]

@@ -154,6 +154,7 @@ class GroundClutter(Effect):
                 gate,
                 context.radar_position,
                 context.pulse_times,
+                signal_only=True,  # e.g. no FMCW point cloud of each patch
             )
             resp[k] = out.signal
         return ranges, resp

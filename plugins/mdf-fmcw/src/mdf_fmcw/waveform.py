@@ -399,7 +399,18 @@ class FmcwRadar(RadarWaveform):
 
     def receive(self, block: PulseBlock) -> Received:
         """Range profiles, slow-time signal, range-Doppler maps and points of whole frames."""
+        return self._receive(block, products=True)
+
+    def receive_signal(self, block: PulseBlock) -> NDArray[np.complex128]:
+        """The slow-time signal of whole frames alone (no range-Doppler maps, no points: the
+        angle scans of a point cloud cost several times the signal itself)."""
+        return self._receive(block, products=False).signal
+
+    def _receive(self, block: PulseBlock, products: bool) -> Received:
+        """:meth:`receive`, with the configured products or (``products`` False) none."""
         seq, c = self.sequence, self.config
+        want_points = products and c.points
+        want_maps = products and c.save_range_doppler
         ranges = np.asarray(block.ranges, np.float64)
         self._check_ranges(ranges)
         n_frames = fmcw.split_frames(ranges.shape[0], seq)
@@ -440,13 +451,13 @@ class FmcwRadar(RadarWaveform):
             signal[sl] = fmcw.gate_signal(
                 profiles, raxis, gate, c.gate_width, c.range_window, c.n_samples
             )
-            if not (c.points or c.save_range_doppler):
+            if not (want_points or want_maps):
                 continue
             cube = fmcw.virtual_cube(profiles, seq, antennas.tx.shape[0])
             rd = fmcw.range_doppler(cube, c.doppler_window, self.n_doppler, c.clutter_removal)
-            if c.save_range_doppler:
+            if want_maps:
                 maps.append(fmcw.detection_map(rd).astype(np.float32))
-            if c.points:
+            if want_points:
                 pts = fmcw.detect_points(
                     rd,
                     raxis,
@@ -458,14 +469,14 @@ class FmcwRadar(RadarWaveform):
                     detection,
                 )
                 frames.append((index, index * seq.frame_period, pts))
-        products: dict[str, NDArray[Any]] = {}
-        if c.save_range_doppler:
-            products["range_doppler"] = (
+        out: dict[str, NDArray[Any]] = {}
+        if want_maps:
+            out["range_doppler"] = (
                 np.stack(maps) if maps else np.zeros((0, self.n_doppler, self.n_range), np.float32)
             )
-        if c.points:
-            products["points"] = fmcw.as_points(frames)
-        return Received(signal, products=products)
+        if want_points:
+            out["points"] = fmcw.as_points(frames)
+        return Received(signal, products=out)
 
     def spectrogram(
         self, signal: NDArray[np.complex128], times: FloatArray, processing: ProcessingConfig
