@@ -25,6 +25,13 @@ importing Dask, sending the motions), and the worker processes (for Dask: starti
 interpreter each, their event loops, the records). "Records only" is the per-record cost
 without the planning workers.
 
+``--contention N`` measures what running side by side costs on this machine: N records of the
+dataset (spread over its sources) built in a 2-worker pool, one worker busy at a time and then
+both at once, alternating three times; and, for comparison, a plain numpy job (the same work
+repeated) on a cache-sized array (256 KiB) and on a large one (16 MiB), alone and two at once.
+Their CPU per record (per job) side by side over alone is the part of the 2-worker cost that
+the machine adds (shared caches, memory bandwidth, the other jobs on it), not the build.
+
 ``--repeat N`` runs every build N times, alternating (1 and 2 workers, local and Dask, then
 again), and reports medians: the load of a shared machine drifts, so figures taken minutes
 apart are not comparable, and alternation pairs them. ``--idle S`` also measures what an idle
@@ -32,7 +39,8 @@ local Dask cluster costs per second of wall time (its periodic monitors), with t
 settings (``LOCAL_DASK_CONFIG``) and with Dask's defaults (the profiler off in both).
 
     .venv/bin/python benchmarks/bench_dataset.py [--config PATH] [--workers 1 2]
-        [--schedulers local dask] [--repeat N] [--idle SECONDS] [--json OUT.json]
+        [--schedulers local dask] [--repeat N] [--idle SECONDS] [--contention N]
+        [--json OUT.json]
 """
 
 from __future__ import annotations
@@ -134,6 +142,77 @@ def _idle_child(settings: str, workers: int, seconds: float) -> None:
             }
         )
     )
+
+
+def _timed_records(specs: list[Any], out: str) -> list[float]:
+    """Thread CPU time of each record built here [s]."""
+    from mdframework.dataset import build_record
+
+    times = []
+    for spec in specs:
+        t0 = _thread_cpu()
+        build_record(spec, out)
+        times.append(_thread_cpu() - t0)
+    return times
+
+
+def _numpy_job(n_values: int, reps: int) -> list[float]:
+    """Thread CPU time [s] of each of ``reps`` rounds of the same numpy work on an array of
+    ``n_values`` float64 (sine, product, cumulative sum, over the whole array)."""
+    import numpy as np
+
+    a = np.linspace(0.0, 1.0, n_values)
+    work = max(1, (1 << 22) // n_values)  # the same number of values touched per round
+    times = []
+    for _ in range(reps):
+        t0 = _thread_cpu()
+        for _ in range(work):
+            b = np.sin(a) * a
+            a = np.cumsum(b) * 1e-9 + a
+        times.append(_thread_cpu() - t0)
+    return times
+
+
+def _contention_child(config: str, n_records: int) -> None:
+    """Run in a fresh process: CPU per record (and per numpy round) with one worker of a
+    2-worker pool busy, and with both busy, alternating three times."""
+    import numpy as np
+
+    from mdframework.dataset import load_dataset_config, plan_records
+    from mdframework.workers import worker_pool
+
+    cfg, base = load_dataset_config(config)
+    specs = plan_records(cfg, base, workers=1)
+    chosen = specs[:: max(1, len(specs) // n_records)][:n_records]
+    halves = [chosen[0::2], chosen[1::2]]
+    out: dict[str, Any] = {}
+    with tempfile.TemporaryDirectory() as tmp, worker_pool(2) as pool:
+        (Path(tmp) / "records").mkdir()
+        jobs: dict[str, tuple[Any, list[Any]]] = {
+            "records": (_timed_records, [[h, tmp] for h in halves]),
+            "numpy 256 KiB": (_numpy_job, [[1 << 15, 20]] * 2),
+            "numpy 16 MiB": (_numpy_job, [[1 << 21, 20]] * 2),
+        }
+        for name, (fn, args) in jobs.items():
+            warm = [pool.submit(fn, *args[0]), pool.submit(fn, *args[1])]
+            [w.result() for w in warm]
+            alone: list[float] = []
+            both: list[float] = []
+            for _ in range(3):
+                for a in args:
+                    alone += pool.submit(fn, *a).result()
+                futures = [pool.submit(fn, *a) for a in args]
+                both += [t for f in futures for t in f.result()]
+            out[name] = {
+                "alone_ms": 1e3 * float(np.mean(alone)),
+                "both_ms": 1e3 * float(np.mean(both)),
+            }
+    print(json.dumps(out))
+
+
+def _thread_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_THREAD)
+    return usage.ru_utime + usage.ru_stime
 
 
 def _self_cpu() -> float:
@@ -243,6 +322,27 @@ def _idle(seconds: float, workers: list[int]) -> dict[str, dict[int, dict[str, f
     return out
 
 
+def _contention(config: str, n_records: int) -> dict[str, dict[str, float]]:
+    """CPU per record (and per numpy round) alone and side by side, in a fresh process."""
+    proc = subprocess.run(
+        [sys.executable, __file__, "--config", config, "--contention-child", str(n_records)],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "PYTHONWARNINGS": "ignore"},
+    )
+    if proc.returncode:
+        raise SystemExit(f"contention child failed:\n{proc.stderr}")
+    res: dict[str, dict[str, float]] = json.loads(proc.stdout.strip().splitlines()[-1])
+    for name, r in res.items():
+        r["ratio"] = r["both_ms"] / r["alone_ms"]
+        print(
+            f"side by side, {name:13s}: {r['alone_ms']:.1f} ms CPU alone, {r['both_ms']:.1f} ms "
+            f"with both workers busy: {r['ratio']:.3f}; load average {os.getloadavg()[0]:.2f}",
+            flush=True,
+        )
+    return res
+
+
 def _spread(values: list[float], scale: float = 1.0, fmt: str = ".2f") -> str:
     """The median of ``values`` (times ``scale``), with their range when there are several."""
     med = format(scale * statistics.median(values), fmt)
@@ -256,14 +356,19 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--config", default=str(DEFAULT_CONFIG))
     ap.add_argument("--workers", type=int, nargs="+", default=[1, 2])
-    ap.add_argument("--schedulers", nargs="+", default=["local", "dask"])
+    ap.add_argument("--schedulers", nargs="*", default=["local", "dask"])
     ap.add_argument("--repeat", type=int, default=1, help="Rounds of alternating builds.")
     ap.add_argument("--idle", type=float, default=0.0, help="Seconds of idle Dask cluster.")
+    ap.add_argument("--contention", type=int, default=0, help="Records side by side.")
     ap.add_argument("--json", type=Path, default=None, help="Also write the results here.")
     ap.add_argument("--child", nargs=4, metavar=("CONFIG", "SCHED", "N", "OUT"), default=None)
     ap.add_argument("--start-only", action="store_true")
     ap.add_argument("--idle-child", nargs=3, metavar=("SETTINGS", "N", "SECONDS"), default=None)
+    ap.add_argument("--contention-child", type=int, default=None)
     a = ap.parse_args()
+    if a.contention_child is not None:
+        _contention_child(a.config, a.contention_child)
+        return
     if a.child is not None:
         config, sched, n, out = a.child
         _child(config, sched, int(n), out, a.start_only)
@@ -355,6 +460,8 @@ def main() -> None:
             )
     if a.idle > 0:
         summary["idle_cluster"] = _idle(a.idle, a.workers)
+    if a.contention > 0:
+        summary["side_by_side"] = _contention(a.config, a.contention)
     if a.json is not None:
         a.json.write_text(json.dumps(summary, indent=2) + "\n")
 
