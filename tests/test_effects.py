@@ -182,6 +182,25 @@ def test_clutter_csr_in_pipeline_and_zero_velocity_bin() -> None:
     assert mean_power[k_target] > 100 * np.median(mean_power)  # the target is still there
 
 
+def test_clutter_with_a_radar_without_bandwidth_is_refused_before_any_pulse() -> None:
+    """A CW radar gives no range resolution: the clutter effect without ``range_resolution`` is
+    refused when the run's plugins are built (the radar never receives a pulse), on one line
+    naming the field; with the field the same scene builds."""
+    from mdframework.errors import SceneError
+    from mdframework.pipeline import build_stages
+
+    cfg = {
+        "motion": {"kind": "point_targets", "length": 0.5, "targets": APPROACHING},
+        "scatterers": {"kind": "points"},
+        "radar": {"kind": "cw"},
+        "effects": [{"kind": "clutter", "csr_db": 10.0}],
+    }
+    with pytest.raises(SceneError, match=r"^effects\.clutter: .*set range_resolution$"):
+        build_stages(validate_run_config(cfg))
+    cfg["effects"] = [{"kind": "clutter", "csr_db": 10.0, "range_resolution": 0.5}]
+    assert build_stages(validate_run_config(cfg)).effects[0].name == "clutter"
+
+
 # --------------------------------------------------------------------------- multipath
 
 MP_RADAR = (10.0, 0.0, 5.0)

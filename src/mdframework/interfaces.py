@@ -433,6 +433,12 @@ class Effect(Plugin):
         record-wide quantities (e.g. a fixed beam's aim) from here and resets what it
         accumulates over blocks. Default: nothing."""
 
+    def check_radar(self, waveform: RadarWaveform) -> None:
+        """Called when a run's plugins are built, with its radar: raise
+        :class:`~mdframework.errors.SceneError` (naming the config field) when this effect
+        cannot work with that radar, so that the run is refused before any pulse is simulated.
+        Default: nothing."""
+
     @abstractmethod
     def apply(self, data: Any, context: SceneContext) -> Any:
         """Return the modified ``Scatterers`` (of one block) or ``Received`` (of the record)."""

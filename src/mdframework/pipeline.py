@@ -88,7 +88,8 @@ class Stages:
 
 
 def build_stages(config: RunConfigBase, registry: Registry | None = None) -> Stages:
-    """Instantiate the plugins a config names."""
+    """Instantiate the plugins a config names; each effect checks the radar
+    (:meth:`Effect.check_radar`)."""
     reg = registry or default_registry()
     cfg: Any = config
 
@@ -98,12 +99,12 @@ def build_stages(config: RunConfigBase, registry: Registry | None = None) -> Sta
         except KeyError as exc:
             raise SceneError(str(exc.args[0])) from None
 
-    return Stages(
-        make("motion", cfg.motion),
-        make("scatterers", cfg.scatterers),
-        make("radar", cfg.radar),
-        tuple(make("effects", e) for e in cfg.effects),
-    )
+    source, model = make("motion", cfg.motion), make("scatterers", cfg.scatterers)
+    waveform = make("radar", cfg.radar)
+    effects = tuple(make("effects", e) for e in cfg.effects)
+    for effect in effects:  # e.g. clutter needs a bandwidth: refused before any pulse
+        effect.check_radar(waveform)
+    return Stages(source, model, waveform, effects)
 
 
 def _apply_effects(stages: Stages, stage: str, data: Any, context: SceneContext) -> Any:

@@ -42,7 +42,15 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field
 
-from mdframework import Effect, PluginConfig, Received, SceneContext, SceneError, receive_points
+from mdframework import (
+    Effect,
+    PluginConfig,
+    RadarWaveform,
+    Received,
+    SceneContext,
+    SceneError,
+    receive_points,
+)
 from mdframework.constants import SPEED_OF_LIGHT
 from mdframework.physics import radar
 from mdframework.settings import Decibels, Rcs
@@ -121,11 +129,19 @@ class GroundClutter(Effect):
         super().__init__(config)
         self._stats: dict[str, Any] = {}
 
+    def check_radar(self, waveform: RadarWaveform) -> None:
+        """A radar without a bandwidth (CW, FMCW) needs ``range_resolution``: refused when the
+        run is built, before any pulse."""
+        self._resolution(waveform)
+
     def resolution(self, context: SceneContext) -> float:
         """Range resolution c/(2B) [m]."""
+        return self._resolution(context.waveform)
+
+    def _resolution(self, waveform: RadarWaveform) -> float:
         if self.config.range_resolution is not None:
             return float(self.config.range_resolution)
-        bandwidth = getattr(getattr(context.waveform, "config", None), "bandwidth", None)
+        bandwidth = getattr(getattr(waveform, "config", None), "bandwidth", None)
         if bandwidth is None:
             raise SceneError(
                 "effects.clutter: the waveform gives no bandwidth; set range_resolution"
