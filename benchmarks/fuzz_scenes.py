@@ -13,7 +13,7 @@ the first few are printed with their configs, and the exit code is 1.
 Reports the counts of each outcome (in all and per radar kind), the refusal reasons (the error's
 first words) and the time per scene (median over all scenes, one run); ``--json`` also writes
 them, with the command, the date, the wall time and the load average, to a file
-(``docs/data/fuzz_results.json`` holds the run that ``docs/input-rules.md`` quotes).
+(``docs/data/fuzz_results.json`` holds the runs that ``docs/input-rules.md`` quotes).
 """
 
 from __future__ import annotations
