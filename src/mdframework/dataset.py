@@ -785,7 +785,7 @@ def _place_record(run: dict[str, Any], config: RunConfigBase, motion: Motion) ->
     recording's placement gives fixed, so that the record starts at the configured position.
     ``config``: ``run`` validated."""
     from .conditioning import condition
-    from .pipeline import place_body
+    from .pipeline import body_placement
 
     scene: dict[str, Any] = json.loads(json.dumps(run.get("scene", {})))
     if motion.canonical_map is None:
@@ -794,8 +794,9 @@ def _place_record(run: dict[str, Any], config: RunConfigBase, motion: Motion) ->
     if config.conditioning.enabled:
         body, _ = condition(body, config.conditioning)
     person = config.scene.person
-    placed = place_body(body, person, np.asarray(config.scene.radar_position, dtype=np.float64))
-    base = placed.joint("base")
+    # only the hip centre's track is placed: the placement comes from the whole recording
+    where = body_placement(body, person, np.asarray(config.scene.radar_position, np.float64))
+    base = where.apply(body.time, body.joint("base"))
     start = body.time[0] + float(run["motion"].get("start", 0.0))
     at = np.array([np.interp(start, body.time, base[:, k]) for k in (0, 1)])
     shift = at - np.asarray(person.position)

@@ -35,6 +35,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict
 
+from .physics.radar import distances
 from .pointcloud import PointCloud
 from .skeleton import Skeleton, to_canonical
 
@@ -157,11 +158,7 @@ class Scatterers:
         key = tuple(float(v) for v in np.asarray(radar_position, dtype=np.float64))
         if self.range_cache is not None and self.range_cache[0] == key:
             return self.range_cache[1]
-        d = self.positions - np.asarray(radar_position, dtype=np.float64)
-        r = d[..., 0] ** 2
-        r += d[..., 1] ** 2
-        r += d[..., 2] ** 2
-        return np.asarray(np.sqrt(r, out=r), dtype=np.float64)
+        return distances(self.positions, radar_position)
 
 
 class ScattererModel(Plugin):

@@ -417,11 +417,7 @@ def _inside(time_s: FloatArray, t_first: float, t_last: float) -> slice:
 
 def _range_span(body: Skeleton, radar_pos: FloatArray) -> tuple[float, float]:
     """Smallest and largest distance [m] of the record's valid joints to the radar."""
-    d = body.positions - radar_pos
-    r2 = d[..., 0] ** 2
-    r2 += d[..., 1] ** 2
-    r2 += d[..., 2] ** 2
-    d = np.sqrt(r2[body.valid])
+    d = radar.distances(body.positions, radar_pos)[body.valid]
     if d.size == 0 or not np.all(np.isfinite(d)):
         raise SceneError("the record has no valid, finite joint positions")
     return float(d.min()), float(d.max())
@@ -553,11 +549,7 @@ def _gate(gate: str | float, at_pulses: Skeleton, radar_pos: FloatArray) -> Floa
     """Range gate per pulse [m]: tracking the hip centre (or the first joint), or fixed."""
     if gate == "track":
         ref = at_pulses.index("base") if "base" in at_pulses.joint_names else 0
-        d = at_pulses.positions[:, ref, :] - radar_pos
-        r = d[:, 0] ** 2
-        r += d[:, 1] ** 2
-        r += d[:, 2] ** 2
-        return np.asarray(np.sqrt(r, out=r), dtype=np.float64)
+        return radar.distances(at_pulses.positions[:, ref, :], radar_pos)
     return np.full(at_pulses.time.shape, float(gate))
 
 
