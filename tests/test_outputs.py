@@ -22,7 +22,7 @@ from conftest import EXAMPLES
 from mdframework import cli
 from mdframework.dataset import load_dataset, read_record
 from mdframework.errors import DataFileError
-from mdframework.outdir import LOCK, safe_name
+from mdframework.outdir import LOCK, atomic_savez, safe_name, wait_for_files
 
 POINT = EXAMPLES / "point_target.toml"
 CMU = EXAMPLES / "data" / "cmu"
@@ -418,6 +418,60 @@ def test_files_get_the_umask_permissions(tmp_path: Path, umask: int) -> None:
         for p in [out, *out.rglob("*")]:
             mode = stat.S_IMODE(p.stat().st_mode)
             assert mode == (expected_dir if p.is_dir() else expected_file), (p, oct(mode))
+
+
+# --------------------------------------------------------------------------- background writes
+
+
+def test_background_writes_are_in_place_after_the_wait(tmp_path: Path) -> None:
+    """Records go to the disk in a thread: after ``wait_for_files`` every file is complete,
+    renamed into place, and no temporary file is left."""
+    data = {f"r{i}": np.arange(i, i + 50_000, dtype=np.float32) for i in range(6)}
+    for name, arr in data.items():
+        atomic_savez(tmp_path / f"{name}.npz", in_background=True, values=arr)
+    wait_for_files()
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(f"{n}.npz" for n in data)
+    for name, arr in data.items():
+        with np.load(tmp_path / f"{name}.npz") as f:
+            assert np.array_equal(f["values"], arr)
+    wait_for_files()  # nothing pending: returns at once
+
+
+def test_a_failed_background_write_raises_at_the_wait_and_leaves_no_partial_file(
+    tmp_path: Path,
+) -> None:
+    # the rename fails: the target is a folder that is not empty
+    (tmp_path / "bad.npz").mkdir()
+    (tmp_path / "bad.npz" / "keep").write_text("x")
+    atomic_savez(tmp_path / "bad.npz", in_background=True, values=np.zeros(3))
+    atomic_savez(tmp_path / "good.npz", in_background=True, values=np.ones(3))
+    with pytest.raises(OSError):
+        wait_for_files()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.npz", "good.npz"]
+    assert (tmp_path / "bad.npz" / "keep").read_text() == "x"
+    with np.load(tmp_path / "good.npz") as f:  # the other file still went into place
+        assert np.array_equal(f["values"], np.ones(3))
+
+
+def test_a_forked_worker_writes_in_the_background_too(tmp_path: Path) -> None:
+    """A pool worker forked after this process wrote in the background gets its own writer
+    thread (a forked child has none of its parent's threads: reusing the parent's would hang)."""
+    import multiprocessing
+
+    atomic_savez(tmp_path / "parent.npz", in_background=True, values=np.zeros(3))
+    ctx = multiprocessing.get_context("fork")
+    child = ctx.Process(target=_write_in_child, args=(str(tmp_path / "child.npz"),))
+    child.start()
+    child.join(timeout=60)
+    wait_for_files()
+    assert child.exitcode == 0
+    with np.load(tmp_path / "child.npz") as f:
+        assert np.array_equal(f["values"], np.arange(4.0))
+
+
+def _write_in_child(path: str) -> None:
+    atomic_savez(Path(path), in_background=True, values=np.arange(4.0))
+    wait_for_files()
 
 
 # --------------------------------------------------------------------------- processes

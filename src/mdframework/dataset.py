@@ -57,7 +57,14 @@ from .config import format_validation_error, read_config_file, validate_run_conf
 from .errors import ConfigError, DataFileError, MdfError, OutputError, SceneError
 from .features import FEATURE_NAMES, spectrogram_features
 from .interfaces import Motion, Recording, RecordingSource
-from .outdir import OutputFolder, atomic_savez, atomic_write_text, output_folder, safe_name
+from .outdir import (
+    OutputFolder,
+    atomic_savez,
+    atomic_write_text,
+    output_folder,
+    safe_name,
+    wait_for_files,
+)
 from .pipeline import build_stages, load_motion, simulate_motion
 from .plugins import default_registry
 from .pointcloud import (
@@ -889,6 +896,7 @@ def _build_recorded(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     }
     atomic_savez(
         Path(out_dir) / RECORDS / f"{spec.record_id}.npz",
+        in_background=True,
         **arrays,
         meta=np.array(json.dumps(meta)),
     )
@@ -917,11 +925,17 @@ def _augmented(motion: Motion, draws: dict[str, Any], start: float, duration: fl
 
 
 def build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
-    """Simulate one record and write it atomically; returns its index row.
+    """Simulate one record and write it atomically; returns its index row once the file is
+    on the disk and in place.
 
     A record that fails raises :class:`MdfError` naming the record, its source file, window
     and cause; with ``on_error = "skip"`` it returns a row with a ``skipped`` cause instead
     (and writes no file)."""
+    return build_records([spec], out_dir)[0]
+
+
+def _record_or_skip(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
+    """:func:`build_record` but for its wait: the file may still be on its way to the disk."""
     try:
         return _build_record(spec, out_dir)
     except (MdfError, ValueError) as exc:
@@ -1016,6 +1030,7 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     }
     atomic_savez(
         Path(out_dir) / RECORDS / f"{spec.record_id}.npz",
+        in_background=True,
         **spectrogram,
         features=feats,
         **extra,
@@ -1201,8 +1216,13 @@ LOCAL_DASK_CONFIG: dict[str, Any] = {
 
 
 def build_records(specs: list[RecordSpec], out_dir: str) -> list[dict[str, Any]]:
-    """Build several records in one task, in order (:func:`build_record` each); their rows."""
-    return [build_record(spec, out_dir) for spec in specs]
+    """Build several records in one task, in order (:func:`build_record` each); their rows.
+    Each record's file is flushed to the disk while the next one is computed; every file is in
+    place before the rows are returned (:func:`mdframework.outdir.wait_for_files`)."""
+    try:
+        return [_record_or_skip(spec, out_dir) for spec in specs]
+    finally:
+        wait_for_files()
 
 
 def record_chunks(specs: list[RecordSpec], threads: int) -> list[list[RecordSpec]]:
@@ -1233,7 +1253,9 @@ def _executor(
     n = build_workers(config, workers)
     if address is None:
         if n == 1:
-            yield lambda specs, out: (build_record(s, out) for s in specs)
+            yield lambda specs, out: (
+                row for chunk in record_chunks(specs, 1) for row in build_records(chunk, out)
+            )
             return
         # Ctrl-C or an error (the generator closed): the queued records are dropped
         with worker_pool(n) as pool:

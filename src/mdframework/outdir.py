@@ -37,6 +37,7 @@ import socket
 import tempfile
 import time
 from collections.abc import Iterator, Sequence
+from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -110,15 +111,38 @@ def atomic_write_text(path: Path, text: str) -> None:
     atomic_write_bytes(path, text.encode("utf-8"))
 
 
-def atomic_savez(path: Path, **arrays: Any) -> None:
-    """``numpy.savez`` into ``path`` atomically (temporary file + rename), umask permissions."""
+def atomic_savez(path: Path, *, in_background: bool = False, **arrays: Any) -> None:
+    """``numpy.savez`` into ``path`` atomically (temporary file + rename), umask permissions.
+
+    The data are written to a temporary file beside ``path`` at once; flushing it to the disk
+    (``fsync``) and renaming it into place wait for the disk, so ``in_background`` leaves them to a
+    thread of this process, and the caller computes on meanwhile: :func:`wait_for_files` waits
+    until every such file is in place (and raises the first error). A dataset worker writes
+    its records so and waits at the end of each task, before it reports the records: the disk's
+    latency (about 2 ms a record here, 6 % of a record's time) overlaps with the next record's
+    computation."""
     import numpy as np
 
     # the partial file must not look like a record (*.npz) to a reader or a resumed build
     fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".part", dir=path.parent)
+    fh = os.fdopen(fd, "wb")
     try:
-        with os.fdopen(fd, "wb") as fh:
-            np.savez(fh, **arrays)
+        np.savez(fh, **arrays)
+    except BaseException:
+        fh.close()
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    if in_background:
+        _PENDING.append(_writer().submit(_put_in_place, fh, tmp, path))
+    else:
+        _put_in_place(fh, tmp, path)
+
+
+def _put_in_place(fh: Any, tmp: str, path: Path) -> None:
+    """Flush the open temporary file ``fh`` (at ``tmp``) to the disk, close it, give it the
+    umask's permissions and rename it to ``path``; on failure the temporary file is removed."""
+    try:
+        with fh:
             fh.flush()
             os.fsync(fh.fileno())
         os.chmod(tmp, new_file_mode())
@@ -126,6 +150,43 @@ def atomic_savez(path: Path, **arrays: Any) -> None:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+_WRITER: ThreadPoolExecutor | None = None
+_PENDING: list[Future[None]] = []
+
+
+def _writer() -> ThreadPoolExecutor:
+    global _WRITER
+    if _WRITER is None:
+        _WRITER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="mdf-files")
+    return _WRITER
+
+
+def _forget_writer() -> None:
+    """In a forked child: the parent's writer thread does not exist here (a new one starts)."""
+    global _WRITER, _PENDING
+    _WRITER = None
+    _PENDING = []
+
+
+os.register_at_fork(after_in_child=_forget_writer)
+
+
+def wait_for_files() -> None:
+    """Wait until every file :func:`atomic_savez` wrote ``in_background`` in this process is
+    on the disk and in place; raises the first error (the others' temporary files are removed
+    all the same)."""
+    pending = list(_PENDING)
+    _PENDING.clear()
+    first: BaseException | None = None
+    for fut in pending:
+        try:
+            fut.result()
+        except BaseException as exc:  # every file waited for before raising
+            first = first or exc
+    if first is not None:
+        raise first
 
 
 def check_output_file(path: str | Path, option: str = "--out") -> Path:
