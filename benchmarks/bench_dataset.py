@@ -27,10 +27,12 @@ without the planning workers.
 
 ``--contention N`` measures what running side by side costs on this machine: N records of the
 dataset (spread over its sources) built in a 2-worker pool, one worker busy at a time and then
-both at once, alternating three times; and, for comparison, a plain numpy job (the same work
+both at once, alternating three times, with their files written to the disk and to a file
+system in memory (``/dev/shm``); and, for comparison, a plain numpy job (the same work
 repeated) on a cache-sized array (256 KiB) and on a large one (16 MiB), alone and two at once.
-Their CPU per record (per job) side by side over alone is the part of the 2-worker cost that
-the machine adds (shared caches, memory bandwidth, the other jobs on it), not the build.
+Their CPU and wall time per record (per job) side by side over alone is the part of the
+2-worker cost that the machine adds (shared caches, memory bandwidth, the kernel's work of
+writing the files to the disk, the other jobs on it), not the build.
 
 ``--repeat N`` runs every build N times, alternating (1 and 2 workers, local and Dask, then
 again), and reports medians: the load of a shared machine drifts, so figures taken minutes
@@ -46,6 +48,7 @@ settings (``LOCAL_DASK_CONFIG``) and with Dask's defaults (the profiler off in b
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import resource
@@ -144,15 +147,17 @@ def _idle_child(settings: str, workers: int, seconds: float) -> None:
     )
 
 
-def _timed_records(specs: list[Any], out: str) -> list[float]:
-    """Thread CPU time of each record built here [s]."""
+def _timed_records(specs: list[Any], out: str) -> list[tuple[float, float]]:
+    """Wall time and CPU time of this whole worker process (the thread that computes and the
+    one that writes each file to the disk) of each record built here [s]; each record's file is
+    in place before the next starts."""
     from mdframework.dataset import build_record
 
     times = []
     for spec in specs:
-        t0 = _thread_cpu()
+        t0, c0 = time.perf_counter(), _self_cpu()
         build_record(spec, out)
-        times.append(_thread_cpu() - t0)
+        times.append((time.perf_counter() - t0, _self_cpu() - c0))
     return times
 
 
@@ -174,8 +179,11 @@ def _numpy_job(n_values: int, reps: int) -> list[float]:
 
 
 def _contention_child(config: str, n_records: int) -> None:
-    """Run in a fresh process: CPU per record (and per numpy round) with one worker of a
-    2-worker pool busy, and with both busy, alternating three times."""
+    """Run in a fresh process: wall and CPU time per record (and CPU per numpy round) with one
+    worker of a 2-worker pool busy, and with both busy, alternating three times. The records
+    are written to the disk (a temporary folder) and, for comparison, to a file system in
+    memory (``/dev/shm``, where there is one): the difference is what writing to the disk adds
+    when both workers are busy."""
     import numpy as np
 
     from mdframework.dataset import load_dataset_config, plan_records
@@ -186,27 +194,42 @@ def _contention_child(config: str, n_records: int) -> None:
     chosen = specs[:: max(1, len(specs) // n_records)][:n_records]
     halves = [chosen[0::2], chosen[1::2]]
     out: dict[str, Any] = {}
-    with tempfile.TemporaryDirectory() as tmp, worker_pool(2) as pool:
-        (Path(tmp) / "records").mkdir()
-        jobs: dict[str, tuple[Any, list[Any]]] = {
-            "records": (_timed_records, [[h, tmp] for h in halves]),
-            "numpy 256 KiB": (_numpy_job, [[1 << 15, 20]] * 2),
-            "numpy 16 MiB": (_numpy_job, [[1 << 21, 20]] * 2),
-        }
+    with contextlib.ExitStack() as stack:
+        disk = stack.enter_context(tempfile.TemporaryDirectory())
+        folders = {"records, disk": disk}
+        if Path("/dev/shm").is_dir():
+            folders["records, memory"] = stack.enter_context(
+                tempfile.TemporaryDirectory(dir="/dev/shm")
+            )
+        pool = stack.enter_context(worker_pool(2))
+        jobs: dict[str, tuple[Any, list[Any]]] = {}
+        for name, folder in folders.items():
+            (Path(folder) / "records").mkdir()
+            jobs[name] = (_timed_records, [[h, folder] for h in halves])
+        jobs["numpy 256 KiB"] = (_numpy_job, [[1 << 15, 20]] * 2)
+        jobs["numpy 16 MiB"] = (_numpy_job, [[1 << 21, 20]] * 2)
         for name, (fn, args) in jobs.items():
             warm = [pool.submit(fn, *args[0]), pool.submit(fn, *args[1])]
             [w.result() for w in warm]
-            alone: list[float] = []
-            both: list[float] = []
+            alone: list[Any] = []
+            both: list[Any] = []
             for _ in range(3):
                 for a in args:
                     alone += pool.submit(fn, *a).result()
                 futures = [pool.submit(fn, *a) for a in args]
                 both += [t for f in futures for t in f.result()]
-            out[name] = {
-                "alone_ms": 1e3 * float(np.mean(alone)),
-                "both_ms": 1e3 * float(np.mean(both)),
-            }
+            if name.startswith("records"):
+                out[name] = {
+                    "alone_ms": 1e3 * float(np.mean([c for _, c in alone])),
+                    "both_ms": 1e3 * float(np.mean([c for _, c in both])),
+                    "alone_wall_ms": 1e3 * float(np.mean([w for w, _ in alone])),
+                    "both_wall_ms": 1e3 * float(np.mean([w for w, _ in both])),
+                }
+            else:
+                out[name] = {
+                    "alone_ms": 1e3 * float(np.mean(alone)),
+                    "both_ms": 1e3 * float(np.mean(both)),
+                }
     print(json.dumps(out))
 
 
@@ -335,9 +358,17 @@ def _contention(config: str, n_records: int) -> dict[str, dict[str, float]]:
     res: dict[str, dict[str, float]] = json.loads(proc.stdout.strip().splitlines()[-1])
     for name, r in res.items():
         r["ratio"] = r["both_ms"] / r["alone_ms"]
+        wall = ""
+        if "alone_wall_ms" in r:
+            r["wall_ratio"] = r["both_wall_ms"] / r["alone_wall_ms"]
+            wall = (
+                f"; wall {r['alone_wall_ms']:.1f} ms alone, {r['both_wall_ms']:.1f} ms side by "
+                f"side: {r['wall_ratio']:.3f}"
+            )
         print(
-            f"side by side, {name:13s}: {r['alone_ms']:.1f} ms CPU alone, {r['both_ms']:.1f} ms "
-            f"with both workers busy: {r['ratio']:.3f}; load average {os.getloadavg()[0]:.2f}",
+            f"side by side, {name:15s}: {r['alone_ms']:.1f} ms CPU alone, {r['both_ms']:.1f} ms "
+            f"with both workers busy: {r['ratio']:.3f}{wall}; load average "
+            f"{os.getloadavg()[0]:.2f}",
             flush=True,
         )
     return res

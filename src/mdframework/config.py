@@ -17,7 +17,6 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Annotated, Any, Union, get_args
 
-import yaml
 from pydantic import BaseModel, Field, ValidationError, create_model, model_validator
 
 from . import limits
@@ -118,6 +117,19 @@ def _decode(p: Path, raw: bytes) -> str:
         ) from None
 
 
+def _load_yaml(p: Path, text: str) -> Any:
+    """The data of a YAML config (PyYAML imported here: only YAML configs need it)."""
+    import yaml
+
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f"line {mark.line + 1}: " if mark is not None else ""
+        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise ConfigError(f"{p}: invalid YAML: {where}{problem}") from None
+
+
 def _check_depth(p: Path, data: Any) -> None:
     """Refuse tables and lists nested deeper than ``limits.MAX_CONFIG_DEPTH`` (iteratively, so
     that the check itself cannot overflow the stack)."""
@@ -191,14 +203,9 @@ def read_config_file(path: str | Path, kind: str | None = None) -> dict[str, Any
         elif suffix == ".json":
             data = json.loads(text)
         else:
-            data = yaml.safe_load(text)
+            data = _load_yaml(p, text)
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{p}: invalid TOML: {exc}") from None
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f"line {mark.line + 1}: " if mark is not None else ""
-        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise ConfigError(f"{p}: invalid YAML: {where}{problem}") from None
     except json.JSONDecodeError as exc:
         raise ConfigError(f"{p}: invalid JSON: line {exc.lineno}: {exc.msg}") from None
     except RecursionError:
