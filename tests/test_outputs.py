@@ -12,14 +12,16 @@ import signal
 import stat
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
 from conftest import EXAMPLES
 
-from mdframework import cli
+from mdframework import cli, outdir
 from mdframework.dataset import load_dataset, read_record
 from mdframework.errors import DataFileError
 from mdframework.outdir import LOCK, atomic_savez, safe_name, wait_for_files
@@ -445,8 +447,9 @@ def test_a_failed_background_write_raises_at_the_wait_and_leaves_no_partial_file
     (tmp_path / "bad.npz" / "keep").write_text("x")
     atomic_savez(tmp_path / "bad.npz", in_background=True, values=np.zeros(3))
     atomic_savez(tmp_path / "good.npz", in_background=True, values=np.ones(3))
-    with pytest.raises(OSError):
+    with pytest.raises(OSError) as caught:
         wait_for_files()
+    assert f"while writing {tmp_path / 'bad.npz'}" in getattr(caught.value, "__notes__", [])
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.npz", "good.npz"]
     assert (tmp_path / "bad.npz" / "keep").read_text() == "x"
     with np.load(tmp_path / "good.npz") as f:  # the other file still went into place
@@ -463,10 +466,61 @@ def test_a_forked_worker_writes_in_the_background_too(tmp_path: Path) -> None:
     child = ctx.Process(target=_write_in_child, args=(str(tmp_path / "child.npz"),))
     child.start()
     child.join(timeout=60)
+    if child.is_alive():  # hung on a writer that does not exist in the child
+        child.kill()
+        child.join()
     wait_for_files()
     assert child.exitcode == 0
     with np.load(tmp_path / "child.npz") as f:
         assert np.array_equal(f["values"], np.arange(4.0))
+
+
+def test_each_thread_waits_for_its_own_files(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Tasks of a multi-threaded (Dask) worker write side by side: a thread's wait covers its
+    own files (and returns only when they are in place), never another thread's, and a failed
+    write of one thread is not raised in another."""
+    real = outdir._put_in_place
+    release, written, go = threading.Event(), threading.Event(), threading.Event()
+    seen: list[bool] = []
+
+    def held(fh: Any, tmp: str, path: Path, mode: int) -> None:
+        if path.name == "held.npz":
+            release.wait(30)
+        real(fh, tmp, path, mode)
+
+    def other_task() -> None:
+        atomic_savez(tmp_path / "held.npz", in_background=True, values=np.zeros(2))
+        written.set()
+        go.wait(30)
+        wait_for_files()
+        seen.append((tmp_path / "held.npz").exists())
+
+    monkeypatch.setattr(outdir, "_put_in_place", held)
+    thread = threading.Thread(target=other_task)
+    thread.start()
+    assert written.wait(30)
+    atomic_savez(tmp_path / "mine.npz", in_background=True, values=np.ones(2))
+    wait_for_files()  # this thread's file only; the other thread's is still held
+    assert (tmp_path / "mine.npz").exists()
+    assert not (tmp_path / "held.npz").exists()
+    go.set()
+    release.set()
+    thread.join(30)
+    assert seen == [True]
+
+
+def test_waiting_without_raising_still_waits_and_cleans_up(tmp_path: Path) -> None:
+    """A task that fails waits for its earlier files without raising their errors (its own
+    error is the one reported); a failed file leaves no temporary file."""
+    (tmp_path / "bad.npz").mkdir()
+    (tmp_path / "bad.npz" / "keep").write_text("x")
+    atomic_savez(tmp_path / "bad.npz", in_background=True, values=np.zeros(3))
+    atomic_savez(tmp_path / "good.npz", in_background=True, values=np.ones(3))
+    wait_for_files(raise_errors=False)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.npz", "good.npz"]
+    wait_for_files()  # nothing left to wait for, nothing raised
 
 
 def _write_in_child(path: str) -> None:

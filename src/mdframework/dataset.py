@@ -1220,9 +1220,12 @@ def build_records(specs: list[RecordSpec], out_dir: str) -> list[dict[str, Any]]
     Each record's file is flushed to the disk while the next one is computed; every file is in
     place before the rows are returned (:func:`mdframework.outdir.wait_for_files`)."""
     try:
-        return [_record_or_skip(spec, out_dir) for spec in specs]
-    finally:
-        wait_for_files()
+        rows = [_record_or_skip(spec, out_dir) for spec in specs]
+    except BaseException:
+        wait_for_files(raise_errors=False)  # the records written so far land; this error wins
+        raise
+    wait_for_files()
+    return rows
 
 
 def record_chunks(specs: list[RecordSpec], threads: int) -> list[list[RecordSpec]]:
@@ -1252,7 +1255,7 @@ def _executor(
     address = scheduler_address(scheduler)
     n = build_workers(config, workers)
     if address is None:
-        if n == 1:
+        if n == 1:  # in this process, in tasks too (rows come a task at a time)
             yield lambda specs, out: (
                 row for chunk in record_chunks(specs, 1) for row in build_records(chunk, out)
             )

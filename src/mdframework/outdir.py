@@ -35,9 +35,9 @@ import re
 import shutil
 import socket
 import tempfile
+import threading
 import time
 from collections.abc import Iterator, Sequence
-from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -114,78 +114,113 @@ def atomic_write_text(path: Path, text: str) -> None:
 def atomic_savez(path: Path, *, in_background: bool = False, **arrays: Any) -> None:
     """``numpy.savez`` into ``path`` atomically (temporary file + rename), umask permissions.
 
-    The data are written to a temporary file beside ``path`` at once; flushing it to the disk
-    (``fsync``) and renaming it into place wait for the disk, so ``in_background`` leaves them to a
-    thread of this process, and the caller computes on meanwhile: :func:`wait_for_files` waits
-    until every such file is in place (and raises the first error). A dataset worker writes
-    its records so and waits at the end of each task, before it reports the records: the disk's
-    latency (about 2 ms a record here, 6 % of a record's time) overlaps with the next record's
-    computation."""
+    The data are written to a temporary file beside ``path`` at once. Flushing it to the disk
+    (``fsync``) and renaming it into place wait for the disk: ``in_background`` leaves them to
+    a thread, and the caller computes on meanwhile; :func:`wait_for_files`, called later by the
+    same thread, waits until every such file of that thread is on the disk and in place. A
+    dataset worker writes its records so and waits at the end of each task, before it reports
+    the task's records (``docs/benchmarks.md`` has what this saves)."""
     import numpy as np
 
+    mode = new_file_mode()  # here: the fallback that reads the umask is not thread-safe
     # the partial file must not look like a record (*.npz) to a reader or a resumed build
     fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".part", dir=path.parent)
-    fh = os.fdopen(fd, "wb")
+    try:
+        fh = os.fdopen(fd, "wb")
+    except BaseException:
+        os.close(fd)
+        Path(tmp).unlink(missing_ok=True)
+        raise
     try:
         np.savez(fh, **arrays)
     except BaseException:
         fh.close()
         Path(tmp).unlink(missing_ok=True)
         raise
-    if in_background:
-        _PENDING.append(_writer().submit(_put_in_place, fh, tmp, path))
-    else:
-        _put_in_place(fh, tmp, path)
+    if not in_background:
+        _put_in_place(fh, tmp, path, mode)
+        return
+    flush = _Flush(fh, tmp, path, mode)
+    try:
+        flush.start()
+    except RuntimeError:  # no thread to be had (e.g. at interpreter shutdown): do it here
+        _put_in_place(fh, tmp, path, mode)
+        return
+    _pending().append(flush)
 
 
-def _put_in_place(fh: Any, tmp: str, path: Path) -> None:
+def _put_in_place(fh: Any, tmp: str, path: Path, mode: int) -> None:
     """Flush the open temporary file ``fh`` (at ``tmp``) to the disk, close it, give it the
-    umask's permissions and rename it to ``path``; on failure the temporary file is removed."""
+    permission bits ``mode`` and rename it to ``path``; on failure the temporary file is
+    removed and the error names ``path``."""
     try:
         with fh:
             fh.flush()
             os.fsync(fh.fileno())
-        os.chmod(tmp, new_file_mode())
+        os.chmod(tmp, mode)
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         Path(tmp).unlink(missing_ok=True)
+        exc.add_note(f"while writing {path}")
         raise
 
 
-_WRITER: ThreadPoolExecutor | None = None
-_PENDING: list[Future[None]] = []
+class _Flush(threading.Thread):
+    """One file's flush and rename (:func:`_put_in_place`), in its own short-lived thread: no
+    idle thread outlives a task, so a process that forks later forks no thread of ours."""
 
+    def __init__(self, fh: Any, tmp: str, path: Path, mode: int) -> None:
+        super().__init__(name="mdf-flush")
+        self._work = (fh, tmp, path, mode)
+        self.path = path
+        self.error: BaseException | None = None
 
-def _writer() -> ThreadPoolExecutor:
-    global _WRITER
-    if _WRITER is None:
-        _WRITER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="mdf-files")
-    return _WRITER
-
-
-def _forget_writer() -> None:
-    """In a forked child: the parent's writer thread does not exist here (a new one starts)."""
-    global _WRITER, _PENDING
-    _WRITER = None
-    _PENDING = []
-
-
-os.register_at_fork(after_in_child=_forget_writer)
-
-
-def wait_for_files() -> None:
-    """Wait until every file :func:`atomic_savez` wrote ``in_background`` in this process is
-    on the disk and in place; raises the first error (the others' temporary files are removed
-    all the same)."""
-    pending = list(_PENDING)
-    _PENDING.clear()
-    first: BaseException | None = None
-    for fut in pending:
+    def run(self) -> None:
         try:
-            fut.result()
-        except BaseException as exc:  # every file waited for before raising
-            first = first or exc
-    if first is not None:
+            _put_in_place(*self._work)
+        except BaseException as exc:  # handed to wait_for_files
+            self.error = exc
+
+
+_LOCAL = threading.local()
+
+
+def _pending() -> list[_Flush]:
+    """The files this thread wrote in the background and has not waited for yet."""
+    files: list[_Flush] | None = getattr(_LOCAL, "files", None)
+    if files is None:
+        files = _LOCAL.files = []
+    return files
+
+
+def _forget_pending() -> None:
+    """In a forked child: the parent's flush threads do not exist here."""
+    global _LOCAL
+    _LOCAL = threading.local()
+
+
+os.register_at_fork(after_in_child=_forget_pending)
+
+
+def wait_for_files(*, raise_errors: bool = True) -> None:
+    """Wait until every file this thread wrote with :func:`atomic_savez` ``in_background`` is
+    on the disk and renamed into place, and flush the folders that hold them (so that the
+    renames are on the disk too). Raises the first error, after waiting for every file (a file
+    that failed leaves no temporary file); ``raise_errors=False`` only waits (for a caller that
+    is already raising an error of its own)."""
+    files = _pending()
+    first: BaseException | None = None
+    folders: set[Path] = set()
+    while files:
+        flush = files.pop(0)
+        flush.join()
+        if flush.error is None:
+            folders.add(flush.path.parent)
+        elif first is None:
+            first = flush.error
+    for folder in folders:
+        _fsync_dir(folder)
+    if first is not None and raise_errors:
         raise first
 
 
