@@ -115,3 +115,26 @@ def test_torso_median_ignores_a_limb_that_briefly_outshines_the_torso() -> None:
     f_median = spectrogram_features(power, vel)
     assert f_peak[1] == pytest.approx(2.5, abs=0.05)  # torso bandwidth inflated by the leg
     assert f_median[1] == pytest.approx(0.0, abs=0.03)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_threshold_envelopes_match_a_per_column_loop(seed: int) -> None:
+    """The vectorised threshold envelopes against a plain loop over the columns: in each live
+    column, the highest and the lowest bin within ``threshold_db`` of the column's peak and
+    above ``floor_db`` below the spectrogram's peak; NaN in silent columns. Exact."""
+    rng = np.random.default_rng(seed)
+    n_bins, n_frames = 64, 50
+    power = rng.random((n_bins, n_frames)) ** 12  # a few strong bins per column
+    power[:, ::7] *= 1e-8  # some columns below the floor: silent
+    vel = np.sort(rng.uniform(-4.0, 4.0, n_bins))
+    vel += np.arange(n_bins) * 1e-9  # strictly ascending
+    env = envelopes(power, vel, threshold_db=-20.0, floor_db=-40.0)
+    floor = power.max() * 10.0 ** (-40.0 / 10.0)
+    for m in range(n_frames):
+        col = power[:, m]
+        keep = [k for k in range(n_bins) if col[k] >= floor and col[k] >= col.max() * 0.01]
+        if not any(col >= floor):
+            assert np.isnan(env.upper[m]) and np.isnan(env.lower[m])
+            continue
+        assert env.upper[m] == vel[max(keep)]
+        assert env.lower[m] == vel[min(keep)]

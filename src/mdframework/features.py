@@ -95,9 +95,10 @@ def envelopes(
     if method == "threshold":
         col_peak = p.max(axis=0)
         mask = above_floor & (p >= col_peak * 10.0 ** (threshold_db / 10.0))
-        idx = np.arange(v.size)[:, None]
-        hi = np.max(np.where(mask, idx, -1), axis=0)
-        lo = np.min(np.where(mask, idx, v.size), axis=0)
+        # the first and the last bin of each column in the mask (a live column has its peak
+        # in it); argmax of a boolean array is the first True
+        lo = np.argmax(mask, axis=0)
+        hi = v.size - 1 - np.argmax(mask[::-1], axis=0)
         upper[live] = v[hi[live]]
         lower[live] = v[lo[live]]
     elif method == "percentile":
