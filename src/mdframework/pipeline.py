@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import time
 import warnings
+import weakref
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -245,11 +246,16 @@ def _simulate_motion(
     t = wf.pulse_times(t_start, t_end)
     frames = interpolation.window_frames(body.time, float(t[0]), float(t[-1]))
     near = body.select_frames(frames)
-    if where is not None:  # placed from the whole recording, applied to the window alone
-        near = near.with_positions(where.apply(near.time, near.positions))
     exact_linear = motion.linear_tracks and body is motion.skeleton
     method = "linear" if exact_linear else proc.interpolation
-    resample = interpolation.TrackResampler(near.time, near.positions, near.valid, method)
+    # placed from the whole recording (where), applied to the window alone
+    if where is not None and method in ("cubic", "linear"):  # linear in the data:
+        resample = _window_resampler(body, near, frames, method).mapped(where.apply)  # placed
+        near = near.with_positions(where.apply(near.time, near.positions))
+    else:
+        if where is not None:
+            near = near.with_positions(where.apply(near.time, near.positions))
+        resample = interpolation.TrackResampler(near.time, near.positions, near.valid, method)
     record_body = near.select_frames(_inside(near.time, t_start, t_end))
     model.start_record(record_body)
     wf.start_record(t, _range_span(record_body, radar_pos))
@@ -399,6 +405,26 @@ def _place(
             f"({motion.metadata.get('source', 'unknown')}) is used as recorded"
         )
     return body, conditioning_report, {"motion": "as given"}, None
+
+
+#: The last window resampler built (one): the records of one window seen from several aspects
+#: (a dataset's variations, built one after another) share its interpolants, placed for each.
+_LAST_WINDOW: list[tuple[weakref.ref[Skeleton], int, int, str, interpolation.TrackResampler]] = []
+
+
+def _window_resampler(
+    body: Skeleton, near: Skeleton, frames: slice, method: interpolation.Method
+) -> interpolation.TrackResampler:
+    """The resampler of the frames ``frames`` of ``body`` (``near``, not placed), kept for the
+    next record of the same window of the same body (same object)."""
+    key = (int(frames.start), int(frames.stop), method)
+    if _LAST_WINDOW:
+        ref, start, stop, last_method, resampler = _LAST_WINDOW[0]
+        if ref() is body and (start, stop, last_method) == key:
+            return resampler
+    resampler = interpolation.TrackResampler(near.time, near.positions, near.valid, method)
+    _LAST_WINDOW[:] = [(weakref.ref(body), *key, resampler)]
+    return resampler
 
 
 def _blocks(n: int, size: int, multiple: int) -> list[tuple[int, int]]:

@@ -7,6 +7,7 @@ are dropped per joint and the spline bridges the gap.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any, Literal
 
 import numpy as np
@@ -94,6 +95,35 @@ class TrackResampler:
         else:
             f = Akima1DInterpolator(t, flat, axis=0, method="makima")
         self._groups.append((joints, t, f))
+
+    def mapped(self, affine: Callable[[FloatArray, FloatArray], FloatArray]) -> TrackResampler:
+        """The resampler of the tracks mapped by ``affine(time, joints)``, a map that is affine
+        in the joints and in time (``R x + a + b t``, e.g. a scene placement), without building
+        the interpolants again: the cubic spline and linear interpolation are linear in their
+        data and reproduce constants and straight lines, so mapping them is mapping their
+        coefficients (a B-spline's at its Greville abscissae, where sum_i xi_i B_i(t) = t).
+        ``affine`` takes ``time`` (n,) [s] and ``joints`` (n, n_sel, 3) [m] and returns the
+        same shape. Equal to building the resampler on the mapped frames, to rounding. Not for
+        pchip or akima, whose interpolants are not linear in their data (ValueError)."""
+        if self.method not in ("cubic", "linear"):
+            raise ValueError(f"{self.method} interpolation is not linear in its data")
+        out = object.__new__(TrackResampler)
+        out.n_joints, out.method, out._groups = self.n_joints, self.method, []
+        for joints, t, f in self._groups:
+            if self.method == "linear":
+                moved = affine(t, f.reshape(t.shape[0], joints.size, 3))
+                out._groups.append((joints, t, moved.reshape(t.shape[0], -1)))
+                continue
+            from scipy.interpolate import BSpline
+
+            k = int(f.k)
+            n_coef = f.c.shape[0]
+            knots = np.asarray(f.t, dtype=np.float64)
+            windows = np.lib.stride_tricks.sliding_window_view(knots[1:], k)[:n_coef]
+            greville = windows.mean(axis=1)
+            coef = affine(greville, f.c.reshape(n_coef, joints.size, 3)).reshape(n_coef, -1)
+            out._groups.append((joints, t, BSpline.construct_fast(knots, coef, k, axis=0)))
+        return out
 
     def __call__(self, t_out: FloatArray) -> FloatArray:
         """Positions (n_out, n_joints, 3) float64 [m] at ``t_out`` (n_out,) [s], which must lie
