@@ -71,5 +71,6 @@ def test_a_run_without_figures_imports_no_heavy_library(tmp_path: Path) -> None:
     written = {p.name for p in (tmp_path / "o").iterdir() if not p.name.startswith(".")}
     assert written == {"result.npz", "features.json", "config.resolved.json", "metadata.json"}
     assert top_level(modules) & HEAVY == set()
+    assert "yaml" not in modules  # PyYAML only for a YAML config
     resolved = json.loads((tmp_path / "o" / "config.resolved.json").read_text())
     assert resolved["figures"]["enabled"] is False  # recorded with the run

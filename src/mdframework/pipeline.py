@@ -248,9 +248,11 @@ def _simulate_motion(
     near = body.select_frames(frames)
     exact_linear = motion.linear_tracks and body is motion.skeleton
     method = "linear" if exact_linear else proc.interpolation
-    # placed from the whole recording (where), applied to the window alone
-    if where is not None and method in ("cubic", "linear"):  # linear in the data:
-        resample = _window_resampler(body, near, frames, method).mapped(where.apply)  # placed
+    # The placement (where) comes from the whole recording and applies to the window alone.
+    # Interpolants linear in their data are built unplaced (shared by the records of one
+    # window) and placed through their coefficients.
+    if where is not None and method in ("cubic", "linear"):
+        resample = _window_resampler(body, near, frames, method).mapped(where.apply)
         near = near.with_positions(where.apply(near.time, near.positions))
     else:
         if where is not None:
