@@ -138,3 +138,10 @@ def test_threshold_envelopes_match_a_per_column_loop(seed: int) -> None:
             continue
         assert env.upper[m] == vel[max(keep)]
         assert env.lower[m] == vel[min(keep)]
+
+
+def test_a_threshold_above_the_peak_is_refused() -> None:
+    vel = np.linspace(-1, 1, 11)
+    power = np.ones((11, 4))
+    with pytest.raises(ValueError, match="threshold_db must be <= 0"):
+        envelopes(power, vel, threshold_db=3.0)

@@ -177,3 +177,24 @@ def test_records_of_one_window_are_the_same_whether_its_interpolant_is_reused() 
         assert np.array_equal(fresh.received.signal, seen.received.signal)
         assert np.array_equal(fresh.spectrogram_db, seen.spectrogram_db)
     assert not np.array_equal(in_a_row[0].received.signal, in_a_row[2].received.signal)
+
+
+def test_another_body_with_the_same_window_does_not_reuse_the_interpolant() -> None:
+    """Two recordings cut at the same frames (a CMU walk and a CMU boxing trial, both 120 Hz),
+    one after the other: the second record is the one built afresh, not one made from the
+    first recording's interpolant."""
+    window = {"start": 0.5, "duration": 1.0}
+    configs = [
+        validate_run_config({"motion": {**m, **window}}, base_dir=EXAMPLES)
+        for m in (CMU_WALK, {"kind": "cmu", "file": "data/cmu/asf-amc/13_18.amc"})
+    ]
+    motions = [build_stages(c).source.load() for c in configs]
+    pipeline._LAST_WINDOW.clear()
+    first = simulate_motion(configs[0], build_stages(configs[0]), motions[0])
+    frames_first = pipeline._LAST_WINDOW[0][1:3]
+    after = simulate_motion(configs[1], build_stages(configs[1]), motions[1])
+    assert pipeline._LAST_WINDOW[0][1:3] == frames_first  # the same frames: only the body differs
+    pipeline._LAST_WINDOW.clear()
+    fresh = simulate_motion(configs[1], build_stages(configs[1]), motions[1])
+    assert np.array_equal(after.received.signal, fresh.received.signal)
+    assert not np.array_equal(after.received.signal, first.received.signal)

@@ -83,6 +83,8 @@ def envelopes(
         raise ValueError(f"power must be (n_doppler={v.shape[0]}, n_frames), got {p.shape}")
     if np.any(np.diff(v) <= 0):
         raise ValueError("velocity must be strictly ascending")
+    if not threshold_db <= 0.0:  # a column's peak must pass its own threshold
+        raise ValueError(f"threshold_db must be <= 0 dB (below the peak), got {threshold_db}")
     n_frames = p.shape[1]
     p_max = float(p.max()) if p.size else 0.0
     upper = np.full(n_frames, np.nan)
