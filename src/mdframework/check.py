@@ -21,7 +21,7 @@ import numpy as np
 from . import limits
 from .errors import SceneError
 from .physics import radar
-from .pipeline import _place, _window, build_stages, load_motion
+from .pipeline import _place, _window, build_stages, load_motion, placed
 from .plugins import Registry, default_registry
 from .settings import RunConfigBase
 
@@ -114,8 +114,7 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
 
     motion = load_motion(stages.source)
     body, _, _, where = _place(config, stages, motion, radar_pos)
-    if where is not None:
-        body = body.with_positions(where.apply(body.time, body.positions))
+    body = placed(body, where)
     t_start, t_end = _window(body, cfg.motion.start, cfg.motion.duration)
     limits.check_pulses(
         t_end - t_start, wf.pulse_rate, body.n_joints, "motion.duration", proc.keep_scatterers

@@ -37,7 +37,7 @@ import socket
 import tempfile
 import threading
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -93,17 +93,29 @@ def _fsync_dir(path: Path) -> None:
 def atomic_write_bytes(path: Path, data: bytes) -> None:
     """Write ``path`` through a temporary file beside it and a rename: it is either the old file
     or the complete new one. The file gets the umask's permissions."""
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", dir=path.parent)
+    fh, tmp = _write_temporary(path, lambda fh: fh.write(data))
+    _put_in_place(fh, tmp, path, new_file_mode())
+
+
+def _write_temporary(
+    path: Path, write: Callable[[Any], object], suffix: str = ""
+) -> tuple[Any, str]:
+    """A temporary file beside ``path`` (``.tmp-*`` + ``suffix``), written by ``write(fh)`` and
+    left open for :func:`_put_in_place`: the open file and its path. Removed if writing fails."""
+    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=suffix, dir=path.parent)
     try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.chmod(tmp, new_file_mode())
-        os.replace(tmp, path)
+        fh = os.fdopen(fd, "wb")
     except BaseException:
+        os.close(fd)
         Path(tmp).unlink(missing_ok=True)
         raise
+    try:
+        write(fh)
+    except BaseException:
+        fh.close()
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return fh, tmp
 
 
 def atomic_write_text(path: Path, text: str) -> None:
@@ -124,19 +136,7 @@ def atomic_savez(path: Path, *, in_background: bool = False, **arrays: Any) -> N
 
     mode = new_file_mode()  # here: the fallback that reads the umask is not thread-safe
     # the partial file must not look like a record (*.npz) to a reader or a resumed build
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".part", dir=path.parent)
-    try:
-        fh = os.fdopen(fd, "wb")
-    except BaseException:
-        os.close(fd)
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    try:
-        np.savez(fh, **arrays)
-    except BaseException:
-        fh.close()
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    fh, tmp = _write_temporary(path, lambda fh: np.savez(fh, **arrays), ".part")
     if not in_background:
         _put_in_place(fh, tmp, path, mode)
         return

@@ -132,7 +132,14 @@ def _describe(stages: Stages, stage: str) -> list[dict[str, Any]]:
 def place_body(body: Skeleton, person: PersonConfig, radar_position: FloatArray) -> Skeleton:
     """Put a canonical body into the scene as ``person`` says (the whole recording; see
     :func:`body_placement`)."""
-    where = body_placement(body, person, radar_position)
+    return placed(body, body_placement(body, person, radar_position))
+
+
+def placed(body: Skeleton, where: scene.Placement | None) -> Skeleton:
+    """``body``'s frames placed by ``where`` (any frames of the recording it was found
+    from); ``body`` itself when ``where`` is None (used as given)."""
+    if where is None:
+        return body
     return body.with_positions(where.apply(body.time, body.positions))
 
 
@@ -251,12 +258,11 @@ def _simulate_motion(
     # The placement (where) comes from the whole recording and applies to the window alone.
     # Interpolants linear in their data are built unplaced (shared by the records of one
     # window) and placed through their coefficients.
-    if where is not None and method in ("cubic", "linear"):
+    if where is not None and method in interpolation.LINEAR_IN_DATA:
         resample = _window_resampler(body, near, frames, method).mapped(where.apply)
-        near = near.with_positions(where.apply(near.time, near.positions))
+        near = placed(near, where)
     else:
-        if where is not None:
-            near = near.with_positions(where.apply(near.time, near.positions))
+        near = placed(near, where)
         resample = interpolation.TrackResampler(near.time, near.positions, near.valid, method)
     record_body = near.select_frames(_inside(near.time, t_start, t_end))
     model.start_record(record_body)

@@ -17,6 +17,8 @@ FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 
 Method = Literal["cubic", "pchip", "akima", "linear"]
+#: The methods whose interpolants are linear in their data (:meth:`TrackResampler.mapped`).
+LINEAR_IN_DATA: tuple[Method, ...] = ("cubic", "linear")
 
 
 def pulse_times(t_first: float, t_last: float, prf: float) -> FloatArray:
@@ -105,7 +107,7 @@ class TrackResampler:
         ``affine`` takes ``time`` (n,) [s] and ``joints`` (n, n_sel, 3) [m] and returns the
         same shape. Equal to building the resampler on the mapped frames, to rounding. Not for
         pchip or akima, whose interpolants are not linear in their data (ValueError)."""
-        if self.method not in ("cubic", "linear"):
+        if self.method not in LINEAR_IN_DATA:
             raise ValueError(f"{self.method} interpolation is not linear in its data")
         out = object.__new__(TrackResampler)
         out.n_joints, out.method, out._groups = self.n_joints, self.method, []
