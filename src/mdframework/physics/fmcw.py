@@ -247,50 +247,84 @@ def window_transform(name: WindowName, n: int, nu: FloatArray) -> ComplexArray:
 # --------------------------------------------------------------------------- IF and range
 
 
-def _window_transform_on_bins(
-    n: int, x: FloatArray, ext: IntArray
-) -> tuple[ComplexArray, ComplexArray]:
-    """The Dirichlet kernel ``D_n(k / n - x)`` of an unpadded FFT at the integer bins ``ext``,
-    factored as ``D = f[..., None] * g`` with ``f`` (*x.shape) and ``g`` (*x.shape, n_ext), so
-    that the factor of each ``x`` multiplies the scatterer's coefficient instead of every bin.
+@dataclass(frozen=True)
+class _KernelOnBins:
+    """The Dirichlet kernel ``D_n(k / n - x)`` of an unpadded FFT at the integer bins ``ext``
+    (n_ext,) for beat frequencies ``x`` (n_chirps, n_scat) [cycles per sample], factored as
+
+        ``D[c, s, k] = factor[c, s] * q[k] * inv_sine[c, s, k]``
+
+    except at the entries ``near`` (chirp, scatterer and bin indices, where ``inv_sine`` is 0),
+    whose value divided by ``factor`` is ``near_value``. See :func:`_kernel_on_bins`."""
+
+    factor: ComplexArray  # (n_chirps, n_scat)
+    q: ComplexArray  # (n_ext,)
+    inv_sine: FloatArray  # (n_chirps, n_scat, n_ext)
+    near: tuple[IntArray, IntArray, IntArray]  # (n_near,) each
+    near_value: ComplexArray  # (n_near,)
+
+    def weighted_sum(self, weights: ComplexArray) -> ComplexArray:
+        """``sum_s weights[c, i, s] D[c, s, k] / factor[c, s]`` (the weights carry the factor)
+        for ``weights`` (n_chirps, m, n_scat): (n_chirps, m, n_ext). Two real matrix products
+        (``q`` does not depend on the summed index), then the near entries."""
+        re = np.matmul(np.ascontiguousarray(weights.real), self.inv_sine)
+        out = np.empty(re.shape, dtype=np.complex128)
+        out.real = re
+        out.imag = np.matmul(np.ascontiguousarray(weights.imag), self.inv_sine)
+        out *= self.q
+        if self.near_value.size:
+            chirp, scat, ext = self.near
+            # a view with the bins before the channels; add.at sums repeated (chirp, bin) pairs
+            by_bin = out.transpose(0, 2, 1)
+            np.add.at(by_bin, (chirp, ext), weights[chirp, :, scat] * self.near_value[:, None])
+        return out
+
+
+def _kernel_on_bins(n: int, x: FloatArray, ext: IntArray) -> _KernelOnBins:
+    """The Dirichlet kernel ``D_n(k / n - x)`` of an unpadded FFT at the integer bins ``ext``
+    (n_ext,) for ``x`` (n_chirps, n_scat),
+    factored (:class:`_KernelOnBins`) so that the factor of each ``x`` multiplies the
+    scatterer's coefficient and the factor of each bin the sum, leaving a real matrix of
+    inverse sines to sum over the scatterers.
 
     On bins, ``D_n(k/n - x) = f(x) q_k / sin(pi (k/n - x))`` with ``f(x) = -sin(pi n x)
     exp(-j pi (n-1) x)`` and ``q_k = (-1)^k exp(j pi (n-1) k / n)``; the sine of the difference
     is expanded (``sin(pi k/n) cos(pi x) - cos(pi k/n) sin(pi x)``), so the only transcendental
     functions are per bin and per ``x``. Within 1e-3 of a bin the ratio of two small sines
     taken of differently rounded arguments loses precision: there ``D`` is evaluated directly
-    from ``nu = k/n - x`` (``n`` on the bin)."""
+    from ``nu = k/n - x`` (``n`` on the bin). ``x`` exactly 0 (``f`` = 0): ``D`` is ``n`` on
+    bin 0 and 0 elsewhere, with ``f`` taken as 1."""
     xe = np.asarray(x, np.float64)
     arg = np.pi * xe
     f = -np.sin(n * arg) * np.exp(-1j * (n - 1) * arg)
-    zero = f == 0  # x = 0 exactly: D is n on bin 0 and 0 elsewhere
+    zero = f == 0
     f = np.where(zero, 1.0 + 0j, f)
     e_arg = np.pi * ext / n
-    den = np.sin(e_arg) * np.cos(arg)[..., None] - np.cos(e_arg) * np.sin(arg)[..., None]
-    near = np.abs(den) < 1e-3
+    inv = np.multiply.outer(np.cos(arg), np.sin(e_arg))
+    inv -= np.multiply.outer(np.sin(arg), np.cos(e_arg))
+    near = np.abs(inv) < 1e-3
     q = np.where(ext % 2 == 0, 1.0, -1.0) * np.exp(1j * (n - 1) * e_arg)
-    inv = 1.0 / np.where(near, 1.0, den)
+    idx = np.nonzero(near)
+    inv[idx] = 1.0
+    np.divide(1.0, inv, out=inv)
+    inv[idx] = 0.0
     if zero.any():
         inv[zero] = 0.0
-    g = np.empty(den.shape, dtype=np.complex128)
-    np.multiply(inv, q.real, out=g.real)
-    np.multiply(inv, q.imag, out=g.imag)
-    if near.any():
-        idx = np.nonzero(near)
-        nu = ext[idx[-1]] / n - xe[idx[:-1]]
-        nu = nu - np.round(nu)  # D is periodic in nu with period 1
-        s_nu = np.sin(np.pi * nu)
-        on = s_nu == 0.0
-        ratio = np.where(on, float(n), np.sin(np.pi * n * nu) / np.where(on, 1.0, s_nu))
-        g[idx] = ratio * np.exp(1j * np.pi * (n - 1) * nu) / f[idx[:-1]]
-    return f, g
+    nu = ext[idx[-1]] / n - xe[idx[:-1]]
+    nu = nu - np.round(nu)  # D is periodic in nu with period 1
+    s_nu = np.sin(np.pi * nu)
+    on = s_nu == 0.0
+    ratio = np.where(on, float(n), np.sin(np.pi * n * nu) / np.where(on, 1.0, s_nu))
+    value = ratio * np.exp(1j * np.pi * (n - 1) * nu) / f[idx[:-1]]
+    chirp, scat, k = idx
+    return _KernelOnBins(f, q, inv, (chirp, scat, k), np.asarray(value, np.complex128))
 
 
 def _window_bins(name: WindowName, n: int, bins: IntArray) -> IntArray:
     """The bins a cosine-sum window's transform at ``bins`` needs (each bin and its neighbours
     up to the window's order), sorted, (n_ext,)."""
     reach = len(WINDOWS[name]) - 1
-    return np.unique((bins[:, None] + np.arange(-reach, reach + 1)[None, :]).ravel() % n)
+    return _distinct_bins(bins[:, None] + np.arange(-reach, reach + 1)[None, :], n)
 
 
 def _window_combine(
@@ -383,12 +417,12 @@ def analytic_range_profile(
         # that commutes with the sum over scatterers: sum first, combine the bins after
         sel = np.asarray(bins, np.int64)
         ext = _window_bins(name, seq.n_samples, sel)
-        factor, dirichlet_ext = _window_transform_on_bins(seq.n_samples, x, ext)
-        coef = coef * factor
+        kernel = _kernel_on_bins(seq.n_samples, x, ext)
+        coef = coef * kernel.factor
+        weights = coef[:, None, :] if phasors is None else phasors * coef[:, None, :]
+        summed = kernel.weighted_sum(weights)
         if phasors is None:
-            summed = np.einsum("cs,csk->ck", coef, dirichlet_ext)
-        else:
-            summed = np.matmul(phasors * coef[:, None, :], dirichlet_ext)
+            summed = summed[:, 0, :]
         total = _window_combine(name, seq.n_samples, summed, ext, sel)
         return np.asarray(total * scale, np.complex128)
     nu = np.asarray(bins, np.float64)[None, None, :] / n_fft - x[:, :, None]
@@ -408,8 +442,15 @@ def bins_near(ranges: FloatArray, seq: ChirpSequence, n_fft: int, margin: int) -
     """Range bins within ``margin`` bins of any of ``ranges`` [m] (after IF aliasing), sorted."""
     pos = np.mod(np.asarray(ranges, np.float64).ravel() / seq.max_range * n_fft, n_fft)
     base = np.floor(pos).astype(np.int64)
-    near = (base[:, None] + np.arange(-margin, margin + 2)[None, :]) % n_fft
-    return np.unique(near).astype(np.int64)
+    return _distinct_bins(base[:, None] + np.arange(-margin, margin + 2)[None, :], n_fft)
+
+
+def _distinct_bins(bins: IntArray, n: int) -> IntArray:
+    """The distinct values of ``bins % n``, sorted (like ``np.unique``, by marking them in a
+    table of the ``n`` bins instead of sorting)."""
+    mark = np.zeros(n, dtype=np.bool_)
+    mark[np.mod(bins, n).ravel()] = True
+    return np.flatnonzero(mark).astype(np.int64)
 
 
 # --------------------------------------------------------------------------- Doppler
@@ -841,7 +882,6 @@ def chirp_profiles(
     n_rx = antennas.rx.shape[0]
     slots = np.arange(n) % seq.n_tx
     tx_index = np.asarray(seq.tdm_order, dtype=np.int64)[slots]
-    out = np.zeros((n, n_rx, n_fft), dtype=np.complex128)
     if path == "raw":
         tx_pos = antenna_positions(antennas.tx, radar_position, axes)[tx_index]
         rx_pos = antenna_positions(antennas.rx, radar_position, axes)
@@ -871,11 +911,15 @@ def chirp_profiles(
         else dist
     )
     bins = bins_near(near, seq, n_fft, margin)
-    out[:, :, bins] = analytic_range_profile(
+    # the noise's profile first (a fresh array), the scatterers' bins added to it
+    out = (
+        range_profile(noise, window_name, n_fft)
+        if noise is not None
+        else np.zeros((n, n_rx, n_fft), dtype=np.complex128)
+    )
+    out[:, :, bins] += analytic_range_profile(
         delays, amplitudes, seq, window_name, n_fft, bins, phasors
     )
-    if noise is not None:
-        out += range_profile(noise, window_name, n_fft)
     return out
 
 

@@ -535,7 +535,10 @@ class FmcwRadar(RadarWaveform):
         rng = np.random.default_rng([self.config.noise_seed, frame])
         shape = (self.sequence.chirps_per_frame, n_rx, self.config.n_samples)
         scale = np.sqrt(power / 2.0)
-        return rng.normal(0.0, scale, shape) + 1j * rng.normal(0.0, scale, shape)
+        noise = np.empty(shape, dtype=np.complex128)  # real part drawn first, then imaginary
+        noise.real = rng.normal(0.0, scale, shape)
+        noise.imag = rng.normal(0.0, scale, shape)
+        return noise
 
     def _check_ranges(self, ranges: FloatArray) -> None:
         if self.config.beyond_max_range == "alias" or ranges.size == 0:
