@@ -7,14 +7,14 @@ one window at its several aspects follow one another, as a worker builds them) w
 process (the thread that computes and the one that writes the files). Each round runs in a
 fresh process.
 
-``--against SRC`` pairs this checkout with another one's ``src`` folder (e.g. a worktree of an
-earlier commit: ``git worktree add /tmp/old <commit>``): the rounds alternate between the two
-(this, other, this, other, ...), and the script prints both medians and the median of the
-per-round ratios, so that the machine's load drifts over both alike. The plugins are the
-installed ones in both.
+``--against OTHER`` pairs this checkout with another one (e.g. a worktree of an earlier commit:
+``git worktree add /tmp/old <commit>``), given by its root or its ``src`` folder: its core and
+its built-in plugins (``plugins/*/src``) go first on the path of the other rounds. The rounds
+alternate between the two (this, other, this, other, ...), and the script prints both medians
+and the median of the per-round ratios, so that the machine's load drifts over both alike.
 
     .venv/bin/python benchmarks/bench_records.py [--config PATH] [--records 160]
-        [--rounds 3] [--against OTHER/src] [--json OUT.json]
+        [--rounds 3] [--against OTHER] [--json OUT.json]
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ import statistics
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_CONFIG = ROOT / "examples" / "datasets" / "paper_480.toml"
@@ -52,13 +53,30 @@ def _child(config: str, first: int, n_records: int) -> None:
         cpu = time.process_time()
         build_records(timed, out)
         per_record = (time.process_time() - cpu) / len(timed)
-    print(json.dumps({"per_record_ms": 1e3 * per_record, "package": mdframework.__file__}))
+    plugins = [m.__file__ for n, m in sys.modules.items() if n.startswith("mdf_") and "." not in n]
+    print(
+        json.dumps(
+            {"per_record_ms": 1e3 * per_record, "package": mdframework.__file__, "plugins": plugins}
+        )
+    )
 
 
-def _round(config: str, first: int, n_records: int, src: str | None) -> dict[str, float]:
+def other_paths(other: str) -> list[Path]:
+    """The import paths of another checkout (its root or its ``src`` folder): its ``src`` and
+    the ``src`` of each of its plugins."""
+    root = Path(other).resolve()
+    if root.name == "src" and (root / "mdframework").is_dir():
+        root = root.parent
+    if not (root / "src" / "mdframework").is_dir():
+        raise SystemExit(f"--against {other}: no src/mdframework there")
+    return [root / "src", *sorted(root.glob("plugins/*/src"))]
+
+
+def _round(config: str, first: int, n_records: int, other: str | None) -> dict[str, Any]:
     env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "PYTHONWARNINGS": "ignore"}
-    if src is not None:
-        env["PYTHONPATH"] = os.pathsep.join([src, env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    if other is not None:
+        paths = [str(p) for p in other_paths(other)]
+        env["PYTHONPATH"] = os.pathsep.join([*paths, env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
     proc = subprocess.run(
         [sys.executable, __file__, "--child", config, str(first), str(n_records)],
         capture_output=True,
@@ -67,7 +85,7 @@ def _round(config: str, first: int, n_records: int, src: str | None) -> dict[str
     )
     if proc.returncode:
         raise SystemExit(f"child failed:\n{proc.stderr}")
-    result: dict[str, float] = json.loads(proc.stdout.strip().splitlines()[-1])
+    result: dict[str, Any] = json.loads(proc.stdout.strip().splitlines()[-1])
     return result
 
 
@@ -78,7 +96,7 @@ def main() -> None:
     ap.add_argument("--records", type=int, default=160)
     ap.add_argument("--first", type=int, default=40, help="Index of the first timed record.")
     ap.add_argument("--rounds", type=int, default=3)
-    ap.add_argument("--against", default=None, help="Another checkout's src folder.")
+    ap.add_argument("--against", default=None, help="Another checkout (root or src).")
     ap.add_argument("--json", type=Path, default=None)
     ap.add_argument("--child", nargs=3, default=None, metavar=("CONFIG", "FIRST", "N"))
     a = ap.parse_args()
@@ -93,8 +111,10 @@ def main() -> None:
         line = f"round {k + 1}: this checkout {this[-1]:.2f} ms a record"
         if a.against is not None:
             res = _round(a.config, a.first, a.records, a.against)
-            if not res["package"].startswith(str(Path(a.against).resolve())):
-                raise SystemExit(f"--against {a.against}: imported {res['package']} instead")
+            root = other_paths(a.against)[0].parent
+            for module in [res["package"], *res["plugins"]]:
+                if not module.startswith(str(root)):
+                    raise SystemExit(f"--against {a.against}: imported {module} instead")
             other.append(res["per_record_ms"])
             line += f", other {other[-1]:.2f} ms, ratio {this[-1] / other[-1]:.3f}"
         print(line, flush=True)
