@@ -647,6 +647,33 @@ def _refine(
     return np.asarray(out + np.clip(off, -0.5, 0.5) * (axis[1] - axis[0] if n > 1 else 0.0))
 
 
+def _second_peaks(maps: FloatArray, best: IntArray, fraction: float) -> tuple[IntArray, IntArray]:
+    """For each beam map of ``maps`` (n_det, n_x, n_z) (``-inf`` off the visible grid) whose
+    strongest cell is ``best`` (n_det,) (flat index), its strongest other local maximum (at
+    least its 8 neighbours, edges clamped) of at least ``fraction`` of that cell's power, if any:
+    the detections that have one and its flat index, (n_found,) each. Ties go to the lower flat
+    index. Only the cells above the threshold are tested, not the whole map."""
+    n_det, n_x, n_z = maps.shape
+    flat = maps.reshape(n_det, -1)
+    peak = flat[np.arange(n_det), best]
+    d, i, k = np.nonzero(maps >= (fraction * peak)[:, None, None])
+    value = maps[d, i, k]
+    local = np.ones(d.size, dtype=np.bool_)
+    for di in (-1, 0, 1):
+        ii = np.clip(i + di, 0, n_x - 1)
+        for dk in (-1, 0, 1):
+            if di or dk:
+                local &= value >= maps[d, ii, np.clip(k + dk, 0, n_z - 1)]
+    index = i * n_z + k
+    keep = local & (index != best[d])
+    d, index, value = d[keep], index[keep], value[keep]
+    order = np.lexsort((-value, d))  # by detection, strongest first; stable: lower index first
+    d, index = d[order], index[order]
+    first = np.ones(d.size, dtype=np.bool_)
+    first[1:] = d[1:] != d[:-1]
+    return d[first].astype(np.int64), index[first].astype(np.int64)
+
+
 def estimate_angles(
     snapshots: ComplexArray, grid: AngleGrid, multi_peak: float | None = None
 ) -> tuple[IntArray, FloatArray, FloatArray, FloatArray]:
@@ -670,17 +697,9 @@ def estimate_angles(
     det = np.arange(n_det)
     best = np.argmax(flat, axis=1)
     if multi_peak is not None:
-        from scipy.ndimage import maximum_filter
-
-        finite = np.where(np.isfinite(maps), maps, -1.0)
-        local = finite == maximum_filter(finite, size=(1, 3, 3), mode="nearest")
-        strong = finite >= multi_peak * flat[det, best][:, None, None]
-        cand = np.where(local & strong, finite, -np.inf).reshape(n_det, -1)
-        cand[det, best] = -np.inf
-        second = np.argmax(cand, axis=1)
-        has = np.isfinite(cand[det, second])
-        det = np.concatenate([det, det[has]])
-        best = np.concatenate([best, second[has]])
+        d2, second = _second_peaks(maps, best, multi_peak)
+        det = np.concatenate([det, d2])
+        best = np.concatenate([best, second])
         order = np.argsort(det, kind="stable")
         det, best = det[order], best[order]
     i, k = np.divmod(best, grid.uz.size)
