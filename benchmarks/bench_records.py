@@ -53,7 +53,11 @@ def _child(config: str, first: int, n_records: int) -> None:
         cpu = time.process_time()
         build_records(timed, out)
         per_record = (time.process_time() - cpu) / len(timed)
-    plugins = [m.__file__ for n, m in sys.modules.items() if n.startswith("mdf_") and "." not in n]
+    plugins = [
+        str(getattr(m, "__file__", None) or getattr(m, "__path__", [""])[0])
+        for n, m in sys.modules.items()
+        if n.startswith("mdf_") and "." not in n
+    ]
     print(
         json.dumps(
             {"per_record_ms": 1e3 * per_record, "package": mdframework.__file__, "plugins": plugins}
@@ -113,7 +117,7 @@ def main() -> None:
             res = _round(a.config, a.first, a.records, a.against)
             root = other_paths(a.against)[0].parent
             for module in [res["package"], *res["plugins"]]:
-                if not module.startswith(str(root)):
+                if not module.startswith(str(root) + os.sep):
                     raise SystemExit(f"--against {a.against}: imported {module} instead")
             other.append(res["per_record_ms"])
             line += f", other {other[-1]:.2f} ms, ratio {this[-1] / other[-1]:.3f}"

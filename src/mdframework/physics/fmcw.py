@@ -254,8 +254,9 @@ class _KernelOnBins:
 
         ``D[c, s, k] = factor[c, s] * q[k] * inv_sine[c, s, k]``
 
-    except at the entries ``near`` (chirp, scatterer and bin indices, where ``inv_sine`` is 0),
-    whose value divided by ``factor`` is ``near_value``. See :func:`_kernel_on_bins`."""
+    except at the entries ``near`` (indices of chirp, scatterer and position in ``ext``, where
+    ``inv_sine`` is 0), whose value divided by ``factor`` is ``near_value``. See
+    :func:`_kernel_on_bins`."""
 
     factor: ComplexArray  # (n_chirps, n_scat)
     q: ComplexArray  # (n_ext,)
@@ -273,10 +274,10 @@ class _KernelOnBins:
         out.imag = np.matmul(np.ascontiguousarray(weights.imag), self.inv_sine)
         out *= self.q
         if self.near_value.size:
-            chirp, scat, ext = self.near
+            chirp, scat, pos = self.near
             # a view with the bins before the channels; add.at sums repeated (chirp, bin) pairs
             by_bin = out.transpose(0, 2, 1)
-            np.add.at(by_bin, (chirp, ext), weights[chirp, :, scat] * self.near_value[:, None])
+            np.add.at(by_bin, (chirp, pos), weights[chirp, :, scat] * self.near_value[:, None])
         return out
 
 
@@ -652,18 +653,20 @@ def _second_peaks(maps: FloatArray, best: IntArray, fraction: float) -> tuple[In
     strongest cell is ``best`` (n_det,) (flat index), its strongest other local maximum (at
     least its 8 neighbours, edges clamped) of at least ``fraction`` of that cell's power, if any:
     the detections that have one and its flat index, (n_found,) each. Ties go to the lower flat
-    index. Only the cells above the threshold are tested, not the whole map."""
+    index; a cell that is not finite is never chosen and counts as -1 beside one that is. Only
+    the cells above the threshold are tested, not the whole map."""
     n_det, n_x, n_z = maps.shape
-    flat = maps.reshape(n_det, -1)
-    peak = flat[np.arange(n_det), best]
-    d, i, k = np.nonzero(maps >= (fraction * peak)[:, None, None])
+    peak = maps.reshape(n_det, n_x * n_z)[np.arange(n_det), best]
+    with np.errstate(invalid="ignore"):  # 0 x an overflowed peak: NaN, no cell above it
+        d, i, k = np.nonzero(maps >= (fraction * peak)[:, None, None])
     value = maps[d, i, k]
-    local = np.ones(d.size, dtype=np.bool_)
+    local = np.isfinite(value)
     for di in (-1, 0, 1):
         ii = np.clip(i + di, 0, n_x - 1)
         for dk in (-1, 0, 1):
             if di or dk:
-                local &= value >= maps[d, ii, np.clip(k + dk, 0, n_z - 1)]
+                other = maps[d, ii, np.clip(k + dk, 0, n_z - 1)]
+                local &= value >= np.where(np.isfinite(other), other, -1.0)
     index = i * n_z + k
     keep = local & (index != best[d])
     d, index, value = d[keep], index[keep], value[keep]
