@@ -64,6 +64,17 @@ def test_a_point_target_run_imports_only_matplotlib_of_the_heavy_libraries(
     assert not {"scipy.interpolate", "matplotlib.pyplot"} & modules
 
 
+def test_an_fmcw_run_imports_neither_scipy_signal_nor_scipy_stats(tmp_path: Path) -> None:
+    """The FMCW preset's frames have gaps, so its spectrogram is one Doppler spectrum per frame,
+    windowed like the STFT (its cosine windows from numpy, not scipy.signal)."""
+    modules = imported_modules(
+        ["run", str(EXAMPLES / "fmcw_walk.toml"), "--out", str(tmp_path / "o"), "--no-figures"]
+    )
+    assert "mdf_fmcw.waveform" in modules  # the FMCW radar ran
+    assert top_level(modules) & HEAVY == set()
+    assert not {"scipy.signal", "scipy.stats"} & modules
+
+
 def test_a_run_without_figures_imports_no_heavy_library(tmp_path: Path) -> None:
     modules = imported_modules(
         ["run", str(EXAMPLES / "point_target.toml"), "--out", str(tmp_path / "o"), "--no-figures"]

@@ -984,14 +984,14 @@ def frame_spectrogram(
     """One Doppler spectrum per frame of the slow-time signal of the first TDM slot.
 
     ``signal`` (n_frames * chirps_per_frame,) one value per chirp. Each frame's ``n_loops``
-    samples of slot 0 are windowed (any scipy window) and transformed with ``nfft`` >= n_loops
-    points. Returns power (nfft, n_frames) [|signal|^2], Doppler (nfft,) [Hz] ascending and the
-    time of each frame's middle loop (n_frames,) [s from the first chirp].
+    samples of slot 0 are windowed (any scipy window, :func:`stft_window`) and transformed with
+    ``nfft`` >= n_loops points. Returns power (nfft, n_frames) [|signal|^2], Doppler (nfft,)
+    [Hz] ascending and the time of each frame's middle loop (n_frames,) [s from the first chirp].
     """
-    from scipy.signal import get_window
+    from .spectrogram import stft_window  # the cosine windows without importing scipy.signal
 
     frames = np.asarray(signal).reshape(-1, seq.chirps_per_frame)[:, :: seq.n_tx]
-    w = get_window(window_name, seq.n_loops, fftbins=True).astype(np.float64)
+    w = stft_window(window_name, seq.n_loops)
     spec = np.fft.fftshift(np.fft.fft(frames * w, n=nfft, axis=1), axes=1)
     power = np.ascontiguousarray((spec.real**2 + spec.imag**2).T)
     time = np.arange(frames.shape[0]) * seq.frame_period + (seq.n_loops - 1) / 2 * seq.loop_period
