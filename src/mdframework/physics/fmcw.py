@@ -283,10 +283,9 @@ class _KernelOnBins:
 
 def _kernel_on_bins(n: int, x: FloatArray, ext: IntArray) -> _KernelOnBins:
     """The Dirichlet kernel ``D_n(k / n - x)`` of an unpadded FFT at the integer bins ``ext``
-    (n_ext,) for ``x`` (n_chirps, n_scat),
-    factored (:class:`_KernelOnBins`) so that the factor of each ``x`` multiplies the
-    scatterer's coefficient and the factor of each bin the sum, leaving a real matrix of
-    inverse sines to sum over the scatterers.
+    (n_ext,) for ``x`` (n_chirps, n_scat), factored (:class:`_KernelOnBins`) so that the
+    factor of each ``x`` multiplies the scatterer's coefficient and the factor of each bin the
+    sum, leaving a real matrix of inverse sines to sum over the scatterers.
 
     On bins, ``D_n(k/n - x) = f(x) q_k / sin(pi (k/n - x))`` with ``f(x) = -sin(pi n x)
     exp(-j pi (n-1) x)`` and ``q_k = (-1)^k exp(j pi (n-1) k / n)``; the sine of the difference
