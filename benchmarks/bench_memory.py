@@ -2,12 +2,14 @@
 
 Each measurement runs in a fresh process (so its peak resident set is its own): a body walking on
 a treadmill 12 m from the radar (17 ellipsoid scatterers, PRF 2400 Hz), simulated end to end for
-a record of the given length on the analytic or the raw LFM path. Reports the wall time, the CPU
+a record of the given length on the analytic or the raw LFM path, or (``fmcw``) through the FMCW
+sensor model (the IWR1443 preset, 6 m from the radar, with its range-Doppler maps and point
+clouds, 30 frames a second). Reports the wall time, the CPU
 time of the simulation, the peak RSS [MiB] and the time exponent between the shortest and the
 longest record (``log(t_long / t_short) / log(len_long / len_short)``), of the wall time and of
 the CPU time (the one to read on a shared machine, where other jobs stretch wall times).
 
-    .venv/bin/python benchmarks/bench_memory.py [--lengths 6 600] [--paths analytic raw]
+    .venv/bin/python benchmarks/bench_memory.py [--lengths 6 600] [--paths analytic raw fmcw]
 """
 
 from __future__ import annotations
@@ -29,12 +31,16 @@ from mdframework.pipeline import build_stages, simulate_motion
 
 length, path = float(sys.argv[1]), sys.argv[2]
 motion = walking_motion(duration=length + 0.5)
+if path == "fmcw":  # the IWR1443 preset (maximum range 10.5 m): the radar 6 m away
+    radar, where = {{"kind": "fmcw", "preset": "iwr1443_short_range_3d"}}, [6.0, 0.0, 1.0]
+else:
+    radar, where = {{"kind": "lfm", "path": path}}, [12.0, 0.0, 1.5]
 cfg = validate_run_config({{
     "motion": {{"kind": "point_targets", "length": 1.0, "targets": [{{"position": [1, 0, 0]}}],
                "duration": length}},
     "scatterers": {{"kind": "ellipsoid", "placement": "joints17", "height": 1.8}},
-    "radar": {{"kind": "lfm", "path": path}},
-    "scene": {{"radar_position": [12.0, 0.0, 1.5], "person": {{"motion": "treadmill"}}}},
+    "radar": radar,
+    "scene": {{"radar_position": where, "person": {{"motion": "treadmill"}}}},
 }})
 stages = build_stages(cfg)
 t0, c0 = time.perf_counter(), time.process_time()

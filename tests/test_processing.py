@@ -121,6 +121,29 @@ def test_db_floor_never_inf_or_nan() -> None:
         spectrogram.power_to_db(np.array([np.inf]), -60.0)
 
 
+def test_db_stored_in_float32_block_by_block_is_the_whole_computation_rounded(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """float64 power converted to a float32 dB map a block of rows at a time (3 rows a block
+    here, so the peak and the floor fall in different blocks) equals the float64 map of the
+    whole array, rounded to float32, exactly; also for a tiny peak (relative floor), all-zero
+    power, no rows and one dimension."""
+    monkeypatch.setattr(spectrogram, "DB_BLOCK_VALUES", 3 * 50)
+    rng = np.random.default_rng(4)
+    cases = [
+        rng.exponential(1.0, (31, 50)) * np.where(rng.random((31, 50)) < 0.1, 0.0, 1.0),
+        rng.exponential(1e-305, (10, 50)),
+        np.zeros((7, 50)),
+        np.zeros((0, 50)),
+        rng.exponential(1.0, 200),
+    ]
+    for p in cases:
+        whole = spectrogram.power_to_db(p, -60.0)
+        stored = spectrogram.power_to_db(p, -60.0, dtype=np.float32)
+        assert whole.dtype == np.float64 and stored.dtype == np.float32
+        np.testing.assert_array_equal(stored, whole.astype(np.float32))
+
+
 @pytest.mark.parametrize("name", sorted(spectrogram.COSINE_WINDOWS))
 @pytest.mark.parametrize("length", [2, 7, 64, 256, 1000])
 def test_numpy_windows_equal_scipys_periodic_windows(name: str, length: int) -> None:

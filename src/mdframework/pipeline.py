@@ -336,7 +336,7 @@ def _simulate_motion(
             )
     except RecordTooShortError as exc:
         raise SceneError(f"processing.window_length: {exc}") from None
-    spec_db = power_to_db(spec.power, proc.floor_db)
+    spec_db = power_to_db(spec.power, proc.floor_db, dtype=np.float32)
     velocity = radar.doppler_to_velocity(spec.doppler, wf.carrier_frequency)
     timings["spectrogram"] = time.perf_counter() - clock
 
@@ -553,18 +553,15 @@ class _Stream:
             self._products.setdefault(key, []).append(np.asarray(value))
 
     def received(self) -> Received:
-        """The whole record's received data."""
+        """The whole record's received data (the blocks' arrays are released as they are
+        joined, so the record's products are never held twice)."""
+        products = {k: _join(self._products.pop(k)) for k in list(self._products)}
         if not self._rt:
-            return Received(
-                self.signal, products={k: np.concatenate(v) for k, v in self._products.items()}
-            )
+            return Received(self.signal, products=products)
         rows = np.arange(0, self.n, self._rt_step, dtype=np.int64)
+        range_time, self._rt = _join(self._rt), []
         return Received(
-            self.signal,
-            np.concatenate(self._rt),
-            self._rt_axis,
-            {k: np.concatenate(v) for k, v in self._products.items()},
-            rows if self._rt_step > 1 else None,
+            self.signal, range_time, self._rt_axis, products, rows if self._rt_step > 1 else None
         )
 
     def scatterers(self) -> Scatterers | None:
@@ -577,6 +574,24 @@ class _Stream:
         if first.axes is not None:
             axes = np.concatenate([b.axes for b in self._blocks if b.axes is not None])
         return Scatterers(cat[0], cat[1], first.names, first.semi_axes, axes)
+
+
+def _join(blocks: list[NDArray[Any]]) -> NDArray[Any]:
+    """``np.concatenate(blocks)`` along the first axis, emptying ``blocks`` as each is copied:
+    at most the result and one block are held at once."""
+    if len(blocks) == 1:
+        return blocks.pop()
+    first = blocks[0]
+    out = np.empty(
+        (sum(b.shape[0] for b in blocks), *first.shape[1:]), dtype=np.result_type(*blocks)
+    )
+    pos = 0
+    blocks.reverse()  # pop from the end, in order
+    while blocks:
+        block = blocks.pop()
+        out[pos : pos + block.shape[0]] = block
+        pos += block.shape[0]
+    return out
 
 
 def _gate(gate: str | float, at_pulses: Skeleton, radar_pos: FloatArray) -> FloatArray:

@@ -977,6 +977,10 @@ def gate_signal(
     return np.asarray(np.sum(profiles[:, 0, :] * (inside * rot), axis=1), dtype=np.complex128)
 
 
+#: Frames transformed at a time by :func:`frame_spectrogram`.
+FRAMES_PER_BLOCK = 256
+
+
 def frame_spectrogram(
     signal: ComplexArray, seq: ChirpSequence, window_name: str, nfft: int
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -991,7 +995,11 @@ def frame_spectrogram(
 
     frames = np.asarray(signal).reshape(-1, seq.chirps_per_frame)[:, :: seq.n_tx]
     w = stft_window(window_name, seq.n_loops)
-    spec = np.fft.fftshift(np.fft.fft(frames * w, n=nfft, axis=1), axes=1)
-    power = np.ascontiguousarray((spec.real**2 + spec.imag**2).T)
-    time = np.arange(frames.shape[0]) * seq.frame_period + (seq.n_loops - 1) / 2 * seq.loop_period
+    n_frames = frames.shape[0]
+    power = np.empty((nfft, n_frames), dtype=np.float64)
+    for lo in range(0, n_frames, FRAMES_PER_BLOCK):  # memory set by the block, not the record
+        hi = min(lo + FRAMES_PER_BLOCK, n_frames)
+        spec = np.fft.fftshift(np.fft.fft(frames[lo:hi] * w, n=nfft, axis=1), axes=1)
+        power[:, lo:hi] = (spec.real**2 + spec.imag**2).T
+    time = np.arange(n_frames) * seq.frame_period + (seq.n_loops - 1) / 2 * seq.loop_period
     return power, doppler_axis(seq, nfft), np.asarray(time, np.float64)

@@ -121,9 +121,17 @@ def spectrogram(
     return Spectrogram(power.T, doppler, time)
 
 
-def power_to_db(power: NDArray[np.floating[Any]], floor_db: float = -60.0) -> NDArray[Any]:
-    """``10 log10(P / P_max)`` clipped below at ``floor_db`` (< 0): never -inf or NaN. The
-    result has the input's precision (float32 or float64; other types become float64).
+def power_to_db(
+    power: NDArray[np.floating[Any]],
+    floor_db: float = -60.0,
+    *,
+    dtype: type[np.floating[Any]] | None = None,
+) -> NDArray[Any]:
+    """``10 log10(P / P_max)`` clipped below at ``floor_db`` (< 0): never -inf or NaN. Computed
+    in the input's precision (float32 or float64; other types in float64) and returned in it,
+    or stored as ``dtype`` (e.g. float64 power into a float32 map: computed a block of rows at a
+    time, so the record is never held in both precisions; each value is the one the whole
+    computation gives, rounded to ``dtype``).
 
     An all-zero input gives ``floor_db`` everywhere (there is no peak to refer to)."""
     if floor_db >= 0:
@@ -134,6 +142,22 @@ def power_to_db(power: NDArray[np.floating[Any]], floor_db: float = -60.0) -> ND
     p_max = float(np.max(p)) if p.size else 0.0
     if not np.isfinite(p_max):
         raise ValueError("the power has non-finite values")
+    if dtype is None or np.dtype(dtype) == p.dtype or p.size == 0 or p.ndim == 0:
+        out = _db(p, p_max, floor_db)
+        return out if dtype is None else out.astype(dtype, copy=False)
+    stored = np.empty(p.shape, dtype=dtype)
+    rows = max(1, DB_BLOCK_VALUES // max(1, p[0].size))
+    for lo in range(0, p.shape[0], rows):
+        stored[lo : lo + rows] = _db(p[lo : lo + rows], p_max, floor_db)
+    return stored
+
+
+#: Values converted at a time by :func:`power_to_db` when it stores another precision.
+DB_BLOCK_VALUES = 1 << 20
+
+
+def _db(p: NDArray[Any], p_max: float, floor_db: float) -> NDArray[Any]:
+    """:func:`power_to_db` of ``p`` (float32 or float64) with the peak ``p_max`` given."""
     if p_max <= 0.0:
         return np.full(p.shape, float(floor_db), dtype=p.dtype)
     floor = p_max * 10.0 ** (floor_db / 10.0)
