@@ -582,6 +582,8 @@ def _join(blocks: list[NDArray[Any]]) -> NDArray[Any]:
     if len(blocks) == 1:
         return blocks.pop()
     first = blocks[0]
+    if any(b.shape[1:] != first.shape[1:] for b in blocks):
+        raise ValueError(f"blocks of different shapes: {sorted({b.shape[1:] for b in blocks})}")
     out = np.empty(
         (sum(b.shape[0] for b in blocks), *first.shape[1:]), dtype=np.result_type(*blocks)
     )
