@@ -553,8 +553,8 @@ class _Stream:
             self._products.setdefault(key, []).append(np.asarray(value))
 
     def received(self) -> Received:
-        """The whole record's received data (the blocks' arrays are released as they are
-        joined, so the record's products are never held twice)."""
+        """The whole record's received data (each block's arrays released as they are joined;
+        called once per record: it empties the stream's lists)."""
         products = {k: _join(self._products.pop(k)) for k in list(self._products)}
         if not self._rt:
             return Received(self.signal, products=products)
@@ -577,8 +577,8 @@ class _Stream:
 
 
 def _join(blocks: list[NDArray[Any]]) -> NDArray[Any]:
-    """``np.concatenate(blocks)`` along the first axis, emptying ``blocks`` as each is copied:
-    at most the result and one block are held at once."""
+    """``np.concatenate(blocks)`` along the first axis, emptying ``blocks`` as each is copied
+    (each block is released once it is in the result, not after the whole join)."""
     if len(blocks) == 1:
         return blocks.pop()
     first = blocks[0]
