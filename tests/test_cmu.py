@@ -9,6 +9,7 @@ The data are the copies shipped in ``examples/data/cmu`` (see its PROVENANCE.md)
 
 from __future__ import annotations
 
+import math
 import re
 from pathlib import Path
 
@@ -518,6 +519,79 @@ def test_crlf_asf_amc_parse(tmp_path: Path) -> None:
     full = load(AMC / "02_01.amc").skeleton
     assert crlf.n_frames == 5
     np.testing.assert_array_equal(crlf.positions, full.positions[:5])
+
+
+def _asf_in_radians(lines: list[str]) -> list[str]:
+    """02.asf rewritten with ``angle rad``: the root orientation and every bone axis in radians
+    (17 significant digits, so the only change is the unit)."""
+    out = []
+    for ln in lines:
+        toks = ln.split()
+        if toks[:1] == ["angle"]:
+            ln = "  angle rad"
+        elif toks[:1] == ["orientation"]:
+            ln = "   orientation " + " ".join(repr(math.radians(float(t))) for t in toks[1:])
+        elif toks[:1] == ["axis"] and len(toks) == 5:
+            angles = " ".join(repr(math.radians(float(t))) for t in toks[1:4])
+            ln = f"     axis {angles} {toks[4]}"
+        out.append(ln)
+    return out
+
+
+def test_asf_angles_in_radians(tmp_path: Path) -> None:
+    """An ASF whose ``:units`` say ``angle rad`` gives its root orientation and bone axes in
+    radians: the same body as the degree file (the AMC keeps its own ``:DEGREES``). A root
+    orientation of 30 deg about z makes the root's term count too."""
+    lines = (AMC / "02.asf").read_text().split("\n")
+    lines = ["   orientation 0 0 30" if ln.split()[:1] == ["orientation"] else ln for ln in lines]
+    (tmp_path / "deg").mkdir()
+    (tmp_path / "rad").mkdir()
+    write(tmp_path / "deg" / "02.asf", lines)
+    write(tmp_path / "rad" / "02.asf", _asf_in_radians(lines))
+    assert "angle rad" in (tmp_path / "rad" / "02.asf").read_text()
+    deg = load(write(tmp_path / "deg" / "02_01.amc", amc_sample(20))).skeleton
+    rad = load(write(tmp_path / "rad" / "02_01.amc", amc_sample(20))).skeleton
+    np.testing.assert_allclose(rad.positions, deg.positions, rtol=0, atol=1e-12)
+    full = load(AMC / "02_01.amc").skeleton  # the root orientation moved the body
+    assert np.max(np.abs(deg.positions - full.positions[:20])) > 0.05
+
+
+def test_asf_unit_given_twice_or_bad_mass(tmp_path: Path) -> None:
+    """A second ``length`` (or a second ``:units`` section repeating one) would silently change
+    the body's size; a mass unit that is not a positive number breaks the input rules."""
+    lines = (AMC / "02.asf").read_text().split("\n")
+    k = next(i for i, ln in enumerate(lines) if ln.strip() == "length 0.45")
+    m = next(i for i, ln in enumerate(lines) if ln.strip() == "mass 1.0")
+    path = write(tmp_path / "02_01.amc", amc_sample(2))
+    cases = [
+        ([*lines[: k + 1], "  length 1.0", *lines[k + 1 :]], k + 2, "unit 'length' given twice"),
+        ([*lines[: k + 2], ":units", "  length 1", *lines[k + 2 :]], k + 4, "given twice"),
+        ([*lines[:m], "  mass nan", *lines[m + 1 :]], m + 1, "non-finite number"),
+        ([*lines[:m], "  mass 0", *lines[m + 1 :]], m + 1, "mass unit must be positive"),
+    ]
+    for text, line, message in cases:
+        write(tmp_path / "02.asf", text)
+        with pytest.raises(DataFileError, match=re.escape(message)) as err:
+            load(path)
+        assert err.value.line == line, (message, err.value)
+
+
+@pytest.mark.parametrize("eol", ["\r", "\r\n"])
+def test_byte_order_mark_and_old_mac_line_ends(eol: str, tmp_path: Path) -> None:
+    """BVH, ASF and AMC files that start with a UTF-8 byte-order mark and end their lines with
+    CR alone (or CRLF) read exactly as the plain LF files."""
+    bvh = tmp_path / "09_03.bvh"
+    bvh.write_bytes(b"\xef\xbb\xbf" + (eol.join(bvh_lines()) + eol).encode())
+    np.testing.assert_array_equal(
+        load(bvh).skeleton.positions, load(BVH / "09_03.bvh").skeleton.positions
+    )
+    asf = (AMC / "02.asf").read_text().split("\n")
+    (tmp_path / "02.asf").write_bytes(b"\xef\xbb\xbf" + eol.join(asf).encode())
+    amc = tmp_path / "02_01.amc"
+    amc.write_bytes(b"\xef\xbb\xbf" + (eol.join(amc_sample(5)) + eol).encode())
+    np.testing.assert_array_equal(
+        load(amc).skeleton.positions, load(AMC / "02_01.amc").skeleton.positions[:5]
+    )
 
 
 def test_asf_unknown_keyword(tmp_path: Path) -> None:

@@ -58,7 +58,8 @@ class AsfBone:
 
     ``direction`` (3,) float64 is a unit vector in the skeleton's global frame (CMU axes);
     ``length`` is in ASF units; ``axis_deg`` (3,) float64 are the bone frame's Euler angles
-    [deg] about x, y, z, composed in ``axis_order``; ``dof`` lists the rotational degrees of
+    [deg] about x, y, z (converted where the ASF's ``:units angle`` is ``rad``), composed in
+    ``axis_order``; ``dof`` lists the rotational degrees of
     freedom (``rx``, ``ry``, ``rz``) in AMC value order; ``parent`` is ``"root"`` or a bone name.
     """
 
@@ -78,9 +79,10 @@ class AsfSkeleton:
 
     ``bones`` are in hierarchy order (every parent before its children). ``root_order`` is the order
     of the root's AMC values, ``root_axis`` the root's rotation order, ``root_orientation_deg`` (3,)
-    its frame's angles [deg]. ``length_scale`` is the ``:units length`` value; ``unit_m`` the
-    metres per ASF unit, ``(1 / length_scale) * 2.54 / 100``. ``angles_in_degrees`` is from
-    ``:units angle``.
+    its frame's angles [deg] (converted, like the bone axes, where the file's angles are in
+    radians). ``length_scale`` is the ``:units length`` value; ``unit_m`` the metres per ASF
+    unit, ``(1 / length_scale) * 2.54 / 100``. ``angles_in_degrees`` is from ``:units angle``:
+    the unit of the AMC's values unless the AMC says ``:DEGREES`` or ``:RADIANS``.
     """
 
     path: Path
@@ -224,6 +226,7 @@ def read_asf(path: str | Path) -> AsfSkeleton:
     root_order: tuple[str, ...] = _ROOT_CHANNELS
     root_axis = "XYZ"
     root_orient = np.zeros(3)
+    unit_lines: dict[str, int] = {}
     bones: dict[str, _BoneDraft] = {}
     current: _BoneDraft | None = None
     last_key = ""
@@ -251,6 +254,11 @@ def read_asf(path: str | Path) -> AsfSkeleton:
                 raise DataFileError(
                     p, f"expected '<unit> <value>' in :units, found {raw.strip()!r}", ln
                 )
+            if key in unit_lines:
+                raise DataFileError(
+                    p, f"unit {key!r} given twice (first on line {unit_lines[key]})", ln
+                )
+            unit_lines[key] = ln
             if key == "length":
                 length_scale = float(_floats(p, toks[1:], 1, "the length unit", ln)[0])
                 if length_scale <= 0:
@@ -260,7 +268,10 @@ def read_asf(path: str | Path) -> AsfSkeleton:
                 if toks[1].lower() not in ("deg", "rad"):
                     raise DataFileError(p, f"angle unit must be deg or rad, got {toks[1]!r}", ln)
                 degrees = toks[1].lower() == "deg"
-            elif key != "mass":
+            elif key == "mass":
+                if _floats(p, toks[1:], 1, "the mass unit", ln)[0] <= 0:
+                    raise DataFileError(p, "the mass unit must be positive", ln)
+            else:
                 raise DataFileError(p, f"unknown unit {key!r} in :units", ln)
         elif section in (":documentation", ":version", ":name", ":skin"):
             continue
@@ -383,6 +394,8 @@ def read_asf(path: str | Path) -> AsfSkeleton:
             raise DataFileError(
                 p, f"bone {name!r} is not connected to the root in :hierarchy", info.line
             )
+    # the ASF's own angles (root orientation, bone axes) follow its `angle` unit
+    to_deg = 1.0 if degrees else 180.0 / math.pi
     out: list[AsfBone] = []
     for name in ordered:
         info = bones[name]
@@ -392,14 +405,16 @@ def read_asf(path: str | Path) -> AsfSkeleton:
                 name=name,
                 direction=info.direction,
                 length=info.length,
-                axis_deg=info.axis_deg,
+                axis_deg=info.axis_deg * to_deg,
                 axis_order=info.axis_order,
                 dof=info.dof,
                 parent=parent_of[name][0],
                 line=info.line,
             )
         )
-    return AsfSkeleton(p, tuple(out), root_order, root_axis, root_orient, length_scale, degrees)
+    return AsfSkeleton(
+        p, tuple(out), root_order, root_axis, root_orient * to_deg, length_scale, degrees
+    )
 
 
 def read_amc(path: str | Path, asf: AsfSkeleton) -> AmcMotion:

@@ -96,7 +96,8 @@ class BvhData:
 
 
 def read_lines(path: Path) -> list[str]:
-    """The lines of a text file without their line ends (CRLF, LF or mixed).
+    """The lines of a text file without their line ends (LF, CRLF, CR or mixed) and without a
+    UTF-8 byte-order mark.
 
     Raises :class:`DataFileError` if the file cannot be read.
     """
@@ -105,11 +106,10 @@ def read_lines(path: Path) -> list[str]:
     except OSError as exc:
         raise DataFileError(path, f"cannot read: {exc.strerror or exc}") from None
     try:
-        text = raw.decode("utf-8")
+        text = raw.decode("utf-8-sig")
     except UnicodeDecodeError:
         text = raw.decode("latin-1")
-    lines = text.split("\n")
-    return [ln[:-1] if ln.endswith("\r") else ln for ln in lines]
+    return text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
 
 
 class _Tokens:
