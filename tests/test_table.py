@@ -179,8 +179,31 @@ def test_missing_values_and_unsorted_rows(tmp_path: Path) -> None:
             r"ragged\.csv:3: 4 fields",
         ),
         ("word.csv", "time,joint,x,y,z\n0,head,1,two,3\n", r"word\.csv:2: coordinate: 'two'"),
-        ("inf.csv", "time,joint,x,y,z\n0,head,1,inf,3\n1,head,1,2,3\n", r"inf\.csv.*not finite"),
-        ("far.csv", "time,joint,x,y,z\n0,head,1,2,3e9\n1,head,1,2,3\n", r"far\.csv.*beyond"),
+        (
+            "inf.csv",
+            "time,joint,x,y,z\n0,head,1,2,3\n1,head,1,-inf,3\n",
+            r"inf\.csv:3: a joint coordinate -inf is not finite",
+        ),
+        (
+            "far.tsv",
+            "# a comment\ntime\thead_x\thead_y\thead_z\n0\t1\t2\t3\n1\t1\t2\t3e9\n",
+            r"far\.tsv:4: a joint coordinate 3000000000\.0 is beyond",
+        ),
+        (
+            "repeated.csv",
+            "# a comment\ntime,head_x,head_y,head_z,head_x\n0,1,2,3,9\n1,1,2,3,9\n",
+            r"repeated\.csv:2: column 'head_x' appears twice \(columns 2 and 5\)",
+        ),
+        (
+            "case.csv",
+            "time,head_X,head_y,head_z,head_x\n0,1,2,3,9\n1,1,2,3,9\n",
+            r"case\.csv:1: columns 'head_X' and 'head_x' are the same coordinate",
+        ),
+        (
+            "repeated_long.csv",
+            "time,joint,x,y,z,time\n0,head,1,2,3,0\n",
+            r"repeated_long\.csv:1: column 'time' appears twice",
+        ),
         ("twice.csv", "time,joint,x,y,z\n0,head,1,2,3\n0,head,1,2,3\n", r"twice\.csv:3: joint"),
         ("one.csv", "time,joint,x,y,z\n0,head,1,2,3\n", r"one\.csv.*two"),
         ("nojoint.csv", "time,a,b\n0,1,2\n1,1,2\n", r"nojoint\.csv:1: no joint columns"),

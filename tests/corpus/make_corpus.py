@@ -1170,6 +1170,7 @@ def _reader_cases(c: _Corpus) -> None:
         UTK.name,
         "".join([*utk[:9], _replace_field(utk[9], 4, "1e308"), *utk[10:]]),
         table,
+        ":10:",
         "beyond",
     )
     table_case(
@@ -1186,6 +1187,8 @@ def _reader_cases(c: _Corpus) -> None:
     rows = "time,joint,x,y,z\n0,head,0,0,1.7\n0.1,head,0,0,1.7\n"
     table_case("missing-joints", "t.csv", rows, long, "lacks base", "joint_map")
     table_case("time-inf", "t.csv", "time,joint,x,y,z\ninf,head,0,0,1\n", long, "time")
+    rows = "time,joint,x,y,z,x\n0,head,0,0,1.7,0\n0.1,head,0,0,1.7,0\n"
+    table_case("column-twice", "t.csv", rows, long, "t.csv:1:", "appears twice")
     d = c.folder("table-npz-objects")
     np.savez(d / "t.npz", positions=np.array([object()]), joints=np.array(["head"]))
     c.run("table-npz-objects", _json_config(d, {"motion": {"kind": "table", "file": "t.npz"}}),

@@ -210,13 +210,19 @@ def _numbers(path: Path, cells: list[str], line: int, what: str) -> FloatArray:
 def _columns(
     path: Path, rows: list[list[str]], line_of: list[int], cols: list[int], what: str
 ) -> FloatArray:
-    """The numbers in columns ``cols`` of every row, (n_rows, len(cols))."""
-    return np.array(
+    """The numbers in columns ``cols`` of every row, (n_rows, len(cols)); coordinates are
+    checked against the file limit here, where each row's line is known."""
+    out = np.array(
         [
             _numbers(path, [r[k] for k in cols], ln, what)
             for r, ln in zip(rows, line_of, strict=True)
         ]
     ).reshape(len(rows), len(cols))
+    if what == "coordinate":
+        limits.check_values(
+            path, out, limits.MAX_FILE_COORDINATE, "a joint coordinate", line_of, allow_nan=True
+        )
+    return out
 
 
 def _read_text(
@@ -225,12 +231,20 @@ def _read_text(
     lines = _lines(path)
     rows = _split(path, lines, spec.delimiter)
     names = _column_names(path, spec, rows[0])
+    # the line that names the columns (None where the config names them)
+    named_at = lines[0][0] if spec.header and names is rows[0] else None
     if spec.header:
         lines, rows = lines[1:], rows[1:]
     limits.check_declared_count(path, lines[0][0] if lines else 1, "rows", len(rows))
     if not rows:
         raise DataFileError(path, "a header but no data rows")
-    col = {n: k for k, n in enumerate(names)}
+    col: dict[str, int] = {}
+    for k, n in enumerate(names):
+        if n in col:
+            raise DataFileError(
+                path, f"column {n!r} appears twice (columns {col[n] + 1} and {k + 1})", named_at
+            )
+        col[n] = k
     layout = spec.layout
     if layout == "auto":
         layout = "long" if spec.joint_column in col else "wide"
@@ -241,8 +255,8 @@ def _read_text(
             )
     line_of = [ln for ln, _ in lines]
     if layout == "long":
-        return _long_text(path, spec, names, col, rows, line_of)
-    return _wide_text(path, spec, names, col, rows, line_of)
+        return _long_text(path, spec, names, col, rows, line_of, named_at)
+    return _wide_text(path, spec, names, col, rows, line_of, named_at)
 
 
 def _time_of(path: Path, spec: TableLayout, values: FloatArray | None, n_rows: int) -> FloatArray:
@@ -258,12 +272,12 @@ def _time_of(path: Path, spec: TableLayout, values: FloatArray | None, n_rows: i
     return values * spec.time_unit_s
 
 
-def _need(path: Path, col: dict[str, int], name: str, what: str) -> int:
+def _need(path: Path, col: dict[str, int], name: str, what: str, named_at: int | None) -> int:
     if name not in col:
         raise DataFileError(
             path,
             f"no column {name!r} ({what}); the columns are {', '.join(col)}: name it in the config",
-            1,
+            named_at,
         )
     return col[name]
 
@@ -275,10 +289,11 @@ def _long_text(
     col: dict[str, int],
     rows: list[list[str]],
     line_of: list[int],
+    named_at: int | None,
 ) -> tuple[FloatArray, tuple[str, ...], FloatArray, str, int]:
-    jcol = _need(path, col, spec.joint_column, "the joint names")
-    xyz = [_need(path, col, c, "a coordinate") for c in spec.xyz]
-    tcol = _need(path, col, spec.time_column, "the time") if spec.time_column else None
+    jcol = _need(path, col, spec.joint_column, "the joint names", named_at)
+    xyz = [_need(path, col, c, "a coordinate", named_at) for c in spec.xyz]
+    tcol = _need(path, col, spec.time_column, "the time", named_at) if spec.time_column else None
     if tcol is None:
         raise DataFileError(path, "a long table needs a time column (motion.time_column)")
     raw_t = _columns(path, rows, line_of, [tcol], "time")[:, 0]
@@ -322,21 +337,31 @@ def _wide_text(
     col: dict[str, int],
     rows: list[list[str]],
     line_of: list[int],
+    named_at: int | None,
 ) -> tuple[FloatArray, tuple[str, ...], FloatArray, str, int]:
-    tcol = _need(path, col, spec.time_column, "the time") if spec.time_column else None
+    tcol = _need(path, col, spec.time_column, "the time", named_at) if spec.time_column else None
     groups: dict[str, dict[str, int]] = {}
     for k, n in enumerate(names):
         m = _WIDE.match(n)
         if k == tcol or m is None:
             continue
-        groups.setdefault(m.group("joint"), {})[m.group("axis").lower()] = k
+        group = groups.setdefault(m.group("joint"), {})
+        axis = m.group("axis").lower()
+        if axis in group:
+            raise DataFileError(
+                path,
+                f"columns {names[group[axis]]!r} and {n!r} are the same coordinate "
+                f"(columns {group[axis] + 1} and {k + 1})",
+                named_at,
+            )
+        group[axis] = k
     joints = [j for j, g in groups.items() if set(g) == {"x", "y", "z"}]
     if not joints:
         raise DataFileError(
             path,
             f"no joint columns: a wide table names three per joint (<joint>_x, <joint>_y, "
             f"<joint>_z); the columns are {', '.join(names[:30])}",
-            1,
+            named_at,
         )
     idx = [groups[j][a] for j in joints for a in "xyz"]
     data = _columns(path, rows, line_of, idx, "coordinate")
