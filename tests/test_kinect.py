@@ -243,6 +243,15 @@ def test_nite_structures_to_skeleton(tmp_path: Path) -> None:
     motion = KinectSource(KinectConfig(format="nite", file=path)).load()
     c = motion.canonical()
     assert c.n_joints == 17 and np.all(np.isfinite(c.positions))
+    # a file is one person: a line of another user is refused, naming it
+    lines = path.read_text().splitlines()
+    k = len(lines) - 3
+    fields = lines[k].split()
+    lines[k] = " ".join([*fields[:2], "4", *fields[3:]])
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(DataFileError, match="user id 4 differs from the first frame's 3") as err:
+        read_nite(path)
+    assert err.value.line == k + 1
 
 
 # --------------------------------------------------------------------------- readers, real data
@@ -285,6 +294,31 @@ def test_utkinect_real() -> None:
     assert m.metadata["segment"] == {"label": "walk", "first_frame": 252, "last_frame": 390}
     assert m.skeleton.duration == pytest.approx((390 - 252) / 60, abs=4 / 60)
     check_body(m, 20, 0.35)
+
+
+@pytest.mark.parametrize(
+    "text,line,match",
+    [
+        ("s01_e01\nwalk: 252 1e300\n", 2, "frame number 1e+300 is not a whole number"),
+        ("s01_e01\nwalk: -50 390\n", 2, "frame number -50.0 is not a whole number"),
+        ("s01_e01\nwalk: 252.7 390\n", 2, "frame number 252.7 is not a whole number"),
+        ("s01_e01\nwalk: 390 252\n", 2, "'walk' ends at frame 252, before its first 390"),
+        ("s01_e01\nwalk: 252 390\n\nwalk: 572 686\n", 4, "action 'walk' of s01_e01 given twice"),
+        ("s01_e01\nwalk: 252 390\ns01_e01\nwalk: 572 686\n", 3, "sequence 's01_e01' given twice"),
+    ],
+)
+def test_utkinect_labels_are_checked(tmp_path: Path, text: str, line: int, match: str) -> None:
+    """A segment label that is not a frame number, runs backwards, or is given twice would cut
+    the wrong part of the recording without a word: each is an error naming the label line."""
+    labels = tmp_path / "actionLabel.txt"
+    labels.write_text(text)
+    with pytest.raises(DataFileError, match=re.escape(match)) as err:
+        KinectSource(KinectConfig(format="utkinect", file=UT, segment="walk", labels=labels)).load()
+    assert err.value.path == labels and err.value.line == line
+    # the same action in another sequence, and an absent one (NaN NaN), are fine
+    labels.write_text("s01_e01\nwalk: 252 390\ncarry: NaN NaN\ns01_e02\nwalk: 10 20\n")
+    m = KinectSource(KinectConfig(format="utkinect", file=UT, segment="walk", labels=labels))
+    assert m.load().metadata["segment"]["last_frame"] == 390
 
 
 @pytest.mark.parametrize("path", MSR, ids=[p.stem for p in MSR])

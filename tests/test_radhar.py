@@ -114,6 +114,10 @@ def test_bad_files_name_the_file_and_line(tmp_path: Path) -> None:
     bad.write_text("point_id: 0\nx: 1.0\ny: 0.0\nz: 0.0\nintensity: 3\n---\n")
     with pytest.raises(DataFileError, match=r"bad\.txt:1: message has no velocity, header\.stamp"):
         read_rostopic_text(bad)
+    # a lost '---' would merge two points into one: the repeated key is refused
+    bad.write_text(_message(0).removesuffix("---\n") + _message(1))
+    with pytest.raises(DataFileError, match=r"bad\.txt:16: secs given twice .*first on line 4"):
+        read_rostopic_text(bad)
     bad.write_text(_message(3) + _message(0, nsecs=5))
     with pytest.raises(DataFileError, match=r"bad\.txt:7: the first message has point_id 3, not 0"):
         text_recording(bad)

@@ -277,24 +277,44 @@ def read_utkinect(path: Path, rate_hz: float = UTKINECT_RATE_HZ) -> Recording:
 
 
 def read_utkinect_labels(path: Path) -> dict[str, dict[str, tuple[int, int]]]:
-    """``actionLabel.txt``: sequence -> action -> (first, last) frame number."""
+    """``actionLabel.txt``: sequence -> action -> (first, last) frame number.
+
+    Each frame number is a whole number within 0 .. ``limits.MAX_FRAME_NUMBER``, the first at
+    most the last; ``NaN NaN`` marks an action missing from the sequence. A sequence, or an
+    action within one, given twice is an error naming the line (either would silently replace
+    the other).
+    """
     out: dict[str, dict[str, tuple[int, int]]] = {}
+    seen: dict[str, int] = {}  # sequence, or sequence/action -> its line
     current: dict[str, tuple[int, int]] | None = None
+    sequence = ""
     for i, line in enumerate(read_text(path), start=1):
         s = line.strip()
         if not s:
             continue
         m = re.fullmatch(r"(\w+)\s*:\s*(\S+)\s+(\S+)", s)
+        key = s if m is None else f"{sequence}/{m.group(1)}"
+        if key in seen:
+            what = f"sequence {s!r}" if m is None else f"action {m.group(1)!r} of {sequence}"
+            raise DataFileError(path, f"{what} given twice (first on line {seen[key]})", i)
         if m is None:
             if re.fullmatch(r"s\d+_e\d+", s):
-                current = out.setdefault(s, {})
+                current, sequence, seen[key] = out.setdefault(s, {}), s, i
                 continue
             raise DataFileError(path, f"expected 'sXX_eYY' or 'action: first last': {s!r}", i)
         if current is None:
             raise DataFileError(path, "an action line before any sequence name", i)
+        seen[key] = i
         a, b = parse_floats(path, [m.group(2), m.group(3)], i, "frame number")
-        if np.isfinite(a) and np.isfinite(b):  # 'NaN NaN': the action is not in the sequence
-            current[m.group(1)] = (int(a), int(b))
+        if np.isnan(a) and np.isnan(b):  # the action is not in the sequence
+            continue
+        check_frame_number(path, a, i)
+        check_frame_number(path, b, i)
+        if a > b:
+            raise DataFileError(
+                path, f"action {m.group(1)!r} ends at frame {b:g}, before its first {a:g}", i
+            )
+        current[m.group(1)] = (int(a), int(b))
     return out
 
 

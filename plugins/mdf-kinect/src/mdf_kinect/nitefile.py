@@ -15,8 +15,9 @@ File format (``.nite.txt``, text, UTF-8)
 
 The first line identifies the format and version. ``#`` lines are ``key: value`` metadata.
 The column line names the 63 columns: time [s] from the device's frame time stamp (relative to the
-first frame), NiTE frame index, user id, then the 15 NiTE joints (:data:`NITE_JOINTS`, NiTE's
-order) as x, y, z [m] and NiTE's position confidence (0..1). NiTE's real-world coordinates
+first frame), NiTE frame index, user id (the same on every line: one person a file), then the
+15 NiTE joints (:data:`NITE_JOINTS`, NiTE's order) as x, y, z [m] and NiTE's position confidence
+(0..1). NiTE's real-world coordinates
 (millimetres, x to the sensor's right) are converted to metres with x negated, giving the Kinect
 SDK's camera space used by every other Kinect reader. Untracked joints are written as ``nan``.
 
@@ -217,6 +218,13 @@ def read_nite(path: Path, foot_length: float = 0.2, min_confidence: float = 0.5)
             )
         rows.append(parse_floats(path, f, i))
         _check_row(path, rows[-1], i)
+        if rows[-1][2] != rows[0][2]:
+            raise DataFileError(
+                path,
+                f"user id {rows[-1][2]:g} differs from the first frame's {rows[0][2]:g}: a NiTE "
+                "recording holds one person (write each user to a file of their own)",
+                i,
+            )
     if not rows:
         raise DataFileError(path, "no frame")
     a = np.asarray(rows)

@@ -179,7 +179,9 @@ class KinectSource(MotionSource):
             keep = (rec.frame_numbers >= first) & (rec.frame_numbers <= last)
             if keep.sum() < 2:
                 raise DataFileError(
-                    path, f"segment {c.segment!r} (frames {first}..{last}) holds < 2 frames"
+                    path,
+                    f"segment {c.segment!r} (frames {first}..{last}) holds < 2 frames of this "
+                    "recording: check its labels against the file",
                 )
             meta["segment"] = {"label": c.segment, "first_frame": first, "last_frame": last}
         t = rec.time[keep]

@@ -210,6 +210,13 @@ def read_rostopic_text(path: str | Path) -> dict[str, NDArray[np.float64]]:
                 problem = _problem(key, number)
                 if problem is not None:
                     raise DataFileError(p, problem, line_no)
+                if key in current:
+                    raise DataFileError(
+                        p,
+                        f"{key} given twice in one message (first on line {at[key]}): is the "
+                        "'---' line between two messages missing?",
+                        line_no,
+                    )
                 current[key] = number
                 at[key] = line_no
             flush()
