@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -15,6 +17,7 @@ from conftest import EXAMPLES
 
 from mdframework import cli
 from mdframework.config import load_run_config, read_config_file
+from mdframework.errors import ConfigError
 
 EXAMPLE_CONFIGS = sorted(p for p in EXAMPLES.glob("*.toml") if not p.stem.startswith("experiment_"))
 
@@ -53,6 +56,31 @@ def test_every_example_runs(
     again = tmp_path / "again.json"
     again.write_text(json.dumps(resolved))
     load_run_config(again)
+
+
+def test_resolved_config_of_a_relative_config_path_runs_from_anywhere(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`mdf run cfg/walk.toml` (a path relative to the working folder): the resolved config
+    names the motion file absolutely, so it checks from another folder and reproduces the run."""
+    cfg = tmp_path / "cfg"
+    cfg.mkdir()
+    for name in ("02_01.amc", "02.asf"):
+        (cfg / name).write_bytes((EXAMPLES / "data" / "cmu" / "asf-amc" / name).read_bytes())
+    (cfg / "walk.toml").write_text(
+        '[motion]\nkind = "cmu"\nfile = "02_01.amc"\nduration = 1.0\n\n'
+        '[scatterers]\nkind = "ellipsoid"\n\n[radar]\nkind = "lfm"\n\n'
+        "[scene]\nradar_position = [10.0, 0.0, 2.0]\n"
+    )
+    monkeypatch.chdir(tmp_path)
+    assert run_cli(["run", "cfg/walk.toml", "--out", "out", "--no-figures"], capsys)[0] == 0
+    resolved = json.loads((tmp_path / "out" / "config.resolved.json").read_text())
+    assert resolved["motion"]["file"] == str(cfg / "02_01.amc")
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    code, _, err = run_cli(["check", str(tmp_path / "out" / "config.resolved.json")], capsys)
+    assert code == 0, err
 
 
 def test_point_target_example_doppler(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -176,6 +204,49 @@ def test_yaml_and_json_configs_run(tmp_path: Path, capsys: pytest.CaptureFixture
         with np.load(out / "result.npz") as d:
             results.append(d["signal"])
     assert np.array_equal(results[0], results[1])
+
+
+@pytest.mark.parametrize(
+    ("name", "text", "expected"),
+    [
+        (
+            "twice.yaml",
+            "motion:\n  kind: point_targets\nmotion: {}\n",
+            "line 3: key 'motion' given",
+        ),
+        (
+            "nested.yml",
+            "radar:\n  kind: lfm\n  prf: 2400\n  prf: 1000\n",
+            "line 4: key 'prf' given twice",
+        ),
+        ("twice.json", '{"radar": {"prf": 2400, "prf": 1000}}', "key 'prf' given twice"),
+    ],
+)
+def test_a_key_given_twice_in_yaml_or_json_is_refused(
+    name: str, text: str, expected: str, tmp_path: Path
+) -> None:
+    """TOML refuses a repeated key; YAML and JSON parsers keep the last one silently, which
+    would run another radar than the one the user reads first."""
+    path = tmp_path / name
+    path.write_text(text)
+    with pytest.raises(ConfigError, match=re.escape(expected)) as err:
+        read_config_file(path)
+    assert str(path) in str(err.value)
+    # a merge key may still be overridden: that is what it is for
+    path = tmp_path / "merge.yaml"
+    path.write_text("base: &b {prf: 2400, kind: lfm}\nradar:\n  <<: *b\n  prf: 1000\n")
+    assert read_config_file(path)["radar"] == {"prf": 1000, "kind": "lfm"}
+
+
+def test_a_config_that_is_not_a_regular_file_is_refused(tmp_path: Path) -> None:
+    """A named pipe would block the reader forever; a folder is named as one."""
+    pipe = tmp_path / "fifo.toml"
+    os.mkfifo(pipe)
+    with pytest.raises(ConfigError, match=r"fifo\.toml: cannot read: not a regular file"):
+        read_config_file(pipe)
+    (tmp_path / "dir.toml").mkdir()
+    with pytest.raises(ConfigError, match=r"dir\.toml: cannot read: it is a folder"):
+        read_config_file(tmp_path / "dir.toml")
 
 
 @pytest.mark.parametrize(

@@ -12,6 +12,7 @@ Relative paths inside a config are relative to the config file's folder.
 from __future__ import annotations
 
 import json
+import stat
 import tomllib
 from functools import lru_cache
 from pathlib import Path
@@ -118,16 +119,45 @@ def _decode(p: Path, raw: bytes) -> str:
 
 
 def _load_yaml(p: Path, text: str) -> Any:
-    """The data of a YAML config (PyYAML imported here: only YAML configs need it)."""
+    """The data of a YAML config (PyYAML imported here: only YAML configs need it). A key given
+    twice in one mapping is an error naming its line (PyYAML would keep the last silently);
+    keys merged in with ``<<`` may still be overridden."""
     import yaml
 
+    class Loader(yaml.SafeLoader):  # type: ignore[misc]  # PyYAML is untyped here
+        def construct_mapping(self, node: Any, deep: bool = False) -> Any:
+            seen: set[Any] = set()
+            for key_node, _ in node.value:
+                if key_node.tag == "tag:yaml.org,2002:merge":
+                    continue
+                key = self.construct_object(key_node, deep=True)
+                if isinstance(key, list | dict) or key in seen:
+                    raise yaml.constructor.ConstructorError(
+                        problem=f"key {key!r} given twice in one mapping"
+                        if key in seen
+                        else "a key that is a list or a mapping",
+                        problem_mark=key_node.start_mark,
+                    )
+                seen.add(key)
+            return super().construct_mapping(node, deep=deep)
+
     try:
-        return yaml.safe_load(text)
+        return yaml.load(text, Loader=Loader)  # a SafeLoader
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f"line {mark.line + 1}: " if mark is not None else ""
         problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
         raise ConfigError(f"{p}: invalid YAML: {where}{problem}") from None
+
+
+def _json_object(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """A JSON object, refusing a key given twice (``json`` would keep the last silently)."""
+    out: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in out:
+            raise ValueError(f"key {key!r} given twice in one object")
+        out[key] = value
+    return out
 
 
 def _check_depth(p: Path, data: Any) -> None:
@@ -184,7 +214,11 @@ def read_config_file(path: str | Path, kind: str | None = None) -> dict[str, Any
     if suffix not in (".toml", ".yaml", ".yml", ".json"):
         raise ConfigError(f"{p}: unknown config format {suffix!r} (use .toml, .yaml or .json)")
     try:
-        size = p.stat().st_size
+        st = p.stat()
+        if not stat.S_ISREG(st.st_mode):  # a folder, a pipe (which would block), a device
+            what = "it is a folder" if p.is_dir() else "not a regular file (a pipe or a device?)"
+            raise ConfigError(f"{p}: cannot read: {what}")
+        size = st.st_size
         if size > limits.MAX_CONFIG_BYTES:
             raise ConfigError(
                 f"{p}: {size:,} bytes; a config file may hold at most "
@@ -201,13 +235,15 @@ def read_config_file(path: str | Path, kind: str | None = None) -> dict[str, Any
         if suffix == ".toml":
             data: Any = tomllib.loads(text)
         elif suffix == ".json":
-            data = json.loads(text)
+            data = json.loads(text, object_pairs_hook=_json_object)
         else:
             data = _load_yaml(p, text)
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{p}: invalid TOML: {exc}") from None
     except json.JSONDecodeError as exc:
         raise ConfigError(f"{p}: invalid JSON: line {exc.lineno}: {exc.msg}") from None
+    except ValueError as exc:  # from _json_object
+        raise ConfigError(f"{p}: invalid JSON: {exc}") from None
     except RecursionError:
         raise ConfigError(
             f"{p}: tables and lists are nested more than {limits.MAX_CONFIG_DEPTH} deep"

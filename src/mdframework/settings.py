@@ -78,10 +78,10 @@ def _resolve_path(value: Path, info: ValidationInfo) -> Path:
         path = Path(base) / path
     if not path.exists():
         raise ValueError(f"file not found: {path}")
-    return path
+    return path.absolute()  # a resolved config read from anywhere names the same file
 
 
-#: A path to an existing file, relative to the config file's folder.
+#: A path to an existing file, relative to the config file's folder (absolute once validated).
 DataPath = Annotated[Path, AfterValidator(_resolve_path)]
 
 
