@@ -9,6 +9,7 @@ import pytest
 from mdf_knn import Knn
 from mdf_sklearn import SklearnClassifier
 
+from mdframework import ConfigError
 from mdframework.classify import (
     Standardizer,
     balanced_accuracy,
@@ -55,6 +56,17 @@ def test_five_classes_two_two_one_split() -> None:
     x = np.array([[1.0], [-1.2], [2.0], [-2.2], [3.0]])
     y = np.array(["walk", "run", "walk", "run", "box"])
     assert knn(k=5).fit(x, y).predict(np.array([[0.0]]))[0] == "walk"
+
+
+def test_more_neighbours_than_training_records_is_refused() -> None:
+    """k above the training set would let every record vote (the largest class always wins):
+    refused naming classifier.k, where it used to be lowered silently; k equal to it is a
+    legal, if degenerate, vote."""
+    x = np.array([[1.0], [-1.2], [2.0], [-2.2], [3.0]])
+    y = np.array(["walk", "run", "walk", "run", "box"])
+    with pytest.raises(ConfigError, match=r"classifier\.k: 6 neighbours, but .* only 5"):
+        knn(k=6).fit(x, y)
+    assert knn(k=5).fit(x, y).neighbours(np.array([[0.0]]))[1].shape == (1, 5)
 
 
 def test_distance_ties_follow_training_order() -> None:

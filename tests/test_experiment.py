@@ -114,6 +114,15 @@ def test_experiment_on_shipped_cmu_data(tmp_path: Path) -> None:
     assert "Selected features (times chosen in 2 splits): " in report
 
 
+def test_a_classifier_config_error_fails_the_experiment(tmp_path: Path) -> None:
+    """An error of the config (k above the records a fold trains on) ends the experiment; it
+    is not reported as one source that could not be evaluated, with an exit code of success."""
+    cfg = exp.load_experiment_config(EXAMPLES / "experiment_cmu.toml")
+    cfg = cfg.model_copy(update={"classifier": {"kind": "knn", "k": 500}})
+    with pytest.raises(ConfigError, match=r"classifier\.k: 500 neighbours"):
+        exp.run_experiment(cfg, tmp_path / "exp", progress=False)
+
+
 def test_selected_features_are_counted_over_splits() -> None:
     subsets = [["a", "b"], ["a", "c"], ["a", "b"]]
     line = exp.selected_features_markdown(subsets, "wrapper")[0]

@@ -633,6 +633,8 @@ def _report(
                 names,
                 progress=f"within {group}" if progress else None,
             )
+        except ConfigError:  # the config is wrong for every source: the experiment fails
+            raise
         except MdfError as exc:  # e.g. a class with a single recording cannot be held out
             report += [f"## Within-source: {group}", "", f"Not evaluated: {exc}.", ""]
             summary["within"][group] = {"skipped": str(exc)}

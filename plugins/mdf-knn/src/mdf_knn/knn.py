@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field
 
-from mdframework import Classifier, PluginConfig
+from mdframework import Classifier, ConfigError, PluginConfig
 from mdframework.classify import Standardizer
 
 #: Queries per block: a block's (queries, training samples, features) difference array stays
@@ -52,6 +52,12 @@ class Knn(Classifier):
         x = np.asarray(features, dtype=np.float64)
         if x.ndim != 2 or x.shape[0] != len(labels):
             raise ValueError("features must be (n_samples, n_features) with one label each")
+        if self.config.k > x.shape[0]:  # every record would vote: the largest class wins
+            raise ConfigError(
+                f"classifier.k: {self.config.k} neighbours, but this fit has only {x.shape[0]} "
+                "training records (cross-validation folds hold fewer than the whole training "
+                "split): lower k"
+            )
         self.scaler_ = Standardizer.fit(x)
         self.labels_ = np.asarray(labels)
         # classes in sorted order; codes_ (n_samples,) indexes them
@@ -76,7 +82,7 @@ class Knn(Classifier):
         """Distances and training indices of the k nearest neighbours, (n_queries, k) each,
         ordered by distance, ties by training order."""
         n_train, n_feat = self.train_.shape
-        k = min(self.config.k, n_train)
+        k = self.config.k  # at most n_train (checked by fit)
         z = self.scaler_.transform(np.asarray(features, dtype=np.float64))
         step = max(1, _BLOCK_ELEMENTS // max(1, n_train * n_feat))
         dist = np.empty((z.shape[0], k))
