@@ -244,6 +244,28 @@ def test_doppler_is_2v_over_lambda() -> None:
     assert est == pytest.approx(2 * v / SEQ.wavelength, abs=1e-3 / (16 * SEQ.loop_period))
 
 
+@pytest.mark.parametrize("name", sorted(fmcw.WINDOWS))
+def test_range_doppler_map_peaks_at_the_target_amplitude(name: str) -> None:
+    """Absolute level (docs/fmcw.md: the map is in W): a target of amplitude a = 0.37 sqrt(W)
+    on range bin 40 and Doppler bin +3 (its slow-time phase advances 3/16 of a cycle per loop)
+    peaks in every virtual channel at |RD| = a and in the detection map at n_virt a^2 [W], to
+    1e-9, whatever the window: the range and the Doppler FFT each divide by the sum of their
+    window (dividing the Doppler FFT by n_loops would leave a Hann-windowed map 6 dB low)."""
+    a, d, k = 0.37, 3, 40
+    t = fmcw.chirp_times(SEQ, 0.0, SEQ.frame_period)  # (48,) one frame, TDM slots included
+    fd = d / (SEQ.n_loops * SEQ.loop_period)  # on Doppler bin d
+    amp = (a * np.exp(2j * np.pi * fd * t))[:, None]  # approaching: the phase advances
+    delays = np.full((t.size, 1), 2 * k * SEQ.range_resolution / C)  # on range bin k
+    prof = fmcw.range_profile(fmcw.if_samples(delays, amp, SEQ), name, 240)  # type: ignore[arg-type]
+    rd = fmcw.range_doppler(fmcw.virtual_cube(prof[:, None, :], SEQ, 3), name, 16)  # type: ignore[arg-type]
+    row = 16 // 2 + d
+    assert fmcw.doppler_axis(SEQ, 16)[row] == pytest.approx(fd, rel=1e-12)
+    np.testing.assert_allclose(np.abs(rd[:, row, k]), a, rtol=1e-9)
+    power = fmcw.detection_map(rd)
+    assert np.unravel_index(np.argmax(power), power.shape) == (row, k)
+    assert power[row, k] == pytest.approx(3 * a**2, rel=1e-9)
+
+
 def test_velocity_beyond_the_tdm_limit_aliases() -> None:
     """Hard case: the unambiguous velocity is lambda / (4 n_tx T_chirp) (TDM: one sample per
     loop); at 1.25 x it the peak wraps to 1.25 v_max - 2 v_max = -0.75 v_max."""

@@ -12,6 +12,7 @@ from mdf_fmcw.waveform import FmcwConfig, FmcwRadar
 from mdf_lfm.waveform import LfmConfig, LfmPulseDoppler
 
 from mdframework.config import load_run_config, validate_run_config
+from mdframework.constants import SPEED_OF_LIGHT as C
 from mdframework.errors import ConfigError, SceneError
 from mdframework.interfaces import PulseBlock, Scatterers, receive_points
 from mdframework.physics import radar
@@ -232,6 +233,38 @@ def test_snr_of_a_point_target_follows_the_range_equation(preset: str) -> None:
     assert round(10 * np.log10(1 + snr), 1) == documented[preset]
     if preset == "iwr1443_short_range_3d":
         assert round(10 * np.log10(snr * (r / 12.0) ** 4), 1) == 10.8
+
+
+@pytest.mark.parametrize("range_window", ["hann", "rect"])
+@pytest.mark.parametrize("doppler_window", ["hann", "rect"])
+def test_range_doppler_map_is_the_received_power_in_watts(
+    range_window: str, doppler_window: str
+) -> None:
+    """Absolute level of the ``range_doppler`` product (docs/fmcw.md: [W], summed over the
+    virtual antennas): a static 0.5 m^2 point on boresight on range bin 40 (zero Doppler: on a
+    Doppler bin too), without receiver noise, peaks at 12 P_r, the 3 x 4 virtual antennas times
+    the received power of the radar range equation
+    ``P_r = P_t G^2 lambda_c^2 sigma / ((4 pi)^3 R^4 L_s L_a)``, computed here from the config's
+    fields, to 1e-5 (the map is stored in float32), with Hann and rectangular windows."""
+    fields = {"transmit_power": 2.0, "gain_dbi": 6.0, "system_loss_db": 3.0}
+    fields |= {"atmospheric_loss_db": 1.0, "clutter_removal": False, **QUIET}
+    seq = FmcwConfig(preset="iwr1443_short_range_3d", **fields).sequence()  # type: ignore[arg-type]
+    r, sigma = 40 * seq.range_resolution, 0.5
+    res = fmcw_run(
+        [{"position": [r, 0.0, 0.0], "rcs": sigma}],
+        duration=2 * seq.frame_period,
+        range_window=range_window,
+        doppler_window=doppler_window,
+        **fields,
+    )
+    maps = res.received.products["range_doppler"]
+    assert maps.shape == (2, 16, 240)
+    lam = C / seq.centre_frequency
+    gain, loss = 10 ** (6.0 / 10), 10 ** ((3.0 + 1.0) / 10)
+    p_r = 2.0 * gain**2 * lam**2 * sigma / ((4 * np.pi) ** 3 * r**4 * loss)
+    for frame in maps:
+        assert np.unravel_index(np.argmax(frame), frame.shape) == (8, 40)
+        assert float(frame[8, 40]) == pytest.approx(12 * p_r, rel=1e-5)
 
 
 def test_receive_is_block_invariant() -> None:
