@@ -23,13 +23,20 @@ QUIET = {"receiver_noise": False}
 IWR1443 = FmcwConfig(preset="iwr1443_short_range_3d")
 
 
-def point_run(targets: list[dict[str, Any]], *, duration: float, radar: dict[str, Any]) -> Any:
-    """Point targets seen by ``radar`` at the origin."""
+def point_run(
+    targets: list[dict[str, Any]],
+    *,
+    duration: float,
+    radar: dict[str, Any],
+    processing: dict[str, Any] | None = None,
+) -> Any:
+    """Point targets seen by ``radar`` at the origin (``processing``: that config section)."""
     cfg = {
         "motion": {"kind": "point_targets", "length": duration, "targets": targets},
         "scatterers": {"kind": "points"},
         "radar": radar,
         "scene": {"radar_position": [0.0, 0.0, 0.0]},
+        "processing": processing or {},
     }
     return simulate(validate_run_config(cfg))
 
@@ -313,6 +320,47 @@ def test_spectrogram_follows_the_frame_timing() -> None:
     assert vel[0] == pytest.approx(-seq.max_velocity, rel=1e-9)
     peaks = vel[np.argmax(spec.power, axis=0)]
     assert np.all(np.abs(peaks - v) < seq.velocity_resolution / 2)
+
+
+@pytest.mark.parametrize(
+    ("tdm_order", "v"),
+    [([1, 3, 2], 1.0), ([1, 3, 2], -1.5), ([1], 1.0), ([1], -1.5)],
+    ids=["3tx-approaching", "3tx-receding", "1tx-approaching", "1tx-receding"],
+)
+def test_gapless_frames_give_the_stft_at_the_loop_rate(tdm_order: list[int], v: float) -> None:
+    """Frames without gaps (``frame_period = n_loops n_tx T_c``): the STFT of the first TDM
+    slot's chirps, one sample per loop, so at the loop rate ``1 / (n_tx T_c)`` (5197 Hz with 3
+    TX, 15590 Hz with 1). A point 3 m out on boresight approaching at ``v`` (receding when
+    negative) peaks in every column at ``v`` within one velocity bin, with ``v = f_D lambda_c /
+    2`` and ``f_c = f0 + S (adc_start_time + (n_samples - 1) / (2 fs))`` (docs/fmcw.md) from the
+    preset's data; the columns are ``hop`` loops apart. (At the chirp rate instead, 1 m/s would
+    show at 3 m/s with 3 TX.)"""
+    base = FmcwConfig(preset="iwr1443_short_range_3d", tdm_order=tdm_order)
+    seq = base.sequence()
+    n_tx = len(tdm_order)
+    loop = n_tx * 64.14e-6  # the preset's chirp period, 7 us idle + 57.14 us ramp
+    res = point_run(
+        [{"position": [3.0, 0.0, 0.0], "velocity": [-v, 0.0, 0.0]}],
+        duration=0.3,
+        radar={
+            "kind": "fmcw",
+            "preset": "iwr1443_short_range_3d",
+            "tdm_order": tdm_order,
+            "frame_period": seq.n_loops * loop,
+            "boresight_azimuth_deg": 0.0,
+            **QUIET,
+        },
+        processing={"window_length": 64, "hop": 16, "nfft": 256},
+    )
+    spec = res.spectrogram
+    np.testing.assert_allclose(np.diff(spec.doppler), 1 / (loop * 256), rtol=1e-9)
+    assert spec.doppler[0] == pytest.approx(-1 / (2 * loop), rel=1e-9)
+    np.testing.assert_allclose(np.diff(spec.time), 16 * loop, rtol=1e-9)
+    f_c = 77e9 + 70e12 * (7e-6 + 239 / (2 * 4.884e6))  # 79.20 GHz
+    vel = spec.doppler * (C / f_c) / 2
+    peaks = vel[np.argmax(spec.power, axis=0)]
+    assert spec.time.size > 50
+    assert np.max(np.abs(peaks - v)) <= vel[1] - vel[0]
 
 
 def test_fmcw_and_lfm_spectrograms_of_the_same_walk_agree() -> None:
