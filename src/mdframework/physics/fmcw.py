@@ -37,7 +37,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -982,24 +982,34 @@ FRAMES_PER_BLOCK = 256
 
 
 def frame_spectrogram(
-    signal: ComplexArray, seq: ChirpSequence, window_name: str, nfft: int
-) -> tuple[FloatArray, FloatArray, FloatArray]:
+    signal: ComplexArray,
+    seq: ChirpSequence,
+    window_name: str,
+    nfft: int,
+    precision: Literal["float32", "float64"] = "float32",
+) -> tuple[NDArray[np.floating[Any]], FloatArray, FloatArray]:
     """One Doppler spectrum per frame of the slow-time signal of the first TDM slot.
 
     ``signal`` (n_frames * chirps_per_frame,) one value per chirp. Each frame's ``n_loops``
     samples of slot 0 are windowed (any scipy window, :func:`stft_window`) and transformed with
-    ``nfft`` >= n_loops points. Returns power (nfft, n_frames) [|signal|^2], Doppler (nfft,)
-    [Hz] ascending and the time of each frame's middle loop (n_frames,) [s from the first chirp].
+    ``nfft`` >= n_loops points, in ``precision`` (as the STFT's ``processing.precision``:
+    float32 is complex64 FFTs and float32 power). Returns power (nfft, n_frames) [|signal|^2]
+    float32 or float64, Doppler (nfft,) [Hz] ascending and the time of each frame's middle loop
+    (n_frames,) [s from the first chirp].
     """
     from .spectrogram import stft_window  # the cosine windows without importing scipy.signal
 
+    single = precision == "float32"
+    real = np.dtype(np.float32 if single else np.float64)
+    cplx = np.dtype(np.complex64 if single else np.complex128)
     frames = np.asarray(signal).reshape(-1, seq.chirps_per_frame)[:, :: seq.n_tx]
-    w = stft_window(window_name, seq.n_loops)
+    w = stft_window(window_name, seq.n_loops).astype(real)
     n_frames = frames.shape[0]
-    power = np.empty((nfft, n_frames), dtype=np.float64)
+    power = np.empty((nfft, n_frames), dtype=real)
     for lo in range(0, n_frames, FRAMES_PER_BLOCK):  # memory set by the block, not the record
         hi = min(lo + FRAMES_PER_BLOCK, n_frames)
-        spec = np.fft.fftshift(np.fft.fft(frames[lo:hi] * w, n=nfft, axis=1), axes=1)
+        x = frames[lo:hi].astype(cplx) * w
+        spec = np.fft.fftshift(np.fft.fft(x, n=nfft, axis=1), axes=1)
         power[:, lo:hi] = (spec.real**2 + spec.imag**2).T
     time = np.arange(n_frames) * seq.frame_period + (seq.n_loops - 1) / 2 * seq.loop_period
     return power, doppler_axis(seq, nfft), np.asarray(time, np.float64)

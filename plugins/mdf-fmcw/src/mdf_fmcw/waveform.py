@@ -484,7 +484,8 @@ class FmcwRadar(RadarWaveform):
         """Micro-Doppler spectrogram from the first TDM slot's chirps (one sample per loop):
         an STFT (``processing`` window, length, hop, FFT size) when the frames follow each other
         without gaps, else one Doppler spectrum per frame (window over the frame's loops, FFT
-        size ``processing.nfft``), at the frame's middle loop."""
+        size ``processing.nfft``), at the frame's middle loop; the power in
+        ``processing.precision`` (float32 by default)."""
         from mdframework.physics.spectrogram import Spectrogram, spectrogram
 
         seq = self.sequence
@@ -497,9 +498,10 @@ class FmcwRadar(RadarWaveform):
                 window_length=p.window_length,
                 hop=p.hop,
                 nfft=p.nfft,
+                precision=p.precision,
             )
         power, doppler, time = fmcw.frame_spectrogram(
-            np.asarray(signal), seq, p.window, max(p.nfft, seq.n_loops)
+            np.asarray(signal), seq, p.window, max(p.nfft, seq.n_loops), p.precision
         )
         return Spectrogram(power, doppler, time)
 
