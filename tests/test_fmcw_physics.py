@@ -464,6 +464,27 @@ def test_sensor_axes_are_a_right_handed_frame() -> None:
     assert a[2, 2] > 0  # z_s points up
 
 
+@pytest.mark.parametrize("n_fft", [240, 512])
+@pytest.mark.parametrize("name", sorted(fmcw.WINDOWS))
+def test_gate_signal_over_every_range_bin_is_the_middle_if_sample(name: str, n_fft: int) -> None:
+    """The identity the gate's flat response rests on: a target's range response (the
+    sampled sinc, a Dirichlet kernel, with a rectangular window; a sum of shifted ones with the
+    cosine windows) summed over every range bin with the gate's phase ramp and scale is one,
+    so the gate signal of a gate covering every bin is exactly the IF sample at
+    ``m0 = n_samples // 2``: to 1e-12 (complex, amplitudes 1 and 0.4), for targets 0.5 bin
+    below to 0.5 bin above bin 120 in 11 steps beside a second one at bin 37.3, every window,
+    with and without zero-padding. A bin left out of the sum (even the last one, 120 bins
+    from the target) or a halved sum breaks it."""
+    x = np.column_stack([120 + np.linspace(-0.5, 0.5, 11), np.full(11, 37.3)])  # [bins of 240]
+    delays = x / 240 * SEQ.sample_rate / SEQ.slope  # beat frequency x / 240 cycles per sample
+    y = fmcw.if_samples(delays, np.tile([1.0, 0.4], (11, 1)), SEQ)
+    prof = fmcw.range_profile(y, name, n_fft)[:, None, :]  # type: ignore[arg-type]
+    axis = fmcw.range_axis(SEQ, n_fft)
+    everything = np.full(11, SEQ.max_range / 2)  # gate centre; width: twice the range axis
+    g = fmcw.gate_signal(prof, axis, everything, 2 * SEQ.max_range, name, 240)  # type: ignore[arg-type]
+    np.testing.assert_allclose(g, y[:, 240 // 2], rtol=0, atol=1e-12)
+
+
 def test_gate_signal_is_flat_inside_the_gate_and_rejects_outside() -> None:
     """The slow-time signal of the gate: a lone target anywhere within 0.8 m of a 2 m gate's
     centre gives its amplitude to 7e-4 (Hann window) with exactly the phase of the middle IF

@@ -169,13 +169,6 @@ def test_sampled_matched_filter_peak_value_position_and_phase() -> None:
     assert np.max(np.abs(np.abs(y) - np.abs(chi))) < 2e-3 * tau
 
 
-def test_sum_of_sinc_over_range_bins_is_one() -> None:
-    x = np.linspace(-0.5, 0.5, 11)
-    k = np.arange(-2000, 2001)
-    sums = np.sinc(k[None, :] - x[:, None]).sum(axis=1)
-    assert np.allclose(sums, 1.0, atol=1e-3)
-
-
 def test_gate_weight_of_scatterer_half_a_metre_away() -> None:
     w = radar.gate_weights(
         np.array([[10.5]]), np.array([10.0]), pulse_width=1e-6, bandwidth=150e6, response="sinc"
