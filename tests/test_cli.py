@@ -83,6 +83,28 @@ def test_resolved_config_of_a_relative_config_path_runs_from_anywhere(
     assert code == 0, err
 
 
+def test_a_full_disk_is_one_line_naming_the_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A full disk cannot be made here, so numpy's writer raises what a full disk makes it
+    raise: the command says so in one line naming the file, exit code 2, and leaves no
+    output folder behind (it was not there before)."""
+    import errno
+
+    def full(file: Any, *args: Any, **kwargs: Any) -> None:
+        raise OSError(errno.ENOSPC, "No space left on device", str(file))
+
+    monkeypatch.setattr(np, "savez_compressed", full)
+    out = tmp_path / "o"
+    code, _, err = run_cli(
+        ["run", str(EXAMPLES / "point_target.toml"), "--out", str(out), "--no-figures"], capsys
+    )
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert err.startswith("mdf: error: No space left on device: ")
+    assert err.strip().endswith("result.npz")
+    assert list(tmp_path.iterdir()) == []  # no output folder, no staging debris
+
+
 def test_point_target_example_doppler(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "pt"
     assert run_cli(["run", str(EXAMPLES / "point_target.toml"), "--out", str(out)], capsys)[0] == 0
