@@ -83,6 +83,28 @@ def test_resolved_config_of_a_relative_config_path_runs_from_anywhere(
     assert code == 0, err
 
 
+def test_a_full_disk_is_one_line_naming_the_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A full disk cannot be made here, so numpy's writer raises what a full disk makes it
+    raise: the command says so in one line naming the file, exit code 2, and leaves no
+    output folder behind (it was not there before)."""
+    import errno
+
+    def full(file: Any, *args: Any, **kwargs: Any) -> None:
+        raise OSError(errno.ENOSPC, "No space left on device", str(file))
+
+    monkeypatch.setattr(np, "savez_compressed", full)
+    out = tmp_path / "o"
+    code, _, err = run_cli(
+        ["run", str(EXAMPLES / "point_target.toml"), "--out", str(out), "--no-figures"], capsys
+    )
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert err.startswith("mdf: error: No space left on device: ")
+    assert err.strip().endswith("result.npz")
+    assert list(tmp_path.iterdir()) == []  # no output folder, no staging debris
+
+
 def test_point_target_example_doppler(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "pt"
     assert run_cli(["run", str(EXAMPLES / "point_target.toml"), "--out", str(out)], capsys)[0] == 0
@@ -236,6 +258,42 @@ def test_a_key_given_twice_in_yaml_or_json_is_refused(
     path = tmp_path / "merge.yaml"
     path.write_text("base: &b {prf: 2400, kind: lfm}\nradar:\n  <<: *b\n  prf: 1000\n")
     assert read_config_file(path)["radar"] == {"prf": 1000, "kind": "lfm"}
+
+
+@pytest.mark.parametrize(
+    ("section", "field", "value", "expected"),
+    [
+        ("radar", "prf", True, "radar.prf: a number, not a flag (true)"),
+        ("radar", "gain_dbi", True, "radar.gain_dbi: a number, not a flag (true)"),
+        ("processing", "floor_db", "-50", 'processing.floor_db: a number, not text ("-50")'),
+        ("processing", "hop", True, "processing.hop: a number, not a flag (true)"),
+        ("processing", "keep_scatterers", 1, "processing.keep_scatterers: true or false, not int"),
+        ("scene", "radar_position", [True, 0, 0], "scene.radar_position: a number, not a flag"),
+    ],
+)
+def test_numbers_and_flags_are_not_converted(
+    section: str, field: str, value: Any, expected: str, tmp_path: Path
+) -> None:
+    """pydantic's lax mode would read `prf = true` as 1 Hz and `floor_db = "-50"` as -50 dB:
+    a flag or text where a number belongs (or a number where a flag belongs) is refused, naming
+    the field, in the core's sections and the plugins' alike, and inside a point target."""
+    import tomllib
+
+    data = tomllib.loads((EXAMPLES / "point_target.toml").read_text())
+    data.setdefault(section, {})[field] = value
+    path = tmp_path / "c.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(ConfigError) as err:
+        load_run_config(path)
+    assert expected in str(err.value)
+    data = tomllib.loads((EXAMPLES / "point_target.toml").read_text())
+    data["motion"]["targets"][0]["rcs"] = "1"
+    path.write_text(json.dumps(data))
+    with pytest.raises(ConfigError, match=re.escape('rcs: a number, not text ("1")')):
+        load_run_config(path)
+    data["motion"]["targets"][0]["rcs"] = 1  # an integer is a number
+    path.write_text(json.dumps(data))
+    assert load_run_config(path).motion.targets[0].rcs == 1.0  # type: ignore[attr-defined]
 
 
 def test_a_config_that_is_not_a_regular_file_is_refused(tmp_path: Path) -> None:
@@ -436,6 +494,25 @@ def test_check_warns_of_aliasing_and_names_the_prf(
         in out
     )
     assert not (tmp_path / "o").exists()
+
+
+def test_check_refuses_a_body_nearer_the_radar_than_min_range(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A radar inside the walker's path: the run refuses the scatterer at the pelvis (the
+    range equation does not hold at centimetres); `mdf check` refuses the joint there too,
+    instead of calling the config valid."""
+    cfg = tmp_path / "close.toml"
+    amc = EXAMPLES / "data" / "cmu" / "asf-amc" / "02_01.amc"
+    cfg.write_text(
+        f'[motion]\nkind = "cmu"\nfile = "{amc}"\nduration = 1.0\n'
+        '[scatterers]\nkind = "ellipsoid"\n[radar]\nkind = "lfm"\n'
+        "[scene]\nradar_position = [0.1, 0.0, 1.0]\n"
+    )
+    code, _, err = run_cli(["check", str(cfg)], capsys)
+    assert code == 2 and "joint 'base' comes within 0.0659 m of the radar" in err, err
+    code, _, err = run_cli(["run", str(cfg), "--out", str(tmp_path / "o")], capsys)
+    assert code == 2 and "scatterer 'base' comes within 0.0657 m of the radar" in err, err
 
 
 def test_progress_notes_only_on_a_terminal(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -18,6 +18,7 @@ if TYPE_CHECKING:
     from .hookspecs import hookimpl
     from .interfaces import (
         Classifier,
+        ConfigSection,
         Effect,
         Motion,
         MotionSource,
@@ -45,6 +46,7 @@ _EXPORTS = {
     "SceneError": "errors",
     "hookimpl": "hookspecs",
     "Classifier": "interfaces",
+    "ConfigSection": "interfaces",
     "Effect": "interfaces",
     "Motion": "interfaces",
     "MotionSource": "interfaces",
@@ -99,6 +101,7 @@ __all__ = [
     "CANONICAL_SEGMENTS",
     "Classifier",
     "ConfigError",
+    "ConfigSection",
     "DataFileError",
     "DataPath",
     "Effect",

@@ -3,7 +3,9 @@
 :func:`plan_run` validates the config, instantiates its plugins, loads the motion (reading the
 input is part of checking it) and places the body, then reports the record, the spectrogram
 geometry, the Doppler and velocity resolution, the unambiguous velocity, the aliasing risk and an
-estimate of the memory the run needs. No pulses are simulated.
+estimate of the memory the run needs. No pulses are simulated. It refuses what the run would
+refuse before its first pulse, and a joint nearer the radar than ``scene.min_range``; what the
+run finds only in the pulses (an empty range gate, an effect's own checks) it cannot see.
 
 The aliasing risk is judged from the radial speed of the body's joints at the motion's own frame
 times (finite differences of each joint's range to the radar): body-part scatterers sit on the
@@ -20,6 +22,7 @@ import numpy as np
 
 from . import limits
 from .errors import SceneError
+from .interfaces import FloatArray
 from .physics import radar
 from .pipeline import _place, _window, build_stages, load_motion, placed
 from .plugins import Registry, default_registry
@@ -80,6 +83,30 @@ def max_joint_radial_speed(
     return float(np.max(rate[both], initial=0.0))
 
 
+def _check_near(
+    time: FloatArray,
+    positions: FloatArray,
+    names: tuple[str, ...],
+    radar_pos: FloatArray,
+    config: RunConfigBase,
+) -> None:
+    """Refuse, as the run would, a joint nearer the radar than ``scene.min_range`` at one of the
+    motion's frames (the run checks every scatterer at every pulse). ``time`` (n,) [s];
+    ``positions`` (n, n_joints, 3) [m], NaN where a joint is not seen."""
+    if time.size == 0:
+        return
+    with np.errstate(invalid="ignore"):
+        r = np.linalg.norm(positions - radar_pos, axis=-1)
+    r = np.where(np.isfinite(r), r, np.inf)
+    k, j = np.unravel_index(int(np.argmin(r)), r.shape)
+    if r[k, j] < config.scene.min_range:
+        raise SceneError(
+            f"joint {names[j]!r} comes within {r[k, j]:.3g} m of the radar at t = "
+            f"{time[k] - time[0]:.3f} s (scene.min_range = {config.scene.min_range:g} m): the "
+            "range equation and far-field RCS do not hold there"
+        )
+
+
 def memory_estimate(
     n_pulses: int,
     n_scatterers: int,
@@ -128,6 +155,7 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
         )
 
     inside = (body.time >= t_start - 1e-9) & (body.time <= t_end + 1e-9)
+    _check_near(body.time[inside], body.positions[inside], body.joint_names, radar_pos, config)
     speed = max_joint_radial_speed(
         body.time[inside], body.positions[inside], body.valid[inside], radar_pos
     )

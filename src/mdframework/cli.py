@@ -9,6 +9,7 @@ imports what it needs when it runs, so ``mdf --help`` and ``mdf plugins`` start 
 from __future__ import annotations
 
 import argparse
+import errno
 import json
 import os
 import signal
@@ -151,6 +152,29 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message: str) -> NoReturn:
         raise UsageError(f"{message} (see `{self.prog} --help`)")
 
+    def parse_known_args(  # type: ignore[override]
+        self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
+    ) -> tuple[argparse.Namespace, list[str]]:
+        """As argparse's, but a command without sub-commands of its own (``mdf run``) refuses
+        arguments it does not know itself, so that the error points to its own ``--help``."""
+        parsed, extras = super().parse_known_args(args, namespace)
+        if extras and self._subparsers is None and " " in self.prog:
+            self.error(f"unrecognized arguments: {' '.join(extras)}")
+        return parsed, extras
+
+
+def _output_path(text: str) -> str:
+    """An ``--out`` value: not empty (``--out "$DIR"`` with DIR unset would mean the working
+    folder)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("must not be empty")
+    return text
+
+
+#: errors of the file system a command writes to (a full disk, a read-only or forbidden
+#: folder): one line naming the file, exit code 2, like bad input
+_WRITE_ERRNOS = (errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.EPERM, errno.EFBIG)
+
 
 def _cmd_check(args: argparse.Namespace) -> int:
     with _progress(args).step("reading the config, the installed plugins and the motion"):
@@ -284,7 +308,7 @@ def _run_arguments(parser: argparse.ArgumentParser) -> None:
     """The arguments `mdf run` and `mdf show` share: the config, the output folder and how it
     is written, and progress."""
     parser.add_argument("config", help="run config file (.toml, .yaml or .json)")
-    parser.add_argument("--out", required=True, help="output folder")
+    parser.add_argument("--out", required=True, type=_output_path, help="output folder")
     parser.add_argument("--force", action="store_true", help=FORCE_HELP)
     parser.add_argument("--staging-dir", default=None, help=STAGING_HELP)
     parser.add_argument("--no-progress", action="store_true", help=PROGRESS_HELP)
@@ -402,7 +426,7 @@ def build_parser() -> argparse.ArgumentParser:
         ],
     )
     build.add_argument("config", help="dataset config file")
-    build.add_argument("--out", required=True, help="dataset folder")
+    build.add_argument("--out", required=True, type=_output_path, help="dataset folder")
     build.add_argument("--workers", type=_positive_int, default=None, help="local processes")
     build.add_argument(
         "--scheduler",
@@ -425,7 +449,7 @@ def build_parser() -> argparse.ArgumentParser:
         ["mdf experiment examples/experiment_cmu.toml --out out/exp"],
     )
     experiment.add_argument("config", help="experiment config file")
-    experiment.add_argument("--out", required=True, help="report folder")
+    experiment.add_argument("--out", required=True, type=_output_path, help="report folder")
     experiment.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     experiment.add_argument(
         "--allow-import",
@@ -648,6 +672,10 @@ def _main(argv: list[str], debug: bool) -> int:
         if args.debug:
             raise
         retract()
+        if isinstance(exc, OSError) and exc.errno in _WRITE_ERRNOS:
+            where = f": {exc.filename}" if exc.filename else ""
+            print(f"mdf: error: {exc.strerror}{where}", file=sys.stderr)
+            return EXIT_USAGE
         print(
             f"mdf: internal error: {type(exc).__name__}: {_one_line(str(exc))} "
             "(run with --debug for the traceback)",

@@ -439,7 +439,7 @@ def format_validation_error(
         msg = f"unknown kind {first['input'].get('kind')!r}; " + first["msg"].split(";")[-1].strip()
     else:
         msg = " or ".join(dict.fromkeys(_plain(e, allowed) for e in same))
-    if first["type"] == "value_error" and not more:
+    if first["type"] == "value_error" and len(same) == 1:
         parts, msg = _field_in_message(parts, msg, _model_at(model, tuple(loc), data))
     hint = _toml_hint(parts, source) if first["type"] == "extra_forbidden" else ""
     return f"{source}: {'.'.join(parts) or '(top level)'}: {msg}{hint}{more}"

@@ -25,6 +25,9 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import json
+import types
+import typing
 import warnings
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
@@ -33,7 +36,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict
+from pydantic import BaseModel, ConfigDict, model_validator
 
 from .physics.radar import distances
 from .pointcloud import PointCloud
@@ -47,11 +50,73 @@ FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
 
 
-class PluginConfig(BaseModel):
-    """Base of every plugin's config model: unknown fields are errors, and float fields must be
-    finite (a field that gives ``inf`` a meaning says so with ``Field(allow_inf_nan=True)``)."""
+def _lax_scalar(annotation: Any, value: Any) -> str | None:
+    """What a config value is if pydantic would convert it to a number or a flag where the
+    field takes only numbers or only flags (``true`` as 1.0, ``"-50"`` as -50.0, ``1`` as
+    ``true``); None where the value is of the field's own kind, or the field takes more."""
+    annotation = _base(annotation)  # a bounded type: its base
+    if annotation is bool:
+        return None if isinstance(value, bool) else type(value).__name__
+    if annotation in (int, float):
+        return "a flag" if isinstance(value, bool) else "text" if isinstance(value, str) else None
+    origin, args = typing.get_origin(annotation), typing.get_args(annotation)
+    if origin in (typing.Union, types.UnionType):
+        kinds = [_base(a) for a in args if a is not type(None)]
+        if all(a in (int, float) for a in kinds):
+            return _lax_scalar(float, value)
+    elif origin is tuple and isinstance(value, list | tuple):
+        kinds = list(args[:1]) * len(value) if args[1:] == (Ellipsis,) else list(args)
+        for kind, item in zip(kinds, value, strict=False):
+            if _base(kind) in (int, float) and (found := _lax_scalar(kind, item)) is not None:
+                return found
+    return None
+
+
+def _base(annotation: Any) -> Any:
+    """The type under ``Annotated[...]`` layers."""
+    while typing.get_origin(annotation) is typing.Annotated:
+        annotation = typing.get_args(annotation)[0]
+    return annotation
+
+
+def refuse_lax_scalars(model: type[BaseModel], data: Any) -> Any:
+    """A config section's raw ``data`` as it is, after refusing a flag or text where a field
+    takes only numbers, and anything but a flag where it takes only flags: pydantic's lax mode
+    would silently read ``prf = true`` as 1 Hz. The error names the field first
+    (``hop: a number, not a flag (true)``), which the config's error message makes its
+    location. Used as a ``mode="before"`` model validator by every config model."""
+    if not isinstance(data, dict):
+        return data
+    for name, info in model.model_fields.items():
+        key = info.alias or name
+        if key not in data:
+            continue
+        found = _lax_scalar(info.annotation, data[key])
+        if found is not None:
+            want = "true or false" if info.annotation is bool else "a number"
+            raise ValueError(f"{key}: {want}, not {found} ({json.dumps(data[key])})")
+    return data
+
+
+class ConfigSection(BaseModel):
+    """Base of every config model, the core's and the plugins' (and of the tables inside a
+    plugin's section, such as a point target): unknown fields are errors, float fields must be
+    finite (a field that gives ``inf`` a meaning says so with ``Field(allow_inf_nan=True)``),
+    and numbers and flags are not converted from each other or from text
+    (:func:`refuse_lax_scalars`)."""
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _no_lax_scalars(cls, data: Any) -> Any:
+        return refuse_lax_scalars(cls, data)
+
+
+class PluginConfig(ConfigSection):
+    """Base of every plugin's config model (a :class:`ConfigSection` with the ``kind`` that
+    chooses the plugin)."""
+
     kind: str
 
 

@@ -12,14 +12,14 @@ earlier run's files only once every new one is complete) are those of
 - ``spectrogram_db`` (n_doppler, n_frames) float32: power in dB re its peak, floored
 - ``doppler_hz`` (n_doppler,), ``velocity_mps`` (n_doppler,): axes (+ approaching)
 - ``time_s`` (n_frames,): STFT window centres [s from the first pulse]
-- ``body_time_s`` (n_frames,), ``body_positions_m`` (n_frames, n_joints, 3) float32: the placed
-  body at the source's frame times within the record [s from the first pulse, m]; ``body_joints``
-  (n_joints,) str
+- ``body_time_s`` (n_body,), ``body_positions_m`` (n_body, n_joints, 3) float32: the placed
+  body at the source's own n_body frame times within the record (not the STFT's n_frames) [s
+  from the first pulse, m]; ``body_joints`` (n_joints,) str
 - with ``processing.keep_scatterers`` only: ``scatterer_range_m`` (n_pulses, n_scatterers),
   ``scatterer_rcs_m2`` (same) float32
 - raw path only: ``range_time_db`` (n_slow, n_range) float32, |compressed output| in dB re peak,
-  decimated in slow time to at most 2000 rows; ``range_time_time_s`` (n_slow,);
-  ``range_m`` (n_range,)
+  decimated in slow time to at most 2000 rows; ``range_time_time_s`` (n_slow,) [s];
+  ``range_m`` (n_range,) [m]
 - ``envelope_upper_mps``, ``envelope_lower_mps``, ``torso_velocity_mps`` (n_frames,): the
   spectrogram's upper and lower envelopes and torso track [m/s] (NaN in silent frames), and
   ``features_mps`` (7,): the seven features of Erol & Gurbuz in

@@ -22,8 +22,6 @@ from typing import Annotated, Literal
 
 from pydantic import (
     AfterValidator,
-    BaseModel,
-    ConfigDict,
     Field,
     ValidationInfo,
     field_validator,
@@ -31,7 +29,7 @@ from pydantic import (
 )
 
 from . import limits
-from .interfaces import FloatArray, PluginConfig
+from .interfaces import ConfigSection, FloatArray, PluginConfig
 from .physics import radar
 from .physics.interpolation import Method
 
@@ -85,11 +83,9 @@ def _resolve_path(value: Path, info: ValidationInfo) -> Path:
 DataPath = Annotated[Path, AfterValidator(_resolve_path)]
 
 
-class StrictModel(BaseModel):
-    """Base of every config model that is not a plugin's: unknown fields are errors, and float
-    fields must be finite."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+class StrictModel(ConfigSection):
+    """Base of every config model that is not a plugin's (see
+    :class:`~mdframework.interfaces.ConfigSection`)."""
 
 
 class SanityConfig(StrictModel):

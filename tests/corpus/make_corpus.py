@@ -1266,6 +1266,16 @@ def _command_cases(c: _Corpus) -> None:
     # a frame every microsecond of the record would render for hours
     case("show-fps-1e6", commands["show"], "run.json", "--fps", "100", options="--fps 1000000")
     case("run-unknown-option", commands["run"], "run.json", "--bogus", options="--bogus")
+    # a second config (or any stray word) points to the command's own help
+    case("run-extra-word", commands["run"], "run.json", "unrecognized", "`mdf run --help`",
+         options="extra")  # fmt: skip
+    case("dataset-extra-word", build, "dataset.json", "unrecognized",
+         "`mdf dataset build --help`", options="extra")  # fmt: skip
+    for name, words in commands.items():
+        if "--out" in words:  # `--out "$DIR"` with DIR unset: never the working folder
+            d = c.folder(f"command-{name}-out-empty")
+            argv = [w for w in words if w != "--out"] + [str(d / "x.json"), "--out", ""]
+            c.command(f"command-{name}-out-empty", argv, d / "out", "--out: must not be empty")
     d = c.folder("command-unknown")
     c.command("command-unknown", ["simulate", str(d)], d / "out", "invalid choice", "mdf --help")
     c.command("command-none", [], d / "out", "required: COMMAND")

@@ -27,9 +27,9 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
-from mdframework import RadarWaveform, Received, limits
+from mdframework import ConfigSection, RadarWaveform, Received, limits
 from mdframework.constants import SPEED_OF_LIGHT
 from mdframework.errors import SceneError
 from mdframework.physics import fmcw
@@ -77,10 +77,9 @@ MAX_FFT = 65536
 AntennaUnits = Annotated[float, Field(ge=-MAX_ANTENNA_UNITS, le=MAX_ANTENNA_UNITS)]
 
 
-class CfarConfig(BaseModel):
+class CfarConfig(ConfigSection):
     """CFAR along one axis of the range-Doppler map."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
     mode: Literal["ca", "so", "go"] = Field(
         "ca", description="ca: cell averaging; so: smallest of the two sides; go: greatest of."
     )

@@ -12,9 +12,10 @@ from __future__ import annotations
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from mdframework import (
+    ConfigSection,
     Motion,
     MotionConfig,
     MotionSource,
@@ -30,10 +31,9 @@ from mdframework.settings import FrameRate, Point3, PositiveSeconds, Rcs
 Speed = Annotated[float, Field(ge=-limits.MAX_TARGET_SPEED_MPS, le=limits.MAX_TARGET_SPEED_MPS)]
 
 
-class Target(BaseModel):
+class Target(ConfigSection):
     """One point scatterer."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
     position: Point3 = Field(description="Position at t = 0 [m].")
     velocity: tuple[Speed, Speed, Speed] = Field(
         (0.0, 0.0, 0.0), description="Constant velocity [m/s]."

@@ -23,9 +23,9 @@ from typing import Annotated, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
-from mdframework import Effect, PluginConfig, Scatterers, SceneContext, limits
+from mdframework import ConfigSection, Effect, PluginConfig, Scatterers, SceneContext, limits
 from mdframework.settings import AngleDeg, Coordinate, Point3, Seed
 
 FloatArray = NDArray[np.float64]
@@ -39,10 +39,9 @@ Reach = Annotated[float, Field(ge=0, le=limits.MAX_COORDINATE_M)]
 SPHERE_M = 0.05
 
 
-class Reflector(BaseModel):
+class Reflector(ConfigSection):
     """One static reflector."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
     position: Point3 = Field(description="Scene position (x, y, z) [m].")
     rcs_m2: PositiveRcs = Field(description="RCS [m^2].")
 
