@@ -242,6 +242,9 @@ class Variations(StrictModel):
 
     @model_validator(mode="after")
     def _radar_one_way(self) -> Variations:
+        for name in type(self).model_fields:
+            if getattr(self, name) == []:  # would silently mean "no variation"
+                raise ValueError(f"{name}: an empty list; give at least one value, or leave it out")
         if self.radar_position is not None and (
             self.radar_range is not None or self.radar_height is not None
         ):
