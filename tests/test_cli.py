@@ -242,6 +242,7 @@ def test_yaml_and_json_configs_run(tmp_path: Path, capsys: pytest.CaptureFixture
             "line 4: key 'prf' given twice",
         ),
         ("twice.json", '{"radar": {"prf": 2400, "prf": 1000}}', "key 'prf' given twice"),
+        ("list-key.yaml", "radar:\n  ? [a, b]\n  : 1\n", "line 2: found unhashable key"),
     ],
 )
 def test_a_key_given_twice_in_yaml_or_json_is_refused(
