@@ -242,6 +242,7 @@ def test_yaml_and_json_configs_run(tmp_path: Path, capsys: pytest.CaptureFixture
             "line 4: key 'prf' given twice",
         ),
         ("twice.json", '{"radar": {"prf": 2400, "prf": 1000}}', "key 'prf' given twice"),
+        ("list-key.yaml", "radar:\n  ? [a, b]\n  : 1\n", "line 2: found unhashable key"),
     ],
 )
 def test_a_key_given_twice_in_yaml_or_json_is_refused(
@@ -294,6 +295,15 @@ def test_numbers_and_flags_are_not_converted(
     data["motion"]["targets"][0]["rcs"] = 1  # an integer is a number
     path.write_text(json.dumps(data))
     assert load_run_config(path).motion.targets[0].rcs == 1.0  # type: ignore[attr-defined]
+
+
+def test_a_data_file_that_is_a_folder_is_named_as_one(tmp_path: Path) -> None:
+    """`file = "data/cmu"` names a folder: the error says so (not "must be a .bvh or .amc
+    file, got 'cmu'", which reads like the source's kind)."""
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(f'[motion]\nkind = "cmu"\nfile = "{EXAMPLES / "data" / "cmu"}"\n')
+    with pytest.raises(ConfigError, match=r"motion\.file: .*data/cmu is a folder; name a file"):
+        load_run_config(cfg)
 
 
 def test_a_config_that_is_not_a_regular_file_is_refused(tmp_path: Path) -> None:

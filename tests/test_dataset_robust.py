@@ -193,3 +193,12 @@ def test_train_test_selection_errors(tmp_path: Path) -> None:
         True,
         False,
     ]
+
+
+def test_an_empty_variation_list_is_refused(tmp_path: Path) -> None:
+    """`aspect_deg = []` would silently mean "no variation" (the base scene's aspect): refused
+    naming the field, like any value a build cannot use."""
+    cfg = walk_config(tmp_path / "d.toml", "[variations]\naspect_deg = []\n")
+    with pytest.raises(MdfError, match=r"variations\.aspect_deg: an empty list"):
+        load_dataset_config(cfg)
+    load_dataset_config(walk_config(tmp_path / "ok.toml", "[variations]\naspect_deg = [0, 90]\n"))

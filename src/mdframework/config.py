@@ -14,6 +14,7 @@ from __future__ import annotations
 import json
 import stat
 import tomllib
+from collections.abc import Hashable
 from functools import lru_cache
 from pathlib import Path
 from typing import Annotated, Any, Union, get_args
@@ -131,11 +132,11 @@ def _load_yaml(p: Path, text: str) -> Any:
                 if key_node.tag == "tag:yaml.org,2002:merge":
                     continue
                 key = self.construct_object(key_node, deep=True)
-                if isinstance(key, list | dict) or key in seen:
+                if not isinstance(key, Hashable):  # PyYAML's own error follows
+                    continue
+                if key in seen:
                     raise yaml.constructor.ConstructorError(
-                        problem=f"key {key!r} given twice in one mapping"
-                        if key in seen
-                        else "a key that is a list or a mapping",
+                        problem=f"key {key!r} given twice in one mapping",
                         problem_mark=key_node.start_mark,
                     )
                 seen.add(key)
@@ -150,12 +151,16 @@ def _load_yaml(p: Path, text: str) -> Any:
         raise ConfigError(f"{p}: invalid YAML: {where}{problem}") from None
 
 
+class _RepeatedKey(ValueError):
+    """A key given twice in one JSON object."""
+
+
 def _json_object(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
     """A JSON object, refusing a key given twice (``json`` would keep the last silently)."""
     out: dict[str, Any] = {}
     for key, value in pairs:
         if key in out:
-            raise ValueError(f"key {key!r} given twice in one object")
+            raise _RepeatedKey(f"key {key!r} given twice in one object")
         out[key] = value
     return out
 
@@ -242,7 +247,7 @@ def read_config_file(path: str | Path, kind: str | None = None) -> dict[str, Any
         raise ConfigError(f"{p}: invalid TOML: {exc}") from None
     except json.JSONDecodeError as exc:
         raise ConfigError(f"{p}: invalid JSON: line {exc.lineno}: {exc.msg}") from None
-    except ValueError as exc:  # from _json_object
+    except _RepeatedKey as exc:
         raise ConfigError(f"{p}: invalid JSON: {exc}") from None
     except RecursionError:
         raise ConfigError(

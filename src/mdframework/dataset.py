@@ -241,6 +241,13 @@ class Variations(StrictModel):
     )
 
     @model_validator(mode="after")
+    def _no_empty_list(self) -> Variations:
+        for name in type(self).model_fields:
+            if getattr(self, name) == []:  # would silently mean "no variation"
+                raise ValueError(f"{name}: an empty list; give at least one value, or leave it out")
+        return self
+
+    @model_validator(mode="after")
     def _radar_one_way(self) -> Variations:
         if self.radar_position is not None and (
             self.radar_range is not None or self.radar_height is not None

@@ -50,33 +50,44 @@ FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
 
 
-def _lax_scalar(annotation: Any, value: Any) -> str | None:
-    """What a config value is if pydantic would convert it to a number or a flag where the
-    field takes only numbers or only flags (``true`` as 1.0, ``"-50"`` as -50.0, ``1`` as
-    ``true``); None where the value is of the field's own kind, or the field takes more."""
-    annotation = _base(annotation)  # a bounded type: its base
-    if annotation is bool:
-        return None if isinstance(value, bool) else type(value).__name__
-    if annotation in (int, float):
-        return "a flag" if isinstance(value, bool) else "text" if isinstance(value, str) else None
-    origin, args = typing.get_origin(annotation), typing.get_args(annotation)
-    if origin in (typing.Union, types.UnionType):
-        kinds = [_base(a) for a in args if a is not type(None)]
-        if all(a in (int, float) for a in kinds):
-            return _lax_scalar(float, value)
-    elif origin is tuple and isinstance(value, list | tuple):
-        kinds = list(args[:1]) * len(value) if args[1:] == (Ellipsis,) else list(args)
-        for kind, item in zip(kinds, value, strict=False):
-            if _base(kind) in (int, float) and (found := _lax_scalar(kind, item)) is not None:
-                return found
-    return None
-
-
 def _base(annotation: Any) -> Any:
     """The type under ``Annotated[...]`` layers."""
     while typing.get_origin(annotation) is typing.Annotated:
         annotation = typing.get_args(annotation)[0]
     return annotation
+
+
+def _scalar_kind(annotation: Any) -> str | None:
+    """``"flag"`` for a bool field, ``"number"`` for an int or float one (optional or not),
+    ``"numbers"`` for a tuple of them; None for any other field (text, choices, tables)."""
+    annotation = _base(annotation)
+    if annotation is bool:
+        return "flag"
+    if annotation in (int, float):
+        return "number"
+    origin, args = typing.get_origin(annotation), typing.get_args(annotation)
+    members = [_base(a) for a in args if a is not type(None) and a is not Ellipsis]
+    if members and all(a in (int, float) for a in members):
+        if origin in (typing.Union, types.UnionType):
+            return "number"
+        if origin is tuple:
+            return "numbers"
+    return None
+
+
+@functools.cache
+def _scalar_fields(model: type[BaseModel]) -> tuple[tuple[str, str], ...]:
+    """(key in the config, kind) of each field of ``model`` that takes only numbers or flags."""
+    out = []
+    for name, info in model.model_fields.items():
+        kind = _scalar_kind(info.annotation)
+        if kind is not None:
+            out.append((info.alias or name, kind))
+    return tuple(out)
+
+
+def _not_a_number(value: Any) -> str | None:
+    return "a flag" if isinstance(value, bool) else "text" if isinstance(value, str) else None
 
 
 def refuse_lax_scalars(model: type[BaseModel], data: Any) -> Any:
@@ -87,14 +98,20 @@ def refuse_lax_scalars(model: type[BaseModel], data: Any) -> Any:
     location. Used as a ``mode="before"`` model validator by every config model."""
     if not isinstance(data, dict):
         return data
-    for name, info in model.model_fields.items():
-        key = info.alias or name
+    for key, kind in _scalar_fields(model):
         if key not in data:
             continue
-        found = _lax_scalar(info.annotation, data[key])
+        value = data[key]
+        if kind == "flag":
+            found = None if isinstance(value, bool) else type(value).__name__
+        elif kind == "number":
+            found = _not_a_number(value)
+        else:
+            items = value if isinstance(value, list | tuple) else ()
+            found = next((f for f in map(_not_a_number, items) if f is not None), None)
         if found is not None:
-            want = "true or false" if info.annotation is bool else "a number"
-            raise ValueError(f"{key}: {want}, not {found} ({json.dumps(data[key])})")
+            want = "true or false" if kind == "flag" else "a number"
+            raise ValueError(f"{key}: {want}, not {found} ({json.dumps(value)})")
     return data
 
 

@@ -76,6 +76,8 @@ def _resolve_path(value: Path, info: ValidationInfo) -> Path:
         path = Path(base) / path
     if not path.exists():
         raise ValueError(f"file not found: {path}")
+    if path.is_dir():
+        raise ValueError(f"{path} is a folder; name a file in it")
     return path.absolute()  # a resolved config read from anywhere names the same file
 
 
