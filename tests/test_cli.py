@@ -337,6 +337,10 @@ def test_more_config_field_errors(
 
 
 FIX_HINTS = {
+    "misspelt motion table": (
+        '[motions]\nkind = "point_targets"\nlength = 1.0\ntargets = [{ position = [10, 0, 0] }]\n',
+        "motion: missing: add a [motion] section with a kind (the config has [motions]: rename it)",
+    ),
     "nearest field": (
         '[motion]\nkind = "point_targets"\nlength = 1.0\n'
         "targets = [{ position = [10, 0, 0] }]\n[scatterers]\nkind = 'points'\n"

@@ -11,6 +11,7 @@ Relative paths inside a config are relative to the config file's folder.
 
 from __future__ import annotations
 
+import difflib
 import json
 import stat
 import tomllib
@@ -477,6 +478,9 @@ def check_plugin_kinds(data: dict[str, Any], source: str, registry: Registry) ->
         if not isinstance(section, dict):
             if section is None:
                 problem = "missing: add a [motion] section with a kind"
+                near = difflib.get_close_matches("motion", [str(k) for k in data], n=1)
+                if near:  # a misspelt [motion] table
+                    problem += f" (the config has [{near[0]}]: rename it)"
             else:
                 problem = f"must be a table with a kind (got {_short(section)})"
             raise ConfigError(f"{source}: {where}: {problem}{_kinds(registry, interface)}")
