@@ -372,6 +372,9 @@ method = "none"
 optimistic = false
 [evaluation]
 repeats = 2
+[classifier]
+kind = "knn"
+k = 1
 """)
     work = tmp_path / "work" / "deep"
     work.mkdir(parents=True)
