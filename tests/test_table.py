@@ -235,3 +235,14 @@ def test_binary_files_and_missing_joints(tmp_path: Path) -> None:
         TableSource(TableConfig(file=path)).load()
     with pytest.raises(DataFileError, match=r"joint_map names joints not in the file: LeftToe"):
         TableSource(TableConfig(file=path, joint_map={"l_toe": "LeftToe"})).load()
+
+
+def test_a_joint_or_column_named_twice_in_the_config_is_the_configs_error(tmp_path: Path) -> None:
+    """`joints = ["HipCenter", "HipCenter", ...]` names columns twice: the error names the
+    config field, not the data file (whose columns the config names)."""
+    path = tmp_path / "t.csv"
+    path.write_text("0,1,2,3,4,5,6\n1,1,2,3,4,5,6\n")
+    with pytest.raises(ValueError, match=r"joints: 'head' named twice"):
+        TableConfig(file=path, header=False, joints=["head", "head"], time_column="t")
+    with pytest.raises(ValueError, match=r"columns: 't' named twice"):
+        TableConfig(file=path, header=False, columns=["t", "t", "head_x"])

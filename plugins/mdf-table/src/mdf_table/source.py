@@ -116,6 +116,11 @@ class TableConfig(MotionConfig):
         check_axes(self.axes)
         if self.time_range is not None and self.time_range[0] > self.time_range[1]:
             raise ValueError(f"time_range: first {self.time_range[0]:g} is after last")
+        for name in ("columns", "joints"):
+            names = getattr(self, name) or []
+            twice = sorted({n for n in names if names.count(n) > 1})
+            if twice:
+                raise ValueError(f"{name}: {', '.join(map(repr, twice))} named twice")
         if not self.header and self.columns is None and self.joints is None:
             raise ValueError("a table without a header row needs columns or joints")
         return self
