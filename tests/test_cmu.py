@@ -592,6 +592,12 @@ def test_byte_order_mark_and_old_mac_line_ends(eol: str, tmp_path: Path) -> None
     np.testing.assert_array_equal(
         load(amc).skeleton.positions, load(AMC / "02_01.amc").skeleton.positions[:5]
     )
+    # a mark before Latin-1 text (a comment in another encoding): skipped there too
+    latin1 = b"\xef\xbb\xbf# caf\xe9" + eol.encode() + eol.join(asf).encode()
+    (tmp_path / "02.asf").write_bytes(latin1)
+    np.testing.assert_array_equal(
+        load(amc).skeleton.positions, load(AMC / "02_01.amc").skeleton.positions[:5]
+    )
 
 
 def test_asf_unknown_keyword(tmp_path: Path) -> None:

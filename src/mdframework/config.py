@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import difflib
 import json
+import re
 import stat
 import tomllib
 from collections.abc import Hashable
@@ -120,6 +121,13 @@ def _decode(p: Path, raw: bytes) -> str:
         ) from None
 
 
+#: numbers PyYAML's YAML 1.1 rules leave as text: an exponent without a dot or sign (15e9),
+#: and inf / nan without YAML's leading dot
+_YAML_FLOAT = re.compile(
+    r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?[eE][-+]?[0-9]+|inf|infinity|nan)$", re.IGNORECASE
+)
+
+
 def _load_yaml(p: Path, text: str) -> Any:
     """The data of a YAML config (PyYAML imported here: only YAML configs need it). A key given
     twice in one mapping is an error naming its line (PyYAML would keep the last silently);
@@ -143,6 +151,9 @@ def _load_yaml(p: Path, text: str) -> Any:
                 seen.add(key)
             return super().construct_mapping(node, deep=deep)
 
+    # YAML 1.1 reads 15e9, 1e-3 and inf as text (it wants 1.5e+10 and .inf): read them as the
+    # numbers TOML, JSON and Python read, but only where unquoted
+    Loader.add_implicit_resolver("tag:yaml.org,2002:float", _YAML_FLOAT, list("-+0123456789iInN"))
     try:
         return yaml.load(text, Loader=Loader)  # a SafeLoader
     except yaml.YAMLError as exc:
@@ -153,7 +164,36 @@ def _load_yaml(p: Path, text: str) -> Any:
 
 
 class _RepeatedKey(ValueError):
-    """A key given twice in one JSON object."""
+    """A key given twice in one JSON object (``line``: where that object starts)."""
+
+    line: int | None = None
+
+
+def _repeated_key_line(text: str) -> int | None:
+    """The line where the JSON object holding a repeated key starts: ``text`` parsed again (only
+    when a key repeats) with the pure-Python scanner, which tells where each object starts."""
+    import json.decoder
+    import json.scanner
+
+    # the json module's own pure-Python parser (JSONObject, py_make_scanner: not in typeshed)
+    objects: Any = getattr(json.decoder, "JSONObject")  # noqa: B009
+    decoder: Any = json.JSONDecoder(object_pairs_hook=_json_object)
+
+    def parse_object(s_and_end: tuple[str, int], *args: Any) -> Any:
+        try:
+            return objects(s_and_end, *args)
+        except _RepeatedKey as exc:
+            if exc.line is None:  # the innermost object: the one holding the key
+                exc.line = text.count("\n", 0, s_and_end[1]) + 1
+            raise
+
+    decoder.parse_object = parse_object
+    decoder.scan_once = getattr(json.scanner, "py_make_scanner")(decoder)  # noqa: B009
+    try:
+        decoder.decode(text)
+    except _RepeatedKey as exc:
+        return exc.line
+    return None
 
 
 def _json_object(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
@@ -249,7 +289,9 @@ def read_config_file(path: str | Path, kind: str | None = None) -> dict[str, Any
     except json.JSONDecodeError as exc:
         raise ConfigError(f"{p}: invalid JSON: line {exc.lineno}: {exc.msg}") from None
     except _RepeatedKey as exc:
-        raise ConfigError(f"{p}: invalid JSON: {exc}") from None
+        line = _repeated_key_line(text)
+        where = f"line {line}: " if line is not None else ""
+        raise ConfigError(f"{p}: invalid JSON: {where}{exc} (the object opened there)") from None
     except RecursionError:
         raise ConfigError(
             f"{p}: tables and lists are nested more than {limits.MAX_CONFIG_DEPTH} deep"

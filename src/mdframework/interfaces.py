@@ -30,7 +30,7 @@ import types
 import typing
 import warnings
 from abc import ABC, abstractmethod
-from collections.abc import Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
@@ -57,61 +57,92 @@ def _base(annotation: Any) -> Any:
     return annotation
 
 
-def _scalar_kind(annotation: Any) -> str | None:
-    """``"flag"`` for a bool field, ``"number"`` for an int or float one (optional or not),
-    ``"numbers"`` for a tuple of them; None for any other field (text, choices, tables)."""
+#: what is wrong with a value (what was wanted, what was found), or None
+_Problem = tuple[str, str] | None
+
+
+def _flag(value: Any) -> _Problem:
+    return None if isinstance(value, bool) else ("true or false", type(value).__name__)
+
+
+def _number(value: Any) -> _Problem:
+    if isinstance(value, bool):
+        return "a number", "a flag"
+    return ("a number", "text") if isinstance(value, str) else None
+
+
+def _first(check: Callable[[Any], _Problem], items: Iterable[Any]) -> _Problem:
+    return next((found for found in map(check, items) if found is not None), None)
+
+
+def _scalar_check(annotation: Any) -> Callable[[Any], _Problem] | None:
+    """The check of a field that takes numbers or flags (also inside an optional, a union with
+    named choices, a tuple, a list or a table of them); None for any other field."""
     annotation = _base(annotation)
     if annotation is bool:
-        return "flag"
+        return _flag
     if annotation in (int, float):
-        return "number"
+        return _number
     origin, args = typing.get_origin(annotation), typing.get_args(annotation)
-    members = [_base(a) for a in args if a is not type(None) and a is not Ellipsis]
-    if members and all(a in (int, float) for a in members):
-        if origin in (typing.Union, types.UnionType):
-            return "number"
-        if origin is tuple:
-            return "numbers"
+    if origin in (typing.Union, types.UnionType):
+        members = [_base(a) for a in args if a is not type(None)]
+        if len(members) == 1:  # optional: None is the field's own "not given"
+            inner = _scalar_check(members[0])
+            return None if inner is None else (lambda v: None if v is None else inner(v))
+        if not any(m in (int, float) for m in members) or bool in members or str in members:
+            return None
+        words = {w for m in members if typing.get_origin(m) is Literal for w in typing.get_args(m)}
+        return lambda v: None if isinstance(v, str) and v in words else _number(v)
+    if origin in (tuple, list) and args:
+        found = [_scalar_check(a) for a in args if a is not Ellipsis]
+        checks = [c for c in found if c is not None]
+        if not checks or len(checks) < len(found):
+            return None
+        if origin is list or args[-1] is Ellipsis:
+            one = checks[0]
+            return lambda v: _first(one, v) if isinstance(v, list | tuple) else None
+        return lambda v: (
+            next((p for c, x in zip(checks, v, strict=False) if (p := c(x))), None)
+            if isinstance(v, list | tuple)
+            else None
+        )
+    if origin is dict and len(args) == 2 and (of := _scalar_check(args[1])) is not None:
+        return lambda v: _first(of, v.values()) if isinstance(v, dict) else None
     return None
 
 
 @functools.cache
-def _scalar_fields(model: type[BaseModel]) -> tuple[tuple[str, str], ...]:
-    """(key in the config, kind) of each field of ``model`` that takes only numbers or flags."""
+def _scalar_fields(model: type[BaseModel]) -> tuple[tuple[str, Callable[[Any], _Problem]], ...]:
+    """(key in the config, check) of each field of ``model`` that takes numbers or flags."""
     out = []
     for name, info in model.model_fields.items():
-        kind = _scalar_kind(info.annotation)
-        if kind is not None:
-            out.append((info.alias or name, kind))
+        check = _scalar_check(info.annotation)
+        if check is not None:
+            out.append((info.alias or name, check))
     return tuple(out)
 
 
-def _not_a_number(value: Any) -> str | None:
-    return "a flag" if isinstance(value, bool) else "text" if isinstance(value, str) else None
+def _shown(value: Any) -> str:
+    """A config value as the file wrote it, at most 40 characters."""
+    try:
+        text = json.dumps(value)
+    except (TypeError, ValueError):  # a date, say
+        text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
 
 
 def refuse_lax_scalars(model: type[BaseModel], data: Any) -> Any:
     """A config section's raw ``data`` as it is, after refusing a flag or text where a field
-    takes only numbers, and anything but a flag where it takes only flags: pydantic's lax mode
-    would silently read ``prf = true`` as 1 Hz. The error names the field first
-    (``hop: a number, not a flag (true)``), which the config's error message makes its
-    location. Used as a ``mode="before"`` model validator by every config model."""
+    takes only numbers (or numbers and named choices), and anything but a flag where it takes
+    only flags, also inside the tuples, lists and tables of a field: pydantic's lax mode would
+    silently read ``prf = true`` as 1 Hz. The error names the field first (``hop: a number, not
+    a flag (true)``), which the config's error message makes its location. Used as a
+    ``mode="before"`` model validator by every config model."""
     if not isinstance(data, dict):
         return data
-    for key, kind in _scalar_fields(model):
-        if key not in data:
-            continue
-        value = data[key]
-        if kind == "flag":
-            found = None if isinstance(value, bool) else type(value).__name__
-        elif kind == "number":
-            found = _not_a_number(value)
-        else:
-            items = value if isinstance(value, list | tuple) else ()
-            found = next((f for f in map(_not_a_number, items) if f is not None), None)
-        if found is not None:
-            want = "true or false" if kind == "flag" else "a number"
-            raise ValueError(f"{key}: {want}, not {found} ({json.dumps(value)})")
+    for key, check in _scalar_fields(model):
+        if key in data and (problem := check(data[key])) is not None:
+            raise ValueError(f"{key}: {problem[0]}, not {problem[1]} ({_shown(data[key])})")
     return data
 
 
