@@ -275,10 +275,17 @@ def test_a_key_given_twice_in_yaml_or_json_is_refused(
         ("processing", "hop", True, "processing.hop: a number, not a flag (true)"),
         ("processing", "keep_scatterers", 1, "processing.keep_scatterers: true or false, not int"),
         ("scene", "radar_position", [True, 0, 0], "scene.radar_position: a number, not a flag"),
-        ("scene", "gate", True, "scene.gate: a number, not a flag (true)"),
-        ("scene", "gate", "2.5", 'scene.gate: a number, not text ("2.5")'),
-        ("figures", "velocity_span", True, "figures.velocity_span: a number, not a flag"),
+        ("scene", "gate", True, "scene.gate: a number or 'track', not a flag (true)"),
+        ("scene", "gate", "2.5", "scene.gate: a number or 'track', not text (\"2.5\")"),
+        (
+            "figures",
+            "velocity_span",
+            True,
+            "figures.velocity_span: a number or 'auto' or 'full', not a flag",
+        ),
         ("processing", "hop", "x" * 100, 'processing.hop: a number, not text ("xxxxxxxxx'),
+        ("scene", "gate", "trak", "scene.gate: a number or 'track', not text (\"trak\")"),
+        ("scene", "radar_position", [0, "1", 0], 'scene.radar_position: a number, not text ("1")'),
     ],
 )
 def test_numbers_and_flags_are_not_converted(
@@ -330,10 +337,15 @@ def test_named_choices_and_yaml_numbers_still_read(tmp_path: Path) -> None:
     cfg: Any = load_run_config(path)
     assert (cfg.radar.carrier_frequency, cfg.radar.bandwidth, cfg.radar.prf) == (15e9, 150e6, 2400)
     assert cfg.scene.radar_position[2] == 1e-3 and cfg.scene.gate == "track"
-    assert read_config_file_text(tmp_path, "a: inf\nb: -Infinity\nc: 1_000e3\n") == {
+    # TOML's lower-case inf only: `Nan` (a given name) and `Infinity` stay text
+    assert read_config_file_text(
+        tmp_path, "a: inf\nb: -inf\nc: 1_000e3\nd: Nan\ne: Infinity\n"
+    ) == {
         "a": float("inf"),
         "b": float("-inf"),
         "c": 1e6,
+        "d": "Nan",
+        "e": "Infinity",
     }
     path.write_text(path.read_text().replace("15e9", '"15e9"'))
     with pytest.raises(ConfigError, match=re.escape("radar.carrier_frequency: a number, not text")):
@@ -352,6 +364,17 @@ def read_config_file_text(folder: Path, text: str) -> Any:
     path = folder / "t.yaml"
     path.write_text(text)
     return read_config_file(path)
+
+
+def test_a_repeated_key_deeper_than_the_line_finder_goes_is_still_one_line(
+    tmp_path: Path,
+) -> None:
+    """The line of a repeated JSON key comes from a second, pure-Python parse, which recurses
+    deeper than the first: at 400 levels it would overflow, so the error names no line there."""
+    path = tmp_path / "deep.json"
+    path.write_text('{"a":' * 400 + '{"x": 1, "x": 2}' + "}" * 400)
+    with pytest.raises(ConfigError, match=r"invalid JSON: key 'x' given twice in one object$"):
+        read_config_file(path)
 
 
 def test_a_config_that_is_not_a_regular_file_is_refused(tmp_path: Path) -> None:

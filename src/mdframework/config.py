@@ -122,10 +122,8 @@ def _decode(p: Path, raw: bytes) -> str:
 
 
 #: numbers PyYAML's YAML 1.1 rules leave as text: an exponent without a dot or sign (15e9),
-#: and inf / nan without YAML's leading dot
-_YAML_FLOAT = re.compile(
-    r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?[eE][-+]?[0-9]+|inf|infinity|nan)$", re.IGNORECASE
-)
+#: and TOML's inf (lower case, without YAML's leading dot)
+_YAML_FLOAT = re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?[eE][-+]?[0-9]+|inf)$")
 
 
 def _load_yaml(p: Path, text: str) -> Any:
@@ -153,7 +151,7 @@ def _load_yaml(p: Path, text: str) -> Any:
 
     # YAML 1.1 reads 15e9, 1e-3 and inf as text (it wants 1.5e+10 and .inf): read them as the
     # numbers TOML, JSON and Python read, but only where unquoted
-    Loader.add_implicit_resolver("tag:yaml.org,2002:float", _YAML_FLOAT, list("-+0123456789iInN"))
+    Loader.add_implicit_resolver("tag:yaml.org,2002:float", _YAML_FLOAT, list("-+0123456789i"))
     try:
         return yaml.load(text, Loader=Loader)  # a SafeLoader
     except yaml.YAMLError as exc:
@@ -289,9 +287,13 @@ def read_config_file(path: str | Path, kind: str | None = None) -> dict[str, Any
     except json.JSONDecodeError as exc:
         raise ConfigError(f"{p}: invalid JSON: line {exc.lineno}: {exc.msg}") from None
     except _RepeatedKey as exc:
-        line = _repeated_key_line(text)
+        try:
+            line = _repeated_key_line(text)
+        except RecursionError:  # deeper than the pure-Python parser goes: no line then
+            line = None
         where = f"line {line}: " if line is not None else ""
-        raise ConfigError(f"{p}: invalid JSON: {where}{exc} (the object opened there)") from None
+        opened = " (the object opened there)" if line is not None else ""
+        raise ConfigError(f"{p}: invalid JSON: {where}{exc}{opened}") from None
     except RecursionError:
         raise ConfigError(
             f"{p}: tables and lists are nested more than {limits.MAX_CONFIG_DEPTH} deep"

@@ -57,18 +57,19 @@ def _base(annotation: Any) -> Any:
     return annotation
 
 
-#: what is wrong with a value (what was wanted, what was found), or None
-_Problem = tuple[str, str] | None
+#: what is wrong with a value: (what was wanted, what was found, the value or the item of it
+#: that is wrong), or None
+_Problem = tuple[str, str, Any] | None
 
 
 def _flag(value: Any) -> _Problem:
-    return None if isinstance(value, bool) else ("true or false", type(value).__name__)
+    return None if isinstance(value, bool) else ("true or false", type(value).__name__, value)
 
 
-def _number(value: Any) -> _Problem:
+def _number(value: Any, want: str = "a number") -> _Problem:
     if isinstance(value, bool):
-        return "a number", "a flag"
-    return ("a number", "text") if isinstance(value, str) else None
+        return want, "a flag", value
+    return (want, "text", value) if isinstance(value, str) else None
 
 
 def _first(check: Callable[[Any], _Problem], items: Iterable[Any]) -> _Problem:
@@ -91,8 +92,9 @@ def _scalar_check(annotation: Any) -> Callable[[Any], _Problem] | None:
             return None if inner is None else (lambda v: None if v is None else inner(v))
         if not any(m in (int, float) for m in members) or bool in members or str in members:
             return None
-        words = {w for m in members if typing.get_origin(m) is Literal for w in typing.get_args(m)}
-        return lambda v: None if isinstance(v, str) and v in words else _number(v)
+        words = [w for m in members if typing.get_origin(m) is Literal for w in typing.get_args(m)]
+        want = "a number or " + " or ".join(map(repr, words)) if words else "a number"
+        return lambda v: None if isinstance(v, str) and v in words else _number(v, want)
     if origin in (tuple, list) and args:
         found = [_scalar_check(a) for a in args if a is not Ellipsis]
         checks = [c for c in found if c is not None]
@@ -142,7 +144,8 @@ def refuse_lax_scalars(model: type[BaseModel], data: Any) -> Any:
         return data
     for key, check in _scalar_fields(model):
         if key in data and (problem := check(data[key])) is not None:
-            raise ValueError(f"{key}: {problem[0]}, not {problem[1]} ({_shown(data[key])})")
+            want, found, value = problem
+            raise ValueError(f"{key}: {want}, not {found} ({_shown(value)})")
     return data
 
 

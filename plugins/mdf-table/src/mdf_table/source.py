@@ -10,6 +10,7 @@ may be the mean of several file joints or markers.
 from __future__ import annotations
 
 import dataclasses
+from collections import Counter
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -117,8 +118,8 @@ class TableConfig(MotionConfig):
         if self.time_range is not None and self.time_range[0] > self.time_range[1]:
             raise ValueError(f"time_range: first {self.time_range[0]:g} is after last")
         for name in ("columns", "joints"):
-            names = getattr(self, name) or []
-            twice = sorted({n for n in names if names.count(n) > 1})
+            counts = Counter(getattr(self, name) or [])
+            twice = sorted(n for n, k in counts.items() if k > 1)
             if twice:
                 raise ValueError(f"{name}: {', '.join(map(repr, twice))} named twice")
         if not self.header and self.columns is None and self.joints is None:
