@@ -22,9 +22,8 @@ import numpy as np
 
 from . import limits
 from .errors import SceneError
-from .interfaces import FloatArray
 from .physics import radar
-from .pipeline import _place, _window, build_stages, load_motion, placed
+from .pipeline import _place, _window, build_stages, load_motion, placed, refuse_near
 from .plugins import Registry, default_registry
 from .settings import RunConfigBase
 
@@ -83,30 +82,6 @@ def max_joint_radial_speed(
     return float(np.max(rate[both], initial=0.0))
 
 
-def _check_near(
-    time: FloatArray,
-    positions: FloatArray,
-    names: tuple[str, ...],
-    radar_pos: FloatArray,
-    config: RunConfigBase,
-) -> None:
-    """Refuse, as the run would, a joint nearer the radar than ``scene.min_range`` at one of the
-    motion's frames (the run checks every scatterer at every pulse). ``time`` (n,) [s];
-    ``positions`` (n, n_joints, 3) [m], NaN where a joint is not seen."""
-    if time.size == 0:
-        return
-    with np.errstate(invalid="ignore"):
-        r = np.linalg.norm(positions - radar_pos, axis=-1)
-    r = np.where(np.isfinite(r), r, np.inf)
-    k, j = np.unravel_index(int(np.argmin(r)), r.shape)
-    if r[k, j] < config.scene.min_range:
-        raise SceneError(
-            f"joint {names[j]!r} comes within {r[k, j]:.3g} m of the radar at t = "
-            f"{time[k] - time[0]:.3f} s (scene.min_range = {config.scene.min_range:g} m): the "
-            "range equation and far-field RCS do not hold there"
-        )
-
-
 def memory_estimate(
     n_pulses: int,
     n_scatterers: int,
@@ -155,7 +130,11 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
         )
 
     inside = (body.time >= t_start - 1e-9) & (body.time <= t_end + 1e-9)
-    _check_near(body.time[inside], body.positions[inside], body.joint_names, radar_pos, config)
+    # a joint nearer than scene.min_range: refused as the run refuses the scatterer there
+    seen = body.valid[inside]
+    ranges = np.where(seen, radar.distances(body.positions[inside], radar_pos), np.inf)
+    t = body.time[inside] - body.time[inside][:1]
+    refuse_near(ranges, body.joint_names, t, config.scene.min_range, "joint")
     speed = max_joint_radial_speed(
         body.time[inside], body.positions[inside], body.valid[inside], radar_pos
     )

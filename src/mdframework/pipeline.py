@@ -15,6 +15,7 @@ from __future__ import annotations
 import time
 import warnings
 import weakref
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -503,12 +504,8 @@ class _Stream:
         if not (np.isfinite(nearest) and np.isfinite(ranges.max())):
             raise SceneError("a scatterer position is not finite")
         if nearest < self.min_range:
-            p, s = np.unravel_index(int(np.argmin(ranges)), ranges.shape)
-            raise SceneError(
-                f"scatterer {scat.names[s]!r} comes within {ranges[p, s]:.3g} m of the radar "
-                f"at t = {self.t[lo + p] - self.t[0]:.3f} s (scene.min_range = "
-                f"{self.min_range:g} m): the range equation and far-field RCS do not hold there"
-            )
+            t = self.t[lo : lo + ranges.shape[0]] - self.t[0]
+            refuse_near(ranges, scat.names, t, self.min_range, "scatterer")
 
     def check(self, lo: int, scat: Scatterers, ranges: FloatArray) -> None:
         """Finite ranges above ``scene.min_range``; the fastest radial speed so far."""
@@ -574,6 +571,23 @@ class _Stream:
         if first.axes is not None:
             axes = np.concatenate([b.axes for b in self._blocks if b.axes is not None])
         return Scatterers(cat[0], cat[1], first.names, first.semi_axes, axes)
+
+
+def refuse_near(
+    ranges: FloatArray, names: Sequence[str], time: FloatArray, min_range: float, what: str
+) -> None:
+    """A :class:`SceneError` naming the ``what`` (scatterer, joint) nearest the radar when it
+    comes within ``min_range`` [m]: ``ranges`` (n, len(names)) [m] (inf where not seen) at
+    ``time`` (n,) [s from the record's start]."""
+    if ranges.size == 0:
+        return
+    k, j = (int(i) for i in np.unravel_index(int(np.argmin(ranges)), ranges.shape))
+    if ranges[k, j] < min_range:
+        raise SceneError(
+            f"{what} {names[j]!r} comes within {ranges[k, j]:.3g} m of the radar at t = "
+            f"{time[k]:.3f} s (scene.min_range = {min_range:g} m): the range equation and "
+            "far-field RCS do not hold there"
+        )
 
 
 def _join(blocks: list[NDArray[Any]]) -> NDArray[Any]:

@@ -997,11 +997,10 @@ def frame_spectrogram(
     float32 or float64, Doppler (nfft,) [Hz] ascending and the time of each frame's middle loop
     (n_frames,) [s from the first chirp].
     """
-    from .spectrogram import stft_window  # the cosine windows without importing scipy.signal
+    # the cosine windows without importing scipy.signal
+    from .spectrogram import precision_dtypes, stft_window
 
-    single = precision == "float32"
-    real = np.dtype(np.float32 if single else np.float64)
-    cplx = np.dtype(np.complex64 if single else np.complex128)
+    real, cplx = precision_dtypes(precision)
     frames = np.asarray(signal).reshape(-1, seq.chirps_per_frame)[:, :: seq.n_tx]
     w = stft_window(window_name, seq.n_loops).astype(real)
     n_frames = frames.shape[0]

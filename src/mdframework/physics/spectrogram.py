@@ -28,6 +28,16 @@ COSINE_WINDOWS: dict[str, tuple[float, ...]] = {
 }
 
 
+def precision_dtypes(
+    precision: Literal["float32", "float64"],
+) -> tuple[np.dtype[Any], np.dtype[Any]]:
+    """The (real, complex) dtypes of a ``processing.precision``."""
+    single = precision == "float32"
+    return np.dtype(np.float32 if single else np.float64), np.dtype(
+        np.complex64 if single else np.complex128
+    )
+
+
 def stft_window(name: str, length: int) -> FloatArray:
     """The periodic STFT window ``name`` (any ``scipy.signal.get_window`` name), (length,)
     float64. ``ValueError`` for an unknown name."""
@@ -93,9 +103,7 @@ def spectrogram(
             f"{window_length}: use a longer record or a shorter window"
         )
     n_frames = 1 + (n - window_length) // hop
-    real, cplx = (
-        (np.float32, np.complex64) if precision == "float32" else (np.float64, np.complex128)
-    )
+    real, cplx = precision_dtypes(precision)
     w = stft_window(window, window_length)
     if nfft % 2 == 0:
         # (-1)^m moves bin k to frequency (k - N/2) PRF/N: ascending bins without fftshift

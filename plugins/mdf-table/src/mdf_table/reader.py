@@ -145,11 +145,11 @@ def read_table(path: Path, spec: TableLayout | None = None) -> Table:
     spec = spec or TableLayout()
     if path.suffix.lower() == ".npz":
         time, names, pos, layout, rows = _read_npz(path, spec)
-    else:
+        limits.check_values(
+            path, pos, limits.MAX_FILE_COORDINATE, "a joint coordinate", allow_nan=True
+        )
+    else:  # text: checked row by row as it is read (the error names the line)
         time, names, pos, layout, rows = _read_text(path, spec)
-    limits.check_values(
-        path, pos, limits.MAX_FILE_COORDINATE, "a joint coordinate", unit="", allow_nan=True
-    )
     limits.check_time_stamps(path, time)
     t, p, _ok, report = sort_timestamps(time, pos)
     if t.shape[0] < 2:
@@ -210,18 +210,24 @@ def _numbers(path: Path, cells: list[str], line: int, what: str) -> FloatArray:
 def _columns(
     path: Path, rows: list[list[str]], line_of: list[int], cols: list[int], what: str
 ) -> FloatArray:
-    """The numbers in columns ``cols`` of every row, (n_rows, len(cols)); coordinates are
-    checked against the file limit here, where each row's line is known."""
-    out = np.array(
+    """The numbers in columns ``cols`` of every row, (n_rows, len(cols))."""
+    return np.array(
         [
             _numbers(path, [r[k] for k in cols], ln, what)
             for r, ln in zip(rows, line_of, strict=True)
         ]
     ).reshape(len(rows), len(cols))
-    if what == "coordinate":
-        limits.check_values(
-            path, out, limits.MAX_FILE_COORDINATE, "a joint coordinate", line_of, allow_nan=True
-        )
+
+
+def _coordinates(
+    path: Path, rows: list[list[str]], line_of: list[int], cols: list[int]
+) -> FloatArray:
+    """:func:`_columns` of joint coordinates, each within the file limit (NaN: not seen); the
+    error names the row's line."""
+    out = _columns(path, rows, line_of, cols, "coordinate")
+    limits.check_values(
+        path, out, limits.MAX_FILE_COORDINATE, "a joint coordinate", line_of, allow_nan=True
+    )
     return out
 
 
@@ -297,7 +303,7 @@ def _long_text(
     if tcol is None:
         raise DataFileError(path, "a long table needs a time column (motion.time_column)")
     raw_t = _columns(path, rows, line_of, [tcol], "time")[:, 0]
-    coords = _columns(path, rows, line_of, xyz, "coordinate")
+    coords = _coordinates(path, rows, line_of, xyz)
     return _long_assemble(path, spec, raw_t, [r[jcol] for r in rows], coords, line_of)
 
 
@@ -364,7 +370,7 @@ def _wide_text(
             named_at,
         )
     idx = [groups[j][a] for j in joints for a in "xyz"]
-    data = _columns(path, rows, line_of, idx, "coordinate")
+    data = _coordinates(path, rows, line_of, idx)
     values = None
     if tcol is not None:
         values = _columns(path, rows, line_of, [tcol], "time")[:, 0]
