@@ -253,6 +253,26 @@ def test_a_draw_beyond_its_fields_range_names_the_randomize_entry_and_its_sectio
     )
 
 
+@pytest.mark.parametrize(
+    ("choice", "shown", "problem"),
+    [("2000", "'2000'", 'a number, not text ("2000")'), (True, "True", "a number, not a flag")],
+)
+def test_a_choice_of_the_wrong_type_is_refused_at_its_draw(
+    tmp_path, choice: object, shown: str, problem: str
+) -> None:
+    """`choice = [1000, "2000"]` for the PRF: the text is never read as 2000 Hz (nor `true` as
+    1 Hz); the record that draws it is refused, naming the draw and asking for the field's
+    type, not for a range."""
+    from mdframework.errors import ConfigError
+
+    params = {"params": {"radar.prf": {"choice": [choice]}}}
+    with pytest.raises(ConfigError) as err:
+        _plan(tmp_path, {}, params)
+    msg = str(err.value)
+    assert f'randomize.params."radar.prf" drew {shown} for radar.prf: {problem}' in msg
+    assert msg.endswith("give the distribution values of the field's type")
+
+
 def test_a_record_skipped_for_a_bad_draw_says_which_draw(tmp_path) -> None:
     """With on_error = "skip" the planner leaves records to the build; the skipped record's
     cause names the draw too."""

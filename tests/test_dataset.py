@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
@@ -521,3 +522,37 @@ def test_cli_dataset_error_names_the_config_and_leaves_nothing(
     assert err[0].startswith("mdf: warning: sources[0] (") and "shorter than" in err[0]
     assert len(err) == 2 and err[1].startswith(f"mdf: error: {p}: no records: every source")
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("where", "named"),
+    [
+        ("base", "base.radar.prf"),
+        ("run", "sources[1].run.radar.prf"),
+        ("motion", "sources[1].motion.scale"),
+    ],
+)
+def test_a_record_error_names_the_field_where_the_dataset_config_wrote_it(
+    tmp_path: Path, where: str, named: str
+) -> None:
+    """A bad PRF written under [base.radar] (or a source's `run`) and a bad motion field of
+    the second source: the error names `base.radar.prf`, `sources[1].run.radar.prf` and
+    `sources[1].motion.scale`, not the record's own `radar.prf` or an anonymous motion."""
+    bvh = CMU / "bvh" / "16_21.bvh"
+    source = {"label": "walk", "record_length": 1.0, "max_records": 1}
+    motion = {"kind": "cmu", "file": str(bvh)}
+    second = {**source, "motion": dict(motion)}
+    base: dict = {"radar": {"kind": "lfm", "prf": 2000.0}}
+    if where == "base":
+        base["radar"]["prf"] = -5.0
+    elif where == "run":
+        second["run"] = {"radar": {"prf": 0.0}}
+    else:
+        second["motion"]["scale"] = 2.0
+    cfg = {"sources": [{**source, "motion": motion}, second], "base": base}
+    path = tmp_path / "d.json"
+    path.write_text(json.dumps(cfg))
+    with pytest.raises(ConfigError) as err:
+        plan_records(*load_dataset_config(path))
+    assert named + ": " in str(err.value)
+    assert where == "motion" or str(err.value).startswith(f"sources[{0 if where == 'base' else 1}]")

@@ -287,6 +287,27 @@ def test_disabled_plugin_is_the_stated_cause_of_a_config_error(
     assert "cmu" in default_registry().names("motion")
 
 
+def test_a_misspelt_disable_plugin_name_is_refused(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--disable-plugin mdf_kinnect`` would leave mdf_kinect on without a word: refused, with the
+    nearest installed name, before anything runs."""
+    from conftest import EXAMPLES
+
+    monkeypatch.delenv(DISABLE_PLUGINS_ENV, raising=False)
+    args = ["run", str(EXAMPLES / "point_target.toml"), "--out", str(tmp_path / "o")]
+    code = cli.main([*args, "--disable-plugin", "mdf_kinnect"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1
+    assert err[0].startswith(
+        "mdf: error: --disable-plugin mdf_kinnect: no installed plugin has this name"
+    )
+    assert "(did you mean 'mdf_kinect'?)" in err[0]
+    assert not (tmp_path / "o").exists()
+    # the distribution's name is a name too
+    assert cli.main(["plugins", "--disable-plugin", "mdf-cmu"]) == 0
+
+
 def test_plugins_off_is_the_stated_cause(
     tmp_path: Path,
     monkeypatch: pytest.MonkeyPatch,

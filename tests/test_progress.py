@@ -206,3 +206,20 @@ def test_no_progress_and_mdf_progress_decide_over_the_terminal(
     monkeypatch.setenv(progress.PROGRESS_ENV, "1")
     assert progress.progress_enabled() and progress.Progress().delay == 0.0
     assert not progress.progress_enabled(False)  # --no-progress wins
+
+
+@pytest.mark.parametrize(
+    ("value", "shown"),
+    [
+        *[("1", True), ("Yes", True), ("on", True), ("TRUE", True)],
+        *[("0", False), ("no", False), ("Off", False), ("false", False)],
+        *[("", None), ("maybe", None), ("2", None)],
+    ],
+)
+def test_progress_variable_reads_the_usual_words_for_on_and_off(
+    value: str, shown: bool | None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`MDF_PROGRESS=yes` used to be ignored silently; words other than these still leave the
+    choice to the terminal."""
+    monkeypatch.setenv(progress.PROGRESS_ENV, value)
+    assert progress._forced() is shown

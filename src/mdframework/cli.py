@@ -40,7 +40,9 @@ from .plugins import (
     autoload_enabled,
     default_registry,
     disabled_by_user,
+    installed_names,
     reset_default_registry,
+    suggest,
 )
 from .progress import Progress, printed, retract
 
@@ -609,6 +611,15 @@ def _catch_interrupts() -> Any:
 def _main_with_options(argv: Sequence[str] | None) -> int:
     raw = sys.argv[1:] if argv is None else argv
     args_list, debug, disable = split_global_options(raw)
+    unknown = sorted(set(disable) - installed_names()) if disable else []
+    if unknown:  # a misspelt name would otherwise leave the plugin on without a word
+        known = sorted(installed_names())
+        print(
+            f"mdf: error: {DISABLE_OPTION} {unknown[0]}: no installed plugin has this name"
+            f"{suggest(unknown[0], known)}; `mdf plugins` lists them",
+            file=sys.stderr,
+        )
+        return EXIT_USAGE
     old_env = os.environ.get(DISABLE_PLUGINS_ENV)
     if disable:  # in the environment, so that worker processes see it too
         off = sorted(disabled_by_user() | set(disable))

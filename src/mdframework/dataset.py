@@ -38,6 +38,7 @@ import io
 import itertools
 import json
 import os
+import re
 import warnings
 from collections.abc import Callable, Generator, Iterator
 from concurrent.futures import as_completed
@@ -346,6 +347,9 @@ def build_workers(config: DatasetConfig, workers: int | None = None) -> int:
     return workers or config.workers or os.cpu_count() or 1
 
 
+_MOTION_WHERE = "dataset motion"
+
+
 def _load_motion(motion_json: str, base_dir: str) -> Motion:
     """Load a motion once per process (records of one recording share it). Local worker
     processes are forked after planning and inherit the motions the planner loaded (in
@@ -358,7 +362,7 @@ def _load_motion(motion_json: str, base_dir: str) -> Motion:
     if motion is None:
         section = json.loads(motion_json)
         config = validate_run_config(
-            {"motion": section}, source="dataset motion", base_dir=Path(base_dir)
+            {"motion": section}, source=_MOTION_WHERE, base_dir=Path(base_dir)
         )
         motion = load_motion(build_stages(config).source)
         _keep_motion(key, motion)
@@ -629,6 +633,10 @@ def _draw_origins(config: DatasetConfig, entry_no: int, entry: SourceEntry) -> d
     }
 
 
+#: the numbers-and-flags check's message (``a number, not text ("2000")``)
+_WRONG_TYPE = re.compile(r"(a number\b.*|true or false), not (text|a flag|\w+) \(")
+
+
 def validate_record(
     run: dict[str, Any],
     source: str,
@@ -652,12 +660,51 @@ def validate_record(
         what = f"{section}.{name}" if name in DRAWN_FIELDS else f'{section}.params."{name}"'
         value = draws[name]
         shown = f"{value:.6g}" if isinstance(value, float) else repr(value)
-        todo = (
-            "this source's config has no such field: remove the draw"
-            if problem.startswith("unknown field")
-            else "keep the distribution within the field's range"
-        )
+        if problem.startswith("unknown field"):
+            todo = "this source's config has no such field: remove the draw"
+        elif _WRONG_TYPE.match(problem):
+            todo = "give the distribution values of the field's type"
+        else:
+            todo = "keep the distribution within the field's range"
         raise ConfigError(f"{source}: {what} drew {shown} for {field}: {problem}; {todo}") from None
+
+
+def _has_path(node: Any, parts: list[str]) -> bool:
+    """Whether ``node["a"][0]["b"]`` exists for ``parts = ["a", "0", "b"]``."""
+    for part in parts:
+        if isinstance(node, dict) and part in node:
+            node = node[part]
+        elif isinstance(node, list) and part.isdigit() and int(part) < len(node):
+            node = node[int(part)]
+        else:
+            return False
+    return True
+
+
+def _as_written(
+    exc: ConfigError, record: str, config: DatasetConfig, entry_no: int, entry: SourceEntry
+) -> ConfigError:
+    """A record's config error with the field named where the dataset config wrote it:
+    ``base.radar.prf``, ``sources[0].run.radar.prf`` or ``sources[0].motion.file`` rather than
+    the record's ``radar.prf``. Scene fields (which variations and placement rewrite), the
+    window's ``start``/``duration``/``height`` and draws keep the record's name."""
+    text = str(exc)
+    rest = text.removeprefix(f"{record}: ")
+    field, _, problem = rest.partition(": ")
+    parts = field.split(".")
+    if rest == text or not problem or parts[0] == "scene":
+        return exc
+    if parts[0] == "motion":
+        if len(parts) < 2 or parts[1] in ("start", "duration", "height"):
+            return exc
+        where = f"sources[{entry_no}]."
+    elif _has_path(entry.run, parts):
+        where = f"sources[{entry_no}].run."
+    elif _has_path(config.base, parts):
+        where = "base."
+    else:
+        return exc
+    return ConfigError(f"{record}: {where}{field}: {problem}")
 
 
 def _randomize(config: DatasetConfig, entry: SourceEntry) -> Randomization:
@@ -702,7 +749,11 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
         if "kind" not in motion:
             raise ConfigError(f"sources[{entry_no}].motion: a kind is required")
         # a source's own start/duration limit the span that records are cut from
-        loaded = _load_motion(_motion_key(motion), str(base_dir))
+        try:
+            loaded = _load_motion(_motion_key(motion), str(base_dir))
+        except ConfigError as exc:  # named where the dataset config wrote it
+            text = str(exc).removeprefix(f"{_MOTION_WHERE}: ")
+            raise ConfigError(f"sources[{entry_no}].{text}") from None
         span_start = float(motion.get("start", 0.0))
         span_end = loaded.skeleton.duration
         if motion.get("duration") is not None:
@@ -765,7 +816,10 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                     draws = rz.sample(rng)
                     _apply_draws(run, section, draws, f"sources[{entry_no}]")
                 if config.place == "record":  # after the draws: it fixes the drawn aspect
-                    placing = validate_record(run, record, base_dir, draws, origins)
+                    try:
+                        placing = validate_record(run, record, base_dir, draws, origins)
+                    except ConfigError as exc:
+                        raise _as_written(exc, record, config, entry_no, entry) from None
                     run["scene"] = _place_record(run, placing, loaded)
                 run["seed"] = _record_seed(config.seed, index)
                 specs.append(
@@ -785,7 +839,10 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                 # every record's run config is valid before any file is written (with
                 # on_error = "skip" an invalid record is skipped by the build instead)
                 if config.on_error == "stop":
-                    validate_record(run, record, base_dir, draws, origins)
+                    try:
+                        validate_record(run, record, base_dir, draws, origins)
+                    except ConfigError as exc:
+                        raise _as_written(exc, record, config, entry_no, entry) from None
     if not specs:
         raise ConfigError(
             f"no records: every source is shorter than its record length ({', '.join(short)})"

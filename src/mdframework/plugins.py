@@ -235,6 +235,17 @@ def _entry_points() -> list[importlib.metadata.EntryPoint]:
     return sorted(importlib.metadata.entry_points(group=hookspecs.PROJECT), key=lambda e: e.name)
 
 
+def installed_names() -> set[str]:
+    """Every name ``--disable-plugin`` accepts: the entry-point names of the installed plugins
+    and their distributions' names (reads package metadata only; imports no plugin)."""
+    names = set()
+    for ep in _entry_points():
+        names.add(ep.name)
+        if ep.dist is not None:
+            names.add(ep.dist.name)
+    return names
+
+
 def _unknown_hooks(plugin: object) -> list[str]:
     """Names of hook implementations on ``plugin`` that match no hook specification."""
     specs = {n for n in dir(hookspecs) if n.startswith("mdframework_")}

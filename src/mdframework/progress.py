@@ -28,7 +28,8 @@ from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from typing import Any
 
-#: Environment variable: ``1`` forces progress on (every step, no delay), ``0`` off.
+#: Environment variable: ``1`` forces progress on (every step, no delay), ``0`` off (also
+#: ``true``/``yes``/``on`` and ``false``/``no``/``off``, in any case; anything else is ignored).
 PROGRESS_ENV = "MDF_PROGRESS"
 #: A step or bar appears once it has lasted this long [s].
 DELAY_S = 1.0
@@ -43,10 +44,10 @@ class _State:
 
 
 def _forced() -> bool | None:
-    value = os.environ.get(PROGRESS_ENV, "").strip()
-    if value == "1":
+    value = os.environ.get(PROGRESS_ENV, "").strip().lower()
+    if value in ("1", "true", "yes", "on"):
         return True
-    if value == "0":
+    if value in ("0", "false", "no", "off"):
         return False
     return None
 
