@@ -310,3 +310,33 @@ def test_blamed_draw_prefers_the_most_specific_field() -> None:
     assert blamed_draw("scene", draws) is None  # a check across the section blames no draw
     assert blamed_draw("radar.prf", draws) is None
     assert blamed_draw("motion.duration", {"speed": 2.0}) is None  # augmentations set no field
+
+
+@pytest.mark.parametrize("warp", [None, [0.25, -0.2, 0.1]])
+@pytest.mark.parametrize("speed", [2.0, 1.6, 0.7])
+def test_a_sped_up_record_stays_within_its_sources_span(speed: float, warp: list | None) -> None:
+    """A source limited to 0.4-2.4 s of a CMU walk, cut into 1 s windows, played `speed` times
+    as fast: every record's motion comes from the span (the frames inside the record's window
+    carry their original time stamps), never from after 2.4 s, which once held another part of
+    the recording; a span too short for the record at that speed is refused."""
+    import json
+
+    from conftest import EXAMPLES
+
+    from mdframework.dataset import _augmented, _load_motion
+    from mdframework.errors import SceneError
+
+    amc = EXAMPLES / "data" / "cmu" / "asf-amc" / "02_01.amc"
+    motion = _load_motion(json.dumps({"kind": "cmu", "file": str(amc)}), str(EXAMPLES))
+    t0 = motion.skeleton.time[0]
+    original = motion.skeleton.time - t0
+    draws = {"speed": speed, **({"time_warp": warp} if warp else {})}
+    span = (0.4, 2.4)
+    for start in (0.4, 0.9, 1.4):
+        out, first = _augmented(motion, draws, start, 1.0, span)
+        t = out.skeleton.time - t0
+        inside = (t >= first - 1e-9) & (t <= first + 1.0 + 1e-9)
+        assert original[inside].max() <= span[1] + 1e-9
+        assert first <= start / speed + 1e-12  # a record is only ever moved back
+    with pytest.raises(SceneError, match=r"leaves 0\.400 s of the source's span"):
+        _augmented(motion, {"speed": 5.0}, 0.4, 1.0, span)

@@ -556,3 +556,27 @@ def test_a_record_error_names_the_field_where_the_dataset_config_wrote_it(
         plan_records(*load_dataset_config(path))
     assert named + ": " in str(err.value)
     assert where == "motion" or str(err.value).startswith(f"sources[{0 if where == 'base' else 1}]")
+
+
+def test_a_stopped_build_removes_the_records_it_was_writing(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Workers stopped by Ctrl-C or by another record's error can leave a record half-written
+    (a `.tmp-*.part` file): the build removes it as it stops, and only it."""
+    cfg, base = load_dataset_config(write_config(tmp_path / "d.toml"))
+    out = tmp_path / "ds"
+
+    def stopped(config: object, workers: object, scheduler: object) -> Any:
+        def run(specs: list[Any], out_dir: str) -> Any:
+            records = Path(out_dir) / RECORDS
+            (records / ".tmp-k3j_9x2a.part").write_bytes(b"half a record")
+            (records / ".tmp-notes.txt").write_text("not a record")
+            raise KeyboardInterrupt
+            yield
+
+        yield run
+
+    monkeypatch.setattr(dataset, "_executor", stopped)
+    with pytest.raises(KeyboardInterrupt):
+        build_dataset(cfg, base, out, workers=2, progress=False)
+    assert sorted(p.name for p in (out / RECORDS).iterdir()) == [".tmp-notes.txt"]

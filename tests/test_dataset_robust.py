@@ -83,6 +83,10 @@ def test_on_error_skip_lists_the_skipped_records_and_place_record_needs_none(
     specs = plan_records(placed, base)
     firsts = [s.run_config["scene"]["person"]["position"][0] for s in specs]
     assert firsts[0] == pytest.approx(0.0, abs=1e-9) and firsts[-1] < -1.5
+    # placing turns the aspect into a fixed heading; the table still says which aspect was
+    # asked for (it used to be blank)
+    assert [r["aspect_deg"] for r in rows] == [0.0] * len(rows)
+    assert all("aspect_deg" not in s.run_config["scene"]["person"] for s in specs)
 
 
 def test_records_carry_subject_recording_source_and_dataset(tmp_path: Path) -> None:

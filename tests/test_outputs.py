@@ -319,6 +319,14 @@ def test_dataset_resumes_only_with_the_same_config(
     # the same config again (other build options do not count): resumed, nothing redone
     assert build(cfg, out, capsys, "--workers", "2")[0] == 0
     assert snapshot(out) == before
+    # on_error changes no record either: a build stopped by a failing record resumes with
+    # on_error = "skip" (it used to be refused as another config)
+    skipping = tmp_path / "skipping.toml"
+    skipping.write_text('on_error = "skip"\n' + cfg.read_text())
+    assert build(skipping, out, capsys)[0] == 0
+    records = {k: v for k, v in snapshot(out).items() if k.startswith("records")}
+    assert records == {k: v for k, v in before.items() if k.startswith("records")}
+    before = snapshot(out)
     other = dataset_config(tmp_path, aspects="[0.0, 30.0]", name="other.toml")
     code, err = build(other, out, capsys)
     assert code == 2
@@ -346,6 +354,16 @@ def test_dataset_into_a_folder_of_other_files(
     assert build(dataset_config(tmp_path), out, capsys, "--force")[0] == 0
     assert (out / "records" / "mine.npz").read_bytes() == b"user data"
     assert (out / "todo.txt").read_text() == "x"
+    # the folder now holds a dataset: a plain rerun (resumed) and a rebuild from another config
+    # remove only the records they made (the rerun used to delete mine.npz, and any .tmp-* file)
+    (out / "records" / ".tmp-mine").write_text("mine too")
+    assert build(dataset_config(tmp_path), out, capsys)[0] == 0
+    other = dataset_config(tmp_path, aspects="[0.0, 30.0]", name="other.toml")
+    assert build(other, out, capsys, "--force")[0] == 0
+    assert (out / "records" / "mine.npz").read_bytes() == b"user data"
+    assert (out / "records" / ".tmp-mine").read_text() == "mine too"
+    ids = {row.split(",")[0] for row in (out / "index.csv").read_text().splitlines()[1:]}
+    assert {p.stem for p in (out / "records").glob("*.npz")} == ids | {"mine"}
     # an index whose record id names a path is refused, not followed out of records/
     index = out / "index.csv"
     lines = index.read_text().splitlines()
@@ -556,17 +574,23 @@ def running(pid: int) -> bool:
     return state not in ("Z", "X")
 
 
-def long_dataset(tmp_path: Path) -> Path:
-    p = tmp_path / "long.toml"
+def long_dataset(
+    tmp_path: Path,
+    hop: str = "0.05",
+    variation: str = "aspect_deg = [0.0, 30.0, 60.0]",
+    name: str = "long.toml",
+) -> Path:
+    """1 s records of a CMU walk every ``hop`` s, with one ``variation``."""
+    p = tmp_path / name
     p.write_text(f"""
 [[sources]]
 label = "walk"
 motion = {{ kind = "cmu", file = "{CMU / "asf-amc" / "02_01.amc"}" }}
-hop = 0.05
+hop = {hop}
 [record_lengths]
 walk = 1.0
 [variations]
-aspect_deg = [0.0, 30.0, 60.0]
+{variation}
 [base.processing]
 nfft = 256
 """)
@@ -612,8 +636,12 @@ def test_workers_end_when_the_parent_is_killed(tmp_path: Path, scheduler: list[s
     assert not (out / LOCK).exists()
 
 
-def test_ctrl_c_during_a_build_is_one_line(tmp_path: Path) -> None:
-    proc, out, workers = start_build(tmp_path)
+@pytest.mark.parametrize("scheduler", [[], ["--scheduler", "local"]], ids=["pool", "dask"])
+def test_ctrl_c_during_a_build_is_one_line(tmp_path: Path, scheduler: list[str]) -> None:
+    """Also with a local Dask cluster, whose log of the cancelled tasks used to come first."""
+    if scheduler:
+        pytest.importorskip("distributed")
+    proc, out, workers = start_build(tmp_path, *scheduler)
     os.killpg(proc.pid, signal.SIGINT)  # Ctrl-C reaches the whole foreground process group
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130
@@ -625,6 +653,21 @@ def test_ctrl_c_during_a_build_is_one_line(tmp_path: Path) -> None:
     assert not (out / LOCK).exists()
     for record in (out / "records").glob("[!.]*.npz"):  # every record file is complete
         read_record(record)
+
+
+def test_a_failing_record_on_a_local_dask_cluster_is_one_line(tmp_path: Path) -> None:
+    """Dask's workers logged the record's error with its traceback, and the cancelled tasks
+    after it, around the one line that says it."""
+    pytest.importorskip("distributed")
+    # the walker's second record is seen from 0.2 m: a body part comes within min_range
+    cfg = long_dataset(tmp_path, "2.0", "radar_range = [6.0, 0.2]", "near.toml")
+    args = ["dataset", "build", str(cfg), "--out", str(tmp_path / "ds"), "--no-progress"]
+    proc = mdf_process([*args, "--workers", "1", "--scheduler", "local"])
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"mdf: error: {cfg}: record "), err
+    assert "comes within" in lines[0]
 
 
 @pytest.mark.parametrize("delay", [0.02, 0.05, 0.15, 0.3, 0.6, 1.0, 2.0])

@@ -42,7 +42,7 @@ import re
 import warnings
 from collections.abc import Callable, Generator, Iterator
 from concurrent.futures import as_completed
-from contextlib import AbstractContextManager, closing
+from contextlib import AbstractContextManager, closing, contextmanager, nullcontext
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -53,7 +53,7 @@ from numpy.typing import NDArray
 from pydantic import Field, ValidationError, field_validator, model_validator
 
 from . import limits
-from .augment import augment_motion
+from .augment import augment_motion, warp_function
 from .config import format_validation_error, read_config_file, validate_run_config
 from .errors import ConfigError, DataFileError, MdfError, OutputError, SceneError
 from .features import FEATURE_NAMES, spectrogram_features
@@ -119,8 +119,9 @@ Percent = Annotated[float, Field(ge=0, le=100)]
 
 #: every name a dataset build writes in its folder
 DATASET_FILES = (RECORDS, INDEX, MANIFEST, SKIPPED)
-#: build options that do not change a dataset (ignored when comparing configs)
-BUILD_OPTIONS = ("workers", "scheduler")
+#: build options that do not change a record (ignored when comparing configs): a build stopped
+#: by a failing record resumes with ``on_error = "skip"``, keeping the records it finished
+BUILD_OPTIONS = ("workers", "scheduler", "on_error")
 
 
 class FeatureConfig(StrictModel):
@@ -316,6 +317,12 @@ class RecordSpec:
     #: the config section each draw's distribution comes from (``randomize`` or
     #: ``sources[N].randomize``), to name it when a drawn value does not fit its field
     draw_origins: dict[str, str] | None = None
+    #: the source's span ``(start, end)`` [s from the motion's first frame] when the source
+    #: gives a ``duration``: a record sped up by a ``speed`` draw stays within it
+    span: tuple[float, float] | None = None
+    #: the aspect [deg] asked for (variation or draw) when ``place = "record"`` turned it into
+    #: a fixed heading, for the table
+    aspect_deg: float | None = None
 
 
 def load_dataset_config(path: str | Path) -> tuple[DatasetConfig, Path]:
@@ -550,11 +557,16 @@ def _spec(
     hist: dict[str, Any] | None,
     meta: tuple[str, str, str] = ("", "", ""),
     draw_origins: dict[str, str] | None = None,
+    span: tuple[float, float] | None = None,
+    aspect_deg: float | None = None,
 ) -> RecordSpec:
     """A record's spec; its id ends with a digest of everything that makes the record.
-    ``meta``: the record's subject, recording and dataset."""
+    ``meta``: the record's subject, recording and dataset; ``span``: the source's span when
+    it gives a duration (:attr:`RecordSpec.span`)."""
     features = config.features.model_dump()
     payload = [run, features] + [x for x in (draws, hist) if x is not None]
+    if span is not None and draws is not None and "speed" in draws:
+        payload.append({"span": list(span)})
     digest = hashlib.sha1(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:10]
     return RecordSpec(
         index,
@@ -569,6 +581,8 @@ def _spec(
         *meta,
         config.on_error,
         draw_origins,
+        span,
+        aspect_deg,
     )
 
 
@@ -815,12 +829,14 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                     rng = np.random.default_rng(np.random.SeedSequence([config.seed, index, 1]))
                     draws = rz.sample(rng)
                     _apply_draws(run, section, draws, f"sources[{entry_no}]")
+                asked = None
                 if config.place == "record":  # after the draws: it fixes the drawn aspect
                     try:
                         placing = validate_record(run, record, base_dir, draws, origins)
                     except ConfigError as exc:
                         raise _as_written(exc, record, config, entry_no, entry) from None
                     run["scene"] = _place_record(run, placing, loaded)
+                    asked = placing.scene.person.aspect_deg
                 run["seed"] = _record_seed(config.seed, index)
                 specs.append(
                     _spec(
@@ -834,6 +850,8 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                         hist,
                         meta,
                         origins if draws else None,
+                        None if motion.get("duration") is None else (span_start, span_end),
+                        asked,
                     )
                 )
                 # every record's run config is valid before any file is written (with
@@ -967,9 +985,18 @@ def _build_recorded(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     return _row(meta, arrays["features"])
 
 
-def _augmented(motion: Motion, draws: dict[str, Any], start: float, duration: float) -> Any:
+def _augmented(
+    motion: Motion,
+    draws: dict[str, Any],
+    start: float,
+    duration: float,
+    span: tuple[float, float] | None = None,
+) -> Any:
     """The augmented motion and the record's start in its time [s] (speed changes the
-    timeline: the record keeps the motion phase where it can, else ends at the end)."""
+    timeline: the record keeps the motion phase where it can, else ends at the end of the
+    motion, or of the source's ``span`` (start, end) [s] when the source gives a duration:
+    that end is carried through the time warp and the speed, so a sped-up record never takes
+    motion from beyond it)."""
     speed = float(draws.get("speed", 1.0))
     warp = draws.get("time_warp")
     out = augment_motion(
@@ -979,13 +1006,23 @@ def _augmented(motion: Motion, draws: dict[str, Any], start: float, duration: fl
         mirror=bool(draws.get("mirror", False)),
         warp=None if warp is None else np.asarray(warp, dtype=np.float64),
     )
-    span = out.skeleton.duration
-    if duration > span + 1e-9:
+    first, end = 0.0, out.skeleton.duration
+    what = "of motion"
+    if span is not None:
+        whole = motion.skeleton.duration
+        at = (
+            span[1]
+            if warp is None
+            else whole * float(warp_function(np.array([span[1] / whole]), warp)[0])
+        )
+        first, end = span[0] / speed, at / speed
+        what = "of the source's span"
+    if duration > end - first + 1e-9:
         raise SceneError(
-            f"randomize.speed: a speed factor of {speed:.3f} leaves {span:.3f} s of motion, "
+            f"randomize.speed: a speed factor of {speed:.3f} leaves {end - first:.3f} s {what}, "
             f"shorter than the {duration:g} s record"
         )
-    return out, min(start / speed, span - duration)
+    return out, min(start / speed, end - duration)
 
 
 def build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
@@ -1042,7 +1079,11 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     draws = spec.draws or {}
     if any(k in draws for k in ("speed", "body_scale", "mirror", "time_warp")):
         motion, start = _augmented(
-            motion, draws, float(run_config["motion"]["start"]), run_config["motion"]["duration"]
+            motion,
+            draws,
+            float(run_config["motion"]["start"]),
+            run_config["motion"]["duration"],
+            spec.span,
         )
         run_config = {**run_config, "motion": {**run_config["motion"], "start": round(start, 9)}}
         config = validate_run_config(run_config, source=where, base_dir=Path(spec.base_dir))
@@ -1077,7 +1118,9 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         "dataset": spec.dataset,
         "start_s": cfg.motion.start,
         "duration_s": cfg.motion.duration,
-        "aspect_deg": cfg.scene.person.aspect_deg,
+        "aspect_deg": (
+            spec.aspect_deg if cfg.scene.person.aspect_deg is None else cfg.scene.person.aspect_deg
+        ),
         "radar_position_m": list(cfg.scene.radar_position),
         "height_m": run_config["motion"].get("height"),
         "seed": cfg.seed,
@@ -1342,28 +1385,65 @@ def _executor(
         raise MdfError("a Dask scheduler needs `pip install mdframework[dask]`") from None
     import dask
 
-    with dask.config.set(LOCAL_DASK_CONFIG):
-        cluster = (
-            LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None)
-            if address == "local"
-            else None
-        )
-    client = _connect(Client, cluster, address)
+    with _quiet_dask_logs() if address == "local" else nullcontext():
+        with dask.config.set(LOCAL_DASK_CONFIG):
+            cluster = (
+                LocalCluster(
+                    n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
+                )
+                if address == "local"
+                else None
+            )
+        client = _connect(Client, cluster, address)
+        try:
+            if cluster is not None:
+                client.run(_quiet_dask_worker)
+            client.run(_receive_motions, dict(_MOTIONS))  # each worker gets what planning loaded
+
+            def run_dask(specs: list[RecordSpec], out: str) -> Iterator[dict[str, Any]]:
+                threads = sum(client.nthreads().values()) or n
+                chunks = record_chunks(specs, threads)
+                futures = client.map(build_records, chunks, out_dir=out, pure=False)
+                for fut in dask_completed(futures):
+                    yield from fut.result()
+
+            yield run_dask
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+
+
+@contextmanager
+def _quiet_dask_logs() -> Iterator[None]:
+    """Silence Dask's own log in this process (the local cluster's nannies and scheduler live
+    here) while a local cluster runs: a record's error reaches the user as one line, and
+    Dask's log of it, of the tasks cancelled after it or of Ctrl-C would only surround it."""
+    import logging
+
+    log = logging.getLogger("distributed")
+    level = log.level
+    log.setLevel(logging.CRITICAL)
     try:
-        client.run(_receive_motions, dict(_MOTIONS))  # each worker gets what planning loaded
-
-        def run_dask(specs: list[RecordSpec], out: str) -> Iterator[dict[str, Any]]:
-            threads = sum(client.nthreads().values()) or n
-            chunks = record_chunks(specs, threads)
-            futures = client.map(build_records, chunks, out_dir=out, pure=False)
-            for fut in dask_completed(futures):
-                yield from fut.result()
-
-        yield run_dask
+        yield
     finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        log.setLevel(level)
+
+
+def _quiet_dask_worker() -> bool:
+    """:func:`_quiet_dask_logs` in a local cluster's worker process, for its lifetime, and
+    Ctrl-C ignored there, as in the process pool's workers: the build's process handles it
+    and closes the cluster (the worker's own KeyboardInterrupt printed a traceback). Whether
+    Ctrl-C could be ignored (only from the worker's main thread)."""
+    import logging
+    import signal
+    import threading
+
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)
+    if threading.current_thread() is not threading.main_thread():
+        return False
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    return True
 
 
 def dataset_folder(out: str | Path, *, force: bool = False) -> AbstractContextManager[OutputFolder]:
@@ -1453,8 +1533,7 @@ def build_dataset(
         folder.write_marker(config=wanted, complete=False)
         (out / RECORDS).mkdir(exist_ok=True)
         if ours:
-            for stale in (out / RECORDS).glob(".tmp-*"):
-                stale.unlink()
+            _remove_partials(out)
         rows: dict[str, dict[str, Any]] = {}
         todo = []
         for spec in specs:
@@ -1473,20 +1552,25 @@ def build_dataset(
         )
         skipped: dict[str, dict[str, Any]] = {}
         executor = _executor(config, workers, scheduler)
-        with closing(executor), bar:  # closing: workers stop at once on Ctrl-C or an error
-            for run in executor:
-                for row in run(todo, str(out)):
-                    if "skipped" in row:
-                        skipped[row["id"]] = row
-                        warnings.warn(
-                            f"record {row['id']} ({row['file']}, window {row['start_s']:.3f} s "
-                            f"+ {row['duration_s']:g} s) skipped: {row['skipped']}",
-                            DatasetWarning,
-                            stacklevel=2,
-                        )
-                    else:
-                        rows[row["id"]] = row
-                    bar.update(1)
+        try:
+            with closing(executor), bar:  # closing: workers stop at once on Ctrl-C or an error
+                for run in executor:
+                    for row in run(todo, str(out)):
+                        if "skipped" in row:
+                            skipped[row["id"]] = row
+                            warnings.warn(
+                                f"record {row['id']} ({row['file']}, window "
+                                f"{row['start_s']:.3f} s + {row['duration_s']:g} s) skipped: "
+                                f"{row['skipped']}",
+                                DatasetWarning,
+                                stacklevel=2,
+                            )
+                        else:
+                            rows[row["id"]] = row
+                        bar.update(1)
+        except BaseException:
+            _remove_partials(out)  # of records that stopped workers were writing
+            raise
         ordered = [rows[s.record_id] for s in specs if s.record_id in rows]
         if not ordered:
             first = next(iter(skipped.values()))["skipped"]
@@ -1496,10 +1580,23 @@ def build_dataset(
         if ours:  # records of an earlier config, now that the new index is in place
             keep = {f"{s.record_id}.npz" for s in specs}
             for old in (out / RECORDS).glob("*.npz"):
-                if old.name not in keep:
+                if old.name not in keep and _RECORD_NAME.fullmatch(old.name):
                     old.unlink()
         folder.write_marker(config=wanted, complete=True)
     return ordered
+
+
+#: a record's file name (``{index:05d}-{digest}.npz``) and a record being written
+#: (:func:`atomic_savez`'s temporary file): the only files of ``records/`` a build removes
+_RECORD_NAME = re.compile(r"\d{5,}-[0-9a-f]{10}\.npz")
+_PARTIAL_NAME = re.compile(r"\.tmp-\w+\.(part|npz)")  # .npz: earlier versions
+
+
+def _remove_partials(out: Path) -> None:
+    """Remove the records that were being written when a build stopped."""
+    for partial in (out / RECORDS).glob(".tmp-*"):
+        if _PARTIAL_NAME.fullmatch(partial.name):
+            partial.unlink(missing_ok=True)
 
 
 def _write_index(
