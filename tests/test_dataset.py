@@ -94,6 +94,7 @@ def test_plan_and_load(tmp_path: Path) -> None:
     )
     _, meta = read_record(out / RECORDS / f"{rows[0]['id']}.npz")
     assert meta["units"]["features"] == "m/s" and meta["label"] == "walk"
+    assert "histograms" not in meta["units"]  # a spectrogram record has none
 
 
 def test_same_result_with_one_and_two_workers_and_dask(

@@ -257,6 +257,7 @@ min_range = 0.25
         np.testing.assert_array_equal(h[f], ref)
     assert h[:, 8].sum() > 0 and h.sum() > h[:, 8].sum()  # static body and moving fists
     assert meta["label"] == "boxing"
+    assert meta["units"]["histograms"] == "points (or weights) per bin and frame"
 
 
 def test_the_sim_to_real_dataset_plan() -> None:

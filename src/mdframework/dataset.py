@@ -117,6 +117,15 @@ TASKS_PER_THREAD = 4
 #: A percentile (0 .. 100).
 Percent = Annotated[float, Field(ge=0, le=100)]
 
+#: the units of a record's arrays, as its ``meta["units"]`` gives them (``histograms`` only in
+#: the records that have them)
+RECORD_UNITS = {
+    "features": "m/s",
+    "spectrogram_db": "dB re peak",
+    "histograms": "points (or weights) per bin and frame",
+    "velocity": "m/s",
+    "time": "s",
+}
 #: every name a dataset build writes in its folder
 DATASET_FILES = (RECORDS, INDEX, MANIFEST, SKIPPED)
 #: build options that do not change a record (ignored when comparing configs): a build stopped
@@ -968,13 +977,7 @@ def _build_recorded(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         "first_frame": run["first_frame"],
         "histogram": spec.histogram["histogram"],
         "recording": dict(rec.metadata),
-        "units": {
-            "features": "m/s",
-            "spectrogram_db": "dB re peak",
-            "histograms": "points (or weights) per bin and frame",
-            "velocity": "m/s",
-            "time": "s",
-        },
+        "units": RECORD_UNITS,
     }
     atomic_savez(
         Path(out_dir) / RECORDS / f"{spec.record_id}.npz",
@@ -1127,12 +1130,7 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         "draws": spec.draws,
         "prf_hz": result.metadata["prf_hz"],
         "carrier_frequency_hz": result.metadata["carrier_frequency_hz"],
-        "units": {
-            "features": "m/s",
-            "spectrogram_db": "dB re peak",
-            "velocity": "m/s",
-            "time": "s",
-        },
+        "units": {k: v for k, v in RECORD_UNITS.items() if k != "histograms" or extra},
         "run_config": json.loads(cfg.model_dump_json()),
     }
     atomic_savez(
