@@ -92,8 +92,17 @@ def test_plan_and_load(tmp_path: Path) -> None:
     assert np.allclose(
         data.table["total_bandwidth"], data.table["upper_max"] - data.table["lower_min"]
     )
-    _, meta = read_record(out / RECORDS / f"{rows[0]['id']}.npz")
+    arrays, meta = read_record(out / RECORDS / f"{rows[0]['id']}.npz")
     assert meta["units"]["features"] == "m/s" and meta["label"] == "walk"
+    # the arrays as docs/datasets.md lists them
+    n_doppler, n_frames = arrays["spectrogram_db"].shape
+    assert arrays["spectrogram_db"].dtype == np.float32
+    assert arrays["velocity_mps"].dtype == np.float64 and arrays["velocity_mps"].shape == (
+        n_doppler,
+    )
+    assert arrays["time_s"].dtype == np.float64 and arrays["time_s"].shape == (n_frames,)
+    assert arrays["features"].dtype == np.float64 and arrays["features"].shape == (7,)
+    assert 0.0 < arrays["time_s"][0] < arrays["time_s"][-1] < float(rows[0]["duration_s"])
     assert "histograms" not in meta["units"]  # a spectrogram record has none
 
 

@@ -250,7 +250,7 @@ min_range = 0.25
     gate = (r >= 0.5) & (r <= 3.0)
     edges = (np.arange(18) - 8.5) * 0.61466867
     h = arrays["histograms"]
-    assert h.shape == (15, 17)  # 0.5 s of 33.33 ms frames
+    assert h.shape == (15, 17) and h.dtype == np.float32  # 0.5 s of 33.33 ms frames
     for f in range(15):
         sel = gate & (points[:, 0] == f)
         ref, _ = np.histogram(points[sel, 5], bins=edges)
