@@ -1,5 +1,9 @@
-"""Every installed plugin passes its interface's contract (the public suite in
-mdframework.testing), and the suite catches broken plugins."""
+"""Every plugin of this project passes its interface's contract (the public suite in
+mdframework.testing), and the suite catches broken plugins.
+
+The checks run on the plugins whose code lives in this tree's ``plugins/`` (a third party's plugin
+installed beside ours is checked by its own tests, with the same suite): one that needs a file,
+or whose name clashes with ours, must not break the collection of this file."""
 
 from __future__ import annotations
 
@@ -9,16 +13,19 @@ from typing import Any, Literal
 
 import numpy as np
 import pytest
-from conftest import EXAMPLES, project_distributions
+from conftest import EXAMPLES
 from helpers import walking_c3d
 
 from mdframework.config import load_run_config
+from mdframework.docgen import project_registry
 from mdframework.interfaces import Effect, PluginConfig, Received, Scatterers, SceneContext
 from mdframework.physics import interpolation
 from mdframework.pipeline import build_stages, place_body
-from mdframework.plugins import INTERFACES, default_registry
+from mdframework.plugins import INTERFACES
 from mdframework.skeleton import Skeleton
 from mdframework.testing import (
+    JointPoints,
+    ReferenceRadar,
     check_block_invariance,
     check_effect,
     check_plugin,
@@ -26,10 +33,10 @@ from mdframework.testing import (
     check_radar_waveform,
     parametrize_with_checks,
     plugin_checks,
+    walking_motion,
 )
 
-REGISTRY = default_registry()
-OWN = project_distributions()
+REGISTRY = project_registry()
 
 #: an example config that uses each of the project's motion sources (every one must have one)
 SOURCE_EXAMPLES = {
@@ -63,11 +70,11 @@ def _instance(interface: str, name: str) -> Any:
         path = WRITTEN_SOURCE_FILES[name](Path(tempfile.mkdtemp(prefix=f"contract-{name}-")))
         cls0: Any = info.cls
         return cls0(cls0.Config(file=path))
-    if interface == "motion" and info.provider.split()[0] in OWN:
+    if interface == "motion":
         assert name in SOURCE_EXAMPLES, f"add an example using the {name!r} source"
         return build_stages(load_run_config(EXAMPLES / SOURCE_EXAMPLES[name])).source
     cls: Any = info.cls
-    if interface == "recording" and info.provider.split()[0] in OWN:
+    if interface == "recording":
         assert name in RECORDING_EXAMPLES, f"add an example recording for the {name!r} source"
         section = {"kind": name, **RECORDING_EXAMPLES[name]}
         return cls(cls.Config.model_validate(section, context={"base_dir": EXAMPLES}))
@@ -142,6 +149,184 @@ def test_the_suite_catches_an_effect_that_drops_pulses_or_is_not_seeded() -> Non
     with pytest.raises(AssertionError, match="must return Scatterers"):
         check_effect(WrongStage(WrongStage.Config()))
     assert Scatterers  # the type the scatterers stage must return
+
+
+class _Stage(_Returns):
+    """A scatterer-stage effect whose apply returns what ``result`` says."""
+
+    stage = "scatterers"  # type: ignore[assignment]
+
+
+class Counted(_Stage):
+    """Scales each pulse's RCS by 1 + 1e-3 k, k counting the pulses since start_record: a
+    correct stateful effect (state carried across blocks, reset in start_record)."""
+
+    def start_record(self, body: Skeleton, radar_position: Any) -> None:
+        self.seen = 0
+
+    def apply(self, data: Any, context: SceneContext) -> Any:
+        k = self.seen + np.arange(data.rcs.shape[0])
+        self.seen += data.rcs.shape[0]
+        return data.replace(rcs=data.rcs * (1 + 1e-3 * k)[:, None])
+
+
+class Smoothed(_Stage):
+    """Smooths each scatterer's RCS over pulses (first-order IIR, time constant 10 pulses),
+    carrying the filter's state across blocks and resetting it in start_record."""
+
+    state: Any = None
+
+    def start_record(self, body: Skeleton, radar_position: Any) -> None:
+        self.state = None
+
+    def apply(self, data: Any, context: SceneContext) -> Any:
+        out = np.empty_like(data.rcs)
+        s = data.rcs[0] if self.state is None else self.state
+        for i, row in enumerate(data.rcs):
+            s = out[i] = 0.9 * s + 0.1 * row
+        self.state = s
+        return data.replace(rcs=out)
+
+
+def test_a_stateful_effect_that_resets_in_start_record_passes() -> None:
+    """The checks start each pass of the block-invariance check as a run starts a record (with
+    start_record), so state carried across blocks is allowed; the smoothing one would pass a
+    constant RCS whatever its state, so the checks feed an RCS that swings over time."""
+    check_plugin(Counted(Counted.Config()))
+    check_plugin(Smoothed(Smoothed.Config()))
+    effect = Counted(Counted.Config())  # check_block_invariance resets it, not its caller
+    effect.seen = 12345
+    motion = walking_motion(0.2)
+    body = motion.canonical()
+    check_block_invariance(
+        JointPoints(JointPoints.Config()),
+        ReferenceRadar(ReferenceRadar.Config()),
+        body,
+        motion,
+        (effect,),
+    )
+
+
+def test_the_suite_catches_state_that_is_never_reset() -> None:
+    """The same smoothing, its state reset only when the effect is made: the record's second
+    pass starts from the first's last RCS (caught only because the checks' RCS changes)."""
+
+    class Stale(Smoothed):
+        """Never resets its filter."""
+
+        def start_record(self, body: Skeleton, radar_position: Any) -> None:
+            pass
+
+    with pytest.raises(AssertionError, match="reset in start_record what apply accumulates"):
+        check_effect(Stale(Stale.Config()))
+    motion = walking_motion(0.2)
+    body = motion.canonical()
+    points = JointPoints(JointPoints.Config(rcs_swing=0.5))
+    radar = ReferenceRadar(ReferenceRadar.Config())
+    with pytest.raises(AssertionError, match=r"effect 'returns' gives different scatterer rcs"):
+        check_block_invariance(points, radar, body, motion, (Stale(Stale.Config()),))
+
+
+def test_the_suite_checks_the_dtypes_the_interfaces_give() -> None:
+    class Real(_Returns):
+        """Drops the imaginary part (a run would show a mirrored spectrogram)."""
+
+        result = staticmethod(lambda r: Received(r.signal.real.copy()))
+
+    class Single(_Returns):
+        """Returns a complex64 signal."""
+
+        result = staticmethod(lambda r: Received(r.signal.astype(np.complex64)))
+
+    class Float32(_Stage):
+        """Returns float32 positions and RCS."""
+
+        result = staticmethod(
+            lambda d: Scatterers(d.positions.astype(np.float32), d.rcs.astype(np.float32), d.names)
+        )
+
+    expected = [
+        (Real, r"Real \('returns'\): apply\(\) must give Received.signal as complex128 .*float64"),
+        (Single, r"Received.signal as complex128 .*got complex64"),
+        (Float32, r"Float32 \('returns'\): apply\(\) must give Scatterers.positions as float64"),
+    ]
+    for cls, message in expected:
+        with pytest.raises(AssertionError, match=message):
+            check_effect(cls(cls.Config()))
+
+
+def test_the_suite_catches_an_effect_that_changes_its_input_in_place() -> None:
+    class Halves(_Stage):
+        """Halves the input's RCS in place and returns it."""
+
+        def apply(self, data: Any, context: SceneContext) -> Any:
+            data.rcs[...] *= 0.5
+            return data
+
+    with pytest.raises(
+        AssertionError, match=r"Halves \('returns'\): apply\(\) changed its input's rcs"
+    ):
+        check_effect(Halves(Halves.Config()))
+
+
+def test_the_suite_names_the_effect_that_is_not_block_invariant() -> None:
+    """An effect that adds a scatterer to the first block only, and one that moves the
+    scatterers by an amount set by the block's length: each is named (not the checks' own
+    radar), in an AssertionError (not numpy's ValueError)."""
+
+    class Extra(_Stage):
+        """Adds a scatterer in the block that starts at pulse 0 only."""
+
+        def apply(self, data: Any, context: SceneContext) -> Any:
+            if context.block_start:
+                return data
+            n = data.positions.shape[0]
+            return Scatterers(
+                np.concatenate([data.positions, data.positions[:, :1] + 1.0], axis=1),
+                np.concatenate([data.rcs, np.ones((n, 1))], axis=1),
+                (*data.names, "extra"),
+            )
+
+    class Shifts(_Stage):
+        """Moves every scatterer by 0.1 mm per pulse of the block."""
+
+        def apply(self, data: Any, context: SceneContext) -> Any:
+            return data.replace(positions=data.positions + 1e-4 * data.positions.shape[0])
+
+    every_block = "effect 'returns': every block must have the same scatterers, but it gives 18"
+    with pytest.raises(AssertionError, match=every_block):
+        check_plugin(Extra(Extra.Config()))
+    with pytest.raises(AssertionError) as info:
+        check_plugin(Shifts(Shifts.Config()))
+    message = str(info.value)
+    assert "effect 'returns' gives different scatterer positions" in message, message
+    assert "radar" not in message and "waveform" not in message, message
+
+
+def test_the_suite_says_a_class_has_no_config() -> None:
+    class Bare(Effect):
+        """An effect without a Config."""
+
+        name = "bare"
+        stage = "scatterers"
+
+        def apply(self, data: Any, context: SceneContext) -> Any:
+            return data
+
+    with pytest.raises(AssertionError, match=r"Bare \('bare'\) has no Config"):
+        check_plugin(Bare)
+
+    class NeedsGain(_Returns):
+        """Its Config needs a gain."""
+
+        class Config(PluginConfig):
+            """A gain."""
+
+            kind: Literal["returns"] = "returns"
+            gain: float
+
+    with pytest.raises(AssertionError, match=r"its Config has required fields \(gain\)"):
+        check_plugin(NeedsGain)
 
 
 def test_the_suite_names_the_plugin_and_the_failing_check() -> None:
@@ -246,8 +431,7 @@ def test_scatterer_effects_are_block_invariant(
 ) -> None:
     motion, skeleton = placed_body
     cls: Any = REGISTRY.get("effects", name)
-    effect = cls(cls.Config())
-    effect.start_record(skeleton, np.array([10.0, 0.0, 1.0]))
+    effect = cls(cls.Config())  # check_block_invariance calls its start_record
     lfm: Any = REGISTRY.get("radar", "lfm")
     check_block_invariance(_model("ellipsoid"), lfm(lfm.Config()), skeleton, motion, (effect,))
 

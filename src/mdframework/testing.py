@@ -20,7 +20,8 @@ or one pytest test per check (the failing check is named in the test id)::
 plugin instance (``check_effect(effect)``), and raises ``AssertionError`` naming the plugin and
 the broken contract. The checks build their own inputs: a walking body (:func:`walking_motion`),
 a reference radar (:class:`ReferenceRadar`) and separable features for classifiers, so they need
-no other plugin. The project runs them over every installed plugin (``tests/test_contracts.py``).
+no other plugin. The project runs them over each of its own plugins
+(``tests/test_contracts.py``); a third party runs them over its plugins in its own tests.
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ from functools import partial
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, ValidationError
 
 from .interfaces import (
     Classifier,
@@ -217,6 +218,7 @@ def check_plugin_class(cls: type[Plugin], interface: str | None = None) -> None:
     assert isinstance(getattr(cls, "name", None), str) and cls.name, f"{cls.__name__} has no name"
     assert (cls.__doc__ or "").strip(), f"{cls.__name__} has no docstring"
     config = getattr(cls, "Config", None)
+    assert config is not None, f"{cls.__name__} has no Config (a mdframework.PluginConfig)"
     assert isinstance(config, type) and issubclass(config, PluginConfig), (
         f"{cls.__name__}.Config must subclass mdframework.PluginConfig"
     )
@@ -299,6 +301,7 @@ def check_scatterer_model(
     assert np.all(np.isfinite(scat.rcs)) and np.all(scat.rcs >= 0), (
         f"{who}: RCS must be finite and >= 0"
     )
+    _check_dtypes(who, "scatterers()", scat)
     return scat
 
 
@@ -325,6 +328,7 @@ def check_radar_waveform(waveform: RadarWaveform) -> None:
     assert isinstance(received, Received), f"{who}: receive() must return Received"
     y = received.signal
     assert y.shape == (n,) and np.iscomplexobj(y), f"{who}: signal must be (n_pulses,) complex"
+    _check_dtypes(who, "receive()", received)
     assert np.all(np.isfinite(y)), f"{who}: the signal must be finite"
     only = receive_points(
         waveform, ranges, np.ones_like(ranges), ranges[:, 0], times=t, signal_only=True
@@ -383,10 +387,12 @@ def check_classifier(classifier: Classifier) -> None:
 def _effect_input(
     effect: Effect, context: SceneContext, model: ScattererModel | None, body: Skeleton
 ) -> Any:
-    """The data an effect of the checks gets: the walking body's scatterers, or what the
-    context's radar receives of them."""
+    """The data an effect of the checks gets: the walking body's scatterers (by default one
+    point per joint whose RCS swings over time, :func:`swinging_rcs`), or what the context's
+    radar receives of them."""
     if model is None:
-        scat = Scatterers(body.positions, np.ones(body.positions.shape[:2]), body.joint_names)
+        rcs = swinging_rcs(body.time, body.n_joints)
+        scat = Scatterers(body.positions, rcs, body.joint_names)
     else:
         model.start_record(body)
         scat = model.scatterers(walking_motion(), body, context.radar_position, 0.03)
@@ -399,12 +405,47 @@ def _effect_input(
     return context.waveform.receive(block)
 
 
+def swinging_rcs(time: np.ndarray, n_points: int, swing: float = 0.5) -> np.ndarray:
+    """RCS (n, n_points) float64 [m^2] of points whose RCS swings about 1 m^2 over ``time``
+    (n,) [s]: ``1 + swing sin(2 pi 1.3 Hz t + k)`` for the k-th point, so that effects whose
+    output depends on the RCS (smoothing it over pulses, say) are checked on an RCS that
+    changes from pulse to pulse and from point to point."""
+    phase = 2 * np.pi * 1.3 * np.asarray(time, dtype=np.float64)[:, None] + np.arange(n_points)
+    return np.asarray(1.0 + swing * np.sin(phase), dtype=np.float64)
+
+
+#: dtype of each array of the data passed between stages (see :mod:`mdframework.interfaces`)
+DTYPES = {
+    "positions": np.dtype(np.float64),
+    "rcs": np.dtype(np.float64),
+    "signal": np.dtype(np.complex128),
+}
+
+
+def _arrays(data: Any) -> dict[str, np.ndarray]:
+    """The arrays of ``Scatterers`` or ``Received`` that :data:`DTYPES` names."""
+    if isinstance(data, Scatterers):
+        return {"positions": data.positions, "rcs": data.rcs}
+    return {"signal": data.signal}
+
+
+def _check_dtypes(who: str, what: str, data: Any) -> None:
+    for name, array in _arrays(data).items():
+        found = np.asarray(array).dtype
+        assert found == DTYPES[name], (
+            f"{who}: {what} must give {type(data).__name__}.{name} as {DTYPES[name]} "
+            f"(mdframework.interfaces), got {found}"
+        )
+
+
 def check_effect(effect: Effect, model: ScattererModel | None = None) -> None:
     """An effect declares its stage; ``apply`` returns the same kind of data it was given
-    (``Scatterers`` or ``Received``, never None), for the same pulses, finite; ``describe()``
-    is a JSON-serialisable dict; the same seed gives the same output; a scatterer-stage effect
-    gives the same scatterers and signal whether the record comes as one block or many.
-    ``model`` makes the scatterers (default: one unit point per joint of a walking body)."""
+    (``Scatterers`` or ``Received``, never None), for the same pulses, finite, with the dtypes
+    of :mod:`mdframework.interfaces` (float64 positions and RCS, complex128 signal), and leaves
+    its input unchanged; ``describe()`` is a JSON-serialisable dict; the same seed gives the
+    same output; a scatterer-stage effect gives the same scatterers and signal whether the
+    record comes as one block or many. ``model`` makes the scatterers (default: one point per
+    joint of a walking body, its RCS swinging over time: :func:`swinging_rcs`)."""
     who = _label(effect)
     stage = getattr(effect, "stage", None)
     assert stage in ("scatterers", "received"), f"{who}: stage must be 'scatterers' or 'received'"
@@ -413,7 +454,15 @@ def check_effect(effect: Effect, model: ScattererModel | None = None) -> None:
     def run() -> Any:
         context = scene_context(stage=stage)
         effect.start_record(body, context.radar_position)
-        return effect.apply(_effect_input(effect, context, model, body), context)
+        data = _effect_input(effect, context, model, body)
+        before = {name: np.array(array, copy=True) for name, array in _arrays(data).items()}
+        out = effect.apply(data, context)
+        for name, array in _arrays(data).items():
+            assert np.array_equal(array, before[name], equal_nan=True), (
+                f"{who}: apply() changed its input's {name} in place: return new arrays "
+                f"(e.g. data.replace({name}=...)) and leave the input as it is"
+            )
+        return out
 
     out = run()
     expected = Scatterers if stage == "scatterers" else Received
@@ -430,6 +479,7 @@ def check_effect(effect: Effect, model: ScattererModel | None = None) -> None:
         assert out.signal.shape == (n,), f"{who}: apply() must keep one sample per pulse"
         assert np.all(np.isfinite(out.signal)), f"{who}: the signal must be finite"
         first = out.signal
+    _check_dtypes(who, "apply()", out)
     described = effect.describe()
     assert isinstance(described, dict), f"{who}: describe() must return a dict"
     try:
@@ -438,30 +488,42 @@ def check_effect(effect: Effect, model: ScattererModel | None = None) -> None:
         raise AssertionError(f"{who}: describe() must be JSON-serialisable: {exc}") from None
     again = run()
     second = again.rcs if isinstance(again, Scatterers) else again.signal
-    assert np.array_equal(first, second), f"{who}: the same seed must give the same output"
+    assert np.array_equal(first, second), (
+        f"{who}: the same seed must give the same output for two records in a row (draw random "
+        "numbers from context.rng only, and reset in start_record what apply accumulates)"
+    )
     if stage == "scatterers":
-        effect.start_record(body, RADAR_POSITION)
-        _invariant(who, JointPoints(JointPoints.Config()), _reference_radar(body), body, (effect,))
+        points = JointPoints(JointPoints.Config(rcs_swing=0.5))
+        _invariant(who, points, _reference_radar(body), body, (effect,))
 
 
 class JointPointsConfig(PluginConfig):
-    """Unit isotropic points at the joints."""
+    """Isotropic points at the joints."""
 
     kind: Literal["joint_points"] = "joint_points"
+    rcs_swing: float = Field(
+        0.0,
+        ge=0,
+        lt=1,
+        description="How far each point's RCS swings about 1 m^2 over time (swinging_rcs); "
+        "0: unit RCS.",
+    )
 
 
 class JointPoints(ScattererModel):
-    """A unit isotropic point scatterer at every joint (the checks' scatterer model)."""
+    """An isotropic point scatterer at every joint, of unit RCS or one that swings over time
+    (the checks' scatterer model)."""
 
     name = "joint_points"
     Config = JointPointsConfig
+    config: JointPointsConfig
     needs_canonical = False
 
     def scatterers(
         self, motion: Motion, skeleton: Skeleton, radar_position: Any, wavelength: float
     ) -> Scatterers:
-        """One unit-RCS point per joint."""
-        rcs = np.ones(skeleton.positions.shape[:2])
+        """One point per joint, its RCS :func:`swinging_rcs` at the block's times."""
+        rcs = swinging_rcs(skeleton.time, skeleton.n_joints, self.config.rcs_swing)
         return Scatterers(skeleton.positions, rcs, skeleton.joint_names)
 
 
@@ -513,19 +575,31 @@ def check_block_invariance(
 ) -> None:
     """The streaming contract: scatterers, scatterer-stage ``effects`` and ``receive`` give the
     same result for a record processed as one block and as blocks of ``block`` pulses
-    (``skeleton``: the body at the pulse times, in the scene frame)."""
-    radar_position = np.array([10.0, 0.0, 1.0])
+    (``skeleton``: the body at the pulse times, in the scene frame). Each pass starts as a run
+    starts a record: ``start_record`` of the model, of every scatterer-stage effect (with
+    ``skeleton``) and of the waveform, so an effect may carry state across blocks and reset it
+    there. A failure names the first stage whose output differs: the model, an effect (in
+    their order) or, when the scatterers agree, the waveform."""
+    radar_position = RADAR_POSITION.copy()
     lam = float(radar.wavelength(waveform.carrier_frequency))
     t = skeleton.time
     span = np.linalg.norm(skeleton.positions - radar_position, axis=-1)
+    scatterer_effects = tuple(e for e in effects if e.stage == "scatterers")
+    stages = [f"scatterer model {model.name!r}"]
+    stages += [f"effect {e.name!r}" for e in scatterer_effects]
 
-    def run(size: int) -> tuple[np.ndarray, np.ndarray]:
+    def cut(size: int) -> int:  # blocks hold a multiple of the waveform's block_multiple
+        return max(waveform.block_multiple, size - size % waveform.block_multiple)
+
+    def run(size: int) -> tuple[list[list[Scatterers]], np.ndarray]:
         model.start_record(skeleton)
+        for effect in scatterer_effects:
+            effect.start_record(skeleton, radar_position)
         waveform.start_record(t, (float(span.min()), float(span.max())))
-        rcs_parts, signal_parts = [], []
-        step = max(waveform.block_multiple, size - size % waveform.block_multiple)
-        for lo in range(0, t.shape[0], step):
-            sk = skeleton.select_frames(slice(lo, lo + step))
+        outputs: list[list[Scatterers]] = [[] for _ in stages]  # per stage, per block
+        signal_parts = []
+        for lo in range(0, t.shape[0], cut(size)):
+            sk = skeleton.select_frames(slice(lo, lo + cut(size)))
             scat = model.scatterers(motion, sk, radar_position, lam)
             gate = np.linalg.norm(sk.positions[:, 0, :] - radar_position, axis=-1)
             rng = np.random.default_rng(0)
@@ -540,28 +614,79 @@ def check_block_invariance(
                 rng,
                 lo,
             )
-            for effect in effects:
-                if effect.stage == "scatterers":
-                    scat = effect.apply(scat, ctx)
-                    assert isinstance(scat, Scatterers), (
-                        f"effect {effect.name!r}: apply must return Scatterers"
-                    )
+            _check_block_output(stages[0], scat, sk.n_frames, lo, outputs[0])
+            outputs[0].append(scat)
+            for i, effect in enumerate(scatterer_effects, start=1):
+                scat = effect.apply(scat, ctx)
+                _check_block_output(stages[i], scat, sk.n_frames, lo, outputs[i])
+                outputs[i].append(scat)
             ranges = scat.ranges(radar_position)
             rec = waveform.receive(PulseBlock(lo, sk.time, scat, ranges, gate, radar_position))
-            rcs_parts.append(scat.rcs)
             signal_parts.append(rec.signal)
-        return np.concatenate(rcs_parts), np.concatenate(signal_parts)
+        return outputs, np.concatenate(signal_parts)
 
-    rcs_one, sig_one = run(t.shape[0])
-    rcs_many, sig_many = run(block)
-    assert np.allclose(rcs_one, rcs_many, rtol=1e-12, atol=0), (
-        "scatterer RCS differs between one block and many: the model or an effect is not "
-        "block-invariant (take record-wide quantities in start_record)"
-    )
+    one, sig_one = run(t.shape[0])
+    many, sig_many = run(block)
+    step = cut(block)
+    for name, whole, blocks in zip(stages, one, many, strict=True):
+        _compare_blocks(name, whole, blocks, step)
     scale = float(np.max(np.abs(sig_one))) or 1.0
     assert np.max(np.abs(sig_one - sig_many)) <= 1e-9 * scale, (
-        "received signal differs between one block and many: the waveform is not block-invariant"
+        f"received signal differs between one block and blocks of {step} pulses although the "
+        f"scatterers agree: the radar {waveform.name!r} is not block-invariant"
     )
+
+
+def _check_block_output(
+    stage: str, scat: Any, n_pulses: int, start: int, earlier: list[Scatterers]
+) -> None:
+    """One block's output of a stage: Scatterers, one row per pulse, and the same scatterers
+    (names) as the stage's earlier blocks."""
+    where = f"the block at pulse {start}"
+    made = "scatterers()" if stage.startswith("scatterer model") else "apply()"
+    assert isinstance(scat, Scatterers), (
+        f"{stage}: {made} must return Scatterers, got {type(scat).__name__} for {where}"
+    )
+    rows = scat.positions.shape[0]
+    assert rows == n_pulses, (
+        f"{stage}: {made} must give one row per pulse: {rows} rows for the {n_pulses} "
+        f"pulses of {where}"
+    )
+    if earlier and scat.names != earlier[0].names:
+        k0, k = len(earlier[0].names), len(scat.names)
+        raise AssertionError(
+            f"{stage}: every block must have the same scatterers, but it gives {k0} "
+            f"scatterers in the block at pulse 0 and {k} ({', '.join(scat.names[:5])}...) "
+            f"in {where}: it is not block-invariant"
+        )
+
+
+def _compare_blocks(
+    stage: str, whole: list[Scatterers], blocks: list[Scatterers], step: int
+) -> None:
+    """A stage's output for the record as one block (``whole``: one block, or two when the
+    record is no multiple of the waveform's ``block_multiple``) against its output in
+    blocks of ``step`` pulses."""
+    how = f"for the record as one block and in blocks of {step} pulses"
+    fix = (
+        "it is not block-invariant (take record-wide quantities in start_record, reset what it "
+        "accumulates there, and take the pulse index from context.block_start)"
+    )
+    k_whole, k_blocks = len(whole[0].names), len(blocks[0].names)
+    assert whole[0].names == blocks[0].names, (
+        f"{stage} gives {k_whole} scatterers for the record as one block but {k_blocks} in "
+        f"blocks of {step} pulses: {fix}"
+    )
+    for field_name in ("positions", "rcs"):
+        a = np.concatenate([getattr(s, field_name) for s in whole])
+        b = np.concatenate([getattr(s, field_name) for s in blocks])
+        if not np.allclose(a, b, rtol=1e-12, atol=0):
+            worst = float(np.max(np.abs(a - b)))
+            unit = "m" if field_name == "positions" else "m^2"
+            raise AssertionError(
+                f"{stage} gives different scatterer {field_name} {how} (by up to "
+                f"{worst:.3g} {unit}): {fix}"
+            )
 
 
 def check_recording_source(source: RecordingSource) -> list[Recording]:
@@ -599,14 +724,26 @@ INSTANCE_CHECKS: dict[str, tuple[Check, ...]] = {
 def _instance(plugin: Plugin | type[Plugin]) -> Plugin:
     if isinstance(plugin, Plugin):
         return plugin
-    try:
-        config = plugin.Config()  # type: ignore[call-arg]
-    except Exception as exc:
+    who, name = _label(plugin), plugin.__name__
+    config = getattr(plugin, "Config", None)
+    if config is None:
         raise AssertionError(
-            f"{_label(plugin)}: its Config has required fields; pass an instance "
-            f"({plugin.__name__}({plugin.__name__}.Config(...))) to the checks"
-        ) from exc
-    return plugin(config)
+            f"{who} has no Config: give it one, a subclass of mdframework.PluginConfig with "
+            f"kind: Literal[{getattr(plugin, 'name', '?')!r}]"
+        )
+    if not (isinstance(config, type) and issubclass(config, PluginConfig)):
+        raise AssertionError(f"{who}: its Config must subclass mdframework.PluginConfig")
+    try:
+        instance = config()  # type: ignore[call-arg]
+    except ValidationError as exc:
+        missing = [".".join(map(str, e["loc"])) for e in exc.errors() if e["type"] == "missing"]
+        if missing:
+            raise AssertionError(
+                f"{who}: its Config has required fields ({', '.join(missing)}); pass an "
+                f"instance ({name}({name}.Config(...))) to the checks"
+            ) from exc
+        raise AssertionError(f"{who}: its Config's defaults are not valid: {exc}") from exc
+    return plugin(instance)
 
 
 def _class_check(plugin: Plugin) -> None:
