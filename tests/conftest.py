@@ -38,6 +38,24 @@ def project_distributions() -> set[str]:
     }
 
 
+def third_party_entry_points() -> set[str]:
+    """Names of the installed ``mdframework`` entry points that no distribution of this
+    repository provides: a third party's plugins installed beside ours (our tests check our
+    plugins and must pass whatever those are, broken ones included)."""
+    import importlib.metadata
+    import re
+
+    def canonical(name: str) -> str:
+        return re.sub(r"[-_.]+", "-", name).lower()
+
+    own = {canonical(name) for name in project_distributions()}
+    return {
+        ep.name
+        for ep in importlib.metadata.entry_points(group="mdframework")
+        if ep.dist is None or canonical(ep.dist.name) not in own
+    }
+
+
 #: Units of ``--dist loadscope`` (a test class, else a file) that take longest, in the order they
 #: start: the random-scene classes (20-60 s of CPU each), the documented commands (each a class of
 #: its own; the experiments take 5-25 s) and the files that start many `mdf` processes. pytest-xdist
