@@ -95,6 +95,18 @@ def subplots(
     return fig, fig.subplots(*args, **kwargs)
 
 
+def wrap_caption(caption: str, width_in: float, fontsize: float = _CAPTION_SIZE) -> str:
+    """``caption`` with its lines wrapped at spaces to fit a figure ``width_in`` inches wide in
+    ``fontsize`` points (a character is taken as at most 0.62 em wide, which DejaVu Sans
+    letters, digits and punctuation are)."""
+    import textwrap
+
+    chars = max(20, int((width_in * 72 - 2 * 0.01 * width_in * 72) / (0.62 * fontsize)))
+    return "\n".join(
+        textwrap.fill(line, chars, break_on_hyphens=False) or line for line in caption.split("\n")
+    )
+
+
 def save(fig: Any, path: Path, caption: str = "", *, title: str = "") -> None:
     """Save ``fig`` (made with constrained layout under :func:`style`, or by :func:`subplots`)
     with ``title`` over its first axes and ``caption`` set in small type below the axes, then
@@ -102,6 +114,7 @@ def save(fig: Any, path: Path, caption: str = "", *, title: str = "") -> None:
     if title:
         fig.axes[0].set_title(title)
     if caption:
+        caption = wrap_caption(caption, fig.get_figwidth())
         lines = caption.count("\n") + 1
         height = fig.get_figheight()
         bottom = min(0.4, (lines * _CAPTION_SIZE * 1.45 + 6) / 72 / height)
@@ -258,7 +271,8 @@ def plot_confusion(
     caption: str = "",
 ) -> None:
     """Save a row-normalised confusion matrix (true class down, predicted across); ``mean``
-    and ``std`` (n_classes, n_classes) rates in [0, 1]."""
+    and ``std`` (n_classes, n_classes) rates in [0, 1] (a NaN row: a class not evaluated,
+    shown as n/a)."""
     n = len(classes)
     with _rc_context():
         fig, ax = subplots(figsize=(1.3 * n + 2.5, 1.1 * n + 1.8), layout="constrained")
@@ -268,14 +282,17 @@ def plot_confusion(
         im = ax.imshow(mean, cmap=cmap, vmin=0.0, vmax=1.0)
         for i in range(n):
             for j in range(n):
-                text = f"{mean[i, j]:.2f}" + (f"\n±{std[i, j]:.2f}" if std is not None else "")
+                if np.isnan(mean[i, j]):  # a class the experiment could not evaluate
+                    text = "n/a\n(not evaluated)" if j == 0 else "n/a"
+                else:
+                    text = f"{mean[i, j]:.2f}" + (f"\n±{std[i, j]:.2f}" if std is not None else "")
                 ax.text(
                     j,
                     i,
                     text,
                     ha="center",
                     va="center",
-                    color="black" if mean[i, j] > 0.6 else "white",
+                    color="white" if mean[i, j] <= 0.6 else "black",  # NaN: on white
                 )
         ax.set_xticks(range(n), classes, rotation=30, ha="right")
         ax.set_yticks(range(n), classes)
