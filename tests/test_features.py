@@ -62,6 +62,29 @@ def test_percentile_method_on_the_synthetic_walk() -> None:
     assert f["lower_min"] == pytest.approx(-1.5, abs=3 * res)
 
 
+def test_the_datasets_page_quotes_the_synthetic_walk() -> None:
+    """docs/datasets.md gives features 1-4 of this walk for both envelope methods (it once
+    gave numbers of an older spectrogram for the threshold method)."""
+    import re
+
+    from conftest import ROOT
+
+    page = " ".join((ROOT / "docs" / "datasets.md").read_text().split())
+    quoted = re.search(
+        r"threshold method gives ([-\d. /]+) m/s for features 1-4 .*?the percentile method "
+        r"([-\d. /]+):",
+        page,
+    )
+    assert quoted is not None
+    power, vel, _ = synthetic_walk(256)
+    for text, options in zip(
+        quoted.groups(), [{}, {"method": "percentile", "floor_db": -60.0}], strict=True
+    ):
+        page_values = [float(v) for v in text.split("/")]
+        computed = spectrogram_features(power, vel, **options)[:4]  # type: ignore[arg-type]
+        np.testing.assert_allclose(page_values, computed, atol=5e-4)
+
+
 def test_exact_envelopes_of_a_drawn_spectrogram() -> None:
     """A spectrogram drawn directly: torso at bin k0, limbs exactly at known bins."""
     vel = np.linspace(-5, 5, 201)  # 0.05 m/s bins

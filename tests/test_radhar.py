@@ -256,7 +256,7 @@ def test_npz_values_and_frames_are_checked(tmp_path: Path) -> None:
 
 def test_the_numbers_on_the_sim_to_real_page() -> None:
     """docs/sim-to-real.md: within 0.5-3 m a frame holds about 8 static points and 3.1
-    (boxing), 2.2 (walk) or 0.24 (jump) moving points; the fastest 1 % of the boxing points
+    (boxing), 2.2 (walk) or 0.24 (jump) moving points; the fastest 1 % of the moving boxing points
     move at 3.1 m/s toward the sensor or faster."""
     moving = {"boxing": 3.1, "walk": 2.2, "jump": 0.24}
     for activity, expected in moving.items():
