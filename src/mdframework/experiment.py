@@ -1,8 +1,11 @@
 """The paper's experiments as config-file runs (``mdf experiment CONFIG --out DIR``).
 
 - **Within-source**: for every source group, repeated stratified train/test splits (60/40 by
-  default); optional wrapper feature selection by cross-validation on the training split only;
-  the confusion matrix's mean and spread over repeats and the per-class rates. The paper's
+  default), splits holding out whole recordings, or leave-subjects-out folds
+  (``evaluation.split``); optional wrapper feature selection by cross-validation on the
+  training split only; the confusion matrix's mean and spread over the splits, the per-class
+  rates, and the balanced accuracy as the mean per-class recall of that matrix (a class no
+  split can test on unseen data is reported as not evaluated, not scored 0). The paper's
   optimistic variant (feature subset chosen on the test split) is reported separately and
   labelled as such.
 - **Cross-source**: train on one group (e.g. Kinect-derived records), test on another (e.g.
@@ -517,8 +520,8 @@ def within_source(
             )
             optimistic.append(opt.score)
     stack = np.stack(mats)  # (n_splits, n_classes, n_classes); NaN rows: class not scored
-    scored = ~np.isnan(stack[:, :, 0])  # (n_splits, n_classes)
-    rows = scored.any(axis=0)
+    scored: NDArray[np.bool_] = ~np.isnan(stack[:, :, 0])  # (n_splits, n_classes)
+    rows: NDArray[np.bool_] = np.any(scored, axis=0)
     for i, c in enumerate(classes):
         if not rows[i] and c not in untested:
             untested[c] = (

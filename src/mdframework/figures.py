@@ -95,16 +95,35 @@ def subplots(
     return fig, fig.subplots(*args, **kwargs)
 
 
-def wrap_caption(caption: str, width_in: float, fontsize: float = _CAPTION_SIZE) -> str:
-    """``caption`` with its lines wrapped at spaces to fit a figure ``width_in`` inches wide in
-    ``fontsize`` points (a character is taken as at most 0.62 em wide, which DejaVu Sans
-    letters, digits and punctuation are)."""
-    import textwrap
+def wrap_caption(caption: str, fig: Any, fontsize: float = _CAPTION_SIZE) -> str:
+    """``caption`` with its lines broken at spaces so that each fits the width of ``fig`` (less
+    the 1 % margins :func:`save` leaves) in ``fontsize`` points of the current style's font,
+    measured by matplotlib's Agg renderer; a word wider than that stays whole on its line."""
+    from matplotlib.backends.backend_agg import RendererAgg
+    from matplotlib.font_manager import FontProperties
 
-    chars = max(20, int((width_in * 72 - 2 * 0.01 * width_in * 72) / (0.62 * fontsize)))
-    return "\n".join(
-        textwrap.fill(line, chars, break_on_hyphens=False) or line for line in caption.split("\n")
-    )
+    renderer = RendererAgg(1, 1, fig.dpi)  # type: ignore[no-untyped-call]
+    prop = FontProperties(size=fontsize)
+    room = 0.98 * fig.get_figwidth() * fig.dpi
+
+    def width(text: str) -> float:
+        size = renderer.get_text_width_height_descent(  # type: ignore[no-untyped-call]
+            text, prop, ismath=False
+        )
+        return float(size[0])
+
+    out = []
+    for line in caption.split("\n"):
+        current = ""
+        for word in line.split(" "):
+            trial = f"{current} {word}" if current else word
+            if current and width(trial) > room:
+                out.append(current)
+                current = word
+            else:
+                current = trial
+        out.append(current)
+    return "\n".join(out)
 
 
 def save(fig: Any, path: Path, caption: str = "", *, title: str = "") -> None:
@@ -114,7 +133,7 @@ def save(fig: Any, path: Path, caption: str = "", *, title: str = "") -> None:
     if title:
         fig.axes[0].set_title(title)
     if caption:
-        caption = wrap_caption(caption, fig.get_figwidth())
+        caption = wrap_caption(caption, fig)
         lines = caption.count("\n") + 1
         height = fig.get_figheight()
         bottom = min(0.4, (lines * _CAPTION_SIZE * 1.45 + 6) / 72 / height)
