@@ -99,10 +99,16 @@ class SelectionConfig(StrictModel):
 
 
 class EvaluationConfig(StrictModel):
-    """Repeated stratified splits."""
+    """How a group's records are split into training and test records: stratified random
+    splits of the records (`record`), held-out recordings (`recording`), or cross-validation that
+    holds out whole groups such as subjects (`groups`)."""
 
-    repeats: int = Field(10, ge=1, le=10_000, description="Number of random splits.")
-    test_fraction: float = Field(0.4, gt=0, lt=1, description="Test share (the paper: 40 %).")
+    repeats: int = Field(
+        10, ge=1, le=10_000, description="Number of random splits (split = 'record', 'recording')."
+    )
+    test_fraction: float = Field(
+        0.4, gt=0, lt=1, description="Test share (the paper: 40 %; not used by split = 'groups')."
+    )
     split: Literal["record", "recording", "groups"] = Field(
         "record",
         description="record: records are split at random (windows of one recording can land "
