@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 import pytest
 from conftest import EXAMPLES
+from sklearn.metrics import balanced_accuracy_score
 from sklearn.model_selection import StratifiedShuffleSplit
 
 from mdframework import experiment as exp
@@ -156,3 +157,265 @@ def test_recording_split_holds_out_whole_recordings(rng: np.random.Generator) ->
     assert np.allclose(res["confusion_mean"].sum(axis=1), 1.0)
     with pytest.raises(exp.MdfError, match="class 'a' has only one recording"):
         exp.recording_splits(labels, np.where(labels == "a", "one", recordings), 1, 0.4, 0)
+
+
+# --------------------------------------------------------------------------- evaluation protocols
+
+MSR = EXAMPLES / "data" / "kinect" / "msr-action3d"
+
+
+@pytest.fixture(scope="module")
+def kinect_dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Built once: MSR jogging and side-boxing of subjects s01-s03 (records of 1 s every
+    0.5 s), and 2 records of forward punches of s01 only (a small class of one subject)."""
+    from mdframework.dataset import build_dataset
+
+    root = tmp_path_factory.mktemp("kinect")
+    sources = []
+    for action, label, subjects in (
+        ("a16", "jog", ("s01", "s02", "s03")),
+        ("a12", "boxing", ("s01", "s02", "s03")),
+        ("a05", "punch", ("s01",)),
+    ):
+        for subject in subjects:
+            f = MSR / f"{action}_{subject}_e01_skeleton3D.txt"
+            cap = "max_records = 2\n" if label == "punch" else ""
+            sources.append(
+                f'[[sources]]\nlabel = "{label}"\nhop = 0.5\n{cap}'
+                f'motion = {{ kind = "kinect", format = "msr-action3d", file = "{f}" }}\n'
+            )
+    p = root / "msr.toml"
+    p.write_text(
+        "\n".join(sources)
+        + "[record_lengths]\njog = 1.0\nboxing = 1.0\npunch = 1.0\n"
+        + "[base.processing]\nnfft = 256\n[base.scene]\nradar_position = [3.0, 0.0, 1.0]\n"
+    )
+    build_dataset(*load_dataset_config(p), root / "dataset", progress=False)
+    return root / "dataset"
+
+
+def _experiment(dataset: Path, tmp_path: Path, body: str) -> Path:
+    p = tmp_path / "e.toml"
+    p.write_text(f'seed = 0\n[dataset]\npath = "{dataset}"\n{body}')
+    return p
+
+
+def _one_class_per_subject() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One feature; class a: subjects s1-s3 at 0 (each recognised when held out); class b: s4
+    at 10 and s5 at 3. Held out, s4 is still nearest to s5's b records (recall 1); held out,
+    s5 is nearest to a (recall 0). Per-class recall: a 1, b 0.5, so the mean per-class recall
+    is 0.75; the mean of the five folds' balanced accuracies weights a by its three subjects:
+    (3 * 1 + 1 + 0) / 5 = 0.8."""
+    subjects = np.repeat(["s1", "s2", "s3", "s4", "s5"], 4)
+    labels = np.repeat(["a", "a", "a", "b", "b"], 4)
+    centre = np.repeat([0.0, 0.1, -0.1, 10.0, 3.0], 4)
+    x = np.zeros((20, 7))
+    x[:, 0] = centre + np.tile([0.0, 0.01, 0.02, 0.03], 5)
+    return x, labels, subjects
+
+
+def _cfg(evaluation: dict[str, Any], classifier: dict[str, Any] | None = None) -> Any:
+    return exp.ExperimentConfig.model_validate(
+        {
+            "dataset": {"path": "unused"},
+            "evaluation": evaluation,
+            "selection": {"method": "none", "optimistic": False},
+            "classifier": classifier or {"kind": "knn", "k": 1},
+        }
+    )
+
+
+def test_leave_subjects_out_accuracy_is_the_mean_recall_of_the_matrix() -> None:
+    x, y, subjects = _one_class_per_subject()
+    cfg = _cfg({"split": "groups", "by": "subject"})
+    res = exp.within_source(cfg, exp.classifier_factory(cfg.classifier, "t"), x, y, subjects)
+    cm = res["confusion_mean"]
+    assert np.allclose(np.diagonal(cm), [1.0, 0.5])
+    assert res["balanced_accuracy_mean"] == pytest.approx(0.75, abs=1e-12)
+    assert res["balanced_accuracy_mean"] == pytest.approx(np.mean(np.diagonal(cm)), abs=1e-12)
+    # every fold holds one class: the spread is over the classes' recalls, and says so
+    assert res["balanced_accuracy_std_over"] == "classes"
+    assert res["balanced_accuracy_std"] == pytest.approx(0.25, abs=1e-12)
+    assert res["splits_tested"] == {"a": 3, "b": 2} and res["not_evaluated"] == {}
+
+
+@pytest.mark.parametrize("split", ["record", "recording"])
+def test_stratified_splits_keep_the_mean_of_per_split_scores(
+    rng: np.random.Generator, split: str
+) -> None:
+    """Where every split tests every class, the mean per-class recall of the matrix is the mean
+    of the splits' balanced accuracies (the result before the protocols were told apart), and
+    its spread is the standard deviation over the splits."""
+    x, y = _toy(rng)
+    x[:, 3] += rng.normal(0, 4.0, 60)  # overlapping classes: the splits differ
+    recordings = np.array([f"{lab}{i // 5}" for lab, i in zip(y, range(60), strict=True)])
+    cfg = _cfg({"repeats": 6, "split": split})
+    factory = exp.classifier_factory(cfg.classifier, "t")
+    res = exp.within_source(cfg, factory, x, y, recordings)
+    if split == "record":
+        splits = StratifiedShuffleSplit(6, test_size=0.4, random_state=0).split(x, y)
+    else:
+        splits = exp.recording_splits(y, recordings, 6, 0.4, 0)
+    scores = [
+        balanced_accuracy_score(y[te], factory().fit(x[tr], y[tr]).predict(x[te]))
+        for tr, te in splits
+    ]
+    assert 0.4 < np.mean(scores) < 0.95 and np.std(scores) > 0.01
+    assert res["balanced_accuracy_mean"] == pytest.approx(np.mean(scores), rel=0, abs=1e-12)
+    assert res["balanced_accuracy_std"] == pytest.approx(np.std(scores), rel=0, abs=1e-12)
+    assert res["balanced_accuracy_std_over"] == "splits"
+
+
+def test_a_class_of_one_subject_is_not_evaluated_not_scored_zero() -> None:
+    x, y, subjects = _one_class_per_subject()
+    x = np.concatenate([x, np.full((4, 7), 50.0)])
+    y = np.concatenate([y, ["c"] * 4])
+    subjects = np.concatenate([subjects, ["s6"] * 4])
+    cfg = _cfg({"split": "groups", "by": "subject"})
+    res = exp.within_source(cfg, exp.classifier_factory(cfg.classifier, "t"), x, y, subjects)
+    assert list(res["not_evaluated"]) == ["c"]
+    assert "one subject ('s6')" in res["not_evaluated"]["c"]
+    assert np.all(np.isnan(res["confusion_mean"][2]))
+    assert res["balanced_accuracy_mean"] == pytest.approx(0.75, abs=1e-12)  # a and b only
+    # a class of one recording under split = "recording": trained on, never tested, listed
+    labels = np.repeat(["a", "b", "c"], 20)
+    recordings = np.array([f"{lab}{i // 5}" for lab, i in zip(labels, range(60), strict=True)])
+    recordings[labels == "c"] = "c-only"
+    xr = np.zeros((60, 7))
+    xr[:, 0] = np.repeat([0.0, 5.0, 10.0], 20)
+    cfg = _cfg({"split": "recording", "repeats": 3})
+    res = exp.within_source(
+        cfg, exp.classifier_factory(cfg.classifier, "t"), xr, labels, recordings
+    )
+    assert list(res["not_evaluated"]) == ["c"] and "one recording only" in res["not_evaluated"]["c"]
+    assert res["balanced_accuracy_mean"] == 1.0
+
+
+def test_leave_subjects_out_report_states_the_protocol(
+    kinect_dataset: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import mdframework.figures as figures
+
+    captions: list[str] = []
+    real = figures.plot_confusion
+
+    def spy(*args: Any, **kwargs: Any) -> None:
+        captions.append(kwargs.get("caption", ""))
+        real(*args, **kwargs)
+
+    monkeypatch.setattr(figures, "plot_confusion", spy)
+    e = _experiment(
+        kinect_dataset,
+        tmp_path,
+        '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\nby = "subject"\n',
+    )
+    with pytest.warns(exp.ExperimentWarning, match=r"class 'punch' not evaluated: .*one subject"):
+        summary = exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+    report = (tmp_path / "o" / "report.md").read_text()
+    assert "evaluation: leave-subjects-out cross-validation (one fold per subject" in report
+    assert "stratified" not in report and "60/40" not in report
+    assert "over 3 leave-subjects-out folds" in report
+    assert "Not evaluated: punch (all its records are of one subject ('s01')" in report
+    assert captions and captions[0].endswith("mean ± std over 3 leave-subjects-out folds")
+    within = summary["within"]["kinect"]
+    assert within["balanced_accuracy_mean"] == pytest.approx(
+        np.nanmean(np.diagonal(np.array(within["confusion_mean"]))), abs=1e-12
+    )
+    with (tmp_path / "o" / "within_kinect_per_class.csv").open() as fh:
+        rows = {r["class"]: r for r in csv.DictReader(fh)}
+    assert rows["punch"]["rate_mean"] == "nan" and rows["punch"]["splits_scored"] == "0"
+
+
+def test_more_folds_than_subjects_warns_on_stderr(
+    kinect_dataset: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from mdframework.cli import main
+
+    e = _experiment(
+        kinect_dataset,
+        tmp_path,
+        '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\nfolds = 5\n',
+    )
+    assert main(["experiment", str(e), "--out", str(tmp_path / "o")]) == 0
+    err = capsys.readouterr().err
+    assert "warning: within-source kinect: not evaluated: evaluation.folds = 5 exceeds" in err
+    assert "Not evaluated: evaluation.folds = 5" in (tmp_path / "o" / "report.md").read_text()
+
+
+@pytest.mark.parametrize(
+    ("body", "message"),
+    [
+        (
+            '[selection]\nmethod = "wrapper"\nsizes = [1]\n[evaluation]\nrepeats = 2\n',
+            "selection.method = 'wrapper': class 'punch' has 1 training record of 2 records; "
+            "the wrapper's cross-validation needs at least 2 training records of every class: "
+            "build more records of it, or set selection.method = 'none'",
+        ),
+    ],
+)
+def test_a_class_too_small_to_split_is_a_config_error(
+    kinect_dataset: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    body: str,
+    message: str,
+) -> None:
+    from mdframework.cli import main
+
+    e = _experiment(kinect_dataset, tmp_path, body)
+    out = tmp_path / "o"
+    assert main(["experiment", str(e), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1] == f"mdf: error: {e}: {message}"
+    assert not out.exists() or not any(out.iterdir())  # nothing half-written
+
+
+def test_a_class_of_one_record_is_a_config_error_for_record_splits(
+    rng: np.random.Generator,
+) -> None:
+    x, y = _toy(rng)
+    y = np.array(["lonely", *y[1:]])
+    cfg = _cfg({"repeats": 2})
+    with pytest.raises(
+        ConfigError, match=r"evaluation.split = 'record': class 'lonely' has 1 record; every class"
+    ):
+        exp.within_source(cfg, exp.classifier_factory(cfg.classifier, "t"), x, y)
+    cfg = _cfg({"repeats": 2, "test_fraction": 0.03})  # 2 test records for 3 classes
+    with pytest.raises(ConfigError, match=r"^evaluation.test_fraction = 0.03: "):
+        exp.within_source(cfg, exp.classifier_factory(cfg.classifier, "t"), *_toy(rng))
+
+
+def test_the_experiment_seed_reaches_the_classifier(rng: np.random.Generator) -> None:
+    from mdf_sklearn import SklearnClassifier
+
+    rf = {"kind": "sklearn", "estimator": "sklearn.ensemble.RandomForestClassifier"}
+    assert exp.classifier_factory(rf, "t", seed=7)().seed == 7
+    assert exp.classifier_factory(rf, "t")().seed is None  # no experiment: no seed
+    make = exp.classifier_factory(rf, "t", seed=7)
+    clf = make()
+    assert isinstance(clf, SklearnClassifier)
+    assert clf.estimator_params() == {"random_state": 7}
+    own = exp.classifier_factory({**rf, "params": {"random_state": 3}}, "t", seed=7)()
+    assert isinstance(own, SklearnClassifier) and own.estimator_params() == {"random_state": 3}
+    knn = {"kind": "sklearn", "estimator": "sklearn.neighbors.KNeighborsClassifier"}
+    other = exp.classifier_factory(knn, "t", seed=7)()
+    assert isinstance(other, SklearnClassifier) and other.estimator_params() == {}
+    x, y = _toy(rng)
+    assert clf.fit(x, y).model_.random_state == 7
+
+
+def test_a_random_forest_experiment_repeats_exactly(kinect_dataset: Path, tmp_path: Path) -> None:
+    e = _experiment(
+        kinect_dataset,
+        tmp_path,
+        '[classifier]\nkind = "sklearn"\nestimator = "sklearn.ensemble.RandomForestClassifier"\n'
+        'params = { n_estimators = 3, max_features = 1 }\n[selection]\nmethod = "none"\n'
+        '[evaluation]\nsplit = "groups"\n',
+    )
+    cfg = exp.load_experiment_config(e)
+    runs = []
+    for i in range(2):
+        with pytest.warns(exp.ExperimentWarning):  # punch: one subject
+            exp.run_experiment(cfg, tmp_path / f"o{i}", progress=False)
+        runs.append([(tmp_path / f"o{i}" / n).read_text() for n in ("summary.json", "report.md")])
+    assert runs[0] == runs[1]

@@ -99,3 +99,27 @@ def test_auto_span_of_the_cmu_walk() -> None:
     lo, hi = velocity_limits(result.spectrogram_db, result.velocity, "auto", 40.0)
     assert result.metadata["max_unambiguous_velocity_mps"] == pytest.approx(12.0, abs=0.05)
     assert -2.0 < lo < -1.0 and 4.5 < hi < 5.5
+
+
+def test_a_long_caption_is_wrapped_inside_the_figure(tmp_path: Path) -> None:
+    """A caption longer than the figure is wide (an experiment's: dataset, classifier,
+    protocol) is wrapped at spaces, and every line lies inside the saved figure."""
+    from mdframework.figures import save, subplots
+
+    caption = (
+        'dataset cross_source.toml (162 records); classifier {"kind": "knn", "k": 5}; '
+        "selection wrapper; mean ± std over 5 leave-subjects-out folds"
+    )
+    with style():
+        fig, ax = subplots(figsize=(4.5, 3.0))
+        ax.imshow(np.eye(3))
+        save(fig, tmp_path / "c.png", caption, title="cmu: within-source")
+    text = fig.texts[-1]
+    assert text.get_text().count("\n") >= 1
+    assert text.get_text().replace("\n", " ") == caption
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    renderer = FigureCanvasAgg(fig).get_renderer()
+    fig.draw(renderer)
+    box = text.get_window_extent(renderer)
+    assert 0 <= box.x0 and box.x1 <= fig.bbox.x1 and box.y0 >= 0

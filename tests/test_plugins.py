@@ -218,13 +218,20 @@ def test_an_interrupt_is_found_behind_wrapping_exceptions() -> None:
     assert not errors.caused_by_interrupt(RuntimeError("a plain failure"))
 
 
-def test_duplicate_names_are_rejected() -> None:
+def test_a_kind_two_plugins_claim_is_withheld_with_one_warning() -> None:
+    """Neither plugin is chosen for the user (it used to stop every command); the warning
+    names both, and the other kinds stay."""
     other = ModuleType("other")
     other.mdframework_register_motion_sources = (  # type: ignore[attr-defined]
         synthetic.mdframework_register_motion_sources
     )
-    with pytest.raises(PluginError, match="two motion plugins are named 'synthetic_walker'"):
-        build_registry([synthetic, other], autoload=False)
+    with pytest.warns(PluginWarning) as caught:
+        reg = build_registry([synthetic, other], autoload=False)
+    assert len(caught) == 1
+    message = str(caught[0].message)
+    assert message.startswith("the motion kind 'synthetic_walker' is disabled: claimed by ")
+    assert "other" in message and "synthetic" in message
+    assert reg.names("motion") == [] and "motion kind 'synthetic_walker'" in reg.disabled
 
 
 def test_wrong_class_disables_the_plugin() -> None:

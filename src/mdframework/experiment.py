@@ -1,8 +1,11 @@
 """The paper's experiments as config-file runs (``mdf experiment CONFIG --out DIR``).
 
 - **Within-source**: for every source group, repeated stratified train/test splits (60/40 by
-  default); optional wrapper feature selection by cross-validation on the training split only;
-  the confusion matrix's mean and spread over repeats and the per-class rates. The paper's
+  default), splits holding out whole recordings, or leave-subjects-out folds
+  (``evaluation.split``); optional wrapper feature selection by cross-validation on the
+  training split only; the confusion matrix's mean and spread over the splits, the per-class
+  rates, and the balanced accuracy as the mean per-class recall of that matrix (a class no
+  split can test on unseen data is reported as not evaluated, not scored 0). The paper's
   optimistic variant (feature subset chosen on the test split) is reported separately and
   labelled as such.
 - **Cross-source**: train on one group (e.g. Kinect-derived records), test on another (e.g.
@@ -25,6 +28,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import warnings
 from collections import Counter
 from collections.abc import Callable, Sequence
 from functools import partial
@@ -95,10 +99,16 @@ class SelectionConfig(StrictModel):
 
 
 class EvaluationConfig(StrictModel):
-    """Repeated stratified splits."""
+    """How a group's records are split into training and test records: stratified random
+    splits of the records (`record`), held-out recordings (`recording`), or cross-validation that
+    holds out whole groups such as subjects (`groups`)."""
 
-    repeats: int = Field(10, ge=1, le=10_000, description="Number of random splits.")
-    test_fraction: float = Field(0.4, gt=0, lt=1, description="Test share (the paper: 40 %).")
+    repeats: int = Field(
+        10, ge=1, le=10_000, description="Number of random splits (split = 'record', 'recording')."
+    )
+    test_fraction: float = Field(
+        0.4, gt=0, lt=1, description="Test share (the paper: 40 %; not used by split = 'groups')."
+    )
     split: Literal["record", "recording", "groups"] = Field(
         "record",
         description="record: records are split at random (windows of one recording can land "
@@ -206,11 +216,13 @@ def classifier_factory(
     registry: Registry | None = None,
     *,
     allow_import: bool = False,
+    seed: int | None = None,
 ) -> Callable[[], Classifier]:
     """A factory of fresh classifiers from a [classifier] section (validated once).
 
     ``allow_import`` (the command line's ``--allow-import``) lets a plugin accept import paths
-    outside its allowlist (the validation context key ``allow_import``)."""
+    outside its allowlist (the validation context key ``allow_import``). ``seed`` (the
+    experiment's seed) is set as :attr:`Classifier.seed` on every classifier made."""
     reg = registry or default_registry()
     kind = section.get("kind")
     try:
@@ -225,7 +237,13 @@ def classifier_factory(
                 f"{source}: ", f"{source}: classifier.", 1
             )
         ) from None
-    return lambda: cls(cfg)  # type: ignore[return-value]
+
+    def make() -> Classifier:
+        classifier: Classifier = cls(cfg)  # type: ignore[assignment]
+        classifier.seed = seed
+        return classifier
+
+    return make
 
 
 def _fit_predict(
@@ -244,9 +262,22 @@ def _select(
     x: NDArray[np.float64],
     y: NDArray[Any],
     seed: int,
+    counts: dict[str, int] | None = None,
 ) -> Selection:
+    """The feature subset for training records ``x``, ``y``; ``counts``: each class's records
+    in the whole source (for the error when a class has too few training records)."""
     if cfg.selection.method == "none":
         return Selection(tuple(range(x.shape[1])), float("nan"))
+    labels, n_train = np.unique(y, return_counts=True)
+    if n_train.min() < 2:
+        small = str(labels[np.argmin(n_train)])
+        total = (counts or {}).get(small, int(n_train.min()))
+        raise ConfigError(
+            f"selection.method = 'wrapper': class {small!r} has {n_train.min()} training "
+            f"record of {total} records; the wrapper's cross-validation needs at least 2 "
+            "training records of every class: build more records of it, or set "
+            "selection.method = 'none'"
+        )
     return wrapper_select(
         x, y, factory, sizes=cfg.selection.sizes, folds=cfg.selection.folds, seed=seed
     )
@@ -285,7 +316,10 @@ def group_splits(
     if len(values) < 2:
         raise MdfError(f"split = 'groups' needs two or more groups, have {values}")
     if folds is not None and folds > len(values):
-        raise MdfError(f"evaluation.folds = {folds} exceeds the {len(values)} groups {values}")
+        raise MdfError(
+            f"evaluation.folds = {folds} exceeds the {len(values)} groups {values}: lower "
+            "evaluation.folds, or leave it out for one fold per group"
+        )
     splitter = LeaveOneGroupOut() if folds is None else GroupKFold(n_splits=folds)
     x = np.zeros((groups.shape[0], 1))
     return [(tr, te) for tr, te in splitter.split(x, groups=groups)]
@@ -340,6 +374,79 @@ def train_test(
     )
 
 
+class ExperimentWarning(UserWarning):
+    """Something the experiment could not evaluate (shown on stderr; the report says it too)."""
+
+
+def protocol(ev: EvaluationConfig) -> str:
+    """The evaluation protocol in words, for the report's header."""
+    pct = round(100 * ev.test_fraction)
+    if ev.split == "groups":
+        folds = f"one fold per {ev.by}" if ev.folds is None else f"{ev.folds} folds"
+        return f"leave-{ev.by}s-out cross-validation ({folds}, each testing unseen {ev.by}s)"
+    if ev.split == "recording":
+        return f"{ev.repeats} random splits holding out {pct} % of every class's recordings"
+    return f"{ev.repeats} stratified random splits of the records, {100 - pct}/{pct}"
+
+
+def _splits_words(ev: EvaluationConfig, n: int) -> str:
+    """``n`` splits of the protocol, in words ('5 leave-subjects-out folds', '10 splits')."""
+    if ev.split == "groups":
+        return f"{n} leave-{ev.by}s-out fold" + ("s" if n != 1 else "")
+    return f"{n} split" + ("s" if n != 1 else "")
+
+
+def _record_splits(
+    ev: EvaluationConfig, x: NDArray[np.float64], y: NDArray[Any], seed: int
+) -> list[tuple[NDArray[np.intp], NDArray[np.intp]]]:
+    """``evaluation.split = 'record'``: stratified random splits; a class too small to be on
+    both sides is a :class:`ConfigError` naming it."""
+    from sklearn.model_selection import StratifiedShuffleSplit
+
+    labels, counts = np.unique(y, return_counts=True)
+    if counts.min() < 2:
+        small = str(labels[np.argmin(counts)])
+        raise ConfigError(
+            f"evaluation.split = 'record': class {small!r} has {counts.min()} record; every "
+            "class needs at least 2 (one to train on, one to test); build more records of it "
+            "(its dataset source) or leave it out"
+        )
+    splitter = StratifiedShuffleSplit(
+        n_splits=ev.repeats, test_size=ev.test_fraction, random_state=seed
+    )
+    try:
+        return list(splitter.split(x, y))
+    except ValueError as exc:  # e.g. fewer test records than classes
+        raise ConfigError(
+            f"evaluation.test_fraction = {ev.test_fraction}: {exc} ({len(y)} records of "
+            f"{len(labels)} classes)"
+        ) from None
+
+
+def _not_testable(
+    ev: EvaluationConfig, classes: list[str], y: NDArray[Any], held: NDArray[Any]
+) -> dict[str, str]:
+    """Classes that no split can test on an unseen recording or group (``held``, (n_records,):
+    each record's recording or ``by`` value), and why."""
+    if ev.split == "record":
+        return {}
+    what = "recording" if ev.split == "recording" else ev.by
+    out = {}
+    for c in classes:
+        values = sorted(set(held[y == c].tolist()))
+        if len(values) < 2 and ev.split == "recording":
+            out[c] = (
+                f"it has one recording only ({values[0]!r}), which cannot be held out: it is "
+                "only trained on"
+            )
+        elif len(values) < 2:
+            out[c] = (
+                f"all its records are of one {what} ({values[0]!r}): every fold that tests it "
+                "has no training record of it"
+            )
+    return out
+
+
 def within_source(
     cfg: ExperimentConfig,
     factory: Callable[[], Classifier],
@@ -349,28 +456,51 @@ def within_source(
     names: Sequence[str] = FEATURE_NAMES,
     progress: str | None = None,
 ) -> dict[str, Any]:
-    """Repeated stratified splits of one group's records; returns matrices and scores.
-    ``recordings`` (n_records,) names each record's source file (for ``split = 'recording'``);
-    ``names`` the columns of ``x``; ``progress``: a progress bar with this label over the
-    splits (on stderr), or none."""
+    """Splits of one group's records by ``cfg.evaluation``; returns matrices and scores.
+    ``recordings`` (n_records,) names each record's source file (``split = 'recording'``) or
+    its ``by`` value (``split = 'groups'``); ``names`` the columns of ``x``; ``progress``: a
+    progress bar with this label over the splits (on stderr), or none.
+
+    A class is scored in a split only when the split both tests it and trains on it: the row of
+    a class tested without a training record of it (its only subject held out) is left out of
+    that split, not counted as 0. A class no split can score is listed in ``not_evaluated``
+    with the reason; fewer than two scored classes is an :class:`MdfError`.
+
+    ``balanced_accuracy_mean`` is the mean per-class recall of the reported matrix (the mean of
+    the diagonal of ``confusion_mean`` over the scored classes). Its spread
+    ``balanced_accuracy_std`` is the standard deviation over splits of each split's balanced
+    accuracy when every split scores every class (then the mean of those equals
+    ``balanced_accuracy_mean``), else (e.g. leave-subjects-out folds that hold one class only)
+    the standard deviation over the scored classes of their recall;
+    ``balanced_accuracy_std_over`` says which ("splits" or "classes")."""
     classes = sorted(set(y.tolist()))
     ev = cfg.evaluation
+    untested: dict[str, str] = {}
     if ev.split == "groups":
         if recordings is None:
             raise MdfError(f"evaluation.split = 'groups' needs each record's {ev.by}")
         splits = group_splits(recordings, ev.folds)
+        untested = _not_testable(ev, classes, y, recordings)
     elif ev.split == "recording":
         if recordings is None:
             raise MdfError("evaluation.split = 'recording' needs each record's recording")
-        splits = recording_splits(y, recordings, ev.repeats, ev.test_fraction, cfg.seed)
-    else:
-        from sklearn.model_selection import StratifiedShuffleSplit
-
-        splitter = StratifiedShuffleSplit(
-            n_splits=ev.repeats, test_size=ev.test_fraction, random_state=cfg.seed
+        untested = _not_testable(ev, classes, y, recordings)
+        only_trained = np.isin(y, list(untested))
+        testable, always = np.flatnonzero(~only_trained), np.flatnonzero(only_trained)
+        some = recording_splits(
+            y[testable], recordings[testable], ev.repeats, ev.test_fraction, cfg.seed
         )
-        splits = list(splitter.split(x, y))
-    mats, accs, optimistic, subsets = [], [], [], []
+        splits = [
+            (np.sort(np.concatenate([testable[tr], always])), testable[te]) for tr, te in some
+        ]
+    else:
+        splits = _record_splits(ev, x, y, cfg.seed)
+    if len(classes) - len(untested) < 2:
+        raise MdfError(
+            "fewer than two classes can be evaluated: "
+            + "; ".join(f"{c}: {why}" for c, why in untested.items())
+        )
+    mats, optimistic, subsets, tested = [], [], [], []
     from tqdm import tqdm
 
     bar = tqdm(
@@ -380,28 +510,60 @@ def within_source(
         disable=progress is None or not progress_enabled(),
         leave=False,
     )
+    counts = {c: int(np.sum(y == c)) for c in classes}
     for rep, (train, test) in enumerate(bar):
-        sel = _select(cfg, factory, x[train], y[train], cfg.seed + rep)
+        sel = _select(cfg, factory, x[train], y[train], cfg.seed + rep, counts)
         pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
-        mats.append(confusion_matrix(y[test], pred, classes))
-        accs.append(balanced_accuracy(y[test], pred))
+        mat = confusion_matrix(y[test], pred, classes)
+        trained = set(y[train].tolist())
+        mat[[i for i, c in enumerate(classes) if c not in trained]] = np.nan
+        mats.append(mat)
+        tested.append(np.isin(classes, y[test]))
         subsets.append([names[i] for i in sel.subset])
         if cfg.selection.optimistic and cfg.selection.method == "wrapper":
             opt = optimistic_select(
                 x[train], y[train], x[test], y[test], factory, sizes=cfg.selection.sizes
             )
             optimistic.append(opt.score)
-    stack = np.stack(mats)
+    stack = np.stack(mats)  # (n_splits, n_classes, n_classes); NaN rows: class not scored
+    scored: NDArray[np.bool_] = ~np.isnan(stack[:, :, 0])  # (n_splits, n_classes)
+    rows: NDArray[np.bool_] = np.any(scored, axis=0)
+    for i, c in enumerate(classes):
+        if not rows[i] and c not in untested:
+            untested[c] = (
+                f"no split both trained on it and tested it ({_splits_words(ev, len(splits))})"
+                + ("; raise evaluation.folds" if ev.split == "groups" else "")
+            )
+    if int(rows.sum()) < 2:
+        raise MdfError(
+            "fewer than two classes can be evaluated: "
+            + "; ".join(f"{c}: {why}" for c, why in untested.items())
+        )
+    mean = np.full(stack.shape[1:], np.nan)
+    std = np.full(stack.shape[1:], np.nan)
+    mean[rows] = np.nanmean(stack[:, rows], axis=0)
+    std[rows] = np.nanstd(stack[:, rows], axis=0)
+    recall = np.diagonal(mean)[rows]
+    if scored[:, rows].all():  # every split scores every class: spread over splits
+        per_split = np.diagonal(stack, axis1=1, axis2=2)[:, rows].mean(axis=1)
+        spread, over = float(np.std(per_split)), "splits"
+    else:
+        spread, over = float(np.std(recall)), "classes"
     return {
         "classes": classes,
-        "confusion_mean": np.nanmean(stack, axis=0),
-        "confusion_std": np.nanstd(stack, axis=0),
-        "balanced_accuracy_mean": float(np.mean(accs)),
-        "balanced_accuracy_std": float(np.std(accs)),
+        "confusion_mean": mean,
+        "confusion_std": std,
+        "balanced_accuracy_mean": float(np.mean(recall)),
+        "balanced_accuracy_std": spread,
+        "balanced_accuracy_std_over": over,
+        "n_splits": len(splits),
+        "splits_tested": {c: int(n) for c, n in zip(classes, np.sum(tested, axis=0), strict=True)},
+        "splits_scored": {c: int(scored[:, i].sum()) for i, c in enumerate(classes)},
+        "not_evaluated": {c: untested[c] for c in classes if c in untested},
         "optimistic_accuracy_mean": float(np.mean(optimistic)) if optimistic else None,
         "subsets": subsets,
         "n_records": len(y),
-        "class_counts": {c: int(np.sum(y == c)) for c in classes},
+        "class_counts": counts,
     }
 
 
@@ -559,7 +721,9 @@ def run_experiment(
     with output_folder(
         out_dir, "experiment", EXPERIMENT_FILES, force=force, staging_dir=staging_dir
     ) as folder:
-        factory = classifier_factory(cfg.classifier, source, registry, allow_import=allow_import)
+        factory = classifier_factory(
+            cfg.classifier, source, registry, allow_import=allow_import, seed=cfg.seed
+        )
         if cfg.dataset.config is not None:
             dcfg, base = load_dataset_config(cfg.dataset.config)
             data_dir = folder.path / "dataset"
@@ -604,9 +768,7 @@ def _report(
         f"Dataset: `{data_dir}` ({len(data.labels)} records).",
         f"Input: {cfg.input}. Classifier: `{json.dumps(cfg.classifier)}`; selection: "
         f"{cfg.selection.method} (sizes {cfg.selection.sizes}); "
-        f"{cfg.evaluation.repeats} stratified splits by {cfg.evaluation.split}, "
-        f"{round(100 * (1 - cfg.evaluation.test_fraction))}/"
-        f"{round(100 * cfg.evaluation.test_fraction)}.",
+        f"evaluation: {protocol(cfg.evaluation)}.",
         "",
     ]
     source = cfg.dataset.config.name if cfg.dataset.config is not None else Path(data_dir).name
@@ -635,11 +797,21 @@ def _report(
             )
         except ConfigError:  # the config is wrong for every source: the experiment fails
             raise
-        except MdfError as exc:  # e.g. a class with a single recording cannot be held out
+        except MdfError as exc:  # e.g. more folds than subjects
+            warnings.warn(
+                f"within-source {group}: not evaluated: {exc}", ExperimentWarning, stacklevel=2
+            )
             report += [f"## Within-source: {group}", "", f"Not evaluated: {exc}.", ""]
             summary["within"][group] = {"skipped": str(exc)}
             continue
         classes = res["classes"]
+        splits = _splits_words(cfg.evaluation, res["n_splits"])
+        for c, why in res["not_evaluated"].items():
+            warnings.warn(
+                f"within-source {group}: class {c!r} not evaluated: {why}",
+                ExperimentWarning,
+                stacklevel=2,
+            )
         stem = f"within_{safe_name(group)}"
         (out / f"{stem}_confusion.csv").write_text(
             _csv(_matrix_rows(classes, res["confusion_mean"]))
@@ -655,6 +827,7 @@ def _report(
                         "n": res["class_counts"][c],
                         "rate_mean": float(res["confusion_mean"][i, i]),
                         "rate_std": float(res["confusion_std"][i, i]),
+                        "splits_scored": res["splits_scored"][c],
                     }
                     for i, c in enumerate(classes)
                 ]
@@ -668,8 +841,7 @@ def _report(
                 res["confusion_mean"],
                 res["confusion_std"],
                 title=f"{group}: within-source",
-                caption=f"{caption}; mean ± std over {cfg.evaluation.repeats} splits by "
-                f"{cfg.evaluation.split}",
+                caption=f"{caption}; mean ± std over {splits}",
             )
         )
         summary["within"][group] = {
@@ -681,9 +853,9 @@ def _report(
             f"## Within-source: {group}",
             "",
             f"Balanced accuracy {res['balanced_accuracy_mean']:.3f} "
-            f"(std {res['balanced_accuracy_std']:.3f}) over {cfg.evaluation.repeats} splits; "
-            f"classes and records: {res['class_counts']}.",
+            f"({_spread_words(res, splits)}); classes and records: {res['class_counts']}.",
             "",
+            *_not_evaluated_markdown(res, splits),
             _markdown_matrix(classes, res["confusion_mean"], res["confusion_std"]),
             "",
             *selected_features_markdown(res["subsets"], cfg.selection.method),
@@ -781,13 +953,46 @@ def _report(
     return summary
 
 
+def _spread_words(res: dict[str, Any], splits: str) -> str:
+    """What a within-source balanced accuracy is and what its spread is, in words."""
+    std = res["balanced_accuracy_std"]
+    if res["balanced_accuracy_std_over"] == "splits":
+        return f"std {std:.3f} over {splits}; the mean per-class recall of the matrix below"
+    return (
+        f"std {std:.3f} over the classes' recalls, as not every split scores every class; the "
+        f"mean per-class recall of the matrix below, mean ± std over {splits}"
+    )
+
+
+def _not_evaluated_markdown(res: dict[str, Any], splits: str) -> list[str]:
+    """Report lines naming the classes a within-source result does not score (and why), and
+    those scored in only some of the splits that tested them."""
+    lines = [f"Not evaluated: {c} ({why})." for c, why in res["not_evaluated"].items()]
+    tested = res["splits_tested"]
+    partial = {
+        c: k
+        for c, k in res["splits_scored"].items()
+        if 0 < k < tested[c] and c not in res["not_evaluated"]
+    }
+    if partial:
+        lines.append(
+            f"Not scored in every split that tests them (of {splits}; a split that tests a "
+            "class without training on it does not score it): "
+            + ", ".join(f"{c} scored in {k} of {tested[c]}" for c, k in partial.items())
+            + "."
+        )
+    return [*lines, ""] if lines else []
+
+
 def _markdown_matrix(
     classes: list[str], mean: NDArray[np.float64], std: NDArray[np.float64] | None
 ) -> str:
     lines = ["| true \\ predicted | " + " | ".join(classes) + " |", "|---|" + "---|" * len(classes)]
     for i, c in enumerate(classes):
         cells = [
-            f"{mean[i, j]:.2f}" + (f" ± {std[i, j]:.2f}" if std is not None else "")
+            "n/a"
+            if np.isnan(mean[i, j])
+            else f"{mean[i, j]:.2f}" + (f" ± {std[i, j]:.2f}" if std is not None else "")
             for j in range(len(classes))
         ]
         lines.append(f"| {c} | " + " | ".join(cells) + " |")

@@ -95,6 +95,37 @@ def subplots(
     return fig, fig.subplots(*args, **kwargs)
 
 
+def wrap_caption(caption: str, fig: Any, fontsize: float = _CAPTION_SIZE) -> str:
+    """``caption`` with its lines broken at spaces so that each fits the width of ``fig`` (less
+    the 1 % margins :func:`save` leaves) in ``fontsize`` points of the current style's font,
+    measured by matplotlib's Agg renderer; a word wider than that stays whole on its line."""
+    from matplotlib.backends.backend_agg import RendererAgg
+    from matplotlib.font_manager import FontProperties
+
+    renderer = RendererAgg(1, 1, fig.dpi)  # type: ignore[no-untyped-call]
+    prop = FontProperties(size=fontsize)
+    room = 0.98 * fig.get_figwidth() * fig.dpi
+
+    def width(text: str) -> float:
+        size = renderer.get_text_width_height_descent(  # type: ignore[no-untyped-call]
+            text, prop, ismath=False
+        )
+        return float(size[0])
+
+    out = []
+    for line in caption.split("\n"):
+        current = ""
+        for word in line.split(" "):
+            trial = f"{current} {word}" if current else word
+            if current and width(trial) > room:
+                out.append(current)
+                current = word
+            else:
+                current = trial
+        out.append(current)
+    return "\n".join(out)
+
+
 def save(fig: Any, path: Path, caption: str = "", *, title: str = "") -> None:
     """Save ``fig`` (made with constrained layout under :func:`style`, or by :func:`subplots`)
     with ``title`` over its first axes and ``caption`` set in small type below the axes, then
@@ -102,6 +133,7 @@ def save(fig: Any, path: Path, caption: str = "", *, title: str = "") -> None:
     if title:
         fig.axes[0].set_title(title)
     if caption:
+        caption = wrap_caption(caption, fig)
         lines = caption.count("\n") + 1
         height = fig.get_figheight()
         bottom = min(0.4, (lines * _CAPTION_SIZE * 1.45 + 6) / 72 / height)
@@ -258,7 +290,8 @@ def plot_confusion(
     caption: str = "",
 ) -> None:
     """Save a row-normalised confusion matrix (true class down, predicted across); ``mean``
-    and ``std`` (n_classes, n_classes) rates in [0, 1]."""
+    and ``std`` (n_classes, n_classes) rates in [0, 1] (a NaN row: a class not evaluated,
+    shown as n/a)."""
     n = len(classes)
     with _rc_context():
         fig, ax = subplots(figsize=(1.3 * n + 2.5, 1.1 * n + 1.8), layout="constrained")
@@ -268,14 +301,17 @@ def plot_confusion(
         im = ax.imshow(mean, cmap=cmap, vmin=0.0, vmax=1.0)
         for i in range(n):
             for j in range(n):
-                text = f"{mean[i, j]:.2f}" + (f"\n±{std[i, j]:.2f}" if std is not None else "")
+                if np.isnan(mean[i, j]):  # a class the experiment could not evaluate
+                    text = "n/a\n(not evaluated)" if j == 0 else "n/a"
+                else:
+                    text = f"{mean[i, j]:.2f}" + (f"\n±{std[i, j]:.2f}" if std is not None else "")
                 ax.text(
                     j,
                     i,
                     text,
                     ha="center",
                     va="center",
-                    color="black" if mean[i, j] > 0.6 else "white",
+                    color="white" if mean[i, j] <= 0.6 else "black",  # NaN: on white
                 )
         ax.set_xticks(range(n), classes, rotation=30, ha="right")
         ax.set_yticks(range(n), classes)

@@ -486,7 +486,17 @@ class RecordingSource(Plugin):
 
 
 class Classifier(Plugin):
-    """Learns activity labels from feature vectors (scikit-learn style)."""
+    """Learns activity labels from feature vectors (scikit-learn style).
+
+    ``seed``: the experiment's ``seed``, set by the framework on every instance it makes,
+    before ``fit`` (``None`` when a classifier is made without one). A classifier that draws
+    random numbers (a random forest, a shuffled solver) seeds them from it, so that an
+    experiment's seed reproduces its results; one that draws none ignores it. A plugin written
+    before the attribute existed keeps working unchanged.
+    """
+
+    #: The experiment's seed, or None (see the class docstring).
+    seed: int | None = None
 
     @abstractmethod
     def fit(self, features: FloatArray, labels: NDArray[Any]) -> Classifier:

@@ -39,11 +39,12 @@ from __future__ import annotations
 import difflib
 import importlib.metadata
 import os
+import typing
 import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from functools import cache
-from typing import Any, NamedTuple
+from typing import Any, Literal, NamedTuple
 
 import pluggy
 
@@ -54,6 +55,7 @@ from .interfaces import (
     Effect,
     MotionSource,
     Plugin,
+    PluginConfig,
     RadarWaveform,
     RecordingSource,
     ScattererModel,
@@ -203,12 +205,15 @@ def _provider_name(pm: pluggy.PluginManager, plugin: object) -> str:
 _DISTRIBUTIONS: dict[str, str] = {}
 
 
-def _warn_disabled(pm: pluggy.PluginManager, name: str, reason: str) -> None:
-    """Record a plugin as disabled and warn once (per plugin manager, i.e. once per process for
-    the installed plugins)."""
+def _warn_disabled(
+    pm: pluggy.PluginManager, name: str, reason: str, what: str | None = None
+) -> None:
+    """Record a plugin (or ``what`` else, e.g. a kind two plugins claim) as disabled and warn
+    once (per plugin manager, i.e. once per process for the installed plugins)."""
     disabled = _disabled(pm)
     if name not in disabled:
-        warnings.warn(f"plugin {name!r} is disabled: {reason}", PluginWarning, stacklevel=2)
+        shown = what or f"plugin {name!r}"
+        warnings.warn(f"{shown} is disabled: {reason}", PluginWarning, stacklevel=2)
     disabled[name] = reason
 
 
@@ -297,15 +302,39 @@ def _hook_classes(
     hook = getattr(pm.hook, hook_name)
     for impl in hook.get_hookimpls():
         provider = _provider_name(pm, impl.plugin)
+        name = pm.get_name(impl.plugin) or provider
         try:
             classes = impl.function()
         except Exception as exc:
             _reraise_interrupt(exc)
-            name = pm.get_name(impl.plugin) or provider
             _warn_disabled(pm, name, f"{provider}: {hook_name} raised {type(exc).__name__}: {exc}")
             yield impl.plugin, provider, None
             continue
+        if classes is not None and not isinstance(classes, list | tuple):
+            _warn_disabled(
+                pm, name, f"{provider}: {hook_name} returned {classes!r}, not a list of classes"
+            )
+            yield impl.plugin, provider, None
+            continue
         yield impl.plugin, provider, list(classes or [])
+
+
+def _class_problem(cls: Any, base: type[Plugin], hook_name: str) -> str:
+    """What makes ``cls`` unusable as a plugin of the interface ``base``, or ``""``: it must be
+    a subclass with a ``name`` and a ``Config`` (a :class:`PluginConfig`) whose ``kind`` is
+    ``Literal[name]``, which the run config's discriminated union is built from."""
+    if not (isinstance(cls, type) and issubclass(cls, base)):
+        return f"{hook_name} returned {cls!r}, which is not a {base.__name__}"
+    if not isinstance(getattr(cls, "name", None), str) or not cls.name:
+        return f"{cls.__name__} has no 'name'"
+    config = getattr(cls, "Config", None)
+    if not (isinstance(config, type) and issubclass(config, PluginConfig)):
+        return f"{cls.__name__}.Config is not a subclass of mdframework.PluginConfig"
+    kind = config.model_fields.get("kind")
+    annotation = None if kind is None else kind.annotation
+    if typing.get_origin(annotation) is not Literal or typing.get_args(annotation) != (cls.name,):
+        return f"{cls.__name__}.Config needs kind: Literal[{cls.name!r}] = {cls.name!r}"
+    return ""
 
 
 def _collect(pm: pluggy.PluginManager) -> Registry:
@@ -321,11 +350,7 @@ def _collect(pm: pluggy.PluginManager) -> Registry:
                 broken.add(plugin)
                 continue
             for cls in classes:
-                problem = ""
-                if not (isinstance(cls, type) and issubclass(cls, base)):
-                    problem = f"{hook_name} returned {cls!r}, which is not a {base.__name__}"
-                elif not isinstance(getattr(cls, "name", None), str) or not cls.name:
-                    problem = f"{cls.__name__} has no 'name'"
+                problem = _class_problem(cls, base, hook_name)
                 if problem:
                     broken.add(plugin)
                     _warn_disabled(pm, pm.get_name(plugin) or provider, f"{provider}: {problem}")
@@ -334,17 +359,23 @@ def _collect(pm: pluggy.PluginManager) -> Registry:
     for plugin in broken:
         if pm.is_registered(plugin):
             pm.unregister(plugin)  # its other hooks (e.g. CLI commands) go with it
+    claims: dict[tuple[str, str], list[tuple[str, type[Plugin]]]] = {}
     for interface, name, plugin, provider, cls in entries:
-        if plugin in broken:
-            continue
-        known = registry.plugins[interface]
-        if name in known:
-            raise PluginError(
-                f"two {interface} plugins are named {name!r}: {known[name].provider} and "
-                f"{provider}; disable one with {DISABLE_PLUGINS_ENV}=<entry point name> "
-                "or mdf --disable-plugin"
+        if plugin not in broken:
+            claims.setdefault((interface, name), []).append((provider, cls))
+    for (interface, name), claimants in claims.items():
+        providers = sorted({provider for provider, _ in claimants})
+        if len(claimants) == 1:
+            provider, cls = claimants[0]
+            registry.plugins[interface][name] = PluginInfo(cls, interface, provider)
+        else:  # neither is chosen for the user: the kind is withheld, everything else works
+            _warn_disabled(
+                pm,
+                f"{interface} kind {name!r}",
+                f"claimed by {' and '.join(providers)}; switch one off with "
+                "mdf --disable-plugin NAME",
+                f"the {interface} kind {name!r}",
             )
-        known[name] = PluginInfo(cls, interface, provider)
     return registry
 
 
@@ -403,6 +434,9 @@ def add_cli_commands(subparsers: Any) -> None:
                 name,
                 f"{provider}: mdframework_add_cli_commands raised {type(exc).__name__}: {exc}",
             )
+            # disabled means disabled: its plugin classes go too (the registry is rebuilt)
+            pm.unregister(impl.plugin)
+            default_registry.cache_clear()
 
 
 def reset_default_registry() -> None:

@@ -12,12 +12,14 @@ import path needs the command-line flag ``mdf experiment --allow-import`` (passe
 the context key ``allow_import``).
 
 Features are standardised with training statistics (zero-variance guarded) unless
-``standardize = false``.
+``standardize = false``. An estimator that takes ``random_state`` gets the experiment's seed
+(:attr:`mdframework.Classifier.seed`) there, unless ``params`` sets ``random_state`` itself.
 """
 
 from __future__ import annotations
 
 import importlib
+import inspect
 import math
 from functools import lru_cache
 from typing import Any, Literal
@@ -132,9 +134,22 @@ class SklearnClassifier(Classifier):
         """Fit the estimator on (optionally standardised) features."""
         x = np.asarray(features, dtype=np.float64)
         self.scaler_ = Standardizer.fit(x) if self.config.standardize else None
-        self.model_ = _import(self.config.estimator)(**self.config.params)
+        self.model_ = _import(self.config.estimator)(**self.estimator_params())
         self.model_.fit(self._scale(x), np.asarray(labels))
         return self
+
+    def estimator_params(self) -> dict[str, Any]:
+        """The estimator's constructor arguments: ``params``, plus ``random_state`` = the
+        experiment's seed where the estimator takes one and ``params`` does not set it."""
+        params = dict(self.config.params)
+        estimator = _import(self.config.estimator)
+        if (
+            self.seed is not None
+            and "random_state" not in params
+            and "random_state" in inspect.signature(estimator).parameters
+        ):
+            params["random_state"] = self.seed
+        return params
 
     def _scale(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         return self.scaler_.transform(x) if self.scaler_ is not None else x
