@@ -72,7 +72,9 @@ def _instance(interface: str, name: str) -> Any:
         return cls0(cls0.Config(file=path))
     if interface == "motion":
         assert name in SOURCE_EXAMPLES, f"add an example using the {name!r} source"
-        return build_stages(load_run_config(EXAMPLES / SOURCE_EXAMPLES[name])).source
+        return build_stages(
+            load_run_config(EXAMPLES / SOURCE_EXAMPLES[name], REGISTRY), REGISTRY
+        ).source
     cls: Any = info.cls
     if interface == "recording":
         assert name in RECORDING_EXAMPLES, f"add an example recording for the {name!r} source"
@@ -372,8 +374,8 @@ def test_the_contracts_catch_broken_waveforms() -> None:
 
 @pytest.fixture(scope="module")
 def placed_body() -> tuple[Any, Skeleton]:
-    config = load_run_config(EXAMPLES / "cmu_walk.toml")
-    motion = build_stages(config).source.load()
+    config = load_run_config(EXAMPLES / "cmu_walk.toml", REGISTRY)
+    motion = build_stages(config, REGISTRY).source.load()
     body = place_body(motion.canonical(), config.scene.person, np.array([10.0, 0.0, 1.0]))
     t = interpolation.pulse_times(body.time[0], body.time[0] + 1.0, 2400.0)
     joints = interpolation.resample_tracks(body.time, body.positions, body.valid, t)

@@ -11,6 +11,7 @@ from __future__ import annotations
 import re
 import sys
 import types
+from functools import cache
 from typing import Annotated, Any, Literal, Union, get_args, get_origin
 
 from pydantic import BaseModel
@@ -231,20 +232,41 @@ def render(registry: Registry | None = None) -> str:
     return "\n".join(out).rstrip("\n") + "\n"
 
 
+@cache
 def project_registry() -> Registry:
-    """The installed plugins whose code lives in this source tree's ``plugins/`` folder (the
-    reference documents those, whatever else is installed)."""
-    import inspect
+    """The plugins whose code lives in this source tree's ``plugins/`` folder, loaded without
+    any other installed plugin: the reference documents those, and the project's tests check
+    them, whatever else is installed (a third party's plugin that fails to load, or claims one
+    of our kinds, changes nothing here)."""
+    import importlib.metadata
+    import importlib.util
+    import os
     from pathlib import Path
 
+    from . import hookspecs
+    from .plugins import DISABLE_PLUGINS_ENV, build_registry
+
     root = Path(__file__).resolve().parents[2] / "plugins"
-    reg = default_registry()
-    own = {
-        info.provider.split()[0]
-        for infos in reg.plugins.values()
-        for info in infos.values()
-        if root in Path(inspect.getfile(info.cls)).resolve().parents
+
+    def ours(ep: importlib.metadata.EntryPoint) -> bool:
+        spec = importlib.util.find_spec(ep.module.split(".")[0])  # imports nothing
+        where = spec.origin if spec is not None else None
+        return where is not None and root in Path(where).resolve().parents
+
+    others = {ep.name for ep in importlib.metadata.entry_points(group=hookspecs.PROJECT)}
+    others -= {
+        ep.name for ep in importlib.metadata.entry_points(group=hookspecs.PROJECT) if ours(ep)
     }
+    before = os.environ.get(DISABLE_PLUGINS_ENV)
+    os.environ[DISABLE_PLUGINS_ENV] = ",".join(sorted(others))
+    try:
+        reg = build_registry(autoload=True)
+    finally:
+        if before is None:
+            del os.environ[DISABLE_PLUGINS_ENV]
+        else:
+            os.environ[DISABLE_PLUGINS_ENV] = before
+    own = {info.provider.split()[0] for infos in reg.plugins.values() for info in infos.values()}
     return reg.provided_by(own)
 
 
