@@ -590,3 +590,29 @@ def test_a_stopped_build_removes_the_records_it_was_writing(
     with pytest.raises(KeyboardInterrupt):
         build_dataset(cfg, base, out, workers=2, progress=False)
     assert sorted(p.name for p in (out / RECORDS).iterdir()) == [".tmp-notes.txt"]
+
+
+def test_a_warped_records_id_covers_where_its_source_ends(tmp_path: Path) -> None:
+    """A time warp can move a record back from the end of its source's span, so two sources
+    that differ only in `duration` make records with different ids (they had the same id, and
+    a resumed or --force build kept the stale record)."""
+    amc = CMU / "asf-amc" / "02_01.amc"
+    ids = []
+    for duration in (2.0, 2.5):  # the recording lasts 2.85 s
+        cfg = {
+            "seed": 2,
+            "sources": [
+                {
+                    "label": "walk",
+                    "motion": {"kind": "cmu", "file": str(amc), "duration": duration},
+                    "record_length": 1.0,
+                    "max_records": 2,
+                }
+            ],
+            "randomize": {"time_warp": 0.9},
+        }
+        path = tmp_path / f"w{duration}.json"
+        path.write_text(json.dumps(cfg))
+        ids.append([s.record_id for s in plan_records(*load_dataset_config(path))])
+    assert len(ids[0]) == len(ids[1]) == 2
+    assert not set(ids[0]) & set(ids[1])
