@@ -318,7 +318,8 @@ def test_a_sped_up_record_stays_within_its_sources_span(speed: float, warp: list
     """A source limited to 0.4-2.4 s of a CMU walk, cut into 1 s windows, played `speed` times
     as fast: every record's motion comes from the span (the frames inside the record's window
     carry their original time stamps), never from after 2.4 s, which once held another part of
-    the recording; a span too short for the record at that speed is refused."""
+    the recording; a span too short for the record at that speed is refused, also a span that
+    only a start limits."""
     import json
 
     from conftest import EXAMPLES
@@ -337,6 +338,14 @@ def test_a_sped_up_record_stays_within_its_sources_span(speed: float, warp: list
         t = out.skeleton.time - t0
         inside = (t >= first - 1e-9) & (t <= first + 1.0 + 1e-9)
         assert original[inside].max() <= span[1] + 1e-9
+        if warp is None:  # a warp shifts the whole motion a little, the window with it
+            assert original[inside].min() >= span[0] - 1e-9
         assert first <= start / speed + 1e-12  # a record is only ever moved back
     with pytest.raises(SceneError, match=r"leaves 0\.400 s of the source's span"):
         _augmented(motion, {"speed": 5.0}, 0.4, 1.0, span)
+    # a span given by its start alone: the motion after it, sped up, must hold the record (a
+    # record was moved back before the start instead)
+    late = (float(original[-1]) - 1.5, None)
+    with pytest.raises(SceneError, match=r"leaves 0\.750 s of the source's span"):
+        _augmented(motion, {"speed": 2.0}, late[0], 1.0, late)
+    _augmented(motion, {"speed": 1.2}, late[0], 1.0, late)  # 1.25 s: it fits

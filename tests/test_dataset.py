@@ -26,7 +26,7 @@ from mdframework.dataset import (
     plan_records,
     read_record,
 )
-from mdframework.errors import ConfigError, DataFileError
+from mdframework.errors import ConfigError, DataFileError, MdfError
 from mdframework.features import FEATURE_NAMES
 from mdframework.sanity import MotionSanityWarning
 
@@ -590,3 +590,47 @@ def test_a_stopped_build_removes_the_records_it_was_writing(
     with pytest.raises(KeyboardInterrupt):
         build_dataset(cfg, base, out, workers=2, progress=False)
     assert sorted(p.name for p in (out / RECORDS).iterdir()) == [".tmp-notes.txt"]
+
+
+def test_a_warped_records_id_covers_where_its_source_ends(tmp_path: Path) -> None:
+    """A time warp can move a record back from the end of its source's span, so two sources
+    that differ only in `duration` make records with different ids (they had the same id, and
+    a resumed or --force build kept the stale record)."""
+    amc = CMU / "asf-amc" / "02_01.amc"
+    ids = []
+    for duration in (2.0, 2.5):  # the recording lasts 2.85 s
+        cfg = {
+            "seed": 2,
+            "sources": [
+                {
+                    "label": "walk",
+                    "motion": {"kind": "cmu", "file": str(amc), "duration": duration},
+                    "record_length": 1.0,
+                    "max_records": 2,
+                }
+            ],
+            "randomize": {"time_warp": 0.9},
+        }
+        path = tmp_path / f"w{duration}.json"
+        path.write_text(json.dumps(cfg))
+        ids.append([s.record_id for s in plan_records(*load_dataset_config(path))])
+    assert len(ids[0]) == len(ids[1]) == 2
+    assert not set(ids[0]) & set(ids[1])
+
+
+def test_a_motion_files_own_error_keeps_its_file_name(tmp_path: Path) -> None:
+    """Only an error in the source's motion section is renamed `sources[N].motion...`; a
+    reader's error names its file (it was glued to the prefix: `sources[0]./.../02_01.amc`)."""
+    import shutil
+
+    lone = tmp_path / "lone"
+    lone.mkdir()
+    shutil.copy(CMU / "asf-amc" / "02_01.amc", lone / "02_01.amc")  # without its skeleton
+    cfg = {
+        "sources": [{"label": "walk", "motion": {"kind": "cmu", "file": str(lone / "02_01.amc")}}]
+    }
+    path = tmp_path / "d.json"
+    path.write_text(json.dumps(cfg))
+    with pytest.raises(MdfError) as err:
+        plan_records(*load_dataset_config(path))
+    assert str(err.value).startswith(str(lone / "02_01.amc"))

@@ -222,8 +222,15 @@ def test_a_kind_two_plugins_claim_is_withheld_with_one_warning() -> None:
     """Neither plugin is chosen for the user (it used to stop every command); the warning
     names both, and the other kinds stay."""
     other = ModuleType("other")
-    other.mdframework_register_motion_sources = (  # type: ignore[attr-defined]
-        synthetic.mdframework_register_motion_sources
+
+    class OtherWalker(synthetic.SyntheticWalker):
+        """Another walker under the same name."""
+
+    def mdframework_register_motion_sources() -> list[type]:
+        return [OtherWalker]
+
+    other.mdframework_register_motion_sources = synthetic.hookimpl(  # type: ignore[attr-defined]
+        mdframework_register_motion_sources
     )
     with pytest.warns(PluginWarning) as caught:
         reg = build_registry([synthetic, other], autoload=False)
@@ -232,6 +239,13 @@ def test_a_kind_two_plugins_claim_is_withheld_with_one_warning() -> None:
     assert message.startswith("the motion kind 'synthetic_walker' is disabled: claimed by ")
     assert "other" in message and "synthetic" in message
     assert reg.names("motion") == [] and "motion kind 'synthetic_walker'" in reg.disabled
+    # the same class from two plugins is no choice to make: it is registered once
+    other.mdframework_register_motion_sources = (  # type: ignore[attr-defined]
+        synthetic.mdframework_register_motion_sources
+    )
+    assert build_registry([synthetic, other], autoload=False).names("motion") == [
+        "synthetic_walker"
+    ]
 
 
 def test_wrong_class_disables_the_plugin() -> None:

@@ -79,6 +79,13 @@ def installed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]
             del sys.modules[name]
 
 
+def listed(capsys: pytest.CaptureFixture[str]) -> tuple[str, str]:
+    """What `mdf plugins` prints (stdout, stderr); it must succeed."""
+    assert cli.main(["plugins"]) == 0
+    out, err = capsys.readouterr()
+    return out, err
+
+
 def run_point_target(tmp_path: Path, *extra: str) -> int:
     out = tmp_path / "out"
     return cli.main(["run", str(EXAMPLES / "point_target.toml"), "--out", str(out), *extra])
@@ -92,8 +99,7 @@ def test_an_unusable_plugin_is_switched_off_and_mdf_works(
     not name the plugin."""
     body, why = BROKEN[how]
     _make_distribution(installed, "acme-fx", "mdf_test_acme", HEADER + body, "acme_fx")
-    assert cli.main(["plugins"]) == 0
-    out, err = capsys.readouterr()
+    out, err = listed(capsys)
     warnings = [line for line in err.splitlines() if "acme" in line]
     assert len(warnings) == 1 and warnings[0].startswith("mdf: warning: plugin 'acme_fx' is ")
     assert why in warnings[0]
@@ -124,8 +130,7 @@ def test_a_kind_claimed_twice_is_withheld_and_the_rest_works(
     too. Now neither `lfm` is chosen for the user; the commands that do not need it work, a run
     that does says why in one line, and switching one plugin off resolves it."""
     _make_distribution(installed, "acme-radar", "mdf_test_acme_radar", CLASH, "acme_radar")
-    assert cli.main(["plugins"]) == 0
-    out, err = capsys.readouterr()
+    out, err = listed(capsys)
     assert "mdf: warning: the radar kind 'lfm' is disabled: claimed by acme-radar 0.0.1 and " in err
     assert "mdf --disable-plugin NAME" in err
     assert "radar kind 'lfm'" in out.split("disabled:")[1]
@@ -157,8 +162,7 @@ def test_a_plugin_whose_command_fails_is_switched_off_whole(
 ) -> None:
     """Its failing CLI hook listed it as disabled while its effect stayed installed and ran."""
     _make_distribution(installed, "acme-cmd", "mdf_test_acme_cmd", CLI_FAILS, "acme_cmd")
-    assert cli.main(["plugins"]) == 0
-    out, err = capsys.readouterr()
+    out, err = listed(capsys)
     assert "no command today" in err and "acme_cmd" in out.split("disabled:")[1]
     assert "acme_fx" not in out.split("disabled:")[0]
     config = tmp_path / "fx.toml"
@@ -166,3 +170,76 @@ def test_a_plugin_whose_command_fails_is_switched_off_whole(
     config.write_text('effects = [{ kind = "acme_fx" }]\n' + text)
     code = cli.main(["run", str(config), "--out", str(tmp_path / "o")])
     assert code == 2 and "no effects plugin named 'acme_fx'" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("returned", ["{AcmeFx}", "(c for c in [AcmeFx])"], ids=["set", "gen"])
+def test_any_collection_of_classes_registers(
+    returned: str, installed: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A set or a generator of classes worked before the check for a returned single class,
+    and still does."""
+    body = (
+        HEADER + EFFECT + f"@hookimpl\ndef mdframework_register_effects():\n    return {returned}\n"
+    )
+    _make_distribution(installed, "acme-fx", "mdf_test_acme", body, "acme_fx")
+    out, err = listed(capsys)
+    assert "acme" not in err and "acme_fx" in out and "disabled:" not in out
+
+
+def test_one_class_under_the_old_and_the_new_hook_name_is_one_plugin(
+    installed: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A plugin that supports two versions of mdframework by returning its class from both
+    `mdframework_register_radar_waveforms` and the old `mdframework_register_waveforms` is not
+    a kind claimed twice."""
+    body = (
+        HEADER
+        + '''
+from mdf_lfm.waveform import LfmConfig, LfmPulseDoppler
+
+class AcmeConfig(LfmConfig):
+    kind: Literal["acme_lfm"] = "acme_lfm"
+
+class AcmeLfm(LfmPulseDoppler):
+    """Our radar, for old and new mdframework."""
+    name = "acme_lfm"
+    Config = AcmeConfig
+
+@hookimpl
+def mdframework_register_radar_waveforms():
+    return [AcmeLfm]
+
+@hookimpl
+def mdframework_register_waveforms():
+    return [AcmeLfm]
+'''
+    )
+    _make_distribution(installed, "acme-lfm", "mdf_test_acme_lfm", body, "acme_lfm")
+    out, err = listed(capsys)
+    assert "acme" not in err and "acme_lfm" in out and "disabled:" not in out
+
+
+def test_the_commands_of_a_failing_command_hook_are_taken_off(
+    installed: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A hook that adds its command and then raises: the command ran in the same invocation
+    although the plugin was reported disabled."""
+    body = (
+        HEADER
+        + """
+@hookimpl
+def mdframework_add_cli_commands(subparsers):
+    sub = subparsers.add_parser("acme", help="an acme command")
+    sub.set_defaults(func=lambda args: 0)
+    raise RuntimeError("half a command")
+"""
+    )
+    _make_distribution(installed, "acme-half", "mdf_test_acme_half", body, "acme_half")
+    assert cli.main(["acme"]) == 2
+    err = capsys.readouterr().err
+    assert "half a command" in err and "invalid choice: 'acme'" in err
+    with pytest.raises(SystemExit) as done:
+        cli.main(["--help"])
+    assert done.value.code == 0
+    help_text = capsys.readouterr().out
+    assert "plugins" in help_text and "acme" not in help_text

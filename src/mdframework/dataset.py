@@ -327,8 +327,9 @@ class RecordSpec:
     #: ``sources[N].randomize``), to name it when a drawn value does not fit its field
     draw_origins: dict[str, str] | None = None
     #: the source's span ``(start, end)`` [s from the motion's first frame] when the source
-    #: gives a ``duration``: a record sped up by a ``speed`` draw stays within it
-    span: tuple[float, float] | None = None
+    #: gives a ``start`` or a ``duration`` (``end``: None without a duration, the motion's end):
+    #: a record sped up or warped by its draws stays within it
+    span: tuple[float, float | None] | None = None
     #: the aspect [deg] asked for (variation or draw) when ``place = "record"`` turned it into
     #: a fixed heading, for the table
     aspect_deg: float | None = None
@@ -566,7 +567,7 @@ def _spec(
     hist: dict[str, Any] | None,
     meta: tuple[str, str, str] = ("", "", ""),
     draw_origins: dict[str, str] | None = None,
-    span: tuple[float, float] | None = None,
+    span: tuple[float, float | None] | None = None,
     aspect_deg: float | None = None,
 ) -> RecordSpec:
     """A record's spec; its id ends with a digest of everything that makes the record.
@@ -574,8 +575,9 @@ def _spec(
     it gives a duration (:attr:`RecordSpec.span`)."""
     features = config.features.model_dump()
     payload = [run, features] + [x for x in (draws, hist) if x is not None]
-    if span is not None and draws is not None and "speed" in draws:
-        payload.append({"span": list(span)})
+    # where the span ends moves a sped-up or warped record (its start only refuses one)
+    if span is not None and span[1] is not None and draws and {"speed", "time_warp"} & set(draws):
+        payload.append({"span_end": span[1]})
     digest = hashlib.sha1(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:10]
     return RecordSpec(
         index,
@@ -775,8 +777,10 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
         try:
             loaded = _load_motion(_motion_key(motion), str(base_dir))
         except ConfigError as exc:  # named where the dataset config wrote it
-            text = str(exc).removeprefix(f"{_MOTION_WHERE}: ")
-            raise ConfigError(f"sources[{entry_no}].{text}") from None
+            text = str(exc)
+            if not text.startswith(f"{_MOTION_WHERE}: "):
+                raise  # names its file already
+            raise ConfigError(f"sources[{entry_no}].{text[len(_MOTION_WHERE) + 2 :]}") from None
         span_start = float(motion.get("start", 0.0))
         span_end = loaded.skeleton.duration
         if motion.get("duration") is not None:
@@ -859,7 +863,7 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                         hist,
                         meta,
                         origins if draws else None,
-                        None if motion.get("duration") is None else (span_start, span_end),
+                        _span(motion, span_start, span_end),
                         asked,
                     )
                 )
@@ -988,18 +992,28 @@ def _build_recorded(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     return _row(meta, arrays["features"])
 
 
+def _span(motion: dict[str, Any], start: float, end: float) -> tuple[float, float | None] | None:
+    """A source's span for :attr:`RecordSpec.span`: None when it gives neither ``start`` nor
+    ``duration`` (the whole motion)."""
+    if motion.get("start") is None and motion.get("duration") is None:
+        return None
+    return start, None if motion.get("duration") is None else end
+
+
 def _augmented(
     motion: Motion,
     draws: dict[str, Any],
     start: float,
     duration: float,
-    span: tuple[float, float] | None = None,
+    span: tuple[float, float | None] | None = None,
 ) -> Any:
     """The augmented motion and the record's start in its time [s] (speed changes the
     timeline: the record keeps the motion phase where it can, else ends at the end of the
-    motion, or of the source's ``span`` (start, end) [s] when the source gives a duration:
-    that end is carried through the time warp and the speed, so a sped-up record never takes
-    motion from beyond it)."""
+    motion, or of the source's ``span`` (start, end or None) [s]: that end is carried through
+    the time warp and the speed, so a sped-up record never takes motion from beyond it, and a
+    span whose start leaves too little motion at that speed is refused. The record's start is
+    its window's divided by the speed; a time warp shifts what it shows by a fraction of the
+    warp's strength, as it shifts the whole motion)."""
     speed = float(draws.get("speed", 1.0))
     warp = draws.get("time_warp")
     out = augment_motion(
@@ -1012,14 +1026,14 @@ def _augmented(
     first, end = 0.0, out.skeleton.duration
     what = "of motion"
     if span is not None:
-        whole = motion.skeleton.duration
-        at = (
-            span[1]
-            if warp is None
-            else whole * float(warp_function(np.array([span[1] / whole]), warp)[0])
-        )
-        first, end = span[0] / speed, at / speed
+        first = span[0] / speed
         what = "of the source's span"
+        if span[1] is not None:
+            whole = motion.skeleton.duration
+            at = span[1]
+            if warp is not None:
+                at = whole * float(warp_function(np.array([span[1] / whole]), warp)[0])
+            end = at / speed
     if duration > end - first + 1e-9:
         raise SceneError(
             f"randomize.speed: a speed factor of {speed:.3f} leaves {end - first:.3f} s {what}, "

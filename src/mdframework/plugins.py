@@ -310,13 +310,24 @@ def _hook_classes(
             _warn_disabled(pm, name, f"{provider}: {hook_name} raised {type(exc).__name__}: {exc}")
             yield impl.plugin, provider, None
             continue
-        if classes is not None and not isinstance(classes, list | tuple):
+        # a list, or any other collection of classes (a set, a generator), but not one class
+        # or text, whose items are no classes
+        if classes is not None and (
+            isinstance(classes, str | bytes | type) or not isinstance(classes, Iterable)
+        ):
             _warn_disabled(
                 pm, name, f"{provider}: {hook_name} returned {classes!r}, not a list of classes"
             )
             yield impl.plugin, provider, None
             continue
-        yield impl.plugin, provider, list(classes or [])
+        try:
+            found = list(classes or [])
+        except Exception as exc:  # a generator that raises
+            _reraise_interrupt(exc)
+            _warn_disabled(pm, name, f"{provider}: {hook_name} raised {type(exc).__name__}: {exc}")
+            yield impl.plugin, provider, None
+            continue
+        yield impl.plugin, provider, found
 
 
 def _class_problem(cls: Any, base: type[Plugin], hook_name: str) -> str:
@@ -359,14 +370,16 @@ def _collect(pm: pluggy.PluginManager) -> Registry:
     for plugin in broken:
         if pm.is_registered(plugin):
             pm.unregister(plugin)  # its other hooks (e.g. CLI commands) go with it
-    claims: dict[tuple[str, str], list[tuple[str, type[Plugin]]]] = {}
+    # one class returned by two hooks of one plugin (the current and the old spelling) is one
+    # claim on its name
+    claims: dict[tuple[str, str], dict[type[Plugin], str]] = {}
     for interface, name, plugin, provider, cls in entries:
         if plugin not in broken:
-            claims.setdefault((interface, name), []).append((provider, cls))
+            claims.setdefault((interface, name), {}).setdefault(cls, provider)
     for (interface, name), claimants in claims.items():
-        providers = sorted({provider for provider, _ in claimants})
+        providers = sorted(set(claimants.values()))
         if len(claimants) == 1:
-            provider, cls = claimants[0]
+            ((cls, provider),) = claimants.items()
             registry.plugins[interface][name] = PluginInfo(cls, interface, provider)
         else:  # neither is chosen for the user: the kind is withheld, everything else works
             _warn_disabled(
@@ -423,10 +436,12 @@ def add_cli_commands(subparsers: Any) -> None:
     pm = default_plugin_manager()
     default_registry()  # unregisters the plugins that fail to register their classes
     for impl in pm.hook.mdframework_add_cli_commands.get_hookimpls():
+        before = set(getattr(subparsers, "choices", {}))
         try:
             impl.function(subparsers=subparsers)
         except Exception as exc:
             _reraise_interrupt(exc)
+            _remove_commands(subparsers, set(getattr(subparsers, "choices", {})) - before)
             provider = _provider_name(pm, impl.plugin)
             name = pm.get_name(impl.plugin) or provider
             _warn_disabled(
@@ -437,6 +452,16 @@ def add_cli_commands(subparsers: Any) -> None:
             # disabled means disabled: its plugin classes go too (the registry is rebuilt)
             pm.unregister(impl.plugin)
             default_registry.cache_clear()
+
+
+def _remove_commands(subparsers: Any, names: set[str]) -> None:
+    """Take the sub-commands ``names`` off an argparse sub-parsers action again (the ones a
+    failing hook added before it raised)."""
+    for name in names:
+        subparsers.choices.pop(name, None)
+    listed = getattr(subparsers, "_choices_actions", None)
+    if isinstance(listed, list):
+        listed[:] = [a for a in listed if getattr(a, "dest", None) not in names]
 
 
 def reset_default_registry() -> None:
