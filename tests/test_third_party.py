@@ -22,13 +22,13 @@ from mdframework import Effect, PluginConfig, Scatterers, SceneContext, hookimpl
 """
 
 EFFECT = '''
-class AcmeConfig(PluginConfig):
-    kind: Literal["acme_fx"] = "acme_fx"
+class XyzzyConfig(PluginConfig):
+    kind: Literal["xyzzy_fx"] = "xyzzy_fx"
 
-class AcmeFx(Effect):
+class XyzzyFx(Effect):
     """Leaves the scatterers as they are."""
-    name = "acme_fx"
-    Config = AcmeConfig
+    name = "xyzzy_fx"
+    Config = XyzzyConfig
     stage = "scatterers"
     def apply(self, data: Scatterers, context: SceneContext) -> Scatterers:
         return data
@@ -37,27 +37,27 @@ class AcmeFx(Effect):
 #: how a plugin can be unusable, and what the warning says
 BROKEN = {
     "one class, not a list": (
-        EFFECT + "@hookimpl\ndef mdframework_register_effects():\n    return AcmeFx\n",
-        "returned <class 'mdf_test_acme.AcmeFx'>, not a list of classes",
+        EFFECT + "@hookimpl\ndef mdframework_register_effects():\n    return XyzzyFx\n",
+        "returned <class 'mdf_test_xyzzy.XyzzyFx'>, not a list of classes",
     ),
     "a number": (
         "@hookimpl\ndef mdframework_register_effects():\n    return 42\n",
         "returned 42, not a list of classes",
     ),
     "no Config": (
-        EFFECT.replace("    Config = AcmeConfig\n", "")
-        + "@hookimpl\ndef mdframework_register_effects():\n    return [AcmeFx]\n",
-        "AcmeFx.Config is not a subclass of mdframework.PluginConfig",
+        EFFECT.replace("    Config = XyzzyConfig\n", "")
+        + "@hookimpl\ndef mdframework_register_effects():\n    return [XyzzyFx]\n",
+        "XyzzyFx.Config is not a subclass of mdframework.PluginConfig",
     ),
     "kind as text": (
-        EFFECT.replace('Literal["acme_fx"] = "acme_fx"', 'str = "acme_fx"')
-        + "@hookimpl\ndef mdframework_register_effects():\n    return [AcmeFx]\n",
-        "AcmeFx.Config needs kind: Literal['acme_fx'] = 'acme_fx'",
+        EFFECT.replace('Literal["xyzzy_fx"] = "xyzzy_fx"', 'str = "xyzzy_fx"')
+        + "@hookimpl\ndef mdframework_register_effects():\n    return [XyzzyFx]\n",
+        "XyzzyFx.Config needs kind: Literal['xyzzy_fx'] = 'xyzzy_fx'",
     ),
     "kind of another plugin": (
-        EFFECT.replace('Literal["acme_fx"] = "acme_fx"', 'Literal["noise"] = "noise"')
-        + "@hookimpl\ndef mdframework_register_effects():\n    return [AcmeFx]\n",
-        "AcmeFx.Config needs kind: Literal['acme_fx']",
+        EFFECT.replace('Literal["xyzzy_fx"] = "xyzzy_fx"', 'Literal["noise"] = "noise"')
+        + "@hookimpl\ndef mdframework_register_effects():\n    return [XyzzyFx]\n",
+        "XyzzyFx.Config needs kind: Literal['xyzzy_fx']",
     ),
 }
 
@@ -98,12 +98,12 @@ def test_an_unusable_plugin_is_switched_off_and_mdf_works(
     """Each of these crashed every command (`mdf --help` included) with a traceback that did
     not name the plugin."""
     body, why = BROKEN[how]
-    _make_distribution(installed, "acme-fx", "mdf_test_acme", HEADER + body, "acme_fx")
+    _make_distribution(installed, "xyzzy-fx", "mdf_test_xyzzy", HEADER + body, "xyzzy_fx")
     out, err = listed(capsys)
-    warnings = [line for line in err.splitlines() if "acme" in line]
-    assert len(warnings) == 1 and warnings[0].startswith("mdf: warning: plugin 'acme_fx' is ")
+    warnings = [line for line in err.splitlines() if "xyzzy" in line]
+    assert len(warnings) == 1 and warnings[0].startswith("mdf: warning: plugin 'xyzzy_fx' is ")
     assert why in warnings[0]
-    assert "acme_fx" in out.split("disabled:")[1]
+    assert "xyzzy_fx" in out.split("disabled:")[1]
     assert cli.main(["config", "schema"]) == 0
     assert run_point_target(tmp_path) == 0
 
@@ -113,33 +113,73 @@ CLASH = (
     + """
 from mdf_lfm.waveform import LfmPulseDoppler
 
-class AcmeLfm(LfmPulseDoppler):
+class XyzzyLfm(LfmPulseDoppler):
     '''Another pulse-Doppler radar that claims the name of ours.'''
 
 @hookimpl
 def mdframework_register_radar_waveforms():
-    return [AcmeLfm]
+    return [XyzzyLfm]
 """
 )
 
 
-def test_a_kind_claimed_twice_is_withheld_and_the_rest_works(
+def test_a_built_in_kind_stays_ours_when_a_third_party_claims_it(
     installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """A third party's radar named `lfm`: every command stopped with exit code 2, `--help`
-    too. Now neither `lfm` is chosen for the user; the commands that do not need it work, a run
-    that does says why in one line, and switching one plugin off resolves it."""
-    _make_distribution(installed, "acme-radar", "mdf_test_acme_radar", CLASH, "acme_radar")
+    """A third party's radar named `lfm` stopped every command with exit code 2, `--help`
+    too. Our `lfm` stays ours: that plugin is switched off with one warning, and our runs
+    work."""
+    _make_distribution(installed, "xyzzy-radar", "mdf_test_xyzzy_radar", CLASH, "xyzzy_radar")
     out, err = listed(capsys)
-    assert "mdf: warning: the radar kind 'lfm' is disabled: claimed by acme-radar 0.0.1 and " in err
-    assert "mdf --disable-plugin NAME" in err
-    assert "radar kind 'lfm'" in out.split("disabled:")[1]
-    assert run_point_target(tmp_path) == 2
+    warned = [line for line in err.splitlines() if "xyzzy" in line]
+    assert len(warned) == 1
+    assert warned[0].startswith(
+        "mdf: warning: plugin 'xyzzy_radar' is disabled: xyzzy-radar 0.0.1: "
+    )
+    assert "its radar kind 'lfm' is built in (mdf-lfm " in warned[0]
+    assert "xyzzy_radar" in out.split("disabled:")[1]
+    assert run_point_target(tmp_path) == 0
+
+
+def test_a_kind_two_third_parties_claim_is_withheld_and_the_rest_works(
+    installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Neither of two third parties' `xyzzy_fx` is chosen for the user: our commands work, a
+    run that asks for it says why in one line, and switching one off settles it."""
+    body = (
+        HEADER + EFFECT + "@hookimpl\ndef mdframework_register_effects():\n    return [XyzzyFx]\n"
+    )
+    _make_distribution(installed, "xyzzy-one", "mdf_test_xyzzy_one", body, "xyzzy_one")
+    _make_distribution(installed, "xyzzy-two", "mdf_test_xyzzy_two", body, "xyzzy_two")
+    out, err = listed(capsys)
+    claimed = "claimed by xyzzy-one 0.0.1 and xyzzy-two 0.0.1"
+    assert f"mdf: warning: the effects kind 'xyzzy_fx' is disabled: {claimed}" in err
+    assert "effects kind 'xyzzy_fx'" in out.split("disabled:")[1]
+    assert run_point_target(tmp_path) == 0
+    config = tmp_path / "fx.toml"
+    config.write_text(
+        'effects = [{ kind = "xyzzy_fx" }]\n' + (EXAMPLES / "point_target.toml").read_text()
+    )
+    capsys.readouterr()
+    assert cli.main(["run", str(config), "--out", str(tmp_path / "fx")]) == 2
     lines = capsys.readouterr().err.strip().splitlines()
-    assert len(lines) == 1, lines
-    assert "radar.kind: no radar plugin named 'lfm'" in lines[0]
-    assert "claimed by acme-radar 0.0.1 and mdf-lfm" in lines[0]
-    assert run_point_target(tmp_path, "--disable-plugin", "acme_radar") == 0
+    assert len(lines) == 1 and "no effects plugin named 'xyzzy_fx'" in lines[0], lines
+    assert claimed in lines[0]
+    assert (
+        cli.main(
+            ["run", str(config), "--out", str(tmp_path / "fx1"), "--disable-plugin", "xyzzy_two"]
+        )
+        == 0
+    )
+
+
+def test_the_built_in_distributions_are_the_plugins_folder() -> None:
+    """The list that keeps our kinds ours names exactly the distributions under plugins/."""
+    from conftest import project_distributions
+
+    from mdframework.plugins import BUILT_IN_DISTRIBUTIONS
+
+    assert project_distributions() == BUILT_IN_DISTRIBUTIONS
 
 
 CLI_FAILS = (
@@ -148,7 +188,7 @@ CLI_FAILS = (
     + """
 @hookimpl
 def mdframework_register_effects():
-    return [AcmeFx]
+    return [XyzzyFx]
 
 @hookimpl
 def mdframework_add_cli_commands(subparsers):
@@ -161,18 +201,18 @@ def test_a_plugin_whose_command_fails_is_switched_off_whole(
     installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """Its failing CLI hook listed it as disabled while its effect stayed installed and ran."""
-    _make_distribution(installed, "acme-cmd", "mdf_test_acme_cmd", CLI_FAILS, "acme_cmd")
+    _make_distribution(installed, "xyzzy-cmd", "mdf_test_xyzzy_cmd", CLI_FAILS, "xyzzy_cmd")
     out, err = listed(capsys)
-    assert "no command today" in err and "acme_cmd" in out.split("disabled:")[1]
-    assert "acme_fx" not in out.split("disabled:")[0]
+    assert "no command today" in err and "xyzzy_cmd" in out.split("disabled:")[1]
+    assert "xyzzy_fx" not in out.split("disabled:")[0]
     config = tmp_path / "fx.toml"
     text = (EXAMPLES / "point_target.toml").read_text()
-    config.write_text('effects = [{ kind = "acme_fx" }]\n' + text)
+    config.write_text('effects = [{ kind = "xyzzy_fx" }]\n' + text)
     code = cli.main(["run", str(config), "--out", str(tmp_path / "o")])
-    assert code == 2 and "no effects plugin named 'acme_fx'" in capsys.readouterr().err
+    assert code == 2 and "no effects plugin named 'xyzzy_fx'" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("returned", ["{AcmeFx}", "(c for c in [AcmeFx])"], ids=["set", "gen"])
+@pytest.mark.parametrize("returned", ["{XyzzyFx}", "(c for c in [XyzzyFx])"], ids=["set", "gen"])
 def test_any_collection_of_classes_registers(
     returned: str, installed: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -181,9 +221,9 @@ def test_any_collection_of_classes_registers(
     body = (
         HEADER + EFFECT + f"@hookimpl\ndef mdframework_register_effects():\n    return {returned}\n"
     )
-    _make_distribution(installed, "acme-fx", "mdf_test_acme", body, "acme_fx")
+    _make_distribution(installed, "xyzzy-fx", "mdf_test_xyzzy", body, "xyzzy_fx")
     out, err = listed(capsys)
-    assert "acme" not in err and "acme_fx" in out and "disabled:" not in out
+    assert "xyzzy" not in err and "xyzzy_fx" in out.split("disabled:")[0]
 
 
 def test_one_class_under_the_old_and_the_new_hook_name_is_one_plugin(
@@ -197,26 +237,26 @@ def test_one_class_under_the_old_and_the_new_hook_name_is_one_plugin(
         + '''
 from mdf_lfm.waveform import LfmConfig, LfmPulseDoppler
 
-class AcmeConfig(LfmConfig):
-    kind: Literal["acme_lfm"] = "acme_lfm"
+class XyzzyConfig(LfmConfig):
+    kind: Literal["xyzzy_lfm"] = "xyzzy_lfm"
 
-class AcmeLfm(LfmPulseDoppler):
+class XyzzyLfm(LfmPulseDoppler):
     """Our radar, for old and new mdframework."""
-    name = "acme_lfm"
-    Config = AcmeConfig
+    name = "xyzzy_lfm"
+    Config = XyzzyConfig
 
 @hookimpl
 def mdframework_register_radar_waveforms():
-    return [AcmeLfm]
+    return [XyzzyLfm]
 
 @hookimpl
 def mdframework_register_waveforms():
-    return [AcmeLfm]
+    return [XyzzyLfm]
 '''
     )
-    _make_distribution(installed, "acme-lfm", "mdf_test_acme_lfm", body, "acme_lfm")
+    _make_distribution(installed, "xyzzy-lfm", "mdf_test_xyzzy_lfm", body, "xyzzy_lfm")
     out, err = listed(capsys)
-    assert "acme" not in err and "acme_lfm" in out and "disabled:" not in out
+    assert "xyzzy" not in err and "xyzzy_lfm" in out.split("disabled:")[0]
 
 
 def test_the_commands_of_a_failing_command_hook_are_taken_off(
@@ -229,17 +269,17 @@ def test_the_commands_of_a_failing_command_hook_are_taken_off(
         + """
 @hookimpl
 def mdframework_add_cli_commands(subparsers):
-    sub = subparsers.add_parser("acme", help="an acme command")
+    sub = subparsers.add_parser("xyzzy", help="an xyzzy command")
     sub.set_defaults(func=lambda args: 0)
     raise RuntimeError("half a command")
 """
     )
-    _make_distribution(installed, "acme-half", "mdf_test_acme_half", body, "acme_half")
-    assert cli.main(["acme"]) == 2
+    _make_distribution(installed, "xyzzy-half", "mdf_test_xyzzy_half", body, "xyzzy_half")
+    assert cli.main(["xyzzy"]) == 2
     err = capsys.readouterr().err
-    assert "half a command" in err and "invalid choice: 'acme'" in err
+    assert "half a command" in err and "invalid choice: 'xyzzy'" in err
     with pytest.raises(SystemExit) as done:
         cli.main(["--help"])
     assert done.value.code == 0
     help_text = capsys.readouterr().out
-    assert "plugins" in help_text and "acme" not in help_text
+    assert "plugins" in help_text and "xyzzy" not in help_text

@@ -61,6 +61,17 @@ from .interfaces import (
     ScattererModel,
 )
 
+#: the distributions of the built-in plugins (``plugins/`` of this repository): a kind one of
+#: them registers stays theirs when a third party's plugin claims it too (that plugin is
+#: switched off)
+BUILT_IN_DISTRIBUTIONS = frozenset(
+    {
+        *("mdf-antenna", "mdf-attenuation", "mdf-c3d", "mdf-clutter", "mdf-cmu", "mdf-cw"),
+        *("mdf-deepmimic", "mdf-ellipsoid", "mdf-fmcw", "mdf-kinect", "mdf-knn", "mdf-lfm"),
+        *("mdf-mujoco", "mdf-multipath", "mdf-noise", "mdf-point-targets", "mdf-radhar"),
+        *("mdf-sklearn", "mdf-static-scene", "mdf-table"),
+    }
+)
 DISABLE_ENV = "MDFRAMEWORK_DISABLE_PLUGIN_AUTOLOAD"
 DISABLE_PLUGINS_ENV = "MDFRAMEWORK_DISABLE_PLUGINS"
 
@@ -367,6 +378,25 @@ def _collect(pm: pluggy.PluginManager) -> Registry:
                     _warn_disabled(pm, pm.get_name(plugin) or provider, f"{provider}: {problem}")
                     continue
                 entries.append((interface, cls.name, plugin, provider, cls))
+    # a kind of ours stays ours: a third party's plugin that claims one is switched off whole
+    built_in = {
+        (interface, name): (cls, provider)
+        for interface, name, plugin, provider, cls in entries
+        if plugin not in broken and provider.split()[0] in BUILT_IN_DISTRIBUTIONS
+    }
+    for interface, name, plugin, provider, cls in entries:
+        ours = built_in.get((interface, name))
+        if plugin in broken or ours is None or ours[0] is cls:
+            continue
+        if provider.split()[0] in BUILT_IN_DISTRIBUTIONS:
+            continue  # two of ours: a kind claimed twice (below)
+        broken.add(plugin)
+        _warn_disabled(
+            pm,
+            pm.get_name(plugin) or provider,
+            f"{provider}: its {interface} kind {name!r} is built in ({ours[1]}); give its class "
+            "another name",
+        )
     for plugin in broken:
         if pm.is_registered(plugin):
             pm.unregister(plugin)  # its other hooks (e.g. CLI commands) go with it
