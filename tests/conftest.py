@@ -70,6 +70,7 @@ LONG_UNITS = (
     "test_outputs.py",
     "test_cli.py",
     "test_docs.py",
+    "test_docs_numbers.py",
 )
 
 

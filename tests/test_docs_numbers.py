@@ -1,0 +1,107 @@
+"""Numbers the docs quote, against the scripts and experiments that make them (each runs a
+simulation or an experiment: a unit of its own for the parallel test run)."""
+
+from __future__ import annotations
+
+import importlib.util
+import re
+import types
+from pathlib import Path
+
+from conftest import EXAMPLES, ROOT
+
+
+def _script(name: str) -> types.ModuleType:
+    """One of the docs' scripts (docs/NAME.py), imported."""
+    spec = importlib.util.spec_from_file_location(name, ROOT / "docs" / f"{name}.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_reproduction_page_quotes_the_held_out_recordings_experiment(tmp_path: Path) -> None:
+    """The page's accuracy with whole CMU recordings held out is what the script that the page
+    names measures (the page once quoted a number no config reproduced)."""
+    report = _script("make_reproduction_figures").held_out_recordings(tmp_path)
+    measured = re.search(r"Balanced accuracy ([\d.]+) \(std ([\d.]+) over 10 splits;", report)
+    page = " ".join((ROOT / "docs" / "reproducing-erol-gurbuz-2015.md").read_text().split())
+    quoted = re.search(r"subjects\) then still reach ([\d.]+) ± ([\d.]+) over 10 splits", page)
+    assert measured is not None and quoted is not None
+    assert quoted.groups() == measured.groups()
+    recalls = re.findall(r"(walk|run|boxing) (0\.\d\d)[,;]", page.split("over 10 splits")[1][:80])
+    assert len(recalls) == 3
+    for cls, recall in recalls:
+        row = re.search(rf"^\| {cls} \|(.*)$", report, flags=re.M)
+        assert row is not None
+        cells = [c.strip() for c in row.group(1).split("|") if c.strip()]
+        order = ["boxing", "run", "walk"]
+        assert cells[order.index(cls)].startswith(recall), (cls, cells)
+
+
+def test_the_validation_page_table_is_what_its_script_computes() -> None:
+    """docs/validation.md's feature table, row by row, against make_validation_figures.py's
+    runs (a hand-copied cell had drifted by 0.001)."""
+    from mdframework.features import FEATURE_NAMES
+
+    script = _script("make_validation_figures")
+    page = (ROOT / "docs" / "validation.md").read_text()
+    runs = {
+        "Boulic (corrected)": lambda: script.boulic(False),
+        "Boulic (chen_compatible)": lambda: script.boulic(True),
+        "CMU 02_01 walk": script.cmu,
+        "Kinect UTKinect walk": script.kinect,
+    }
+    for name, run in runs.items():
+        row = re.search(rf"^\| {re.escape(name)} \|(.*)\|$", page, flags=re.M)
+        assert row is not None, name
+        quoted = [float(c) for c in row.group(1).split("|")]
+        f = script.features(run())
+        computed = [f[k] for k in FEATURE_NAMES]
+        assert max(abs(q - c) for q, c in zip(quoted, computed, strict=True)) <= 5.0001e-4, name
+
+
+def _half_unit(number: str) -> float:
+    """Half a unit of the last digit a number is written with (``-0.762`` -> 0.0005)."""
+    decimals = len(number.split(".")[1]) if "." in number else 0
+    return 0.5 * 10.0**-decimals
+
+
+def test_the_reproduction_page_feature_table_is_the_cross_source_experiments(
+    tmp_path: Path,
+) -> None:
+    """The page's Table 2 of our data, cell by cell (mean and variance), against the
+    feature_stats.csv that `mdf experiment examples/experiment_cross_source.toml` writes, each
+    within the page's rounding (hand-copied cells had drifted by up to 0.0008)."""
+    import csv
+
+    from mdframework import cli
+
+    out = tmp_path / "x"
+    args = ["experiment", str(EXAMPLES / "experiment_cross_source.toml"), "--out", str(out)]
+    assert cli.main([*args, "--no-progress"]) == 0
+    with (out / "feature_stats.csv").open() as fh:
+        stats = {(r["label"], r["group"]): r for r in csv.DictReader(fh)}
+    page = (ROOT / "docs" / "reproducing-erol-gurbuz-2015.md").read_text().splitlines()
+    first = page.index(next(line for line in page if line.startswith("| feature [m/s] | walk K")))
+    header = [c.strip() for c in page[first].split("|")[2:-1]]
+    columns = [re.fullmatch(r"(\w+) (\w+) \(n=(\d+)\)", c) for c in header]
+    checked = 0
+    for line in page[first + 2 : first + 9]:
+        feature, *cells = [c.strip() for c in line.split("|")[1:-1]]
+        for column, text in zip(columns, cells, strict=True):
+            assert column is not None
+            row = stats[(column.group(1), column.group(2).lower())]
+            assert row["n"] == column.group(3)
+            m = re.fullmatch(r"(-?[\d.]+) \(([\d.]+)\)", text)
+            assert m is not None, text
+            for shown, key in zip(m.groups(), ("mean", "var"), strict=True):
+                exact = float(row[f"{feature}_{key}"])
+                assert abs(float(shown) - exact) <= _half_unit(shown) + 1e-12, (
+                    feature,
+                    column.group(0),
+                    shown,
+                    exact,
+                )
+                checked += 1
+    assert checked == 84
