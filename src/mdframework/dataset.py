@@ -572,7 +572,7 @@ def _spec(
 ) -> RecordSpec:
     """A record's spec; its id ends with a digest of everything that makes the record.
     ``meta``: the record's subject, recording and dataset; ``span``: the source's span when
-    it gives a duration (:attr:`RecordSpec.span`)."""
+    it gives a start or a duration (:attr:`RecordSpec.span`)."""
     features = config.features.model_dump()
     payload = [run, features] + [x for x in (draws, hist) if x is not None]
     # where the span ends moves a sped-up or warped record (its start only refuses one)
@@ -732,6 +732,23 @@ def _as_written(
     return ConfigError(f"{record}: {where}{field}: {problem}")
 
 
+def _validate_planned(
+    run: dict[str, Any],
+    record: str,
+    draws: dict[str, Any] | None,
+    origins: dict[str, str],
+    entry_no: int,
+    plan: tuple[DatasetConfig, Path],
+) -> RunConfigBase:
+    """A planned record's run config, validated (:func:`validate_record`); an error names the
+    field where the dataset config (``plan``: it and its folder) wrote it (:func:`_as_written`)."""
+    config, base_dir = plan
+    try:
+        return validate_record(run, record, base_dir, draws, origins)
+    except ConfigError as exc:
+        raise _as_written(exc, record, config, entry_no, config.sources[entry_no]) from None
+
+
 def _randomize(config: DatasetConfig, entry: SourceEntry) -> Randomization:
     """The draws of one source: the dataset's, with the fields the source gives replaced."""
     if entry.randomize is None:
@@ -766,6 +783,7 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
         _preload_motions(config, base_dir, workers)
     specs: list[RecordSpec] = []
     short: list[str] = []
+    plan = (config, base_dir)
     for entry_no, entry in enumerate(config.sources):
         if entry.recording is not None:
             specs += _plan_recordings(config, entry_no, entry, base_dir, len(specs))
@@ -807,6 +825,7 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
         hop = entry.hop or length
         rz = _randomize(config, entry)
         origins = _draw_origins(config, entry_no, entry)
+
         n_windows = int(np.ceil((duration - length + 1e-9) / hop))
         if entry.max_records is not None:
             n_windows = min(n_windows, entry.max_records)
@@ -844,10 +863,7 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                     _apply_draws(run, section, draws, f"sources[{entry_no}]")
                 asked = None
                 if config.place == "record":  # after the draws: it fixes the drawn aspect
-                    try:
-                        placing = validate_record(run, record, base_dir, draws, origins)
-                    except ConfigError as exc:
-                        raise _as_written(exc, record, config, entry_no, entry) from None
+                    placing = _validate_planned(run, record, draws, origins, entry_no, plan)
                     run["scene"] = _place_record(run, placing, loaded)
                     asked = placing.scene.person.aspect_deg
                 run["seed"] = _record_seed(config.seed, index)
@@ -870,10 +886,7 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                 # every record's run config is valid before any file is written (with
                 # on_error = "skip" an invalid record is skipped by the build instead)
                 if config.on_error == "stop":
-                    try:
-                        validate_record(run, record, base_dir, draws, origins)
-                    except ConfigError as exc:
-                        raise _as_written(exc, record, config, entry_no, entry) from None
+                    _validate_planned(run, record, draws, origins, entry_no, plan)
     if not specs:
         raise ConfigError(
             f"no records: every source is shorter than its record length ({', '.join(short)})"

@@ -316,29 +316,20 @@ def _hook_classes(
         name = pm.get_name(impl.plugin) or provider
         try:
             classes = impl.function()
-        except Exception as exc:
+            # a list, or any other collection of classes (a set, a generator), but not one
+            # class or text, whose items are no classes
+            if isinstance(classes, str | bytes | type) or not isinstance(classes, Iterable | None):
+                problem = f"{hook_name} returned {classes!r}, not a list of classes"
+            else:
+                found, problem = list(classes or []), ""
+        except Exception as exc:  # in the hook, or in a generator it returned
             _reraise_interrupt(exc)
-            _warn_disabled(pm, name, f"{provider}: {hook_name} raised {type(exc).__name__}: {exc}")
+            problem = f"{hook_name} raised {type(exc).__name__}: {exc}"
+        if problem:
+            _warn_disabled(pm, name, f"{provider}: {problem}")
             yield impl.plugin, provider, None
-            continue
-        # a list, or any other collection of classes (a set, a generator), but not one class
-        # or text, whose items are no classes
-        if classes is not None and (
-            isinstance(classes, str | bytes | type) or not isinstance(classes, Iterable)
-        ):
-            _warn_disabled(
-                pm, name, f"{provider}: {hook_name} returned {classes!r}, not a list of classes"
-            )
-            yield impl.plugin, provider, None
-            continue
-        try:
-            found = list(classes or [])
-        except Exception as exc:  # a generator that raises
-            _reraise_interrupt(exc)
-            _warn_disabled(pm, name, f"{provider}: {hook_name} raised {type(exc).__name__}: {exc}")
-            yield impl.plugin, provider, None
-            continue
-        yield impl.plugin, provider, found
+        else:
+            yield impl.plugin, provider, found
 
 
 def _class_problem(cls: Any, base: type[Plugin], hook_name: str) -> str:
