@@ -82,3 +82,25 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
         return next((i for i, u in enumerate(LONG_UNITS) if u in item.nodeid), len(LONG_UNITS))
 
     items.sort(key=rank)
+
+
+@pytest.fixture
+def clean_modules() -> object:
+    """Forget the modules a test imported from the distributions it made (``mdf_test*``)."""
+    import sys
+
+    before = set(sys.modules)
+    yield None
+    for name in set(sys.modules) - before:
+        if name.startswith("mdf_test"):
+            del sys.modules[name]
+
+
+@pytest.fixture
+def fresh_default_registry() -> object:
+    """Rebuild the process's default registry around a test (which changes the environment)."""
+    from mdframework.plugins import reset_default_registry
+
+    reset_default_registry()
+    yield None
+    reset_default_registry()

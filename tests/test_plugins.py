@@ -22,7 +22,6 @@ from mdframework.plugins import (
     PluginWarning,
     build_registry,
     default_registry,
-    reset_default_registry,
 )
 
 
@@ -64,15 +63,6 @@ THIRD_PARTY = """
     def mdframework_register_motion_sources():
         return [StillPoint]
 """
-
-
-@pytest.fixture
-def clean_modules() -> object:
-    before = set(sys.modules)
-    yield None
-    for name in set(sys.modules) - before:
-        if name.startswith("mdf_test"):
-            del sys.modules[name]
 
 
 def test_builtin_plugins_come_from_their_distributions() -> None:
@@ -124,14 +114,6 @@ def test_documented_example_distribution_runs(
     dv = res.velocity[1] - res.velocity[0]
     assert v.max() == pytest.approx(np.pi, abs=0.1 + dv)
     assert v.min() == pytest.approx(-np.pi, abs=0.1 + dv)
-
-
-@pytest.fixture
-def fresh_default_registry() -> object:
-    """Rebuild the process's default registry around a test (which changes the environment)."""
-    reset_default_registry()
-    yield None
-    reset_default_registry()
 
 
 BROKEN = {

@@ -4,8 +4,6 @@ unusable is switched off with one warning, and the rest of mdf works."""
 
 from __future__ import annotations
 
-import sys
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -13,7 +11,7 @@ from conftest import EXAMPLES
 from test_plugins import _make_distribution
 
 from mdframework import cli
-from mdframework.plugins import DISABLE_PLUGINS_ENV, reset_default_registry
+from mdframework.plugins import DISABLE_PLUGINS_ENV
 
 HEADER = """
 from typing import Literal
@@ -34,49 +32,54 @@ class XyzzyFx(Effect):
         return data
 '''
 
+
+def registering(returned: str) -> str:
+    """Source of a hook that registers effects by returning the expression ``returned``."""
+    return f"@hookimpl\ndef mdframework_register_effects():\n    return {returned}\n"
+
+
 #: how a plugin can be unusable, and what the warning says
 BROKEN = {
     "one class, not a list": (
-        EFFECT + "@hookimpl\ndef mdframework_register_effects():\n    return XyzzyFx\n",
+        EFFECT + registering("XyzzyFx"),
         "returned <class 'mdf_test_xyzzy.XyzzyFx'>, not a list of classes",
     ),
     "a number": (
-        "@hookimpl\ndef mdframework_register_effects():\n    return 42\n",
+        registering("42"),
         "returned 42, not a list of classes",
     ),
     "no Config": (
-        EFFECT.replace("    Config = XyzzyConfig\n", "")
-        + "@hookimpl\ndef mdframework_register_effects():\n    return [XyzzyFx]\n",
+        EFFECT.replace("    Config = XyzzyConfig\n", "") + registering("[XyzzyFx]"),
         "XyzzyFx.Config is not a subclass of mdframework.PluginConfig",
     ),
     "kind as text": (
         EFFECT.replace('Literal["xyzzy_fx"] = "xyzzy_fx"', 'str = "xyzzy_fx"')
-        + "@hookimpl\ndef mdframework_register_effects():\n    return [XyzzyFx]\n",
+        + registering("[XyzzyFx]"),
         "XyzzyFx.Config needs kind: Literal['xyzzy_fx'] = 'xyzzy_fx'",
     ),
     "kind of another plugin": (
         EFFECT.replace('Literal["xyzzy_fx"] = "xyzzy_fx"', 'Literal["noise"] = "noise"')
-        + "@hookimpl\ndef mdframework_register_effects():\n    return [XyzzyFx]\n",
+        + registering("[XyzzyFx]"),
         "XyzzyFx.Config needs kind: Literal['xyzzy_fx']",
     ),
 }
 
 
 @pytest.fixture
-def installed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
+def installed(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    clean_modules: object,
+    fresh_default_registry: object,
+) -> Path:
     """A folder on sys.path to install distributions into; the registry is rebuilt before and
-    after, and the test's modules are forgotten."""
-    before = set(sys.modules)
+    after (``fresh_default_registry``), and the test's modules are forgotten
+    (``clean_modules``)."""
     root = tmp_path / "site"
     root.mkdir()
     monkeypatch.syspath_prepend(str(root))
     monkeypatch.delenv(DISABLE_PLUGINS_ENV, raising=False)
-    reset_default_registry()
-    yield root
-    reset_default_registry()
-    for name in set(sys.modules) - before:
-        if name.startswith("mdf_test"):
-            del sys.modules[name]
+    return root
 
 
 def listed(capsys: pytest.CaptureFixture[str]) -> tuple[str, str]:
@@ -146,9 +149,7 @@ def test_a_kind_two_third_parties_claim_is_withheld_and_the_rest_works(
 ) -> None:
     """Neither of two third parties' `xyzzy_fx` is chosen for the user: our commands work, a
     run that asks for it says why in one line, and switching one off settles it."""
-    body = (
-        HEADER + EFFECT + "@hookimpl\ndef mdframework_register_effects():\n    return [XyzzyFx]\n"
-    )
+    body = HEADER + EFFECT + registering("[XyzzyFx]")
     _make_distribution(installed, "xyzzy-one", "mdf_test_xyzzy_one", body, "xyzzy_one")
     _make_distribution(installed, "xyzzy-two", "mdf_test_xyzzy_two", body, "xyzzy_two")
     out, err = listed(capsys)
@@ -185,11 +186,8 @@ def test_the_built_in_distributions_are_the_plugins_folder() -> None:
 CLI_FAILS = (
     HEADER
     + EFFECT
+    + registering("[XyzzyFx]")
     + """
-@hookimpl
-def mdframework_register_effects():
-    return [XyzzyFx]
-
 @hookimpl
 def mdframework_add_cli_commands(subparsers):
     raise RuntimeError("no command today")
@@ -218,9 +216,7 @@ def test_any_collection_of_classes_registers(
 ) -> None:
     """A set or a generator of classes worked before the check for a returned single class,
     and still does."""
-    body = (
-        HEADER + EFFECT + f"@hookimpl\ndef mdframework_register_effects():\n    return {returned}\n"
-    )
+    body = HEADER + EFFECT + registering(returned)
     _make_distribution(installed, "xyzzy-fx", "mdf_test_xyzzy", body, "xyzzy_fx")
     out, err = listed(capsys)
     assert "xyzzy" not in err and "xyzzy_fx" in out.split("disabled:")[0]

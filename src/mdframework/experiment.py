@@ -447,6 +447,15 @@ def _not_testable(
     return out
 
 
+def _too_few_classes(untested: dict[str, str]) -> MdfError:
+    """The error of a source in which fewer than two classes can be scored (``untested``:
+    class -> why not)."""
+    return MdfError(
+        "fewer than two classes can be evaluated: "
+        + "; ".join(f"{c}: {why}" for c, why in untested.items())
+    )
+
+
 def within_source(
     cfg: ExperimentConfig,
     factory: Callable[[], Classifier],
@@ -496,10 +505,7 @@ def within_source(
     else:
         splits = _record_splits(ev, x, y, cfg.seed)
     if len(classes) - len(untested) < 2:
-        raise MdfError(
-            "fewer than two classes can be evaluated: "
-            + "; ".join(f"{c}: {why}" for c, why in untested.items())
-        )
+        raise _too_few_classes(untested)
     mats, optimistic, subsets, tested = [], [], [], []
     from tqdm import tqdm
 
@@ -535,10 +541,7 @@ def within_source(
                 + ("; raise evaluation.folds" if ev.split == "groups" else "")
             )
     if int(rows.sum()) < 2:
-        raise MdfError(
-            "fewer than two classes can be evaluated: "
-            + "; ".join(f"{c}: {why}" for c, why in untested.items())
-        )
+        raise _too_few_classes(untested)
     mean = np.full(stack.shape[1:], np.nan)
     std = np.full(stack.shape[1:], np.nan)
     mean[rows] = np.nanmean(stack[:, rows], axis=0)
