@@ -279,3 +279,30 @@ def mdframework_add_cli_commands(subparsers):
     assert done.value.code == 0
     help_text = capsys.readouterr().out
     assert "plugins" in help_text and "xyzzy" not in help_text
+
+
+def test_the_project_registry_loads_only_this_trees_plugins(
+    installed: Path, recwarn: pytest.WarningsRecorder
+) -> None:
+    """The reference pages and the contract tests document and check our plugins whatever
+    else is installed: a third party's plugin, usable or not, is not even imported."""
+    import sys
+
+    from conftest import project_distributions
+
+    from mdframework.docgen import project_registry
+
+    body, _ = BROKEN["one class, not a list"]
+    _make_distribution(installed, "xyzzy-fx", "mdf_test_xyzzy", HEADER + body, "xyzzy_fx")
+    good = HEADER + EFFECT.replace("xyzzy_fx", "xyzzy_ok") + registering("[XyzzyFx]")
+    _make_distribution(installed, "xyzzy-ok", "mdf_test_xyzzy_ok", good, "xyzzy_ok")
+    project_registry.cache_clear()
+    try:
+        reg = project_registry()
+    finally:
+        project_registry.cache_clear()
+    providers = {i.provider.split()[0] for infos in reg.plugins.values() for i in infos.values()}
+    assert providers == project_distributions()
+    assert "noise" in reg.names("effects") and "xyzzy_ok" not in reg.names("effects")
+    assert not {"mdf_test_xyzzy", "mdf_test_xyzzy_ok"} & set(sys.modules)
+    assert not [w for w in recwarn if "xyzzy" in str(w.message)]

@@ -240,11 +240,9 @@ def project_registry() -> Registry:
     of our kinds, changes nothing here)."""
     import importlib.metadata
     import importlib.util
-    import os
     from pathlib import Path
 
-    from . import hookspecs
-    from .plugins import DISABLE_PLUGINS_ENV, build_registry
+    from .plugins import build_registry
 
     root = Path(__file__).resolve().parents[2] / "plugins"
 
@@ -253,21 +251,7 @@ def project_registry() -> Registry:
         where = spec.origin if spec is not None else None
         return where is not None and root in Path(where).resolve().parents
 
-    others = {ep.name for ep in importlib.metadata.entry_points(group=hookspecs.PROJECT)}
-    others -= {
-        ep.name for ep in importlib.metadata.entry_points(group=hookspecs.PROJECT) if ours(ep)
-    }
-    before = os.environ.get(DISABLE_PLUGINS_ENV)
-    os.environ[DISABLE_PLUGINS_ENV] = ",".join(sorted(others))
-    try:
-        reg = build_registry(autoload=True)
-    finally:
-        if before is None:
-            del os.environ[DISABLE_PLUGINS_ENV]
-        else:
-            os.environ[DISABLE_PLUGINS_ENV] = before
-    own = {info.provider.split()[0] for infos in reg.plugins.values() for info in infos.values()}
-    return reg.provided_by(own)
+    return build_registry(autoload=True, select=ours)
 
 
 if __name__ == "__main__":

@@ -41,7 +41,7 @@ import importlib.metadata
 import os
 import typing
 import warnings
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from functools import cache
 from typing import Any, Literal, NamedTuple
@@ -274,10 +274,14 @@ def _unknown_hooks(plugin: object) -> list[str]:
     return bad
 
 
-def _load_entry_points(pm: pluggy.PluginManager) -> None:
+def _load_entry_points(
+    pm: pluggy.PluginManager, select: Callable[[importlib.metadata.EntryPoint], bool] | None
+) -> None:
     off = disabled_by_user()
     for ep in _entry_points():
         if pm.get_plugin(ep.name) is not None or pm.is_blocked(ep.name):
+            continue
+        if select is not None and not select(ep):
             continue
         dist_name = ep.dist.name if ep.dist else ep.name
         dist = f"{dist_name} {ep.dist.version}" if ep.dist else ep.name
@@ -414,11 +418,15 @@ def _collect(pm: pluggy.PluginManager) -> Registry:
 
 
 def make_plugin_manager(
-    modules: Iterable[Any] = (), *, autoload: bool | None = None
+    modules: Iterable[Any] = (),
+    *,
+    autoload: bool | None = None,
+    select: Callable[[importlib.metadata.EntryPoint], bool] | None = None,
 ) -> pluggy.PluginManager:
     """A plugin manager with the hookspecs, the given plugin modules and (unless disabled) every
-    ``mdframework`` entry point. The given modules must be valid (an unknown hook raises);
-    an entry point that fails to load is disabled with one :class:`PluginWarning`."""
+    ``mdframework`` entry point, or those for which ``select`` is true. The given modules must be
+    valid (an unknown hook raises); an entry point that fails to load is disabled with one
+    :class:`PluginWarning`."""
     pm = pluggy.PluginManager(hookspecs.PROJECT)
     pm.add_hookspecs(hookspecs)
     for module in modules:
@@ -426,7 +434,7 @@ def make_plugin_manager(
     if autoload is None:
         autoload = autoload_enabled()
     if autoload:
-        _load_entry_points(pm)
+        _load_entry_points(pm, select)
     else:
         for ep in _entry_points():
             _disabled(pm)[ep.name] = f"plugin autoloading is off: {DISABLE_ENV}=1"
@@ -434,9 +442,14 @@ def make_plugin_manager(
     return pm
 
 
-def build_registry(modules: Iterable[Any] = (), *, autoload: bool | None = None) -> Registry:
+def build_registry(
+    modules: Iterable[Any] = (),
+    *,
+    autoload: bool | None = None,
+    select: Callable[[importlib.metadata.EntryPoint], bool] | None = None,
+) -> Registry:
     """Load plugins and build the registry (see :func:`make_plugin_manager`)."""
-    return _collect(make_plugin_manager(modules, autoload=autoload))
+    return _collect(make_plugin_manager(modules, autoload=autoload, select=select))
 
 
 @cache
