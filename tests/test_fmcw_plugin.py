@@ -617,3 +617,39 @@ def test_the_input_rules_page_states_the_radar_bounds_and_messages_of_the_code()
         fmcw_run([{"position": [12.0, 0.0, 0.0], "rcs": 1.0}], duration=0.2, **QUIET)
     text = str(scene_err.value).split(": raise")[0]
     assert text in page, text
+
+
+def test_a_record_shorter_than_one_frame_is_refused_naming_duration_and_minimum(
+    tmp_path: Any, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The IWR1443 preset's frame is 48 chirps of 64.14 us, 3.079 ms: a 3 ms record holds no
+    frame. `mdf run` and `mdf check` both stop with one line naming motion.duration and the
+    minimum (exit 2, not an IndexError); a record of one frame's chirps runs."""
+    from mdframework import cli
+
+    need = IWR1443.sequence().frame_active_time
+    assert need == pytest.approx(48 * 64.14e-6, rel=1e-4)
+    target = "{ position = [2.0, 0.0, 0.0], velocity = [0.0, 0.0, 0.0], rcs = 1.0 }"
+    text = (
+        '[motion]\nkind = "point_targets"\nlength = 0.1\nduration = DURATION\n'
+        f"targets = [{target}]\n"
+        '[scatterers]\nkind = "points"\n'
+        '[radar]\nkind = "fmcw"\npreset = "iwr1443_short_range_3d"\n'
+        "[scene]\nradar_position = [0.0, 0.0, 0.0]\n"
+    )
+    short = tmp_path / "short.toml"
+    short.write_text(text.replace("DURATION", "0.003"))
+    line = (
+        "motion.duration: the 3.000 ms record holds no pulse of the fmcw radar, whose pulses "
+        "need a record of at least 3.079 ms: lengthen motion.duration"
+    )
+    for command in (["run", str(short), "--out", str(tmp_path / "out")], ["check", str(short)]):
+        assert cli.main(command) == 2
+        err = capsys.readouterr().err
+        assert err.strip() == f"mdf: error: {short}: {line}"
+    assert not (tmp_path / "out").exists()
+    one = tmp_path / "one.toml"
+    one.write_text(text.replace("DURATION", f"{need + 1e-6:.7f}"))
+    assert cli.main(["run", str(one), "--out", str(tmp_path / "one"), "--no-figures"]) == 0
+    with np.load(tmp_path / "one" / "result.npz") as d:
+        assert d["signal"].shape == (48,)

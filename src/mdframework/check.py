@@ -23,7 +23,15 @@ import numpy as np
 from . import limits
 from .errors import SceneError
 from .physics import radar
-from .pipeline import _place, _window, build_stages, load_motion, placed, refuse_near
+from .pipeline import (
+    _place,
+    _window,
+    build_stages,
+    load_motion,
+    placed,
+    record_pulses,
+    refuse_near,
+)
 from .plugins import Registry, default_registry
 from .settings import RunConfigBase
 
@@ -121,7 +129,7 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
     limits.check_pulses(
         t_end - t_start, wf.pulse_rate, body.n_joints, "motion.duration", proc.keep_scatterers
     )
-    n_pulses = int(wf.pulse_times(t_start, t_end).shape[0])
+    n_pulses = int(record_pulses(wf, t_start, t_end).shape[0])
     if n_pulses < proc.window_length:
         raise SceneError(
             f"processing.window_length: the record has {n_pulses} pulses "

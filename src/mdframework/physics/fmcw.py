@@ -109,6 +109,12 @@ class ChirpSequence:
         return self.n_loops * self.n_tx
 
     @property
+    def frame_active_time(self) -> float:
+        """From a frame's start to the end of its last ramp [s]: ``chirps_per_frame T_chirp``
+        (the shortest span :func:`chirp_times` finds a frame in)."""
+        return self.chirps_per_frame * self.chirp_period
+
+    @property
     def sampled_bandwidth(self) -> float:
         """Bandwidth swept while the ADC samples [Hz]: ``S N / fs``."""
         return self.slope * self.n_samples / self.sample_rate
@@ -166,7 +172,7 @@ class ChirpSequence:
                 f"{self.ramp_end_time * 1e6:.3f} us: lengthen the ramp, raise sample_rate or "
                 "take fewer samples"
             )
-        busy = self.chirps_per_frame * self.chirp_period
+        busy = self.frame_active_time
         if busy > self.frame_period * (1 + 1e-9):
             out.append(
                 f"frame_period: {self.chirps_per_frame} chirps of "

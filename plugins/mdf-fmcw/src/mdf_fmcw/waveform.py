@@ -366,6 +366,12 @@ class FmcwRadar(RadarWaveform):
         """Chirps per second over whole frames [Hz] (the pulse budget counts chirps)."""
         return self.sequence.chirps_per_frame / self.sequence.frame_period
 
+    @property
+    def shortest_record(self) -> float:
+        """One frame's chirps, ``chirps_per_frame (idle_time + ramp_end_time)`` [s]: a record
+        holds whole frames only."""
+        return self.sequence.frame_active_time
+
     def start_record(self, times: FloatArray, range_span: tuple[float, float]) -> None:
         """Stop before any block when the body's farthest joint is beyond the maximum range,
         or when the record's range-Doppler maps would not fit the product limit."""
