@@ -653,3 +653,21 @@ def test_a_record_shorter_than_one_frame_is_refused_naming_duration_and_minimum(
     assert cli.main(["run", str(one), "--out", str(tmp_path / "one"), "--no-figures"]) == 0
     with np.load(tmp_path / "one" / "result.npz") as d:
         assert d["signal"].shape == (48,)
+
+
+def test_one_loop_per_frame_gives_finite_points_at_zero_velocity() -> None:
+    """n_loops = 1 with the preset's Hann Doppler window (was 0/0: a one-sample periodic Hann
+    is [0]): a static 1 m^2 point 3 m ahead, 20 deg to the right, gives in every frame a
+    strongest point there with v = 0 (the only Doppler bin) and a finite intensity."""
+    az = np.deg2rad(20.0)
+    pos = [3 * np.cos(az), -3 * np.sin(az), 0.0]  # sensor right = scene -y
+    res = fmcw_run([{"position": pos, "velocity": [0.0, 0.0, 0.0], "rcs": 1.0}], 0.2, n_loops=1)
+    pts = res.received.products["points"]
+    assert np.all(np.isfinite(pts))
+    assert res.received.products["range_doppler"].shape[1] == 1
+    for f in range(6):  # 0.2 s of 33.3 ms frames
+        p = pts[pts[:, 0] == f]
+        best = p[np.argmax(p[:, 6])]
+        assert np.linalg.norm(best[2:5]) == pytest.approx(3.0, abs=0.0436)
+        assert best[2] / 3.0 == pytest.approx(np.sin(az), abs=0.05)
+        assert best[5] == 0.0 and best[6] > 15.0

@@ -214,7 +214,13 @@ def beat_frequency(ranges: FloatArray | float, slope: float) -> FloatArray:
 
 
 def window(name: WindowName, n: int) -> FloatArray:
-    """Periodic cosine-sum window ``w_m = sum_c (-1)^c a_c cos(2 pi c m / n)``, (n,)."""
+    """Periodic cosine-sum window ``w_m = sum_c (-1)^c a_c cos(2 pi c m / n)``, (n,).
+
+    A one-sample window is ``[1]`` whatever its name (as scipy's and the STFT's): the formula
+    would give a periodic Hann ``[0]``, which would null the only sample (``n_loops = 1``: the
+    Doppler FFT of one loop is the identity)."""
+    if n == 1:
+        return np.ones(1, dtype=np.float64)
     m = np.arange(n, dtype=np.float64)
     w = np.zeros(n, dtype=np.float64)
     for c, a in enumerate(WINDOWS[name]):
@@ -241,6 +247,8 @@ def window_transform(name: WindowName, n: int, nu: FloatArray) -> ComplexArray:
     """``W(nu) = sum_m w_m exp(j 2 pi m nu)`` of :func:`window` in closed form: a sum of shifted
     Dirichlet kernels (any shape of ``nu`` [cycles per sample])."""
     nu = np.asarray(nu, dtype=np.float64)
+    if n == 1:  # the one-sample window is [1] (:func:`window`)
+        return np.ones(nu.shape, dtype=np.complex128)
     out = np.zeros(nu.shape, dtype=np.complex128)
     for c, a in enumerate(WINDOWS[name]):
         if c == 0:
