@@ -671,3 +671,36 @@ def test_one_loop_per_frame_gives_finite_points_at_zero_velocity() -> None:
         assert np.linalg.norm(best[2:5]) == pytest.approx(3.0, abs=0.0436)
         assert best[2] / 3.0 == pytest.approx(np.sin(az), abs=0.05)
         assert best[5] == 0.0 and best[6] > 15.0
+
+
+@pytest.mark.parametrize("tdm_order", [[1, 3, 2], [1, 3]])
+def test_angles_come_from_the_virtual_antennas_of_the_used_transmitters(
+    tdm_order: list[int],
+) -> None:
+    """Two points 3 m away, one on boresight at z = 0 approaching at 1.23 m/s, one 20 deg to the
+    right and 0.5 m up receding at 1.23 m/s. With TX1, TX3, TX2 the strongest point of each is
+    at its x and z; leaving TX2 (the one above the others) out of the TDM order leaves an
+    azimuth-only array of 8 virtual antennas: x still right and z exactly 0, not the garbage
+    elevations (z from -3 to +1 m) that the 4 zero channels of the unused TX gave."""
+    az = np.deg2rad(20.0)
+    b = np.array([np.sqrt(9 - 0.25) * np.cos(az), -np.sqrt(9 - 0.25) * np.sin(az), 0.5])
+    v = 2 * 0.61472423
+    targets = [
+        {"position": [3.0, 0.0, 0.0], "velocity": [-v, 0.0, 0.0], "rcs": 1.0},
+        {"position": b.tolist(), "velocity": (v * b / 3.0).tolist(), "rcs": 1.0},
+    ]
+    res = fmcw_run(targets, 0.2, tdm_order=tdm_order)
+    pts = res.received.products["points"]
+    for f in range(6):
+        p = pts[pts[:, 0] == f]
+        t = f * 33.333e-3
+        for target, sign in zip(targets, (1.0, -1.0), strict=True):
+            at = np.add(target["position"], t * np.asarray(target["velocity"]))
+            near = p[p[:, 5] * sign > 0]  # approaching or receding
+            best = near[np.argmax(near[:, 6])]
+            assert np.linalg.norm(best[2:5]) == pytest.approx(np.linalg.norm(at), abs=0.05)
+            assert best[2] == pytest.approx(-at[1], abs=0.1)  # sensor right = scene -y
+            if len(tdm_order) == 3:
+                assert best[4] == pytest.approx(at[2], abs=0.1)
+            else:
+                assert np.all(p[:, 4] == 0.0)

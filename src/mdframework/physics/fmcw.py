@@ -883,6 +883,12 @@ class Antennas:
             slot[tx] = s
         return np.repeat(slot, self.rx.shape[0])
 
+    def used_virtual(self, seq: ChirpSequence) -> IntArray:
+        """Indices (n_used,) of the virtual antennas whose TX the TDM order uses: only these
+        hold signal (:func:`virtual_cube` leaves the others zero), so only these may take part
+        in the angle estimation (a zero channel beside real ones distorts every beam)."""
+        return np.flatnonzero(self.slot_of_virtual(seq) >= 0).astype(np.int64)
+
 
 def chirp_profiles(
     positions: FloatArray,

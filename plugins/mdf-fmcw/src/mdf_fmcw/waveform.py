@@ -427,8 +427,12 @@ class FmcwRadar(RadarWaveform):
         antennas = self.antennas
         axes = self.axes()
         raxis = axes["range_m"]
-        grid = fmcw.angle_grid(antennas.virtual, seq.wavelength)
-        slots = antennas.slot_of_virtual(seq)
+        # the angles from the virtual antennas of the TXs the TDM order uses, not the zero
+        # channels of an unused TX
+        used = antennas.used_virtual(seq)
+        every = used.size == antennas.virtual.shape[0]
+        grid = fmcw.angle_grid(antennas.virtual[used], seq.wavelength)
+        slots = antennas.slot_of_virtual(seq)[used]
         detection = self.detection()
         signal = np.empty(ranges.shape[0], dtype=np.complex128)
         maps: list[NDArray[np.float32]] = []
@@ -464,7 +468,7 @@ class FmcwRadar(RadarWaveform):
                 maps.append(fmcw.detection_map(rd).astype(np.float32))
             if want_points:
                 pts = fmcw.detect_points(
-                    rd,
+                    rd if every else rd[used],
                     raxis,
                     axes["doppler_hz"],
                     grid,
