@@ -1243,15 +1243,21 @@ def read_record(path: Path) -> tuple[dict[str, NDArray[Any]], dict[str, Any]]:
 
 
 def _complete(path: Path) -> dict[str, Any] | None:
-    """The index row of a finished record, or None if it must be (re)built."""
+    """The index row of a finished record, or None if it must be (re)built: a record cut
+    short, corrupt, or whose metadata lacks a field is removed. A record that cannot be read
+    for want of permission is an error (it is not removed)."""
+    import zipfile
+
     if not path.exists():
         return None
     try:
         arrays, meta = read_record(path)
-    except Exception:
+        return _row(meta, arrays["features"])
+    except PermissionError as exc:
+        raise OutputError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    except (OSError, EOFError, ValueError, KeyError, TypeError, zipfile.BadZipFile):
         path.unlink(missing_ok=True)
         return None
-    return _row(meta, arrays["features"])
 
 
 def scheduler_address(given: str | None) -> str | None:
