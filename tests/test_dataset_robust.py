@@ -246,5 +246,5 @@ max_gap_s = 0.1
 long_gaps = "error"
 """)
     cfg, base = load_dataset_config(config)
-    with pytest.raises(MdfError, match="conditioning: joint 'l_hand' is untracked for 0.73"):
+    with pytest.raises(MdfError, match=r"conditioning: joint 'l_hand' is untracked for 0\.73"):
         plan_records(cfg, base)
