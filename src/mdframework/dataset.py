@@ -913,15 +913,13 @@ def _place_record(run: dict[str, Any], config: RunConfigBase, motion: Motion) ->
     moved back by the placed recording's travel up to the record's start, and the heading the
     recording's placement gives fixed, so that the record starts at the configured position.
     ``config``: ``run`` validated."""
-    from .conditioning import condition
-    from .pipeline import body_placement
+    from .physics.scene import scene_heading_deg
+    from .pipeline import body_placement, condition_body
 
     scene: dict[str, Any] = json.loads(json.dumps(run.get("scene", {})))
     if motion.canonical_map is None:
         return scene
-    body = motion.canonical()
-    if config.conditioning.enabled:
-        body, _ = condition(body, config.conditioning)
+    body, _ = condition_body(motion.canonical(), config.conditioning)
     person = config.scene.person
     # only the hip centre's track is placed: the placement comes from the whole recording
     where = body_placement(body, person, np.asarray(config.scene.radar_position, np.float64))
@@ -929,7 +927,12 @@ def _place_record(run: dict[str, Any], config: RunConfigBase, motion: Motion) ->
     start = body.time[0] + float(run["motion"].get("start", 0.0))
     at = np.array([np.interp(start, body.time, base[:, k]) for k in (0, 1)])
     shift = at - np.asarray(person.position)
-    heading = _heading_deg(body, person, config.scene.radar_position)
+    heading = scene_heading_deg(
+        np.asarray(person.position, dtype=np.float64),
+        np.asarray(config.scene.radar_position, dtype=np.float64),
+        aspect_deg=person.aspect_deg,
+        heading_deg=person.heading_deg,
+    )
     new_person = dict(scene.get("person", {}))
     new_person.pop("aspect_deg", None)
     new_person["heading_deg"] = heading
@@ -939,14 +942,6 @@ def _place_record(run: dict[str, Any], config: RunConfigBase, motion: Motion) ->
     ]
     scene["person"] = new_person
     return scene
-
-
-def _heading_deg(body: Any, person: Any, radar_position: Any) -> float:
-    """The heading [deg] the pipeline's placement gives a person config (aspect or heading)."""
-    if person.heading_deg is not None:
-        return float(person.heading_deg)
-    to_radar = np.asarray(radar_position[:2]) - np.asarray(person.position)
-    return float(np.degrees(np.arctan2(to_radar[1], to_radar[0])) + (person.aspect_deg or 0.0))
 
 
 def _feature_options(fcfg: dict[str, Any]) -> dict[str, Any]:
@@ -1265,15 +1260,21 @@ def read_record(path: Path) -> tuple[dict[str, NDArray[Any]], dict[str, Any]]:
 
 
 def _complete(path: Path) -> dict[str, Any] | None:
-    """The index row of a finished record, or None if it must be (re)built."""
+    """The index row of a finished record, or None if it must be (re)built: a record cut
+    short, corrupt, or whose metadata lacks a field is removed. A record that cannot be read
+    for want of permission is an error (it is not removed)."""
+    import zipfile
+
     if not path.exists():
         return None
     try:
         arrays, meta = read_record(path)
-    except Exception:
+        return _row(meta, arrays["features"])
+    except PermissionError as exc:
+        raise OutputError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    except (OSError, EOFError, ValueError, KeyError, TypeError, zipfile.BadZipFile):
         path.unlink(missing_ok=True)
         return None
-    return _row(meta, arrays["features"])
 
 
 def scheduler_address(given: str | None) -> str | None:
