@@ -62,6 +62,7 @@ from .outdir import (
     OutputFolder,
     atomic_savez,
     atomic_write_text,
+    marker_name,
     output_folder,
     safe_name,
     wait_for_files,
@@ -1622,6 +1623,9 @@ def build_dataset(
             first = next(iter(skipped.values()))["skipped"]
             raise MdfError(f"every record failed; the first: {first}")
         dropped = [skipped[s.record_id] for s in specs if s.record_id in skipped]
+        # three files, each replaced whole: a kill between them leaves them not matching, and
+        # the marker says so until the build ends (load_dataset refuses such a folder)
+        folder.write_marker(config=wanted, complete=False, index=INDEX_WRITING)
         _write_index(out, ordered, config, dropped)
         if ours:  # records of an earlier config, now that the new index is in place
             keep = {f"{s.record_id}.npz" for s in specs}
@@ -1643,6 +1647,19 @@ def _remove_partials(out: Path) -> None:
     for partial in (out / RECORDS).glob(".tmp-*"):
         if _PARTIAL_NAME.fullmatch(partial.name):
             partial.unlink(missing_ok=True)
+
+
+#: the marker's ``index`` while the index files are being replaced
+INDEX_WRITING = "writing"
+
+
+def _index_half_written(root: Path) -> bool:
+    """Whether the build of the dataset at ``root`` stopped while it wrote its index files."""
+    try:
+        marker = json.loads((root / marker_name("dataset")).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return isinstance(marker, dict) and marker.get("index") == INDEX_WRITING
 
 
 def _write_index(
@@ -1707,6 +1724,11 @@ def load_dataset(
     index = root / INDEX
     if not index.exists():
         raise MdfError(f"{root}: not a built dataset (no {INDEX}); run `mdf dataset build`")
+    if _index_half_written(root):
+        raise MdfError(
+            f"{root}: the build stopped while it wrote {INDEX}, {SKIPPED} and {MANIFEST} (they "
+            "may not match); run the same `mdf dataset build` again to finish it"
+        )
     with index.open(newline="") as fh:
         rows = list(csv.DictReader(fh))
     if not rows:

@@ -4,21 +4,23 @@ Every command that writes a folder (``mdf run``, ``mdf dataset build``, ``mdf ex
 it through :func:`output_folder`, before any work starts:
 
 - ``--out`` may be missing (it is created, with its parents), an empty folder, or a folder that
-  holds an earlier output of the same command (recognised by its marker file
-  ``.mdf-<command>.json``, or, for folders written before markers existed, by holding only files
-  that command writes).
-  Anything else (a file, a non-empty folder of other files, another command's output) is refused
-  with one line, unless ``force``: then the command writes its own files into the folder,
-  replacing files of the same names, and deletes nothing.
+  holds an earlier output of the same command, recognised only by its marker file
+  ``.mdf-<command>.json`` (a folder of files that merely have the command's names is the
+  user's). Anything else (a file, a non-empty folder without the marker, another command's
+  output) is refused with one line, unless ``force``: then the command writes its own files
+  into the folder, replacing files of the same names, and deletes nothing.
+- The marker lists the files the command wrote, each with its inode, size and modification
+  time: a rerun removes only those that still match, never a user's file.
 - One lock file (``.mdf.lock``) per folder: a second command on the same folder is refused and
   told the holder's process id and start time. The lock is an advisory ``flock`` on that file, so
   the kernel drops it when its holder dies, however it dies: a lock left by a killed process is
   stale by construction and the next command takes it over.
 - Files are staged in a ``.mdf-staging-*`` folder inside ``--out`` (or in a folder the user
-  chooses on the same file system) and moved into place by renames only once every new file is
-  complete; only then are the earlier output's own files that the new output does not make
-  removed. A killed command leaves the earlier output as it was (and a staging folder that the
-  next command on the folder removes).
+  chooses on the same file system), locked by its command while it lives, and moved into place
+  in one swap (:meth:`OutputFolder.commit`) once every new file is complete. A command killed
+  before the swap leaves the earlier output as it was and a staging folder that the next
+  command removes; a swap killed half done is recorded in the marker and undone by the next
+  command on the folder.
 - New files get the permissions the user's umask gives any new file.
 
 POSIX only (``fcntl``).
@@ -34,6 +36,7 @@ import os
 import re
 import shutil
 import socket
+import stat
 import tempfile
 import threading
 import time
@@ -49,8 +52,10 @@ LOCK = ".mdf.lock"
 STAGING_PREFIX = ".mdf-staging-"
 MARKER_PREFIX = ".mdf-"
 MARKER_SUFFIX = ".json"
+#: a marker being written (a command killed then leaves it; the next one removes it)
+MARKER_TMP = ".mdf-tmp-"
 #: names a command never counts as user content (its lock, markers, staging folders)
-_INTERNAL = re.compile(r"^\.mdf(\.lock|-.+\.json|-staging-.*)$")
+_INTERNAL = re.compile(r"^\.mdf(\.lock|-.+\.json|-staging-.*|-tmp-.*)$")
 
 
 def marker_name(command: str) -> str:
@@ -90,19 +95,20 @@ def _fsync_dir(path: Path) -> None:
         os.close(fd)
 
 
-def atomic_write_bytes(path: Path, data: bytes) -> None:
-    """Write ``path`` through a temporary file beside it and a rename: it is either the old file
-    or the complete new one. The file gets the umask's permissions."""
-    fh, tmp = _write_temporary(path, lambda fh: fh.write(data))
+def atomic_write_bytes(path: Path, data: bytes, *, prefix: str = ".tmp-") -> None:
+    """Write ``path`` through a temporary file beside it (named ``prefix``...) and a rename: it
+    is either the old file or the complete new one. The file gets the umask's permissions."""
+    fh, tmp = _write_temporary(path, lambda fh: fh.write(data), prefix=prefix)
     _put_in_place(fh, tmp, path, new_file_mode())
 
 
 def _write_temporary(
-    path: Path, write: Callable[[Any], object], suffix: str = ""
+    path: Path, write: Callable[[Any], object], suffix: str = "", prefix: str = ".tmp-"
 ) -> tuple[Any, str]:
-    """A temporary file beside ``path`` (``.tmp-*`` + ``suffix``), written by ``write(fh)`` and
-    left open for :func:`_put_in_place`: the open file and its path. Removed if writing fails."""
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=suffix, dir=path.parent)
+    """A temporary file beside ``path`` (``prefix`` + ``*`` + ``suffix``), written by
+    ``write(fh)`` and left open for :func:`_put_in_place`: the open file and its path. Removed
+    if writing fails."""
+    fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=suffix, dir=path.parent)
     try:
         fh = os.fdopen(fd, "wb")
     except BaseException:
@@ -118,9 +124,9 @@ def _write_temporary(
     return fh, tmp
 
 
-def atomic_write_text(path: Path, text: str) -> None:
+def atomic_write_text(path: Path, text: str, *, prefix: str = ".tmp-") -> None:
     """:func:`atomic_write_bytes` of UTF-8 text."""
-    atomic_write_bytes(path, text.encode("utf-8"))
+    atomic_write_bytes(path, text.encode("utf-8"), prefix=prefix)
 
 
 def atomic_savez(path: Path, *, in_background: bool = False, **arrays: Any) -> None:
@@ -362,62 +368,224 @@ class OutputFolder:
     marker: dict[str, Any]
     created: bool
     staging_dir: Path | None = None
+    force: bool = False
     _stages: list[Path] = field(default_factory=list)
+    _stage_locks: list[int] = field(default_factory=list)
 
     def own(self, name: str) -> bool:
         """Whether ``name`` is a file this command writes."""
         return any(fnmatch.fnmatchcase(name, p) for p in self.patterns)
 
     def stage(self) -> Path:
-        """A new, empty staging folder on the output's file system."""
+        """A new, empty staging folder on the output's file system, locked (``flock`` on the
+        folder itself) while this process lives, so that a sweep of ``--staging-dir`` can tell
+        a live command's staging folder from one a killed command left."""
         where = self.staging_dir or self.path
         stage = Path(tempfile.mkdtemp(prefix=f"{STAGING_PREFIX}{self.command}-", dir=where))
         self._stages.append(stage)
+        fd = os.open(stage, os.O_RDONLY)
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # new: nobody else holds it
+        self._stage_locks.append(fd)
         return stage
 
     def previous_files(self) -> list[str]:
-        """The earlier output's own files (listed in its marker, or all own-named entries)."""
+        """The earlier output's own files: those its marker lists, and only while each is still
+        the very file the command wrote (same inode, size and modification time, recorded in
+        the marker), never a file of the user's that merely has one of the command's names."""
         if not self.previous:
             return []
         listed = self.marker.get("files")
-        if isinstance(listed, list):
-            return [n for n in listed if isinstance(n, str) and self.own(n)]
-        return [p.name for p in self.path.iterdir() if self.own(p.name)]
+        stamps = self.marker.get("stamps")
+        if not isinstance(listed, list):
+            return []
+        names = [n for n in listed if isinstance(n, str) and self.own(n) and "/" not in n]
+        if not isinstance(stamps, dict):  # markers of earlier versions listed names only
+            return [n for n in names if (self.path / n).is_file()]
+        return [n for n in names if _stamp(self.path / n) == stamps.get(n)]
 
     def write_marker(self, **extra: Any) -> None:
         """Write this command's marker (which makes the folder a previous output next time)."""
         marker = {"command": self.command, **extra}
-        atomic_write_text(self.path / marker_name(self.command), json.dumps(marker, indent=2))
+        atomic_write_text(
+            self.path / marker_name(self.command), json.dumps(marker, indent=2), prefix=MARKER_TMP
+        )
         self.marker = marker
         self.previous = True
 
     def commit(self, stage: Path, *, keep: Sequence[str] = ()) -> list[Path]:
-        """Move every file of ``stage`` into the folder (one rename each, after all of them are
-        complete), then delete the earlier output's own files that were not made again (never
-        the names in ``keep``, never anything else). Returns the new files' paths."""
+        """Move every file of ``stage`` into the folder, once all of them are complete, and
+        remove the earlier output's own files (:meth:`previous_files`) that were not made again
+        (never the names in ``keep``, never anything else). Returns the new files' paths.
+
+        The swap is all or nothing: the files it replaces are first moved aside into the
+        staging folder, and the marker records the swap (``"swap"``) before the first rename.
+        An error or Ctrl-C during the swap moves everything back at once (and Ctrl-C or SIGTERM
+        arriving during the swap is held until it ends); a process killed outright leaves the
+        record, and the next command on the folder moves everything back before it starts
+        (:func:`_undo_swap`): the earlier output as it was. Without ``force`` a file the
+        command would replace that it did not write (a file of the user's with one of its
+        names) is refused, before anything moves."""
         names = sorted(p.name for p in stage.iterdir())
         for name in names:
             if not self.own(name):
                 raise RuntimeError(f"{name!r} is not one of the files `{self.command}` writes")
-        stale = [n for n in self.previous_files() if n not in names and n not in keep]
-        written = []
-        for name in names:
-            os.replace(stage / name, self.path / name)
-            written.append(self.path / name)
-        for name in stale:
-            target = self.path / name
-            if target.is_dir() and not target.is_symlink():
-                shutil.rmtree(target)
-            else:
-                target.unlink(missing_ok=True)
-        self.write_marker(files=sorted({*names, *(k for k in keep if (self.path / k).exists())}))
+        ours = set(self.previous_files())
+        folders = [n for n in names if (self.path / n).is_dir() and n not in ours]
+        if folders:
+            raise OutputError(
+                f"--out {self.path}: holds the folder {_describe(folders)}, where `mdf "
+                f"{self.command}` writes a file; move it away or choose another folder"
+            )
+        if not self.force:
+            foreign = [n for n in names if os.path.lexists(self.path / n) and n not in ours]
+            if foreign:
+                raise OutputError(
+                    f"--out {self.path}: holds {_describe(foreign)}, which `mdf {self.command}` "
+                    "writes but did not write there; move it away, or add --force to replace it"
+                )
+        stale = [n for n in sorted(ours) if n not in names and n not in keep]
+        aside = stage / _ASIDE
+        aside.mkdir()
+        marker_path = self.path / marker_name(self.command)
+        try:
+            before: str | None = marker_path.read_text(encoding="utf-8")
+        except OSError:
+            before = None
+        journal = {"stage": str(stage), "new": names, "previous_marker": before}
+        with _signals_held():
+            self.write_marker(swap=journal)  # from here on a kill is undone by the next command
+            moved_in: list[str] = []
+            moved_aside: list[str] = []
+            try:
+                for name in names:
+                    if os.path.lexists(self.path / name):
+                        os.replace(self.path / name, aside / name)
+                        moved_aside.append(name)
+                    os.replace(stage / name, self.path / name)
+                    moved_in.append(name)
+                for name in stale:
+                    os.replace(self.path / name, aside / name)
+                    moved_aside.append(name)
+                files = sorted({*names, *(k for k in keep if (self.path / k).exists())})
+                self.write_marker(files=files, stamps={n: _stamp(self.path / n) for n in names})
+            except BaseException:
+                for name in reversed(moved_in):
+                    os.replace(self.path / name, stage / name)
+                for name in moved_aside:
+                    os.replace(aside / name, self.path / name)
+                _restore_marker(marker_path, before)
+                self.marker = json.loads(before) if before else {}
+                raise
         _fsync_dir(self.path)
-        shutil.rmtree(stage, ignore_errors=True)
-        return written
+        shutil.rmtree(stage, ignore_errors=True)  # with the replaced files
+        return [self.path / name for name in names]
 
     def user_entries(self) -> list[str]:
         """Entries of the folder other than the lock, markers and staging folders."""
         return sorted(p.name for p in self.path.iterdir() if not _INTERNAL.match(p.name))
+
+
+#: the folder inside a staging folder that holds the files a commit replaces, until it ends
+_ASIDE = ".mdf-aside"
+
+
+def _stamp(path: Path) -> list[int] | None:
+    """What identifies the file a command wrote: inode, size, modification time [ns] (a rename
+    keeps all three; a user's edit or a new file changes them); None for no regular file."""
+    try:
+        st = os.lstat(path)
+    except OSError:
+        return None
+    if not stat.S_ISREG(st.st_mode):
+        return None
+    return [st.st_ino, st.st_size, st.st_mtime_ns]
+
+
+def _restore_marker(path: Path, text: str | None) -> None:
+    """Put back the marker a commit started from (``None``: there was none)."""
+    if text is None:
+        path.unlink(missing_ok=True)
+    else:
+        atomic_write_text(path, text, prefix=MARKER_TMP)
+
+
+@contextmanager
+def _signals_held() -> Iterator[None]:
+    """Hold Ctrl-C and SIGTERM for the block (a swap of files lasts milliseconds): one that
+    arrives meanwhile is delivered, to the handler that was in place, when the block ends. Only
+    in the main thread (elsewhere signals cannot be handled and the block runs as it is)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    import signal
+
+    held: list[int] = []
+    wanted = (signal.SIGINT, signal.SIGTERM)
+    previous: dict[int, Any] = {}
+    for sig in wanted:
+        previous[sig] = signal.signal(sig, lambda signum, frame: held.append(signum))
+    try:
+        yield
+    finally:
+        for sig in wanted:
+            signal.signal(sig, previous[sig])
+        for num in dict.fromkeys(held):
+            handler = previous[num]
+            if callable(handler):
+                handler(num, None)
+            elif handler == signal.SIG_DFL:
+                signal.raise_signal(num)
+
+
+def _undo_swap(folder: Path, command: str) -> None:
+    """If a command was killed while it moved its files into ``folder`` (its marker still holds
+    the swap's record), move everything back: the earlier output as it was, with its marker.
+    Called with the folder's lock held, before staging folders are swept."""
+    path = folder / marker_name(command)
+    try:
+        marker = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return
+    swap = marker.get("swap") if isinstance(marker, dict) else None
+    if not isinstance(swap, dict):
+        return
+    stage = Path(str(swap.get("stage", "")))
+    new = swap.get("new")
+    before = swap.get("previous_marker")
+    if not stage.name.startswith(STAGING_PREFIX) or not stage.is_dir() or not isinstance(new, list):
+        # the staging folder is gone (another command swept its --staging-dir): what moved
+        # in stays, as files the earlier output did not write
+        _restore_marker(path, before if isinstance(before, str) else None)
+        return
+    for name in new:
+        if isinstance(name, str) and "/" not in name and not (stage / name).exists():
+            (folder / name).unlink(missing_ok=True)  # moved in: the new output's
+    aside = stage / _ASIDE
+    if aside.is_dir():
+        for old in aside.iterdir():
+            os.replace(old, folder / old.name)
+    _restore_marker(path, before if isinstance(before, str) else None)
+    shutil.rmtree(stage, ignore_errors=True)
+    _fsync_dir(folder)
+
+
+def _sweep_stale_stages(where: Path) -> None:
+    """Remove the staging folders in ``where`` that killed commands left: those no live
+    process holds (a command holds each of its staging folders' ``flock`` while it lives)."""
+    for leftover in where.glob(f"{STAGING_PREFIX}*"):
+        if not leftover.is_dir() or leftover.is_symlink():
+            continue
+        try:
+            fd = os.open(leftover, os.O_RDONLY)
+        except OSError:
+            continue
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            continue  # a live command's
+        finally:
+            os.close(fd)  # (releases the lock taken, if any)
+        shutil.rmtree(leftover, ignore_errors=True)
 
 
 def _check_staging_dir(staging_dir: Path, out: Path) -> Path:
@@ -443,8 +611,12 @@ def _describe(entries: list[str]) -> str:
 
 
 def _inspect(out: Path, command: str, patterns: tuple[str, ...], force: bool) -> OutputFolder:
-    """Classify an existing folder (called with its lock held)."""
-    folder = OutputFolder(out, command, patterns, previous=False, marker={}, created=False)
+    """Classify an existing folder (called with its lock held). Only the command's marker makes
+    a folder an earlier output: a folder of files with the command's names but no marker is
+    the user's (or an output of a version before markers, 2026-11), refused without ``force``."""
+    folder = OutputFolder(
+        out, command, patterns, previous=False, marker={}, created=False, force=force
+    )
     entries = folder.user_entries()
     markers = sorted(
         p.name
@@ -454,7 +626,7 @@ def _inspect(out: Path, command: str, patterns: tuple[str, ...], force: bool) ->
     mine = marker_name(command)
     if mine in markers:
         try:
-            marker = json.loads((out / mine).read_text())
+            marker = json.loads((out / mine).read_text(encoding="utf-8"))
         except (OSError, ValueError):
             marker = {}
         folder.marker = marker if isinstance(marker, dict) else {}
@@ -462,9 +634,6 @@ def _inspect(out: Path, command: str, patterns: tuple[str, ...], force: bool) ->
         return folder
     others = [m[len(MARKER_PREFIX) : -len(MARKER_SUFFIX)] for m in markers]
     if not entries and not others:
-        return folder
-    if entries and not others and all(folder.own(e) for e in entries):
-        folder.previous = True  # written before markers existed
         return folder
     if force:
         return folder
@@ -522,18 +691,24 @@ def output_folder(
     ok = False
     try:
         lock = acquire_lock(out, f"mdf {command}")
-        for leftover in out.glob(f"{STAGING_PREFIX}*"):  # from a killed command; ours now
-            shutil.rmtree(leftover, ignore_errors=True)
+        for partial in out.glob(f"{MARKER_TMP}*"):  # markers a killed command was writing
+            partial.unlink(missing_ok=True)
+        for marker in out.glob(f"{MARKER_PREFIX}*{MARKER_SUFFIX}"):  # swaps killed half done
+            _undo_swap(out, marker.name[len(MARKER_PREFIX) : -len(MARKER_SUFFIX)])
         folder = _inspect(out, command, tuple(patterns), force)
         folder.created = created
         if staging_dir is not None:
             folder.staging_dir = _check_staging_dir(Path(staging_dir), out)
+            _sweep_stale_stages(folder.staging_dir)
+        _sweep_stale_stages(out)  # from a killed command
         yield folder
         ok = True
     finally:
         if folder is not None:
             for stage in folder._stages:
                 shutil.rmtree(stage, ignore_errors=True)
+            for fd in folder._stage_locks:
+                os.close(fd)
         if not ok and created:
             _remove_if_empty(out, missing)  # while still holding the lock
         if lock is not None:
