@@ -62,9 +62,10 @@ class C3dMarkers:
     """What :func:`read_c3d` returns. ``positions`` (n_frames, n_markers, 3) float64 in the
     file's unit, NaN where a marker is not seen; ``labels`` the marker names (``POINT:LABELS``
     then ``LABELS2``, ``LABELS3``... for files of more than 255 points; every point of the
-    file); ``rate_hz`` the header's frame rate; ``units`` ``POINT:UNITS`` and ``unit_m`` metres per unit; ``subject`` the first of ``SUBJECTS:NAMES`` (or None);
-    ``events`` (label, context, time [s]) from the ``EVENT`` group; ``first_frame`` the
-    header's; ``software`` ``MANUFACTURER:SOFTWARE`` (or None)."""
+    file); ``rate_hz`` the header's frame rate; ``units`` ``POINT:UNITS`` and ``unit_m`` metres
+    per unit; ``subject`` the first of ``SUBJECTS:NAMES`` (or None); ``events`` (label, context,
+    time [s]) from the ``EVENT`` group; ``first_frame`` the header's; ``software``
+    ``MANUFACTURER:SOFTWARE`` (or None)."""
 
     path: Path
     labels: tuple[str, ...]
