@@ -1433,7 +1433,10 @@ def _executor(
     import dask
 
     with _quiet_dask_logs() if address == "local" else nullcontext():
-        with dask.config.set(LOCAL_DASK_CONFIG):
+        with dask.config.set(LOCAL_DASK_CONFIG), warnings.catch_warnings():
+            # its scheduler's HTTP server takes another port when 8787 is taken (by another
+            # cluster on the machine): nothing for the user to do
+            warnings.filterwarnings("ignore", message=r"Port \d+ is already in use")
             cluster = (
                 LocalCluster(
                     n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
