@@ -746,3 +746,27 @@ def test_without_receiver_noise_points_stand_over_the_receivers_mean_noise() -> 
     a2 = float(radar_.config.amplitudes(np.ones(1), np.full(1, 3.0), seq.wavelength)[0] ** 2)
     snr = a2 * 12 / radar_.map_noise_power()  # the map sums 12 antennas' signal and noise
     assert 15.0 < quiet[:, 6].max() <= 10 * np.log10(1 + snr)
+
+
+def test_the_ambiguous_doppler_bin_as_documented() -> None:
+    """docs/fmcw.md: with the IWR1443 preset's 16 Doppler bins the simulated axis runs from
+    -4.92 (the ambiguous bin, read as receding) to +4.30 m/s; the real RadHAR points, their range
+    rate negated by the reader, run from -4.30 to +4.92 m/s (the shipped boxing subset holds
+    points in both end bins)."""
+    from mdf_radhar.source import npz_recordings
+
+    radar_ = FmcwRadar(IWR1443)
+    v = radar_.axes()["velocity_mps"]
+    v_max = radar_.max_unambiguous_velocity
+    assert v[0] == pytest.approx(-v_max, rel=1e-12) and v[0] == pytest.approx(-4.92, abs=5e-3)
+    assert v[-1] == pytest.approx(7 / 8 * v_max, rel=1e-12) and round(v[-1], 2) == 4.30
+    step = 2 * v_max / 16
+    real = np.concatenate(
+        [
+            c.velocity
+            for _, c in npz_recordings(EXAMPLES / "data" / "radhar" / "radhar_boxing_subset.npz")
+        ]
+    )
+    bins = np.round(real / step)
+    assert bins.max() == 8 and bins.min() == -7
+    assert real.max() == pytest.approx(4.92, abs=5e-3) and round(real.min(), 2) == -4.30
