@@ -770,3 +770,32 @@ def test_the_ambiguous_doppler_bin_as_documented() -> None:
     bins = np.round(real / step)
     assert bins.max() == 8 and bins.min() == -7
     assert real.max() == pytest.approx(4.92, abs=5e-3) and round(real.min(), 2) == -4.30
+
+
+def test_the_aliasing_advice_names_the_fields_that_set_the_slow_time_rate() -> None:
+    """The default FMCW radar (3 TX, 70 us chirps: loop rate 4762 Hz, v_max 4.58 m/s) and a
+    point approaching at 5.5 m/s: the error names the chirp timing and the TDM order (fmcw has
+    no prf field) with the chirp period that reaches 4 v / lambda; that period, or one TX,
+    runs. The CW radar names its sample_rate."""
+    target = [{"position": [3.0, 0.0, 0.0], "velocity": [-5.5, 0.0, 0.0], "rcs": 1.0}]
+    fields = {"kind": "fmcw", "boresight_azimuth_deg": 0.0, "points": False}
+    error = {"aliasing": "error"}
+    with pytest.raises(SceneError) as info:
+        point_run(target, duration=0.2, radar=fields, processing=error)
+    seq = FmcwConfig().sequence()
+    rate = 4 * 5.5 / seq.wavelength
+    period = 1 / (3 * rate)
+    text = str(info.value)
+    assert "prf" not in text.replace("PRF", "")
+    assert (
+        f"raise the loop rate to at least {np.ceil(rate):.0f} Hz: shorten radar.idle_time + "
+        f"radar.ramp_end_time from 70.00 us to at most {np.floor(period * 1e8) / 100:.2f} us, "
+        "or use fewer "
+        "than 3 TX in radar.tdm_order (processing.aliasing = 'error' stops such runs)"
+    ) in text
+    advised = np.floor(period * 1e8) / 1e8  # as printed, rounded down
+    for change in ({"idle_time": 1e-6, "ramp_end_time": advised - 1e-6}, {"tdm_order": [1]}):
+        point_run(target, duration=0.2, radar={**fields, **change}, processing=error)
+    cw = {"kind": "cw", "carrier_frequency": 24e9, "sample_rate": 1000.0}
+    with pytest.raises(SceneError, match=r"aliases; raise radar\.sample_rate to at least 1762 Hz"):
+        point_run(target, duration=0.2, radar=cw, processing=error)

@@ -366,6 +366,27 @@ class FmcwRadar(RadarWaveform):
         """Chirps per second over whole frames [Hz] (the pulse budget counts chirps)."""
         return self.sequence.chirps_per_frame / self.sequence.frame_period
 
+    def faster_sampling(self, rate: float) -> str:
+        """The loop rate ``1 / (n_tx (idle_time + ramp_end_time))`` is the slow-time rate: the
+        chirp period that reaches ``rate`` [Hz] with this TDM order, and what bounds it (the
+        ramp must outlast the ADC samples)."""
+        seq = self.sequence
+        period = 1.0 / (rate * seq.n_tx)
+        adc = seq.adc_start_time + seq.n_samples / seq.sample_rate
+        advice = (
+            f"raise the loop rate to at least {np.ceil(rate):.0f} Hz: shorten radar.idle_time "
+            f"+ radar.ramp_end_time from {seq.chirp_period * 1e6:.2f} us to at most "
+            f"{np.floor(period * 1e8) / 100:.2f} us"
+        )
+        if period < adc:
+            advice += (
+                f" (the ramp must outlast the ADC's adc_start_time + n_samples / sample_rate "
+                f"= {adc * 1e6:.2f} us: take fewer n_samples or raise sample_rate)"
+            )
+        if seq.n_tx > 1:
+            advice += f", or use fewer than {seq.n_tx} TX in radar.tdm_order"
+        return advice
+
     @property
     def shortest_record(self) -> float:
         """One frame's chirps, ``chirps_per_frame (idle_time + ramp_end_time)`` [s]: a record
