@@ -223,9 +223,7 @@ def format_plan(plan: RunPlan, source: str) -> str:
     ]
     speed = f"fastest joint {p.max_joint_radial_speed_mps:.3g} m/s radially"
     if p.aliasing:
-        lines.append(
-            f"  {'aliasing':<12}LIKELY: {speed}; {p.faster_sampling}"
-        )
+        lines.append(f"  {'aliasing':<12}LIKELY: {speed}; {p.faster_sampling}")
     else:
         lines.append(f"  {'aliasing':<12}none expected: {speed}")
     terms = ", ".join(f"{k} {v:.3g}" for k, v in p.memory_terms_mib.items())
