@@ -1679,7 +1679,7 @@ def build_dataset(
         indexed = _indexed_configs(folder, built)
         ours = folder.previous  # the folder holds an earlier build: its files are ours
         # the config of the build under way (resumed), or of the complete dataset that a
-        # stopped rebuild left in place (rebuilt from its records, which are all still there)
+        # stopped rebuild left in place (finished from its records, any missing one recomputed)
         if built is not None and built != wanted and wanted not in indexed and not force:
             diff = config_differences(built, wanted)
             shown = "; ".join(diff[:3]) + (f" and {len(diff) - 3} more" if len(diff) > 3 else "")
