@@ -1357,7 +1357,10 @@ def _complete(path: Path, spec: RecordSpec) -> dict[str, Any] | None:
             atomic_savez(path, **stored)
         return _row(meta, arrays["features"])
     except PermissionError as exc:
-        raise OutputError(f"{path}: cannot read: {exc.strerror or exc}") from None
+        raise OutputError(
+            f"{path}: {exc.strerror or exc}: a record of this dataset must be readable and "
+            "writable by you to resume it; fix its permissions or build into another --out"
+        ) from None
     except (OSError, EOFError, ValueError, KeyError, TypeError, zipfile.BadZipFile):
         path.unlink(missing_ok=True)
         return None
