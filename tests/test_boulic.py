@@ -41,6 +41,17 @@ def walk(chen: bool, rv: float = 1.0, nt: int = 2048, cycles: int = 3) -> tuple[
     return g, motion.skeleton.positions[:-1]
 
 
+def test_the_walker_motion_carries_its_gait_and_is_resampled_as_a_body() -> None:
+    """The motion hands its Gait to the mujoco_body model (which evaluates the MuJoCo model at
+    the pulse times) and is not flagged as linear tracks (a positional argument had put the
+    Gait into ``linear_tracks``: the model fell back to the sampled frames, and the walker was
+    resampled linearly)."""
+    cfg = BoulicConfig(height=H, rv=1.0, nt=64, n_cycles=1)
+    motion = BoulicWalker(cfg).load()
+    assert isinstance(motion.gait, Gait) and motion.gait.nt == 64
+    assert motion.linear_tracks is False and motion.point_rcs is None
+
+
 def velocity(g: Gait, p: np.ndarray) -> np.ndarray:
     return np.asarray(np.gradient(p, axis=0) * g.nt / g.cycle_duration)
 

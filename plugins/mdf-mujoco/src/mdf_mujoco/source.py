@@ -136,4 +136,4 @@ class BoulicWalker(MotionSource):
             "chen_compatible": g.chen_compatible,
         }
         skel = Skeleton(t, frames.joints, CANONICAL_JOINTS)
-        return BoulicMotion(skel, meta, {j: j for j in CANONICAL_JOINTS}, None, g)
+        return BoulicMotion(skel, meta, {j: j for j in CANONICAL_JOINTS}, gait=g)
