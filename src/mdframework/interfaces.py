@@ -246,10 +246,12 @@ class Scatterers:
     #: c-axis (not necessarily unit length). ``None`` for point scatterers.
     semi_axes: FloatArray | None = None
     axes: FloatArray | None = None
-    #: Optional ranges already computed by the model: ``(radar_position, ranges)`` with ranges
-    #: (n_pulses, n_scatterers) [m]; :meth:`ranges` returns them for that radar position. It
-    #: survives :meth:`replace` only when the positions are not replaced.
-    range_cache: tuple[tuple[float, float, float], FloatArray] | None = field(
+    #: Optional ranges already computed by the model (set it with :meth:`with_ranges`):
+    #: ``(positions, radar_position, ranges)``, valid for that very ``positions`` array (by
+    #: identity) and radar position (3 floats) [m], ranges (n_pulses, n_scatterers) [m]. A copy
+    #: whose positions are another array (``replace(positions=...)``, also through
+    #: ``dataclasses.replace``) drops it, so it can never give the ranges of other positions.
+    range_cache: tuple[FloatArray, tuple[float, float, float], FloatArray] | None = field(
         default=None, repr=False, compare=False
     )
 
@@ -262,19 +264,37 @@ class Scatterers:
             raise ValueError(f"rcs must be {self.positions.shape[:2]}, got {self.rcs.shape}")
         if len(self.names) != self.positions.shape[1]:
             raise ValueError("one name per scatterer is required")
+        if self.range_cache is not None and self.range_cache[0] is not self.positions:
+            object.__setattr__(self, "range_cache", None)
 
     def replace(self, **changes: Any) -> Scatterers:
         """A copy with some fields replaced (e.g. ``rcs``)."""
-        if "positions" in changes:
-            changes.setdefault("range_cache", None)
         return dataclasses.replace(self, **changes)
+
+    def with_ranges(self, radar_position: FloatArray, ranges: FloatArray) -> Scatterers:
+        """A copy that remembers ``ranges`` (n_pulses, n_scatterers) [m] of these positions from
+        ``radar_position`` (3,) [m], so that :meth:`ranges` need not compute them again (a
+        model that computed them anyway, for its RCS, passes them on)."""
+        if ranges.shape != self.rcs.shape:
+            raise ValueError(f"ranges must be {self.rcs.shape}, got {ranges.shape}")
+        cache = (self.positions, _position_key(radar_position), ranges)
+        return dataclasses.replace(self, range_cache=cache)
 
     def ranges(self, radar_position: FloatArray) -> FloatArray:
         """Distance of every scatterer to the radar, (n_pulses, n_scatterers) float64 [m]."""
-        key = tuple(float(v) for v in np.asarray(radar_position, dtype=np.float64))
-        if self.range_cache is not None and self.range_cache[0] == key:
-            return self.range_cache[1]
+        cache = self.range_cache
+        if (
+            cache is not None
+            and cache[0] is self.positions
+            and cache[1] == _position_key(radar_position)
+        ):
+            return cache[2]
         return distances(self.positions, radar_position)
+
+
+def _position_key(radar_position: FloatArray) -> tuple[float, float, float]:
+    x, y, z = (float(v) for v in np.asarray(radar_position, dtype=np.float64))
+    return x, y, z
 
 
 class ScattererModel(Plugin):
