@@ -67,6 +67,18 @@ def test_real_oni_through_openni2() -> None:
     assert 500 < np.median(valid) < 4000
 
 
+def test_the_python_scan_counts_the_frames_openni2_reads() -> None:
+    """scan_oni walks the record chain without the library; its frames per stream agree with
+    what OpenNI2 itself reports for the same real recording (12 depth, 12 colour)."""
+    scan = scan_oni(ONI)
+    by_name = {scan.nodes[node]: n for node, n in scan.frames_per_node.items()}
+    streams = oni_info(ONI)["streams"]  # frame counts from OpenNI2
+    assert by_name == {"Depth1": streams["depth"]["frames"], "Image1": streams["color"]["frames"]}
+    assert by_name["Depth1"] == len(read_oni_depth(ONI)) == 12
+    assert scan.by_type["new data"] == sum(scan.frames_per_node.values())
+    assert scan.by_type["end"] == 1 and scan.n_records == sum(scan.by_type.values())
+
+
 def test_oni_reads_survive_repeated_fresh_processes() -> None:
     """Regression: OpenNI2's file player thread walks its list of streams without a lock, so
     destroying a stream (or closing the device with a stream alive) while it runs crashed it

@@ -90,6 +90,30 @@ def test_aspect_needs_a_horizontal_direction(registry: Registry) -> None:
         walk(registry, scene={"radar_position": [0.0, 0.0, 8.0]})
 
 
+@pytest.mark.parametrize(
+    ("person", "radar_xy", "aspect", "heading", "expected"),
+    [
+        ((0.0, 0.0), (10.0, 0.0), 0.0, None, 0.0),  # radar on +x, faced
+        ((0.0, 0.0), (10.0, 0.0), 180.0, None, 180.0),  # facing away
+        ((1.0, 1.0), (1.0, 6.0), 0.0, None, 90.0),  # radar on +y of the person
+        ((0.0, 0.0), (-3.0, -3.0), 45.0, None, -90.0),  # -135 deg, turned by 45
+        ((0.0, 0.0), (0.0, 0.0), 30.0, 17.0, 17.0),  # heading wins, even straight below
+    ],
+)
+def test_scene_heading(
+    person: Any, radar_xy: Any, aspect: float, heading: Any, expected: float
+) -> None:
+    """The heading rule that the pipeline and a dataset's ``place = "record"`` share."""
+    from mdframework.physics.scene import scene_heading_deg
+
+    got = scene_heading_deg(
+        np.array(person), np.array([*radar_xy, 2.0]), aspect_deg=aspect, heading_deg=heading
+    )
+    assert got == pytest.approx(expected, abs=1e-12)
+    with pytest.raises(ValueError, match="straight above"):
+        scene_heading_deg(np.array(person), np.array([*person, 5.0]), aspect_deg=aspect)
+
+
 @pytest.mark.parametrize("collapse", ["l_forearm", "all"])
 @pytest.mark.parametrize("placement", ["joints17", "chen16"])
 def test_zero_length_segments_stay_finite(

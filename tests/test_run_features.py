@@ -10,6 +10,7 @@ import pytest
 from conftest import EXAMPLES
 
 from mdframework import cli
+from mdframework.dataset import FeatureConfig
 from mdframework.features import FEATURE_NAMES, spectrogram_features
 
 
@@ -38,9 +39,19 @@ person = {{ position = [0.0, 0.0], aspect_deg = 0.0 }}
     n = arrays["time_s"].shape[0]
     for key in ("envelope_upper_mps", "envelope_lower_mps", "torso_velocity_mps"):
         assert arrays[key].shape == (n,) and len(doc[key]) == n
-    # the same numbers as a dataset record computes from the same spectrogram
+    # the same numbers as a dataset record with the default features computes from the same
+    # spectrogram, and as the settings written beside them give
+    settings = doc["settings"]
+    assert settings == {k: v for k, v in FeatureConfig().model_dump().items() if k in settings}
     power = 10 ** (arrays["spectrogram_db"].astype(float) / 10)
-    expected = spectrogram_features(power, arrays["velocity_mps"])
+    expected = spectrogram_features(
+        power,
+        arrays["velocity_mps"],
+        method=settings["method"],
+        threshold_db=settings["threshold_db"],
+        floor_db=settings["floor_db"],
+        torso_method=settings["torso"],
+    )
     np.testing.assert_allclose(arrays["features_mps"], expected, rtol=1e-5, atol=1e-6)
     assert list(doc["features"]) == list(FEATURE_NAMES)
     np.testing.assert_allclose([doc["features"][k] for k in FEATURE_NAMES], arrays["features_mps"])

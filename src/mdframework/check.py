@@ -23,7 +23,7 @@ import numpy as np
 from . import limits
 from .errors import SceneError
 from .physics import radar
-from .pipeline import _place, _window, build_stages, load_motion, placed, refuse_near
+from .pipeline import build_stages, load_motion, placed, prepare_body, record_window, refuse_near
 from .plugins import Registry, default_registry
 from .settings import RunConfigBase
 
@@ -115,9 +115,9 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
     proc = config.processing
 
     motion = load_motion(stages.source)
-    body, _, _, where = _place(config, stages, motion, radar_pos)
+    body, _, _, where = prepare_body(config, stages, motion, radar_pos)
     body = placed(body, where)
-    t_start, t_end = _window(body, cfg.motion.start, cfg.motion.duration)
+    t_start, t_end = record_window(body, cfg.motion.start, cfg.motion.duration)
     limits.check_pulses(
         t_end - t_start, wf.pulse_rate, body.n_joints, "motion.duration", proc.keep_scatterers
     )

@@ -900,6 +900,7 @@ def _place_record(run: dict[str, Any], config: RunConfigBase, motion: Motion) ->
     recording's placement gives fixed, so that the record starts at the configured position.
     ``config``: ``run`` validated."""
     from .conditioning import condition
+    from .physics.scene import scene_heading_deg
     from .pipeline import body_placement
 
     scene: dict[str, Any] = json.loads(json.dumps(run.get("scene", {})))
@@ -915,7 +916,12 @@ def _place_record(run: dict[str, Any], config: RunConfigBase, motion: Motion) ->
     start = body.time[0] + float(run["motion"].get("start", 0.0))
     at = np.array([np.interp(start, body.time, base[:, k]) for k in (0, 1)])
     shift = at - np.asarray(person.position)
-    heading = _heading_deg(body, person, config.scene.radar_position)
+    heading = scene_heading_deg(
+        np.asarray(person.position, dtype=np.float64),
+        np.asarray(config.scene.radar_position, dtype=np.float64),
+        aspect_deg=person.aspect_deg,
+        heading_deg=person.heading_deg,
+    )
     new_person = dict(scene.get("person", {}))
     new_person.pop("aspect_deg", None)
     new_person["heading_deg"] = heading
@@ -925,14 +931,6 @@ def _place_record(run: dict[str, Any], config: RunConfigBase, motion: Motion) ->
     ]
     scene["person"] = new_person
     return scene
-
-
-def _heading_deg(body: Any, person: Any, radar_position: Any) -> float:
-    """The heading [deg] the pipeline's placement gives a person config (aspect or heading)."""
-    if person.heading_deg is not None:
-        return float(person.heading_deg)
-    to_radar = np.asarray(radar_position[:2]) - np.asarray(person.position)
-    return float(np.degrees(np.arctan2(to_radar[1], to_radar[0])) + (person.aspect_deg or 0.0))
 
 
 def _feature_options(fcfg: dict[str, Any]) -> dict[str, Any]:

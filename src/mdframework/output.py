@@ -88,10 +88,10 @@ def feature_arrays(result: RunResult) -> dict[str, np.ndarray]:
     env = envelopes(
         result.spectrogram.power,
         result.velocity,
-        method="threshold",
+        method=FEATURE_SETTINGS["method"],
         threshold_db=FEATURE_SETTINGS["threshold_db"],
         floor_db=FEATURE_SETTINGS["floor_db"],
-        torso_method="median",
+        torso_method=FEATURE_SETTINGS["torso"],
     )
     try:
         feats = features_from_envelopes(env)

@@ -156,21 +156,20 @@ def body_placement(
         )
     except ValueError as exc:
         raise SceneError(f"scene.person.facing: {exc}") from None
-    if person.heading_deg is not None:
-        heading = np.deg2rad(person.heading_deg)
-    else:
-        to_radar = radar_position[:2] - np.asarray(person.position)
-        if np.hypot(*to_radar) < 1e-9:
-            raise SceneError(
-                "scene.person.aspect_deg: the radar is straight above the person; "
-                "give heading_deg instead"
-            )
-        heading = np.arctan2(to_radar[1], to_radar[0]) + np.deg2rad(person.aspect_deg or 0.0)
+    try:
+        heading = scene.scene_heading_deg(
+            np.asarray(person.position, dtype=np.float64),
+            radar_position,
+            aspect_deg=person.aspect_deg,
+            heading_deg=person.heading_deg,
+        )
+    except ValueError as exc:
+        raise SceneError(f"scene.person.aspect_deg: {exc}") from None
     return scene.placement(
         body.time,
         base,
         heading_now=heading_now,
-        heading=float(heading),
+        heading=float(np.deg2rad(heading)),
         position=np.asarray(person.position),
         mode=person.motion,
         speed=person.speed or 0.0,
@@ -242,8 +241,8 @@ def _simulate_motion(
 
     clock = time.perf_counter()
     progress.stage("conditioning and placing the body")
-    body, conditioning_report, placement, where = _place(config, stages, motion, radar_pos)
-    t_start, t_end = _window(body, cfg.motion.start, cfg.motion.duration)
+    body, conditioning_report, placement, where = prepare_body(config, stages, motion, radar_pos)
+    t_start, t_end = record_window(body, cfg.motion.start, cfg.motion.duration)
     limits.check_pulses(
         t_end - t_start,
         wf.pulse_rate,
@@ -391,7 +390,7 @@ def _check_empty(
     )
 
 
-def _place(
+def prepare_body(
     config: RunConfigBase, stages: Stages, motion: Motion, radar_pos: FloatArray
 ) -> tuple[Skeleton, dict[str, Any], dict[str, Any], scene.Placement | None]:
     """The conditioned body (whole recording, not yet placed), the conditioning report, the
@@ -458,19 +457,6 @@ def _range_span(body: Skeleton, radar_pos: FloatArray) -> tuple[float, float]:
     return float(d.min()), float(d.max())
 
 
-def _fastest(ranges: FloatArray, t: FloatArray) -> float:
-    """The fastest radial speed [m/s] between consecutive pulses: ``ranges`` (n, n_scatterers)
-    [m] at times ``t`` (n,) [s], n >= 2. Pulses evenly spaced to 1e-9 (every waveform's) take
-    the largest range step over the shortest interval (at most 1e-9 above the exact value,
-    without a pass per pulse); others divide each pulse's largest step by its interval."""
-    step = ranges[1:] - ranges[:-1]
-    dt = np.diff(t)
-    dt_min, dt_max = float(dt.min()), float(dt.max())
-    if dt_max - dt_min <= 1e-9 * dt_min:
-        return max(float(step.max()), -float(step.min())) / dt_min
-    return float(np.max(np.maximum(step.max(axis=1), -step.min(axis=1)) / dt))
-
-
 class _Stream:
     """Collects a record's blocks: the slow-time signal, gate, range-time rows and products
     (arrays of n_pulses or fewer rows), and checks ranges and radial speeds as blocks pass."""
@@ -512,7 +498,7 @@ class _Stream:
         self.check_near(lo, scat, ranges)
         tb = self.t[lo : lo + ranges.shape[0]]
         if ranges.shape[0] > 1:
-            self.speed = max(self.speed, _fastest(ranges, tb))
+            self.speed = max(self.speed, radar.max_range_rate(ranges, tb))
         if self._last is not None and self._last[1].shape == ranges[0].shape:
             jump = float(np.max(np.abs(ranges[0] - self._last[1])))
             self.speed = max(self.speed, jump / (float(tb[0]) - self._last[0]))
@@ -618,7 +604,7 @@ def _gate(gate: str | float, at_pulses: Skeleton, radar_pos: FloatArray) -> Floa
     return np.full(at_pulses.time.shape, float(gate))
 
 
-def _window(body: Skeleton, start: float, duration: float | None) -> tuple[float, float]:
+def record_window(body: Skeleton, start: float, duration: float | None) -> tuple[float, float]:
     """First and last time [s] of the record (``start``/``duration`` from the first frame)."""
     end = start + duration if duration is not None else body.duration
     if start >= body.duration:

@@ -17,7 +17,7 @@ Checks, on the canonical 17-joint body:
    (5 x the median of the 13 frames around). Flagged in the metadata and warned about by
    default; ``glitches = "repair"`` replaces the frame by linear interpolation from the
    unflagged frames (:func:`repair_glitches`).
-2. **Human limits** (:func:`limit_violations`): the frame-to-frame speed and the acceleration
+2. **Human limits**: the frame-to-frame speed and the acceleration
    implied by ``e`` (``2 e / (dt1 dt2)``) against :data:`SPEED_LIMITS_MPS` and
    :data:`ACCEL_LIMITS_MPS2` (times ``speed_scale``).
 3. **Bone lengths** (:func:`bone_lengths`): the coefficient of variation of each limb bone's
@@ -170,27 +170,17 @@ def joint_speeds(time: FloatArray, positions: FloatArray) -> FloatArray:
     return np.asarray(step / np.diff(time)[:, None], dtype=np.float64)
 
 
-def limit_violations(
-    skeleton: Skeleton, scale: float = 1.0, exclude: BoolArray | None = None
+def _limit_violations(
+    skeleton: Skeleton, acc: FloatArray, scale: float, exclude: BoolArray | None
 ) -> list[dict[str, Any]]:
-    """Joints of a canonical skeleton over the speed or acceleration limits.
+    """Joints of a canonical skeleton over the speed or acceleration limits, with the implied
+    accelerations ``acc`` (n_frames, n_joints) [m/s^2] of :func:`deviations`.
 
     ``exclude`` (n_frames, n_joints) marks frames already reported as glitches (their implied
     acceleration is not counted twice). Returns one entry per offending joint and quantity:
     ``joint``, ``quantity`` ('speed' [m/s] or 'acceleration' [m/s^2]), ``max``, ``limit``,
     ``frames`` (count over the limit) and ``first_time_s``.
     """
-    if skeleton.n_frames < 3:
-        return []
-    _, acc = deviations(skeleton.time, skeleton.positions, skeleton.valid)
-    return _limit_violations(skeleton, acc, scale, exclude)
-
-
-def _limit_violations(
-    skeleton: Skeleton, acc: FloatArray, scale: float, exclude: BoolArray | None
-) -> list[dict[str, Any]]:
-    """:func:`limit_violations` with the implied accelerations ``acc`` (n_frames, n_joints)
-    [m/s^2] of :func:`deviations`."""
     t, p, valid = skeleton.time, skeleton.positions, skeleton.valid
     out: list[dict[str, Any]] = []
     if skeleton.n_frames < 3:
@@ -243,9 +233,15 @@ def bone_lengths(skeleton: Skeleton) -> dict[str, dict[str, float]]:
 def _period_strength(
     time: FloatArray, signal: FloatArray, min_strength: float = 0.3
 ) -> tuple[float, float] | None:
-    """(period [s], autocorrelation there) of the first clear period (see
-    :func:`first_period`), the lag refined to a fraction of a sample by a parabola through the
-    peak and its neighbours (at 15 frames per second a whole-sample lag is 10 % off)."""
+    """(period [s], autocorrelation there) of the signal's shortest clear period, or None:
+    the lag of the first local maximum of its autocorrelation (after the first zero crossing)
+    that reaches ``min_strength``. The signal is resampled linearly to its mean rate first, and
+    the lag refined to a fraction of a sample by a parabola through the peak and its neighbours
+    (at 15 frames per second a whole-sample lag is 10 % off).
+
+    The first such peak rather than the highest one: in a short clip the autocorrelation at a
+    multiple of the period can be higher than at the period itself.
+    """
     t = np.asarray(time, dtype=np.float64)
     n = t.shape[0]
     if n < 8 or t[-1] <= t[0]:
@@ -285,19 +281,6 @@ class _Autocorrelation:
             k = len(values)
             values.append(float(x[k:] @ x[: n - k]) / self.denom)
         return values[lag]
-
-
-def first_period(time: FloatArray, signal: FloatArray, min_strength: float = 0.3) -> float | None:
-    """The signal's shortest clear period [s]: the lag of the first local maximum of its
-    autocorrelation (after the first zero crossing) that reaches ``min_strength``; None if
-    there is none. The signal is resampled linearly to its mean rate first, and the lag refined
-    to a fraction of a sample.
-
-    The first such peak rather than the highest one: in a short clip the autocorrelation at a
-    multiple of the period can be higher than at the period itself.
-    """
-    found = _period_strength(time, signal, min_strength)
-    return None if found is None else found[0]
 
 
 def cadence_estimate(
@@ -352,9 +335,9 @@ def cadence_spm(
     """Steps per minute (:func:`cadence_estimate`), or None if nothing has a clear period.
 
     With the ankles alone: the distance between them peaks once per step (feet apart at double
-    support for a walk) whichever foot leads, so the cadence is ``60 / period``
-    (:func:`first_period`, strength 0.3 or more). A recording shorter than about two steps
-    gives None.
+    support for a walk) whichever foot leads, so the cadence is ``60 / period`` (the first
+    clear period of its autocorrelation, strength 0.3 or more). A recording shorter than about
+    two steps gives None.
     """
     found = cadence_estimate(time, l_ankle, r_ankle, pairs)
     return None if found is None else found[0]

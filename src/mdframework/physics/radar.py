@@ -69,6 +69,19 @@ def alias_frequency(doppler: ArrayLike, prf: float) -> FloatArray:
     return np.asarray(np.mod(f + prf / 2.0, prf) - prf / 2.0, dtype=np.float64)
 
 
+def max_range_rate(ranges: FloatArray, t: FloatArray) -> float:
+    """The fastest radial speed [m/s] between consecutive pulses: ``ranges`` (n, n_scatterers)
+    [m] at times ``t`` (n,) [s], n >= 2. Pulses evenly spaced to 1e-9 (every waveform's) take
+    the largest range step over the shortest interval (at most 1e-9 above the exact value,
+    without a pass per pulse); others divide each pulse's largest step by its interval."""
+    step = ranges[1:] - ranges[:-1]
+    dt = np.diff(t)
+    dt_min, dt_max = float(dt.min()), float(dt.max())
+    if dt_max - dt_min <= 1e-9 * dt_min:
+        return max(float(step.max()), -float(step.min())) / dt_min
+    return float(np.max(np.maximum(step.max(axis=1), -step.min(axis=1)) / dt))
+
+
 def range_equation_amplitude(
     rcs: ArrayLike,
     ranges: ArrayLike,

@@ -56,6 +56,25 @@ def body_heading(
     return facing_heading(left_hip, right_hip)
 
 
+def scene_heading_deg(
+    position: FloatArray,
+    radar_position: FloatArray,
+    *,
+    aspect_deg: float | None = None,
+    heading_deg: float | None = None,
+) -> float:
+    """The heading [deg] a person at horizontal ``position`` (2,) [m] is given: ``heading_deg``
+    when set; else the direction from the person to the radar (``radar_position`` (3,) [m],
+    its horizontal part) turned by ``aspect_deg`` (0: facing the radar, 180: facing away).
+    Raises ValueError when an aspect is asked of a radar straight above the person."""
+    if heading_deg is not None:
+        return float(heading_deg)
+    to_radar = np.asarray(radar_position, dtype=np.float64)[:2] - np.asarray(position)
+    if np.hypot(to_radar[0], to_radar[1]) < 1e-9:
+        raise ValueError("the radar is straight above the person; give heading_deg instead")
+    return float(np.degrees(np.arctan2(to_radar[1], to_radar[0])) + (aspect_deg or 0.0))
+
+
 def linear_drift_rate(time: FloatArray, track: FloatArray) -> FloatArray:
     """Slope (2,) [m/s] of the least-squares straight-line fit of a horizontal track
     (n_frames, 2) [m] over ``time`` (n_frames,) [s]: the velocity a treadmill removes (zero
