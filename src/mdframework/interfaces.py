@@ -43,7 +43,7 @@ from .pointcloud import PointCloud
 from .skeleton import Skeleton, to_canonical
 
 if TYPE_CHECKING:
-    from .physics.spectrogram import Spectrogram
+    from .physics.spectrogram import Spectrogram, SpectrogramGeometry
     from .settings import ProcessingConfig
 
 FloatArray = NDArray[np.float64]
@@ -435,8 +435,24 @@ class RadarWaveform(Plugin):
     ) -> Spectrogram | None:
         """The record's micro-Doppler spectrogram when this radar's slow time is not uniform
         (e.g. FMCW frames with gaps): ``signal`` (n_pulses,), ``times`` (n_pulses,) [s].
-        Default ``None``: the pipeline takes the STFT of ``signal`` at :attr:`prf`."""
+        Default ``None``: the pipeline takes the STFT of ``signal`` at :attr:`prf`. A radar that
+        overrides it overrides :meth:`spectrogram_geometry` to match."""
         return None
+
+    def spectrogram_geometry(
+        self, n_pulses: int, processing: ProcessingConfig
+    ) -> SpectrogramGeometry:
+        """The geometry of the spectrogram of a record of ``n_pulses`` pulses (window, hop, FFT
+        size, number of spectra, slow-time rate), worked out without its pulses: ``mdf check``
+        reports it and the run refuses a record too short for it before the first pulse.
+        :class:`~mdframework.physics.spectrogram.RecordTooShortError` when the record is too
+        short for one spectrum. Default: the pipeline's STFT of ``n_pulses`` samples at
+        :attr:`prf` (``processing`` window length, hop and FFT size); it must describe what
+        :meth:`spectrogram` gives (:func:`mdframework.testing.check_radar_waveform` compares)."""
+        from .physics.spectrogram import stft_geometry
+
+        p = processing
+        return stft_geometry(n_pulses, self.prf, p.window_length, p.hop, p.nfft)
 
     def gate_gain(self, ranges: FloatArray, gate_range: FloatArray) -> FloatArray | None:
         """Power gain (n_pulses, n_scatterers) of each scatterer in the range gate of

@@ -36,13 +36,26 @@ from .interfaces import (
     SceneContext,
 )
 from .physics import interpolation, radar, scene
-from .physics.spectrogram import RecordTooShortError, Spectrogram, power_to_db, spectrogram
+from .physics.spectrogram import (
+    RecordTooShortError,
+    Spectrogram,
+    SpectrogramGeometry,
+    power_to_db,
+    spectrogram,
+)
 from .plugins import PluginError, Registry, default_registry
 from .progress import QUIET, Progress
-from .settings import ConditioningConfig, PersonConfig, RunConfigBase, SanityConfig
+from .settings import (
+    ConditioningConfig,
+    PersonConfig,
+    ProcessingConfig,
+    RunConfigBase,
+    SanityConfig,
+)
 from .skeleton import Skeleton
 
 FloatArray = NDArray[np.float64]
+ComplexArray = NDArray[np.complex128]
 
 
 class AliasingWarning(UserWarning):
@@ -204,6 +217,42 @@ def load_motion(source: MotionSource) -> Motion:
     return sanity.check_motion(motion, getattr(source.config, "sanity", SanityConfig()))
 
 
+def spectrogram_geometry(
+    wf: RadarWaveform, n_pulses: int, proc: ProcessingConfig
+) -> SpectrogramGeometry:
+    """The geometry of the spectrogram the radar ``wf`` makes of ``n_pulses`` pulses
+    (:meth:`RadarWaveform.spectrogram_geometry`); a record too short for it is a
+    :class:`SceneError` naming ``processing.window_length``. ``mdf check`` reports it."""
+    try:
+        return wf.spectrogram_geometry(n_pulses, proc)
+    except RecordTooShortError as exc:
+        raise SceneError(f"processing.window_length: {exc}") from None
+
+
+def record_spectrogram(
+    wf: RadarWaveform, signal: ComplexArray, times: FloatArray, proc: ProcessingConfig
+) -> Spectrogram:
+    """The record's spectrogram: the radar's own (:meth:`RadarWaveform.spectrogram`, for a slow
+    time that is not uniform) or the STFT of ``signal`` (n_pulses,) at its PRF with the
+    ``processing`` window; ``times`` (n_pulses,) [s]. Its power is
+    :func:`spectrogram_geometry`'s shape (the radar contract checks this)."""
+    try:
+        spec = wf.spectrogram(signal, times, proc)  # a waveform's own slow time (FMCW)
+        if spec is None:
+            spec = spectrogram(
+                signal,
+                wf.prf,
+                window=proc.window,
+                window_length=proc.window_length,
+                hop=proc.hop,
+                nfft=proc.nfft,
+                precision=proc.precision,
+            )
+    except RecordTooShortError as exc:
+        raise SceneError(f"processing.window_length: {exc}") from None
+    return spec
+
+
 def simulate_motion(
     config: RunConfigBase,
     stages: Stages,
@@ -251,6 +300,7 @@ def _simulate_motion(
         keep_scatterers=proc.keep_scatterers,
     )
     t = wf.pulse_times(t_start, t_end)
+    spectrogram_geometry(wf, t.shape[0], proc)  # a record too short: refused before any pulse
     frames = interpolation.window_frames(body.time, float(t[0]), float(t[-1]))
     near = body.select_frames(frames)
     exact_linear = motion.linear_tracks and body is motion.skeleton
@@ -322,20 +372,7 @@ def _simulate_motion(
 
     clock = time.perf_counter()
     progress.stage("spectrogram")
-    try:
-        spec = wf.spectrogram(received.signal, t, proc)  # a waveform's own slow time (FMCW)
-        if spec is None:
-            spec = spectrogram(
-                received.signal,
-                wf.prf,
-                window=proc.window,
-                window_length=proc.window_length,
-                hop=proc.hop,
-                nfft=proc.nfft,
-                precision=proc.precision,
-            )
-    except RecordTooShortError as exc:
-        raise SceneError(f"processing.window_length: {exc}") from None
+    spec = record_spectrogram(wf, received.signal, t, proc)
     spec_db = power_to_db(spec.power, proc.floor_db, dtype=np.float32)
     velocity = radar.doppler_to_velocity(spec.doppler, wf.carrier_frequency)
     timings["spectrogram"] = time.perf_counter() - clock
