@@ -229,6 +229,23 @@ def spectrogram_geometry(
         raise SceneError(f"processing.window_length: {exc}") from None
 
 
+def processing_stft(
+    signal: ComplexArray, sample_rate: float, proc: ProcessingConfig
+) -> Spectrogram:
+    """The STFT of ``signal`` (n,) sampled at ``sample_rate`` [Hz] with the ``processing``
+    window, window length, hop, FFT size and precision (:func:`physics.spectrogram.spectrogram`;
+    :class:`RecordTooShortError` for a record shorter than the window)."""
+    return spectrogram(
+        signal,
+        sample_rate,
+        window=proc.window,
+        window_length=proc.window_length,
+        hop=proc.hop,
+        nfft=proc.nfft,
+        precision=proc.precision,
+    )
+
+
 def record_spectrogram(
     wf: RadarWaveform, signal: ComplexArray, times: FloatArray, proc: ProcessingConfig
 ) -> Spectrogram:
@@ -239,15 +256,7 @@ def record_spectrogram(
     try:
         spec = wf.spectrogram(signal, times, proc)  # a waveform's own slow time (FMCW)
         if spec is None:
-            spec = spectrogram(
-                signal,
-                wf.prf,
-                window=proc.window,
-                window_length=proc.window_length,
-                hop=proc.hop,
-                nfft=proc.nfft,
-                precision=proc.precision,
-            )
+            spec = processing_stft(signal, wf.prf, proc)
     except RecordTooShortError as exc:
         raise SceneError(f"processing.window_length: {exc}") from None
     return spec

@@ -517,20 +517,13 @@ class FmcwRadar(RadarWaveform):
         size ``max(processing.nfft, n_loops)``), at the frame's middle loop; the power in
         ``processing.precision`` (float32 by default). :meth:`spectrogram_geometry` gives its
         geometry."""
-        from mdframework.physics.spectrogram import Spectrogram, spectrogram
+        from mdframework.physics.spectrogram import Spectrogram
+        from mdframework.pipeline import processing_stft
 
         seq = self.sequence
         p = processing
         if self._gapless():
-            return spectrogram(
-                np.asarray(signal)[:: seq.n_tx],
-                self.prf,
-                window=p.window,
-                window_length=p.window_length,
-                hop=p.hop,
-                nfft=p.nfft,
-                precision=p.precision,
-            )
+            return processing_stft(np.asarray(signal)[:: seq.n_tx], self.prf, p)
         power, doppler, time = fmcw.frame_spectrogram(
             np.asarray(signal), seq, p.window, max(p.nfft, seq.n_loops), p.precision
         )
