@@ -750,3 +750,34 @@ def test_ctrl_c_wrapped_by_python_is_still_an_interrupt(
     monkeypatch.setattr(cli, "_cmd_plugins", interrupted)
     assert cli.main(["plugins"]) == cli.EXIT_INTERRUPTED
     assert capsys.readouterr().err == "mdf: interrupted\n"
+
+
+@pytest.mark.parametrize("command", ["run", "check"])
+def test_a_bug_in_a_plugins_constructor_is_an_internal_error_naming_the_plugin(
+    command: str,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A KeyError inside a radar's __init__ is the plugin's bug, not the user's input: exit 1,
+    one line naming the exception and the plugin (it used to be `mdf: error: presets`, exit 2,
+    as if the config had named an unknown kind); --debug shows the traceback."""
+    from mdf_lfm import LfmPulseDoppler
+
+    def broken_init(self: Any, config: Any) -> None:
+        self.preset = {}["presets"]  # type: ignore[misc]
+
+    monkeypatch.setattr(LfmPulseDoppler, "__init__", broken_init)
+    args = [command, str(EXAMPLES / "point_target.toml")]
+    if command == "run":
+        args += ["--out", str(tmp_path / "o")]
+    code, _, err = run_cli(args, capsys)
+    assert code == 1, err
+    assert err.strip() == (
+        "mdf: internal error: KeyError: 'presets' (in the radar plugin 'lfm' "
+        "(mdf_lfm.waveform.LfmPulseDoppler) while it was built from its config; run with --debug "
+        "for the traceback)"
+    )
+    assert not (tmp_path / "o").exists()
+    with pytest.raises(KeyError, match="presets"):
+        cli.main([*args, "--debug"])

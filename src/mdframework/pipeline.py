@@ -110,9 +110,17 @@ def build_stages(config: RunConfigBase, registry: Registry | None = None) -> Sta
 
     def make(interface: str, section: Any) -> Any:
         try:
-            return reg.get(interface, section.kind)(section)
+            cls = reg.get(interface, section.kind)
         except KeyError as exc:
             raise SceneError(str(exc.args[0])) from None
+        try:
+            return cls(section)
+        except Exception as exc:  # a bug in the plugin: the CLI's internal error names it
+            exc.add_note(
+                f"in the {interface} plugin {section.kind!r} "
+                f"({cls.__module__}.{cls.__qualname__}) while it was built from its config"
+            )
+            raise
 
     source, model = make("motion", cfg.motion), make("scatterers", cfg.scatterers)
     waveform = make("radar", cfg.radar)
