@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 from types import ModuleType
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 import pytest
@@ -75,6 +75,24 @@ class Approach(Effect):
         return Scatterers(moved, data.rcs, data.names, data.semi_axes, data.axes)
 
 
+class ProbeConfig(PluginConfig):
+    kind: Literal["probe"] = "probe"
+    label: str = ""
+
+
+class Probe(Effect):
+    """Draws five normal numbers from its generator and records them under its label."""
+
+    name = "probe"
+    Config = ProbeConfig
+    stage = "received"
+    drawn: ClassVar[dict[str, np.ndarray]] = {}
+
+    def apply(self, data: Received, context: SceneContext) -> Received:
+        Probe.drawn[self.config.label] = context.rng.standard_normal(5)  # type: ignore[attr-defined]
+        return data
+
+
 class NoiseConfig(PluginConfig):
     kind: Literal["unit_noise"] = "unit_noise"
 
@@ -94,7 +112,7 @@ class UnitNoise(Effect):
 
 @hookimpl
 def mdframework_register_effects() -> list[type[Effect]]:
-    return [Explode, ScaleRcs, Approach, UnitNoise]
+    return [Explode, ScaleRcs, Approach, Probe, UnitNoise]
 
 
 @pytest.fixture(scope="module")
@@ -172,3 +190,33 @@ def test_remembered_ranges_belong_to_the_positions_they_were_computed_from() -> 
     for copy in (dataclasses.replace(scat, positions=pos.copy()), scat.replace(positions=pos + 0)):
         assert copy.range_cache is None
         assert np.allclose(copy.ranges(radar), exact, rtol=0, atol=1e-12)
+
+
+def draws(registry: Registry, labels: list[str], seed: int = 5, **more: Any) -> dict[str, Any]:
+    """What each probe effect drew in a run listing them (after ``more`` effects)."""
+    Probe.drawn = {}
+    effects = [*more.get("before", []), *({"kind": "probe", "label": x} for x in labels)]
+    run(registry, effects, seed=seed)
+    return dict(Probe.drawn)
+
+
+def test_each_effect_draws_from_its_own_stream(registry: Registry) -> None:
+    """Listing an effect before another leaves the other's draws as they were (it used to share
+    one generator, so the second effect drew what the first left); two effects draw different
+    numbers; a scatterer-stage effect before them changes nothing."""
+    alone = draws(registry, ["b"])["b"]
+    both = draws(registry, ["a", "b"])
+    assert np.array_equal(both["b"], alone)
+    assert not np.any(np.isin(both["a"], alone))
+    three = draws(registry, ["c", "a", "b"])
+    assert np.array_equal(three["b"], alone) and np.array_equal(three["a"], both["a"])
+    after_scatterers = draws(registry, ["b"], before=[{"kind": "scale_rcs"}])
+    assert np.array_equal(after_scatterers["b"], alone)
+
+
+def test_a_lone_effect_draws_what_it_always_drew(registry: Registry) -> None:
+    """A run with one effect keeps its stream: the first child of the run seed's SeedSequence,
+    so every published number made with one random effect stays as it was."""
+    for seed in (0, 5, 2**63 + 1):
+        expected = np.random.default_rng(np.random.SeedSequence(seed).spawn(2)[0])
+        assert np.array_equal(draws(registry, ["x"], seed)["x"], expected.standard_normal(5))

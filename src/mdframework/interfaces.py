@@ -555,9 +555,10 @@ class SceneContext:
     of the whole record for received-stage effects; ``skeleton``: the body at the block's pulse
     times in the scene frame (canonical joints when the scatterer model uses them), ``None`` for
     received-stage effects; ``waveform``: the radar plugin (for its bandwidth, pulse width, range
-    equation); ``rng``: the effect's own seeded generator (derived from the run's seed and the
-    effect's position; received-stage effects only: a scatterer-stage effect must not draw
-    random numbers, so that it is block-invariant); ``block_start``: index of the block's first
+    equation); ``rng``: the effect's own seeded generator (from the run's seed and the number of
+    effects of its stage listed after it: :func:`mdframework.pipeline.effect_generators`;
+    received-stage effects only: a scatterer-stage effect must not draw random numbers, so that
+    it is block-invariant); ``block_start``: index of the block's first
     pulse in the record (0 for received-stage effects).
     """
 

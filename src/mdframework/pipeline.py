@@ -130,11 +130,33 @@ def build_stages(config: RunConfigBase, registry: Registry | None = None) -> Sta
     return Stages(source, model, waveform, effects)
 
 
-def _apply_effects(stages: Stages, stage: str, data: Any, context: SceneContext) -> Any:
+def effect_generators(seed: int, effects: Sequence[Effect]) -> tuple[np.random.Generator, ...]:
+    """Each effect's own random generator, in the order of ``effects``.
+
+    A received-stage effect with ``k`` received-stage effects listed after it draws from stream
+    ``k`` of the run's seed (``SeedSequence(seed).spawn(n)[k]``): listing an effect before
+    another leaves the other's draws as they were, and a lone effect (the last of its stage)
+    draws from stream 0 as every run always has. A scatterer-stage effect draws nothing (it
+    must be block-invariant); it gets stream ``(k, 1)``, which no received-stage effect has."""
+    streams: list[np.random.Generator] = []
+    for i, effect in enumerate(effects):
+        after = sum(e.stage == effect.stage for e in effects[i + 1 :])
+        key = (after,) if effect.stage == "received" else (after, 1)
+        streams.append(np.random.default_rng(np.random.SeedSequence(seed, spawn_key=key)))
+    return tuple(streams)
+
+
+def _apply_effects(
+    stages: Stages,
+    stage: str,
+    data: Any,
+    context: SceneContext,
+    generators: Sequence[np.random.Generator],
+) -> Any:
     expected = type(data)
-    for effect in stages.effects:
+    for effect, rng in zip(stages.effects, generators, strict=True):
         if effect.stage == stage:
-            data = effect.apply(data, context)
+            data = effect.apply(data, replace(context, rng=rng))
             if not isinstance(data, expected):
                 raise PluginError(
                     f"effect {effect.name!r} ({type(effect).__module__}.{type(effect).__name__}) "
@@ -339,8 +361,9 @@ def _simulate_motion(
     timings["prepare"] = time.perf_counter() - clock
 
     n = t.shape[0]
-    seeds = np.random.SeedSequence(config.seed).spawn(len(stages.effects) + 1)
-    rng = np.random.default_rng(seeds[0])
+    generators = effect_generators(config.seed, stages.effects)
+    # the contexts' generator: _apply_effects gives each effect its own in its place
+    rng = generators[0] if generators else np.random.default_rng(config.seed)
     stream = _Stream(n, proc.keep_scatterers, proc.aliasing, wf, sc.min_range, t)
     losses = emptiness.Losses()
     blocks = _blocks(n, proc.block_pulses, wf.block_multiple)
@@ -360,7 +383,7 @@ def _simulate_motion(
         )
         if early_effects:  # the body itself within scene.min_range: refused before any effect
             stream.check_near(lo, scat, scat.ranges(radar_pos))
-        scat = _apply_effects(stages, "scatterers", scat, context)
+        scat = _apply_effects(stages, "scatterers", scat, context, generators)
         ranges = scat.ranges(radar_pos)
         stream.check(lo, scat, ranges)
         s = slice(None, None, emptiness.SAMPLE_EVERY)
@@ -382,7 +405,7 @@ def _simulate_motion(
         received = replace(received, products={**received.products, **wf.product_axes()})
     echo = received.signal.copy()  # the target's echo, before noise and clutter
     context = SceneContext(radar_pos, wf.prf, wf.carrier_frequency, t, stream.gate, None, wf, rng)
-    received = _apply_effects(stages, "received", received, context)
+    received = _apply_effects(stages, "received", received, context, generators)
     _check_empty(echo, losses, proc, fixed_gate=sc.gate != "track")
     effects_ran = _describe(stages, "scatterers") + _describe(stages, "received")
     timings["received_effects"] = time.perf_counter() - clock
