@@ -362,12 +362,19 @@ def test_corrupt_and_partial_records_are_redone(tmp_path: Path) -> None:
     files = sorted((out / RECORDS).glob("*.npz"))
     files[0].write_bytes(files[0].read_bytes()[:200])  # truncated by a crash
     files[1].unlink()  # never written
+    with np.load(files[2]) as npz:  # readable, but its metadata lacks a field (it crashed)
+        arrays = {k: npz[k] for k in npz.files}
+    meta = json.loads(str(arrays["meta"]))
+    del meta["start_s"]
+    arrays["meta"] = np.array(json.dumps(meta))
+    with files[2].open("wb") as fh:
+        np.savez(fh, **arrays)
     (out / RECORDS / ".tmp-abc.npz").write_bytes(b"half")  # temp file of a killed writer
-    stamp = {p.name: p.stat().st_mtime_ns for p in files[2:]}
+    stamp = {p.name: p.stat().st_mtime_ns for p in files[3:]}
     build_dataset(cfg, base, out, workers=1, progress=False)
     assert_same(out, reference)
     assert not list((out / RECORDS).glob(".tmp-*"))
-    assert {p.name: p.stat().st_mtime_ns for p in files[2:]} == stamp  # not redone
+    assert {p.name: p.stat().st_mtime_ns for p in files[3:]} == stamp  # not redone
 
 
 def finished_records(out: Path) -> list[Path]:

@@ -206,3 +206,45 @@ def test_an_empty_variation_list_is_refused(tmp_path: Path) -> None:
     with pytest.raises(MdfError, match=r"variations\.aspect_deg: an empty list"):
         load_dataset_config(cfg)
     load_dataset_config(walk_config(tmp_path / "ok.toml", "[variations]\naspect_deg = [0, 90]\n"))
+
+
+def test_place_record_with_a_motion_conditioning_refuses_is_one_clear_error(
+    tmp_path: Path,
+) -> None:
+    """A real Kinect table whose left hand is lost for about 0.7 s, with conditioning told to stop
+    on gaps over 0.1 s: placing each record (``place = "record"``) conditions the recording
+    while planning, and that stop is one clear error, not an internal ValueError."""
+    example = EXAMPLES / "table_utkinect_walk.toml"
+    source = EXAMPLES / "data" / "kinect" / "utkinect" / "joints_s01_e01.txt"
+    rows = source.read_text().splitlines()
+    lost = []
+    for row in rows:
+        cells = row.split()
+        if 300 <= int(cells[0]) < 340:  # frames at 60 per second
+            cells[1 + 3 * 7 : 1 + 3 * 8] = ["0", "0", "0"]  # HandLeft, the 8th joint
+        lost.append(" ".join(cells))
+    table = tmp_path / "joints.txt"
+    table.write_text("\n".join(lost) + "\n")
+    motion = example.read_text().split("[motion]")[1].split("[scatterers]")[0]
+    motion = motion.replace('"data/kinect/utkinect/joints_s01_e01.txt"', f'"{table}"')
+    motion = motion.replace('activity = "walk"\n', "")
+    config = tmp_path / "d.toml"
+    config.write_text(f"""
+seed = 1
+place = "record"
+[[sources]]
+label = "walk"
+record_length = 1.0
+[sources.motion]
+{motion}
+[base.scene]
+radar_position = [0.0, 0.0, 0.0]
+person = {{ position = [2.3, 0.0], aspect_deg = 0.0 }}
+[base.conditioning]
+enabled = true
+max_gap_s = 0.1
+long_gaps = "error"
+""")
+    cfg, base = load_dataset_config(config)
+    with pytest.raises(MdfError, match=r"conditioning: joint 'l_hand' is untracked for 0\.73"):
+        plan_records(cfg, base)

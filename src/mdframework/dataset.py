@@ -899,16 +899,13 @@ def _place_record(run: dict[str, Any], config: RunConfigBase, motion: Motion) ->
     moved back by the placed recording's travel up to the record's start, and the heading the
     recording's placement gives fixed, so that the record starts at the configured position.
     ``config``: ``run`` validated."""
-    from .conditioning import condition
     from .physics.scene import scene_heading_deg
-    from .pipeline import body_placement
+    from .pipeline import body_placement, condition_body
 
     scene: dict[str, Any] = json.loads(json.dumps(run.get("scene", {})))
     if motion.canonical_map is None:
         return scene
-    body = motion.canonical()
-    if config.conditioning.enabled:
-        body, _ = condition(body, config.conditioning)
+    body, _ = condition_body(motion.canonical(), config.conditioning)
     person = config.scene.person
     # only the hip centre's track is placed: the placement comes from the whole recording
     where = body_placement(body, person, np.asarray(config.scene.radar_position, np.float64))
@@ -1243,15 +1240,21 @@ def read_record(path: Path) -> tuple[dict[str, NDArray[Any]], dict[str, Any]]:
 
 
 def _complete(path: Path) -> dict[str, Any] | None:
-    """The index row of a finished record, or None if it must be (re)built."""
+    """The index row of a finished record, or None if it must be (re)built: a record cut
+    short, corrupt, or whose metadata lacks a field is removed. A record that cannot be read
+    for want of permission is an error (it is not removed)."""
+    import zipfile
+
     if not path.exists():
         return None
     try:
         arrays, meta = read_record(path)
-    except Exception:
+        return _row(meta, arrays["features"])
+    except PermissionError as exc:
+        raise OutputError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    except (OSError, EOFError, ValueError, KeyError, TypeError, zipfile.BadZipFile):
         path.unlink(missing_ok=True)
         return None
-    return _row(meta, arrays["features"])
 
 
 def scheduler_address(given: str | None) -> str | None:

@@ -480,7 +480,7 @@ def prepare_body(
             f"motion ({motion.metadata.get('source', 'unknown')}) has no canonical joints"
         )
     body = motion.canonical() if stages.model.needs_canonical else motion.skeleton
-    body, conditioning_report = _condition(body, config.conditioning)
+    body, conditioning_report = condition_body(body, config.conditioning)
     if stages.model.needs_canonical:
         where = body_placement(body, sc.person, radar_pos)
         return body, conditioning_report, sc.person.model_dump(), where
@@ -697,8 +697,9 @@ def record_window(body: Skeleton, start: float, duration: float | None) -> tuple
     return float(body.time[0] + start), float(body.time[0] + min(end, body.duration))
 
 
-def _condition(body: Skeleton, cfg: ConditioningConfig) -> tuple[Skeleton, dict[str, Any]]:
-    """Skeleton conditioning when enabled (:func:`conditioning.condition`)."""
+def condition_body(body: Skeleton, cfg: ConditioningConfig) -> tuple[Skeleton, dict[str, Any]]:
+    """Skeleton conditioning when enabled (:func:`conditioning.condition`): the body and the
+    conditioning report; a body it cannot condition is a :class:`SceneError`."""
     if not cfg.enabled:
         return body, {"enabled": False}
     try:
