@@ -390,8 +390,9 @@ class ConditioningConfig(StrictModel):
     )
     smoothing: Literal["none", "violating", "all"] = Field(
         "violating",
-        description="Gaussian smoothing after the speed limit: of no joint, of the joints that "
-        "exceeded the limit, or of all joints.",
+        description="Gaussian smoothing of the joint tracks, after the speed limit: of no joint, "
+        "of the joints that exceeded the limit (none when speed_limit is false), or of all "
+        "joints (with or without speed_limit).",
     )
     smoothing_sigma_s: float = Field(
         0.03, ge=0, le=10, description="Standard deviation of the smoothing kernel [s]."
