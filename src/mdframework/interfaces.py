@@ -357,8 +357,8 @@ class Received:
     ``range_time`` (n_rows, n_bins) complex128 and ``range_axis`` (n_bins,) float64 [m]: the
     compressed output over a window of ranges, when the waveform computes it (else ``None``); a
     waveform returns one row per pulse of a block, and the pipeline keeps every pulse's row of a
-    record up to ``processing.max_range_time_rows`` and evenly spaced rows beyond
-    (``range_time_pulses`` (n_rows,) int64 then gives the pulse index of each row).
+    record up to :data:`mdframework.pipeline.MAX_KEPT_RANGE_TIME_ROWS` (16384) and evenly spaced
+    rows beyond (``range_time_pulses`` (n_rows,) int64 then gives the pulse index of each row).
     ``products``: further arrays a waveform produces (e.g. range-Doppler maps or point clouds),
     each stacked along axis 0 over a record's blocks and saved under its name.
     """

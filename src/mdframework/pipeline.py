@@ -66,9 +66,10 @@ class EmptyResultWarning(UserWarning):
     """The record holds (almost) nothing of the target (see :mod:`mdframework.emptiness`)."""
 
 
-#: Range-time rows a record keeps: every pulse's row up to this many pulses, evenly spaced rows
-#: beyond (the map is for display; the slow-time ``signal`` keeps every pulse).
-MAX_RANGE_TIME_ROWS = 16384
+#: Range-time rows a record keeps in memory (``Received.range_time``): every pulse's row up to
+#: this many pulses, evenly spaced rows beyond (the map is for display; the slow-time ``signal``
+#: keeps every pulse). ``output.MAX_SAVED_RANGE_TIME_ROWS`` bounds the rows saved to a file.
+MAX_KEPT_RANGE_TIME_ROWS = 16384
 
 
 @dataclass(frozen=True)
@@ -556,7 +557,7 @@ class _Stream:
         self.names: tuple[str, ...] = ()
         self._last: tuple[float, FloatArray] | None = None
         self._blocks: list[Scatterers] = []
-        self._rt_step = max(1, -(-n // MAX_RANGE_TIME_ROWS))
+        self._rt_step = max(1, -(-n // MAX_KEPT_RANGE_TIME_ROWS))
         self._rt: list[NDArray[np.complex128]] = []
         self._rt_axis: FloatArray | None = None
         self._products: dict[str, list[NDArray[Any]]] = {}
