@@ -19,7 +19,7 @@ from mdframework.dataset import (
     plan_records,
     read_record,
 )
-from mdframework.errors import ConfigError
+from mdframework.errors import ConfigError, MdfError
 from mdframework.features import FEATURE_NAMES
 
 RADHAR = EXAMPLES / "data" / "radhar"
@@ -280,3 +280,83 @@ def test_the_sim_to_real_dataset_plan() -> None:
     sim = [s for s in specs if s.group == "sim"]
     assert all(s.draws and "radar_height" in s.draws for s in sim)
     assert len({s.draws["radar_height"] for s in sim if s.draws}) == len(sim)
+
+
+def write_recorded(path: Path, length: float, extra: str = "", lo: float = 0.5) -> Path:
+    """One real RadHAR recording (20_boxing_3.txt) cut into records of ``length`` s given by
+    ``record_lengths.boxing``; histograms of the points ``lo``..``lo + 2.5`` m."""
+    path.write_text(f"""
+{extra}
+[record_lengths]
+boxing = {length}
+[[sources]]
+label = "boxing"
+max_records = 1
+[sources.recording]
+kind = "radhar"
+file = "{RADHAR / "radhar_boxing_subset.npz"}"
+recordings = ["20_boxing_3.txt"]
+[histogram]
+min_range = {lo}
+max_range = {lo + 2.5}
+""")
+    return path
+
+
+def test_a_record_length_below_one_frame_of_a_recording_names_the_field(tmp_path: Path) -> None:
+    """10 ms is under one 33.3 ms frame of the IWR1443 recordings: refused naming
+    record_lengths.boxing and the frame, not as "0 frames do not fit 601 frames"."""
+    cfg, base = load_dataset_config(write_recorded(tmp_path / "r.toml", 0.01))
+    with pytest.raises(ConfigError) as info:
+        plan_records(cfg, base)
+    assert str(info.value) == (
+        "record_lengths.boxing: 0.01 s is shorter than one 33.3 ms frame of 20_boxing_3.txt: "
+        "give at least 0.03333 s"
+    )
+    # one frame is the shortest record
+    cfg, base = load_dataset_config(write_recorded(tmp_path / "one.toml", 0.0334))
+    [spec] = plan_records(cfg, base)
+    assert spec.run_config["frames"] == 1
+
+
+def test_a_failing_recorded_record_names_its_recording_and_window(tmp_path: Path) -> None:
+    """A recorded record's error names its recording file and window (frames 0-59 of a 30 Hz
+    recording: 0-2 s), and with on_error = "skip" its index row does too."""
+    cfg, base = load_dataset_config(write_recorded(tmp_path / "r.toml", 2.0, lo=8.0))
+    with pytest.raises(MdfError) as info:
+        build_dataset(cfg, base, tmp_path / "stop", workers=1, progress=False)
+    assert "(boxing; source file 20_boxing_3.txt, window 0.000-2.000 s)" in str(info.value)
+    assert "no point within 8-10.5 m in any frame" in str(info.value)
+    path = write_recorded(tmp_path / "skip.toml", 2.0, 'on_error = "skip"', lo=8.0)
+    cfg, base = load_dataset_config(path)
+    # the skipped row's file and window (read from the warning: every record failed)
+    skipped = r"\(20_boxing_3.txt, window 0.000 s \+ 1.9999\d* s\) skipped: .*no point within"
+    with pytest.warns(UserWarning, match=skipped), pytest.raises(MdfError, match="every record"):
+        build_dataset(cfg, base, tmp_path / "skip", workers=1, progress=False)
+
+
+def test_a_simulated_record_shorter_than_one_fmcw_frame_names_record_lengths(
+    tmp_path: Path,
+) -> None:
+    """2 ms records with the IWR1443 preset, whose frame takes 48 chirps x 64.14 us = 3.079 ms:
+    the build stops naming record_lengths.walk and the minimum (not an IndexError)."""
+    path = tmp_path / "short.toml"
+    path.write_text(f"""
+[record_lengths]
+walk = 0.002
+[[sources]]
+label = "walk"
+motion = {{ kind = "cmu", file = "{CMU_WALK}" }}
+max_records = 1
+[base.radar]
+kind = "fmcw"
+preset = "iwr1443_short_range_3d"
+[base.scene]
+radar_position = [4.0, 0.0, 1.0]
+""")
+    cfg, base = load_dataset_config(path)
+    with pytest.raises(MdfError) as info:
+        build_dataset(cfg, base, tmp_path / "ds", workers=1, progress=False)
+    text = str(info.value)
+    assert "record_lengths.walk: the 2.000 ms record holds no pulse of the fmcw radar" in text
+    assert "at least 3.079 ms" in text and "motion.duration" not in text

@@ -266,6 +266,28 @@ def test_range_doppler_map_peaks_at_the_target_amplitude(name: str) -> None:
     assert power[row, k] == pytest.approx(3 * a**2, rel=1e-9)
 
 
+@pytest.mark.parametrize("name", sorted(fmcw.WINDOWS))
+def test_one_loop_per_frame_keeps_the_target_amplitude(name: str) -> None:
+    """Hard case n_loops = 1: a one-sample window is [1] whatever its name (a periodic Hann
+    formula gives [0] and nulled the only loop, then 0/0), so the Doppler "FFT" of one loop is
+    the identity: the map holds each virtual channel's range profile, a lone on-bin target at
+    its amplitude a in every channel and n_virt a^2 in the detection map, at 0 Hz."""
+    seq = fmcw.ChirpSequence(77e9, 70e12, 7e-6, 7e-6, 57.14e-6, 4.884e6, 240, 1, (0, 2, 1), 33e-3)
+    a, k = 0.37, 40
+    np.testing.assert_array_equal(fmcw.window(name, 1), [1.0])  # type: ignore[arg-type]
+    assert fmcw.window_transform(name, 1, np.array([0.0, 0.3]))[1] == 1.0  # type: ignore[arg-type]
+    t = fmcw.chirp_times(seq, 0.0, seq.frame_period)
+    amp = np.full((t.size, 1), a, dtype=np.complex128)
+    delays = np.full((t.size, 1), 2 * k * seq.range_resolution / C)
+    prof = fmcw.range_profile(fmcw.if_samples(delays, amp, seq), "hann", 240)
+    cube = fmcw.virtual_cube(prof[:, None, :], seq, 3)
+    rd = fmcw.range_doppler(cube, name, 1)  # type: ignore[arg-type]
+    np.testing.assert_array_equal(rd, cube)
+    np.testing.assert_allclose(np.abs(rd[:, 0, k]), a, rtol=1e-9)
+    assert fmcw.doppler_axis(seq, 1).tolist() == [0.0]
+    assert fmcw.detection_map(rd)[0, k] == pytest.approx(3 * a**2, rel=1e-9)
+
+
 def test_velocity_beyond_the_tdm_limit_aliases() -> None:
     """Hard case: the unambiguous velocity is lambda / (4 n_tx T_chirp) (TDM: one sample per
     loop); at 1.25 x it the peak wraps to 1.25 v_max - 2 v_max = -0.75 v_max."""

@@ -617,3 +617,90 @@ def test_the_input_rules_page_states_the_radar_bounds_and_messages_of_the_code()
         fmcw_run([{"position": [12.0, 0.0, 0.0], "rcs": 1.0}], duration=0.2, **QUIET)
     text = str(scene_err.value).split(": raise")[0]
     assert text in page, text
+
+
+def test_a_record_shorter_than_one_frame_is_refused_naming_duration_and_minimum(
+    tmp_path: Any, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The IWR1443 preset's frame is 48 chirps of 64.14 us, 3.079 ms: a 3 ms record holds no
+    frame. `mdf run` and `mdf check` both stop with one line naming motion.duration and the
+    minimum (exit 2, not an IndexError); a record of one frame's chirps runs."""
+    from mdframework import cli
+
+    need = IWR1443.sequence().frame_active_time
+    assert need == pytest.approx(48 * 64.14e-6, rel=1e-4)
+    target = "{ position = [2.0, 0.0, 0.0], velocity = [0.0, 0.0, 0.0], rcs = 1.0 }"
+    text = (
+        '[motion]\nkind = "point_targets"\nlength = 0.1\nduration = DURATION\n'
+        f"targets = [{target}]\n"
+        '[scatterers]\nkind = "points"\n'
+        '[radar]\nkind = "fmcw"\npreset = "iwr1443_short_range_3d"\n'
+        "[scene]\nradar_position = [0.0, 0.0, 0.0]\n"
+    )
+    short = tmp_path / "short.toml"
+    short.write_text(text.replace("DURATION", "0.003"))
+    line = (
+        "motion.duration: the 3.000 ms record holds no pulse of the fmcw radar, whose pulses "
+        "need a record of at least 3.079 ms: lengthen motion.duration"
+    )
+    for command in (["run", str(short), "--out", str(tmp_path / "out")], ["check", str(short)]):
+        assert cli.main(command) == 2
+        err = capsys.readouterr().err
+        assert err.strip() == f"mdf: error: {short}: {line}"
+    assert not (tmp_path / "out").exists()
+    one = tmp_path / "one.toml"
+    one.write_text(text.replace("DURATION", f"{need + 1e-6:.7f}"))
+    assert cli.main(["run", str(one), "--out", str(tmp_path / "one"), "--no-figures"]) == 0
+    with np.load(tmp_path / "one" / "result.npz") as d:
+        assert d["signal"].shape == (48,)
+
+
+def test_one_loop_per_frame_gives_finite_points_at_zero_velocity() -> None:
+    """n_loops = 1 with the preset's Hann Doppler window (was 0/0: a one-sample periodic Hann
+    is [0]): a static 1 m^2 point 3 m ahead, 20 deg to the right, gives in every frame a
+    strongest point there with v = 0 (the only Doppler bin) and a finite intensity."""
+    az = np.deg2rad(20.0)
+    pos = [3 * np.cos(az), -3 * np.sin(az), 0.0]  # sensor right = scene -y
+    res = fmcw_run([{"position": pos, "velocity": [0.0, 0.0, 0.0], "rcs": 1.0}], 0.2, n_loops=1)
+    pts = res.received.products["points"]
+    assert np.all(np.isfinite(pts))
+    assert res.received.products["range_doppler"].shape[1] == 1
+    for f in range(6):  # 0.2 s of 33.3 ms frames
+        p = pts[pts[:, 0] == f]
+        best = p[np.argmax(p[:, 6])]
+        assert np.linalg.norm(best[2:5]) == pytest.approx(3.0, abs=0.0436)
+        assert best[2] / 3.0 == pytest.approx(np.sin(az), abs=0.05)
+        assert best[5] == 0.0 and best[6] > 15.0
+
+
+@pytest.mark.parametrize("tdm_order", [[1, 3, 2], [1, 3]])
+def test_angles_come_from_the_virtual_antennas_of_the_used_transmitters(
+    tdm_order: list[int],
+) -> None:
+    """Two points 3 m away, one on boresight at z = 0 approaching at 1.23 m/s, one 20 deg to the
+    right and 0.5 m up receding at 1.23 m/s. With TX1, TX3, TX2 the strongest point of each is
+    at its x and z; leaving TX2 (the one above the others) out of the TDM order leaves an
+    azimuth-only array of 8 virtual antennas: x still right and z exactly 0, not the garbage
+    elevations (z from -3 to +1 m) that the 4 zero channels of the unused TX gave."""
+    az = np.deg2rad(20.0)
+    b = np.array([np.sqrt(9 - 0.25) * np.cos(az), -np.sqrt(9 - 0.25) * np.sin(az), 0.5])
+    v = 2 * 0.61472423
+    targets = [
+        {"position": [3.0, 0.0, 0.0], "velocity": [-v, 0.0, 0.0], "rcs": 1.0},
+        {"position": b.tolist(), "velocity": (v * b / 3.0).tolist(), "rcs": 1.0},
+    ]
+    res = fmcw_run(targets, 0.2, tdm_order=tdm_order)
+    pts = res.received.products["points"]
+    for f in range(6):
+        p = pts[pts[:, 0] == f]
+        t = f * 33.333e-3
+        for target, sign in zip(targets, (1.0, -1.0), strict=True):
+            at = np.add(target["position"], t * np.asarray(target["velocity"]))
+            near = p[p[:, 5] * sign > 0]  # approaching or receding
+            best = near[np.argmax(near[:, 6])]
+            assert np.linalg.norm(best[2:5]) == pytest.approx(np.linalg.norm(at), abs=0.05)
+            assert best[2] == pytest.approx(-at[1], abs=0.1)  # sensor right = scene -y
+            if len(tdm_order) == 3:
+                assert best[4] == pytest.approx(at[2], abs=0.1)
+            else:
+                assert np.all(p[:, 4] == 0.0)

@@ -288,3 +288,26 @@ def test_the_same_real_markers_in_a_c3d_file_give_the_same_body(tmp_path) -> Non
     assert a.metadata["markers"] == b.metadata["markers"]
     np.testing.assert_allclose(b.skeleton.time, a.skeleton.time)
     np.testing.assert_allclose(b.skeleton.positions, a.skeleton.positions, rtol=0, atol=1e-6)
+
+
+def test_skipped_frame_numbers_keep_their_time(tmp_path, lines) -> None:
+    """A tracker that lost the subject for Frame# 31..60 (0.5 s at 60 Hz) writes no rows for
+    them: each kept frame stays at (Frame# - 1) / 60 s, so the body is where the full
+    recording has it at that time, and the run is warned about the gap."""
+    rows = [r for r in lines[6:] if not 31 <= int(r.split("\t")[0]) <= 60]
+    head = _header(list(lines[:6]), "NumFrames", str(len(rows)))
+    path = _write(tmp_path, [*head, *rows])
+    with pytest.warns(UserWarning) as caught:
+        gap = TrcSource(TrcConfig(file=path)).load()
+    # as docs/motion-formats.md shows it
+    assert [str(w.message) for w in caught] == [
+        f"{path}: Frame# skips 30 frame(s) (the longest gap 0.5167 s, after Frame# 30 at "
+        "0.4833 s): the time base keeps the gaps, and the motion is interpolated across them"
+    ]
+    frame_numbers = np.array([int(r.split("\t")[0]) for r in rows])
+    t = gap.skeleton.time
+    np.testing.assert_allclose(t, (frame_numbers - 1) / 60.0, rtol=0, atol=1e-12)
+    assert t[30] == pytest.approx(1.0) and t[-1] == pytest.approx(2.5)
+    assert gap.skeleton.duration == pytest.approx(2.5) and gap.metadata["frames_skipped"] == 30
+    full = TrcSource(TrcConfig(file=REAL)).load().skeleton
+    np.testing.assert_array_equal(gap.skeleton.positions, full.positions[frame_numbers - 1])

@@ -27,6 +27,7 @@ from .pipeline import (
     load_motion,
     placed,
     prepare_body,
+    record_pulses,
     record_window,
     refuse_near,
     spectrogram_geometry,
@@ -129,7 +130,7 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
     limits.check_pulses(
         t_end - t_start, wf.pulse_rate, body.n_joints, "motion.duration", proc.keep_scatterers
     )
-    n_pulses = int(wf.pulse_times(t_start, t_end).shape[0])
+    n_pulses = int(record_pulses(wf, t_start, t_end).shape[0])
     geometry = spectrogram_geometry(wf, n_pulses, proc)
 
     inside = (body.time >= t_start - 1e-9) & (body.time <= t_end + 1e-9)

@@ -43,7 +43,7 @@ import warnings
 from collections.abc import Callable, Generator, Iterator
 from concurrent.futures import as_completed
 from contextlib import AbstractContextManager, closing, contextmanager, nullcontext
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -333,6 +333,11 @@ class RecordSpec:
     #: the aspect [deg] asked for (variation or draw) when ``place = "record"`` turned it into
     #: a fixed heading, for the table
     aspect_deg: float | None = None
+    #: the dataset config field that sets the record's length (``record_lengths.<label>`` or
+    #: ``sources[N].record_length``; None: the whole source), named by a record's errors
+    length_field: str | None = None
+    #: a recorded record's (file, start [s], duration [s]), named by its errors and skip row
+    window: tuple[str, float, float] | None = None
 
 
 def load_dataset_config(path: str | Path) -> tuple[DatasetConfig, Path]:
@@ -531,29 +536,39 @@ def _plan_recordings(
         length_s = entry.record_length or config.record_lengths.get(entry.label)
         length = rec.cloud.n_frames if length_s is None else round(length_s / period)
         hop = length if entry.hop is None else max(1, round(entry.hop / period))
-        if length < 1 or length > rec.cloud.n_frames:
+        field = _length_field(config, entry_no, entry) or where
+        if length < 1:
             raise ConfigError(
-                f"{where}: record length {length} frames does not fit the "
-                f"{rec.cloud.n_frames} frames of {rec.name}"
+                f"{field}: {length_s:g} s is shorter than one {period * 1e3:.1f} ms frame of "
+                f"{rec.name}: give at least {period:.4g} s"
+            )
+        if length > rec.cloud.n_frames:
+            raise ConfigError(
+                f"{field}: {length} frames of {period * 1e3:.1f} ms ({length_s:g} s) do not fit "
+                f"the {rec.cloud.n_frames} frames of {rec.name}"
             )
         starts = range(0, rec.cloud.n_frames - length + 1, hop)
         for n, first in enumerate(starts):
             if entry.max_records is not None and n >= entry.max_records:
                 break
             run = {"recording": section, "name": rec.name, "first_frame": first, "frames": length}
+            spec = _spec(
+                config, first_index + len(specs), entry, section["kind"], run, base_dir, None, hist
+            )
+            window = (rec.name, first * period, length * period)
             specs.append(
-                _spec(
-                    config,
-                    first_index + len(specs),
-                    entry,
-                    section["kind"],
-                    run,
-                    base_dir,
-                    None,
-                    hist,
-                )
+                replace(spec, length_field=_length_field(config, entry_no, entry), window=window)
             )
     return specs
+
+
+def _length_field(config: DatasetConfig, entry_no: int, entry: SourceEntry) -> str | None:
+    """The dataset config field that sets a source's record length (None: the whole source)."""
+    if entry.record_length is not None:
+        return f"sources[{entry_no}].record_length"
+    if entry.label in config.record_lengths:
+        return f"record_lengths.{entry.label}"
+    return None
 
 
 def _spec(
@@ -867,22 +882,21 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                     run["scene"] = _place_record(run, placing, loaded)
                     asked = placing.scene.person.aspect_deg
                 run["seed"] = _record_seed(config.seed, index)
-                specs.append(
-                    _spec(
-                        config,
-                        index,
-                        entry,
-                        motion["kind"],
-                        run,
-                        base_dir,
-                        draws,
-                        hist,
-                        meta,
-                        origins if draws else None,
-                        _span(motion, span_start, span_end),
-                        asked,
-                    )
+                spec = _spec(
+                    config,
+                    index,
+                    entry,
+                    motion["kind"],
+                    run,
+                    base_dir,
+                    draws,
+                    hist,
+                    meta,
+                    origins if draws else None,
+                    _span(motion, span_start, span_end),
+                    asked,
                 )
+                specs.append(replace(spec, length_field=_length_field(config, entry_no, entry)))
                 # every record's run config is valid before any file is written (with
                 # on_error = "skip" an invalid record is skipped by the build instead)
                 if config.on_error == "stop":
@@ -1065,23 +1079,29 @@ def _record_or_skip(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     try:
         return _build_record(spec, out_dir)
     except (MdfError, ValueError) as exc:
-        motion = spec.run_config.get("motion", {})
-        start = float(motion.get("start", 0.0))
-        end = start + float(motion.get("duration") or 0.0)
+        if spec.window is not None:
+            file, start, length = spec.window
+        else:
+            motion = spec.run_config.get("motion", {})
+            file = str(motion.get("file", motion.get("kind", "?")))
+            start = float(motion.get("start", 0.0))
+            length = float(motion.get("duration") or 0.0)
         where = (
-            f"record {spec.record_id} ({spec.label}; source file "
-            f"{motion.get('file', motion.get('kind', '?'))}, window {start:.3f}-{end:.3f} s)"
+            f"record {spec.record_id} ({spec.label}; source file {file}, window "
+            f"{start:.3f}-{start + length:.3f} s)"
         )
         cause = " ".join(str(exc).split())
+        if spec.length_field is not None:  # the record's duration is the dataset's length
+            cause = cause.replace("motion.duration", spec.length_field)
         if spec.on_error != "skip":
             raise MdfError(f"{where}: {cause}") from None
         return {
             "id": spec.record_id,
             "label": spec.label,
             "group": spec.group,
-            "file": str(motion.get("file", motion.get("kind", ""))),
+            "file": file,
             "start_s": start,
-            "duration_s": end - start,
+            "duration_s": length,
             "skipped": cause,
         }
     except Exception as exc:

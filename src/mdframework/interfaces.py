@@ -402,6 +402,12 @@ class RadarWaveform(Plugin):
 
         return max_unambiguous_velocity(self.carrier_frequency, self.prf)
 
+    @property
+    def shortest_record(self) -> float:
+        """Shortest record [s] that :meth:`pulse_times` gives any pulse in (e.g. the chirps of
+        one FMCW frame). Default 0: uniform pulses from the record's start."""
+        return 0.0
+
     def start_record(self, times: FloatArray, range_span: tuple[float, float]) -> None:
         """Called once per record before its blocks: ``times`` (n_pulses,) [s] of the whole
         record and the smallest and largest distance [m] of the body's joints to the radar over

@@ -339,7 +339,7 @@ def _simulate_motion(
         "motion.duration",
         keep_scatterers=proc.keep_scatterers,
     )
-    t = wf.pulse_times(t_start, t_end)
+    t = record_pulses(wf, t_start, t_end)
     spectrogram_geometry(wf, t.shape[0], proc)  # a record too short: refused before any pulse
     frames = interpolation.window_frames(body.time, float(t[0]), float(t[-1]))
     near = body.select_frames(frames)
@@ -680,6 +680,21 @@ def _gate(gate: str | float, at_pulses: Skeleton, radar_pos: FloatArray) -> Floa
         ref = at_pulses.index("base") if "base" in at_pulses.joint_names else 0
         return radar.distances(at_pulses.positions[:, ref, :], radar_pos)
     return np.full(at_pulses.time.shape, float(gate))
+
+
+def record_pulses(wf: RadarWaveform, t_start: float, t_end: float) -> FloatArray:
+    """The radar's pulse times (n_pulses,) [s] of the record from ``t_start`` to ``t_end`` [s];
+    a :class:`SceneError` naming ``motion.duration`` and the shortest record the radar can
+    sample when there is none (a record shorter than one FMCW frame's chirps)."""
+    t = np.asarray(wf.pulse_times(t_start, t_end), dtype=np.float64)
+    if t.size == 0:
+        kind = getattr(wf, "name", "radar")
+        raise SceneError(
+            f"motion.duration: the {(t_end - t_start) * 1e3:.3f} ms record holds no pulse of "
+            f"the {kind} radar, whose pulses need a record of at least "
+            f"{wf.shortest_record * 1e3:.3f} ms: lengthen motion.duration"
+        )
+    return t
 
 
 def record_window(body: Skeleton, start: float, duration: float | None) -> tuple[float, float]:

@@ -109,6 +109,12 @@ class ChirpSequence:
         return self.n_loops * self.n_tx
 
     @property
+    def frame_active_time(self) -> float:
+        """From a frame's start to the end of its last ramp [s]: ``chirps_per_frame T_chirp``
+        (the shortest span :func:`chirp_times` finds a frame in)."""
+        return self.chirps_per_frame * self.chirp_period
+
+    @property
     def sampled_bandwidth(self) -> float:
         """Bandwidth swept while the ADC samples [Hz]: ``S N / fs``."""
         return self.slope * self.n_samples / self.sample_rate
@@ -166,7 +172,7 @@ class ChirpSequence:
                 f"{self.ramp_end_time * 1e6:.3f} us: lengthen the ramp, raise sample_rate or "
                 "take fewer samples"
             )
-        busy = self.chirps_per_frame * self.chirp_period
+        busy = self.frame_active_time
         if busy > self.frame_period * (1 + 1e-9):
             out.append(
                 f"frame_period: {self.chirps_per_frame} chirps of "
@@ -208,7 +214,13 @@ def beat_frequency(ranges: FloatArray | float, slope: float) -> FloatArray:
 
 
 def window(name: WindowName, n: int) -> FloatArray:
-    """Periodic cosine-sum window ``w_m = sum_c (-1)^c a_c cos(2 pi c m / n)``, (n,)."""
+    """Periodic cosine-sum window ``w_m = sum_c (-1)^c a_c cos(2 pi c m / n)``, (n,).
+
+    A one-sample window is ``[1]`` whatever its name (as scipy's and the STFT's): the formula
+    would give a periodic Hann ``[0]``, which would null the only sample (``n_loops = 1``: the
+    Doppler FFT of one loop is the identity)."""
+    if n == 1:
+        return np.ones(1, dtype=np.float64)
     m = np.arange(n, dtype=np.float64)
     w = np.zeros(n, dtype=np.float64)
     for c, a in enumerate(WINDOWS[name]):
@@ -235,6 +247,8 @@ def window_transform(name: WindowName, n: int, nu: FloatArray) -> ComplexArray:
     """``W(nu) = sum_m w_m exp(j 2 pi m nu)`` of :func:`window` in closed form: a sum of shifted
     Dirichlet kernels (any shape of ``nu`` [cycles per sample])."""
     nu = np.asarray(nu, dtype=np.float64)
+    if n == 1:  # the one-sample window is [1] (:func:`window`)
+        return np.ones(nu.shape, dtype=np.complex128)
     out = np.zeros(nu.shape, dtype=np.complex128)
     for c, a in enumerate(WINDOWS[name]):
         if c == 0:
@@ -868,6 +882,12 @@ class Antennas:
         for s, tx in enumerate(seq.tdm_order):
             slot[tx] = s
         return np.repeat(slot, self.rx.shape[0])
+
+    def used_virtual(self, seq: ChirpSequence) -> IntArray:
+        """Indices (n_used,) of the virtual antennas whose TX the TDM order uses: only these
+        hold signal (:func:`virtual_cube` leaves the others zero), so only these may take part
+        in the angle estimation (a zero channel beside real ones distorts every beam)."""
+        return np.flatnonzero(self.slot_of_virtual(seq) >= 0).astype(np.int64)
 
 
 def chirp_profiles(

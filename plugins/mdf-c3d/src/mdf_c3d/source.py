@@ -8,6 +8,7 @@ or ``marker_map``).
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Any, ClassVar, Literal
 
@@ -101,12 +102,15 @@ def markers_motion(
     positions: NDArray[np.float64],
     unit_m: float,
     rate: float,
+    time: NDArray[np.float64],
     meta: dict[str, Any],
 ) -> Motion:
     """The canonical body from a marker file's tracks.
 
     ``positions`` (n_frames, n_markers, 3) in the file's unit (``unit_m`` metres each), NaN
-    where a marker is not seen; ``labels`` their names; ``rate`` [Hz] the frames' rate. The
+    where a marker is not seen; ``labels`` their names; ``rate`` [Hz] the frames' rate;
+    ``time`` (n_frames,) float64 [s] from 0, each frame's time (not uniform where the file
+    skips frames). The
     marker set is detected (or taken from ``config``), each canonical joint is the mean of its
     markers, the frame is turned by ``config.axes``. ``meta`` (the format's own entries) is
     completed with the marker set and the markers of each joint.
@@ -133,7 +137,6 @@ def markers_motion(
         raise DataFileError(
             path, "fewer than two frames where any mapped marker is seen: nothing to move"
         )
-    time = np.arange(pos.shape[0], dtype=np.float64) / rate
     limits.check_time_stamps(path, time)
     limits.check_values(
         path, pos, limits.MAX_COORDINATE_M, "a joint coordinate", unit=" m", allow_nan=True
@@ -196,7 +199,8 @@ class C3dSource(MotionSource):
             "events": len(data.events),
         }
         rate = float(c.frame_rate) if c.frame_rate is not None else data.rate_hz
-        return markers_motion(path, c, data.labels, data.positions, data.unit_m, rate, meta)
+        time = np.arange(data.n_frames, dtype=np.float64) / rate
+        return markers_motion(path, c, data.labels, data.positions, data.unit_m, rate, time, meta)
 
 
 class TrcSource(MotionSource):
@@ -212,13 +216,14 @@ class TrcSource(MotionSource):
         Returns
         -------
         Motion
-            ``skeleton``: time (n_frames,) [s] from 0 at ``DataRate`` (the frame numbers
-            counted at the header's rate, or at ``frame_rate``); positions (n_frames, 17, 3) [m]
-            of the canonical joints (each the mean of its markers, NaN and invalid where one of
-            them is not seen). ``metadata``: source, format, file, subject, activity,
-            frame_rate_hz and frame_rate_from, units, unit_m, unit_from, axes, marker_set,
+            ``skeleton``: time (n_frames,) [s] ``(Frame# - first Frame#) / DataRate`` (or
+            ``/ frame_rate``), so frames the file skips leave a gap in time; positions
+            (n_frames, 17, 3) [m] of the canonical joints (each the mean of its markers, NaN and
+            invalid where one of them is not seen). ``metadata``: source, format, file, subject,
+            activity, frame_rate_hz and frame_rate_from, units, unit_m, unit_from, axes, marker_set,
             markers (joint -> markers), n_frames, first_frame (the first ``Frame#``),
-            camera_rate_hz (``CameraRate``, when given).
+            frames_skipped (frame numbers missing between the first and last), camera_rate_hz
+            (``CameraRate``, when given).
 
         Raises
         ------
@@ -232,6 +237,16 @@ class TrcSource(MotionSource):
         path = Path(c.file)
         data = read_trc(path, c.unit_m, c.frame_rate)
         camera = data.header.get("CameraRate")
+        skipped = int(data.frames[-1] - data.frames[0] + 1 - data.n_frames)
+        if skipped:
+            k = int(np.argmax(np.diff(data.frames)))
+            warnings.warn(
+                f"{path}: Frame# skips {skipped} frame(s) (the longest gap "
+                f"{data.time[k + 1] - data.time[k]:.4g} s, after Frame# {data.frames[k]} at "
+                f"{data.time[k]:.4g} s): the time base keeps the gaps, and the motion is "
+                "interpolated across them",
+                stacklevel=2,
+            )
         meta: dict[str, Any] = {
             "source": "trc",
             "format": "trc",
@@ -240,8 +255,12 @@ class TrcSource(MotionSource):
             "unit_from": "config" if c.unit_m is not None else "Units",
             "first_frame": int(data.frames[0]),
             "camera_rate_hz": _number(camera),
+            # frames the file skips (Frame# steps over them): the time base keeps the gap
+            "frames_skipped": skipped,
         }
-        return markers_motion(path, c, data.labels, data.positions, data.unit_m, data.rate_hz, meta)
+        return markers_motion(
+            path, c, data.labels, data.positions, data.unit_m, data.rate_hz, data.time, meta
+        )
 
 
 def _number(text: str | None) -> float | None:

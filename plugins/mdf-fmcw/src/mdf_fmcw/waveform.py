@@ -366,6 +366,12 @@ class FmcwRadar(RadarWaveform):
         """Chirps per second over whole frames [Hz] (the pulse budget counts chirps)."""
         return self.sequence.chirps_per_frame / self.sequence.frame_period
 
+    @property
+    def shortest_record(self) -> float:
+        """One frame's chirps, ``chirps_per_frame (idle_time + ramp_end_time)`` [s]: a record
+        holds whole frames only."""
+        return self.sequence.frame_active_time
+
     def start_record(self, times: FloatArray, range_span: tuple[float, float]) -> None:
         """Stop before any block when the body's farthest joint is beyond the maximum range,
         or when the record's range-Doppler maps would not fit the product limit."""
@@ -421,8 +427,12 @@ class FmcwRadar(RadarWaveform):
         antennas = self.antennas
         axes = self.axes()
         raxis = axes["range_m"]
-        grid = fmcw.angle_grid(antennas.virtual, seq.wavelength)
-        slots = antennas.slot_of_virtual(seq)
+        # the angles from the virtual antennas of the TXs the TDM order uses, not the zero
+        # channels of an unused TX
+        used = antennas.used_virtual(seq)
+        every = used.size == antennas.virtual.shape[0]
+        grid = fmcw.angle_grid(antennas.virtual[used], seq.wavelength)
+        slots = antennas.slot_of_virtual(seq)[used]
         detection = self.detection()
         signal = np.empty(ranges.shape[0], dtype=np.complex128)
         maps: list[NDArray[np.float32]] = []
@@ -458,7 +468,7 @@ class FmcwRadar(RadarWaveform):
                 maps.append(fmcw.detection_map(rd).astype(np.float32))
             if want_points:
                 pts = fmcw.detect_points(
-                    rd,
+                    rd if every else rd[used],
                     raxis,
                     axes["doppler_hz"],
                     grid,
