@@ -201,3 +201,144 @@ def test_cli_unknown_rig_is_one_line_and_exit_2(
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith(f"mdf: error: {odd}: no known BVH rig fits")
     assert not out.exists()
+
+
+# --------------------------------------------------------------------------- other rigs
+
+
+#: A studio rig that is none of the four: the real CMU 16_21 walk with every signature joint of
+#: the CMU rig renamed (as other exporters name them), written in centimetres from its first
+#: captured frame (cgspeed's added pose dropped).
+OTHER_NAMES = {
+    "LHipJoint": "LeftHipJoint",
+    "RHipJoint": "RightHipJoint",
+    "LowerBack": "Waist",
+    "Neck1": "Neck2",
+    "LeftFingerBase": "LeftHandEnd",
+    "RightFingerBase": "RightHandEnd",
+    "LeftHandIndex1": "LeftIndex",
+    "RightHandIndex1": "RightIndex",
+}
+
+
+def other_rig_copy(dst: Path, frame_time: str, names: dict[str, str] = OTHER_NAMES) -> Path:
+    """16_21.bvh renamed by ``names``, in cm, without frame 0, at ``frame_time`` [s]."""
+    from mdf_cmu.kinematics import CMU_UNIT_M
+
+    src = CMU_BVH / "16_21.bvh"
+    b = read_bvh(src)
+    hier = renamed_copy(src, dst, names).read_text().split("MOTION")[0]
+    cm = CMU_UNIT_M * 100
+
+    def offset(m: re.Match[str]) -> str:
+        return "OFFSET " + " ".join(f"{float(v) * cm:.6f}" for v in m.group(1).split())
+
+    hier = re.sub(r"OFFSET ([^\n]*)", offset, hier)
+    values = b.values[1:].copy()
+    values[:, :3] *= cm
+    rows = "\n".join(" ".join(f"{v:.6f}" for v in r) for r in values)
+    dst.write_text(f"{hier}MOTION\nFrames: {len(values)}\nFrame Time: {frame_time}\n{rows}\n")
+    return dst
+
+
+@pytest.fixture(scope="module")
+def cmu_walk():
+    """The real walk as the cmu source reads it: the reference body, in metres."""
+    return CmuSource(CmuConfig(file=CMU_BVH / "16_21.bvh")).load()
+
+
+def test_a_file_no_rig_signature_fits_is_refused_not_read_as_cmu(tmp_path: Path) -> None:
+    """Its joints would map onto the CMU and the Mixamo rigs, but it has neither's signature:
+    read as CMU it came out 5.6 times too large, lost its first frame and, named like a CMU
+    trial, got CMU's 120 Hz instead of its own 30 Hz."""
+    path = other_rig_copy(tmp_path / "2024_03_take.bvh", "0.0333333")
+    with pytest.raises(DataFileError) as err:
+        bvh(path)
+    msg = str(err.value)
+    assert msg.startswith(f"{path}: no known BVH rig fits this file's joints (Hips, LeftHipJoint")
+    assert "tried cmu-cgspeed, cmu-3dsmax, mixamo, biovision: the joints of 'cmu-cgspeed', " in msg
+    assert "'mixamo' would map, but none of any rig's signature joints is there" in msg
+    assert "give motion.rig (cmu-cgspeed, cmu-3dsmax, mixamo, biovision)" in msg
+    assert "\n" not in msg
+    with pytest.raises(DataFileError, match="no known BVH rig fits"):
+        CmuSource(CmuConfig(file=path)).load()
+
+
+def test_other_rig_named_read_in_its_units_rate_and_frames(tmp_path: Path, cmu_walk) -> None:
+    """Named (rig = mixamo: cm, every frame, the header's rate) the body is the real walk: the
+    same positions in metres, 1.4-1.9 m tall, at 30 Hz a quarter of the real speed."""
+    path = other_rig_copy(tmp_path / "2024_03_take.bvh", "0.0333333")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FrameRateWarning)
+        m = bvh(path, rig="mixamo")
+    md = m.metadata
+    assert (md["unit_m"], md["frames_dropped_at_start"], md["frame_rate_hz"]) == (0.01, 0, 30.0)
+    assert md["subject"] is None and md["frame_rate_from"] == "header"
+    ref = cmu_walk.canonical()
+    body = m.canonical()
+    assert body.n_frames == ref.n_frames
+    np.testing.assert_allclose(body.positions, ref.positions, atol=2e-5)
+    height = body.joint("head")[:, 2].max() - body.joint("l_toe")[:, 2].min()
+    assert 1.4 < height < 1.9
+    assert m.skeleton.time[-1] == pytest.approx((ref.n_frames - 1) / 30.0)
+    base = body.joint("base")
+    speed = np.linalg.norm(base[-1, :2] - base[0, :2]) / m.skeleton.time[-1]
+    ref_base = ref.joint("base")
+    ref_speed = np.linalg.norm(ref_base[-1, :2] - ref_base[0, :2]) / cmu_walk.skeleton.time[-1]
+    assert speed == pytest.approx(ref_speed * 30.0 / 120.0, rel=1e-6)
+
+
+def test_partial_map_completes_the_rig_with_most_signature_joints(tmp_path: Path, cmu_walk):
+    """A LAFAN-like rig: toes named LeftToe, a Spine2. The user's map gives the toes; of the two
+    rigs it completes, Mixamo has a signature joint there (Spine2) and the CMU rig none: cm, all
+    frames, the true body (it came out 8.4 m tall through the CMU rig)."""
+    names = {**OTHER_NAMES, "LowerBack": "Spine2", "LeftToeBase": "LeftToe"}
+    names["RightToeBase"] = "RightToe"
+    path = other_rig_copy(tmp_path / "lafan_like.bvh", "0.0333333", names)
+    with pytest.raises(DataFileError, match="the nearest is 'cmu-cgspeed'"):
+        bvh(path)
+    m = bvh(path, joint_map={"l_toe": "LeftToe_end", "r_toe": "RightToe_end"})
+    assert m.metadata["rig"] == "mixamo" and m.metadata["frames_dropped_at_start"] == 0
+    np.testing.assert_allclose(m.canonical().positions, cmu_walk.canonical().positions, atol=2e-5)
+    # one signature joint each for the CMU rig (Neck1) and Mixamo (Spine2): a tie is refused
+    tie = other_rig_copy(tmp_path / "tie.bvh", "0.0333333", {**names, "Neck1": "Neck1"})
+    with pytest.raises(DataFileError) as err:
+        bvh(tie, joint_map={"l_toe": "LeftToe_end", "r_toe": "RightToe_end"})
+    assert "fit the rigs 'cmu-cgspeed' and 'mixamo' with 1 signature joint(s) each: the rig " in (
+        str(err.value)
+    )
+    assert str(err.value).endswith("is ambiguous; give motion.rig")
+
+
+def test_cmu_rate_correction_only_for_cmu_subjects(tmp_path: Path) -> None:
+    """Subject 80 is a 60 Hz subject of CMU's index (corrected, warned, elsewhere); 200 is no
+    CMU subject: its 120 Hz header stands."""
+    from mdf_cmu.source import CMU_SUBJECTS
+
+    assert len(CMU_SUBJECTS) == 109 and min(CMU_SUBJECTS) == 1 and max(CMU_SUBJECTS) == 144
+    assert 80 in CMU_SUBJECTS and 4 not in CMU_SUBJECTS and 200 not in CMU_SUBJECTS
+    copy = renamed_copy(CMU_BVH / "80_10.bvh", tmp_path / "200_10.bvh", {})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FrameRateWarning)
+        m = bvh(copy)
+    assert (m.metadata["frame_rate_hz"], m.metadata["frame_rate_from"]) == (120.0, "header")
+    assert np.allclose(np.diff(m.skeleton.time), 1 / 120)
+
+
+def test_docs_rig_table_lists_each_rigs_signature_and_joints() -> None:
+    """docs/motion-formats.md's rig table says exactly what mdf_cmu.rigs detects and maps."""
+    from mdf_cmu.rigs import RIGS
+
+    doc = (Path(__file__).parents[1] / "docs" / "motion-formats.md").read_text()
+    rows = {
+        m.group(1): m.group(2, 3)
+        for m in re.finditer(r"^\| `([a-z0-9-]+)`[^|]*\| ([^|]+) \| ([^|]+) \|", doc, re.M)
+    }
+    assert set(RIGS) <= set(rows)
+    for name, rig in RIGS.items():
+        signature, joints = rows[name]
+        assert re.findall(r"`([^`]+)`", signature) == list(rig.signature), name
+        left = ["base", "neck", "head", "l_shoulder", "l_elbow", "l_hand", "l_hip", "l_knee"]
+        left += ["l_ankle", "l_toe"]
+        expected = [n for j in left for n in rig.joints[j]]
+        assert re.findall(r"`([^`]+)`", joints) == expected, name

@@ -12,7 +12,8 @@ four shipped rigs) facing +x with its left at +y.
 Frame rate, in order:
 
 1. the config's ``frame_rate``;
-2. for a CMU conversion whose file name gives a subject (``80_10.bvh``) whose header rate
+2. for a file recognised as a CMU conversion (rig ``cmu-cgspeed`` or ``cmu-3dsmax``) whose
+   file name gives a subject of CMU's index (``80_10.bvh``) whose header rate
    differs from CMU's index (cgspeed wrote ``Frame Time: .0083333``, 120 Hz, into every file,
    also for the subjects captured at 60 Hz): the index's rate, with a
    :class:`FrameRateWarning` naming both (``cmu_rate_correction = false`` turns this off);
@@ -72,12 +73,12 @@ def choose_rate(
 ) -> tuple[float, str]:
     """The frame rate [Hz] of a BVH file and where it came from (see the module docstring);
     warns (:class:`FrameRateWarning`) when CMU's index corrects the header."""
-    from .source import subject_frame_rate
+    from .source import CMU_SUBJECTS, subject_frame_rate
 
     if config_rate is not None:
         return float(config_rate), "config"
     rate = header_rate(frame_time)
-    if rig is not None and rig.cmu and cmu_correction and subject is not None:
+    if rig is not None and rig.cmu and cmu_correction and subject in CMU_SUBJECTS:
         index = subject_frame_rate(subject, trial)
         if abs(index - rate) > 1e-3 * index:
             warnings.warn(
@@ -109,8 +110,9 @@ def load_any_bvh(
     Raises
     ------
     mdframework.DataFileError
-        Malformed file; no rig fits and no complete joint map is given (the message lists
-        the file's joints and the nearest rig); a mapped joint is not in the file.
+        Malformed file; no rig is recognised (none has a signature joint in the file and
+        its other joints there or in ``joint_map``), or two are as likely, and no complete joint
+        map is given (see :func:`mdf_cmu.rigs.detect_rig`); a mapped joint is not in the file.
     """
     bvh = read_bvh(path)
     names = bvh.joint_names
@@ -126,19 +128,11 @@ def load_any_bvh(
                 f"its joints are {', '.join(names)}",
             )
     elif not joint_map or set(joint_map) != set(CANONICAL_JOINTS):
+        # detected; a partial user map completes the rig with most signature joints
         try:
-            rig, mapping = detect_rig(names)
+            rig, mapping = detect_rig(names, joint_map or {})
         except RigMismatch as exc:
-            if not joint_map:
-                raise DataFileError(path, str(exc)) from None
-            # a partial user map: complete it from the nearest rig that it makes fit
-            for candidate in RIGS.values():
-                cmap, missing = resolve(candidate, names)
-                if {m.split(" ")[0] for m in missing} <= set(joint_map):
-                    rig, mapping = candidate, cmap
-                    break
-            else:
-                raise DataFileError(path, str(exc)) from None
+            raise DataFileError(path, str(exc)) from None
     if joint_map:
         for canon, joint in joint_map.items():
             if joint not in names:
@@ -187,7 +181,8 @@ class BvhConfig(MotionConfig):
     joint_map: dict[str, str] | None = Field(
         None,
         description="Canonical joint -> file joint (e.g. {l_hand = 'LeftWrist'}): overrides "
-        "the rig's, or maps a rig that is not known (then all 17 canonical joints).",
+        "the rig's, completes the recognised rig (the one with most signature joints in the "
+        "file), or maps a rig that is not known (then all 17 canonical joints, and unit_m).",
     )
     unit_m: float | None = Field(
         None, gt=0, le=1000, description="Metres per file unit; default: the rig's."

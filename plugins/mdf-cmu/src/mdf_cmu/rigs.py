@@ -23,8 +23,11 @@ biovision       Studio captures in the Biovision naming (as exported by MocapBan
 ==============  ==============================================================================
 
 Detection (:func:`detect_rig`): a rig fits when every canonical joint has one of its names in the
-file; among fitting rigs the one with the most of its signature joints present wins. When none
-fits, :class:`RigMismatch` names the file's joints and the nearest rig with its missing joints.
+file (or in a user's partial joint map) and at least one of its signature joints is in the file;
+among fitting rigs the one with the most signature joints present wins, and a tie is refused.
+When none fits, :class:`RigMismatch` names the file's joints, the rigs tried and the nearest rig
+with its missing joints (or, when joints would map but no signature joint is there, every rig's
+signature), and says to give ``motion.rig`` or ``motion.joint_map``.
 """
 
 from __future__ import annotations
@@ -188,32 +191,67 @@ def resolve(rig: Rig, names: Iterable[str]) -> tuple[dict[str, str], list[str]]:
     return mapping, missing
 
 
-def detect_rig(names: Iterable[str]) -> tuple[Rig, dict[str, str]]:
-    """The rig that fits a file's joints best, and its canonical map.
+def signature_count(rig: Rig, names: Iterable[str]) -> int:
+    """How many of ``rig``'s signature joints are among ``names`` (namespace prefixes ignored)."""
+    plain = {strip_namespace(n) for n in names}
+    return sum(s in plain for s in rig.signature)
+
+
+def detect_rig(names: Iterable[str], mapped: Iterable[str] = ()) -> tuple[Rig, dict[str, str]]:
+    """The rig a file's joints are recognised as, and its canonical map.
+
+    A rig is a candidate when every canonical joint not in ``mapped`` (the canonical joints a
+    user's partial joint map gives) has one of its names in the file and at least one of its
+    signature joints is there; the candidate with the most signature joints wins.
 
     Raises
     ------
     RigMismatch
-        No rig fits; names every joint of the file and the nearest rig's missing joints, and
-        says how to give a joint map.
+        No candidate (the message names the file's joints, the rigs tried and, for the nearest,
+        what it lacks), or two candidates with as many signature joints (a tie). Each message
+        says what to give: ``motion.rig`` or ``motion.joint_map``.
     """
     names = tuple(names)
-    plain = {strip_namespace(n) for n in names}
+    given = set(mapped)
     fits: list[tuple[int, Rig, dict[str, str]]] = []
-    nearest: tuple[int, Rig, list[str]] | None = None
+    unsigned: list[Rig] = []
+    nearest: tuple[Rig, list[str]] | None = None
     for rig in RIGS.values():
         mapping, missing = resolve(rig, names)
-        if not missing:
-            fits.append((sum(s in plain for s in rig.signature), rig, mapping))
-        elif nearest is None or len(missing) < len(nearest[2]):
-            nearest = (len(missing), rig, missing)
-    if fits:
-        fits.sort(key=lambda f: -f[0])
-        return fits[0][1], fits[0][2]
-    assert nearest is not None
-    raise RigMismatch(
-        f"no known BVH rig fits this file's joints ({', '.join(names)}); the nearest is "
-        f"{nearest[1].name!r} ({nearest[1].description}), which lacks "
-        f"{', '.join(nearest[2])}; give motion.joint_map (canonical joint = file joint) "
-        "for every canonical joint, or motion.rig"
+        missing = [m for m in missing if m.split(" ")[0] not in given]
+        count = signature_count(rig, names)
+        if missing:
+            if nearest is None or len(missing) < len(nearest[1]):
+                nearest = (rig, missing)
+        elif count == 0:
+            unsigned.append(rig)
+        else:
+            fits.append((count, rig, mapping))
+    todo = (
+        f"give motion.rig ({', '.join(RIGS)}) if the file is one of them, or "
+        "motion.joint_map (canonical joint = file joint) for the joints a rig lacks, or for "
+        "all 17 with motion.unit_m"
     )
+    joints = f"this file's joints ({', '.join(names)})"
+    fits.sort(key=lambda f: -f[0])
+    if len(fits) > 1 and fits[0][0] == fits[1][0]:
+        tied = [f[1].name for f in fits if f[0] == fits[0][0]]
+        raise RigMismatch(
+            f"{joints} fit the rigs {' and '.join(repr(t) for t in tied)} with "
+            f"{fits[0][0]} signature joint(s) each: the rig is ambiguous; give motion.rig"
+        )
+    if fits:
+        return fits[0][1], fits[0][2]
+    signatures = "; ".join(f"{r.name}: {', '.join(r.signature)}" for r in RIGS.values())
+    if unsigned:
+        reason = (
+            f"the joints of {', '.join(repr(r.name) for r in unsigned)} would map, but none "
+            f"of any rig's signature joints is there ({signatures})"
+        )
+    else:
+        assert nearest is not None
+        reason = (
+            f"the nearest is {nearest[0].name!r} ({nearest[0].description}), which lacks "
+            f"{', '.join(nearest[1])}"
+        )
+    raise RigMismatch(f"no known BVH rig fits {joints}; tried {', '.join(RIGS)}: {reason}; {todo}")

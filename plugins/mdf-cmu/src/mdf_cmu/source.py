@@ -91,6 +91,12 @@ ACKNOWLEDGEMENT = (
 #: 136_19 (see :data:`TRIAL_RATES`).
 SUBJECT_60HZ: frozenset[int] = frozenset({33, 34, 42, 60, 61, 62, 74, 75, 77, 79, 80, 87, 88, 89})
 
+#: The subjects of CMU's index (``cmu-index.csv``): 109 numbers from 1 to 144.
+CMU_SUBJECTS: frozenset[int] = frozenset(range(1, 145)) - frozenset(
+    {4, 44, 48, 50, 51, 52, 53, 57, 58, 59, 65, 66, 67, 68, 71, 72, 73, 84, 92, 95, 96, 97}
+    | {98, 99, 100, 101, 109, 110, 112, 116, 117, 119, 121, 129, 130}
+)
+
 #: Trials whose rate differs from their subject's (``cmu-index.csv``): (subject, trial) -> Hz.
 TRIAL_RATES: dict[tuple[int, int], float] = {(136, 19): 60.0}
 
