@@ -246,3 +246,72 @@ def test_a_joint_or_column_named_twice_in_the_config_is_the_configs_error(tmp_pa
         TableConfig(file=path, header=False, joints=["head", "head"], time_column="t")
     with pytest.raises(ValueError, match=r"columns: 't' named twice"):
         TableConfig(file=path, header=False, columns=["t", "t", "head_x"])
+
+
+def _ut_table(path: Path, stamps: np.ndarray, long: bool) -> Path:
+    """The real UTKinect track as a CSV with the time column ``stamps``."""
+    rec = read_utkinect(UT)
+    names, pos = rec.joint_names, rec.positions
+    if long:
+        rows = ["time,joint,x,y,z"] + [
+            f"{stamps[k]:.17g},{n},{p[0]:.17g},{p[1]:.17g},{p[2]:.17g}"
+            for k in range(len(stamps))
+            for n, p in zip(names, pos[k], strict=True)
+        ]
+    else:
+        rows = ["time," + ",".join(f"{n}_{a}" for n in names for a in "xyz")]
+        rows += [
+            f"{stamps[k]:.17g}," + ",".join(f"{v:.17g}" for v in pos[k].ravel())
+            for k in range(len(stamps))
+        ]
+    path.write_text("\n".join(rows) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("long", [False, True], ids=["wide", "long"])
+@pytest.mark.parametrize(
+    ("offset", "per_s", "options"),
+    [
+        (100_000.0, 1000.0, {"time_unit_s": 0.001}),  # a logger's milliseconds, 100 s in
+        (1.7e9, 1.0, {}),  # Unix epoch seconds
+        (90_000.0, 30.0, {"frame_rate": 30.0}),  # frame numbers at 30 Hz from 90000 (50 min)
+    ],
+    ids=["ms", "epoch", "frames"],
+)
+def test_times_far_from_zero_in_any_unit_count_from_the_first_frame(
+    tmp_path: Path, long: bool, offset: float, per_s: float, options: dict[str, float]
+) -> None:
+    """The 86,400 s limit is on seconds, and on the span: a 35 s walk stamped 100,000 ms,
+    1.7e9 s or frame 90,000 onward was refused (the values compared with 86,400 as they stand).
+    Its times are the Kinect reader's, from 0; its speed the real walk's."""
+    ref = read_utkinect(UT)
+    seconds = ref.time - ref.time[0]
+    stamps = offset + (np.round(seconds * 30) if "frame_rate" in options else seconds * per_s)
+    path = _ut_table(tmp_path / "walk.csv", stamps, long)
+    m = TableSource(TableConfig(file=path, joint_set="kinect-v1", axes=["z", "x", "y"], **options))
+    motion = m.load()
+    t = motion.skeleton.time
+    want = np.unique(np.round(seconds * 30) / 30 if "frame_rate" in options else seconds)
+    np.testing.assert_allclose(t, want, rtol=0, atol=1e-6)
+    assert t[-1] == pytest.approx(35.0, abs=1e-6)
+    base = motion.canonical().joint("base")
+    speed = np.linalg.norm(base[-1, :2] - base[0, :2]) / t[-1]
+    kin = to_project_frame(ref.positions)[:, KINECT_V1_JOINTS.index("HipCenter")]
+    assert speed == pytest.approx(np.linalg.norm(kin[-1, :2] - kin[0, :2]) / 35.0, rel=1e-6)
+
+
+def test_time_limits_are_in_seconds_and_say_so(tmp_path: Path) -> None:
+    """Microseconds read as seconds span 35e6 s: refused with the unit named and what to set;
+    a time beyond 1e10 s (no clock) is refused as such."""
+    ref = read_utkinect(UT)
+    micro = _ut_table(tmp_path / "us.csv", (ref.time - ref.time[0]) * 1e6, long=False)
+    with pytest.raises(DataFileError) as err:
+        read_table(micro)
+    assert str(err.value) == (
+        f"{micro}: the times span 3.5e+07 s (motion.time_unit_s = 1 s per unit), more than "
+        "86400 s: check the time column's unit (motion.time_unit_s or motion.frame_rate)"
+    )
+    assert read_table(micro, TableLayout(time_unit_s=1e-6)).time[-1] == pytest.approx(35.0)
+    far = _ut_table(tmp_path / "far.csv", 2e10 + ref.time, long=False)
+    with pytest.raises(DataFileError, match=r"far\.csv:2: time \[s\] \(motion\.time_unit_s = 1 s"):
+        read_table(far)

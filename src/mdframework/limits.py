@@ -34,6 +34,9 @@ MAX_FILE_COORDINATE = MAX_COORDINATE_M * 1000.0
 MAX_ANGLE_DEG = 100_000.0
 #: Longest recording, window or time stamp [s] (one day).
 MAX_DURATION_S = 86_400.0
+#: Largest |time stamp| [s] of a file whose times count from its first frame (joint tables):
+#: clock times such as Unix epoch seconds are accepted up to the year 2286.
+MAX_CLOCK_TIME_S = 1e10
 #: Frame rates of recordings and generated tracks [Hz].
 MIN_FRAME_RATE_HZ = 1.0
 MAX_FRAME_RATE_HZ = 10_000.0

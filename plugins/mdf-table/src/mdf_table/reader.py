@@ -32,7 +32,9 @@ marks that joint as not tracked in that frame.
 Checks before anything is allocated for the data: text is UTF-8 (a NUL byte means binary), an
 NPZ member's declared shape is read from its header and must stay within
 ``limits.MAX_FRAMES`` frames and :data:`MAX_JOINTS` joints; then every number is finite (or
-missing) and within ``limits.MAX_FILE_COORDINATE``, and every time stamp within
+missing) and within ``limits.MAX_FILE_COORDINATE``; every time, in seconds (after
+``time_unit_s`` or ``frame_rate``), within ``limits.MAX_CLOCK_TIME_S`` (clock times such as Unix
+epoch seconds pass: the motion counts from its first frame), and the times spanning at most
 ``limits.MAX_DURATION_S``.
 
 Arrays: :class:`Table` ``positions`` (n_frames, n_joints, 3) float64 in the file's unit, NaN
@@ -150,7 +152,8 @@ def read_table(path: Path, spec: TableLayout | None = None) -> Table:
         )
     else:  # text: checked row by row as it is read (the error names the line)
         time, names, pos, layout, rows = _read_text(path, spec)
-    limits.check_time_stamps(path, time)
+    # times count from the first frame: a clock time (epoch seconds) is checked by its span
+    limits.check_time_stamps(path, time - (time.min() if time.size else 0.0))
     t, p, _ok, report = sort_timestamps(time, pos)
     if t.shape[0] < 2:
         raise DataFileError(path, "fewer than two distinct time stamps: a motion needs two")
@@ -265,17 +268,42 @@ def _read_text(
     return _wide_text(path, spec, names, col, rows, line_of, named_at)
 
 
-def _time_of(path: Path, spec: TableLayout, values: FloatArray | None, n_rows: int) -> FloatArray:
-    """Seconds from a time column's values (or the row order, without one)."""
+def _time_of(
+    path: Path,
+    spec: TableLayout,
+    values: FloatArray | None,
+    n_rows: int,
+    line_of: Sequence[int] | None = None,
+) -> FloatArray:
+    """Seconds from a time column's values (or the row order, without one): frame numbers at
+    ``spec.frame_rate``, else values times ``spec.time_unit_s``.
+
+    Checked in seconds: every time finite and within +-``limits.MAX_CLOCK_TIME_S`` (clock times
+    such as epoch seconds pass; the motion counts from its first frame), and the span from the
+    earliest to the latest at most ``limits.MAX_DURATION_S``.
+    """
     if values is None:
         if spec.frame_rate is None:
             raise DataFileError(
                 path, "no time column: give motion.time_column or motion.frame_rate"
             )
         return np.arange(n_rows, dtype=np.float64) / spec.frame_rate
+    limits.check_values(path, values, float("inf"), "time", line_of)  # finite, in any unit
     if spec.frame_rate is not None:
-        return values / spec.frame_rate
-    return values * spec.time_unit_s
+        seconds = values / spec.frame_rate
+        unit = f"frame numbers at motion.frame_rate = {spec.frame_rate:g} Hz"
+    else:
+        seconds = values * spec.time_unit_s
+        unit = f"motion.time_unit_s = {spec.time_unit_s:g} s per unit"
+    limits.check_values(path, seconds, limits.MAX_CLOCK_TIME_S, f"time [s] ({unit})", line_of, " s")
+    span = float(seconds.max() - seconds.min()) if seconds.size else 0.0
+    if span > limits.MAX_DURATION_S:
+        raise DataFileError(
+            path,
+            f"the times span {span:g} s ({unit}), more than {limits.MAX_DURATION_S:g} s: check "
+            "the time column's unit (motion.time_unit_s or motion.frame_rate)",
+        )
+    return seconds
 
 
 def _need(path: Path, col: dict[str, int], name: str, what: str, named_at: int | None) -> int:
@@ -316,12 +344,13 @@ def _long_assemble(
     line_of: Sequence[int] | None,
 ) -> tuple[FloatArray, tuple[str, ...], FloatArray, str, int]:
     """Frames x joints from long-form rows: times (n_rows,) in the column's unit, the joint
-    of each row, coordinates (n_rows, 3)."""
-    limits.check_values(path, raw_t, limits.MAX_DURATION_S / spec.time_unit_s, "time", line_of)
+    of each row, coordinates (n_rows, 3). Returns the frames' times [s] (sorted), the joint
+    names, positions (n_frames, n_joints, 3), the layout and the row count."""
+    row_time = _time_of(path, spec, raw_t, len(raw_t), line_of)
     joint_names = list(dict.fromkeys(joint_of_row))
     if len(joint_names) > MAX_JOINTS:
         raise DataFileError(path, f"{len(joint_names)} joints: more than {MAX_JOINTS}")
-    times, t_index = np.unique(raw_t, return_inverse=True)
+    times, t_index = np.unique(row_time, return_inverse=True)
     j_index = {n: k for k, n in enumerate(joint_names)}
     pos = np.full((times.shape[0], len(joint_names), 3), np.nan)
     seen = np.zeros((times.shape[0], len(joint_names)), dtype=bool)
@@ -333,7 +362,7 @@ def _long_assemble(
         seen[i, j] = True
         pos[i, j] = coords[r]
     n_rows = len(joint_of_row)
-    return _time_of(path, spec, times, len(times)), tuple(joint_names), pos, "long", n_rows
+    return times, tuple(joint_names), pos, "long", n_rows
 
 
 def _wide_text(
@@ -374,8 +403,7 @@ def _wide_text(
     values = None
     if tcol is not None:
         values = _columns(path, rows, line_of, [tcol], "time")[:, 0]
-        limits.check_values(path, values, limits.MAX_DURATION_S, "time", line_of)
-    time = _time_of(path, spec, values, len(rows))
+    time = _time_of(path, spec, values, len(rows), line_of)
     return time, tuple(joints), data.reshape(len(rows), len(joints), 3), "wide", len(rows)
 
 
@@ -447,8 +475,6 @@ def _read_npz(
                 raise DataFileError(
                     path, f"{values.shape[0]} time stamps for {pos.shape[0]} frames of positions"
                 )
-            if values is not None:
-                limits.check_values(path, values, limits.MAX_DURATION_S, "time")
             return _time_of(path, spec, values, pos.shape[0]), names, pos, "wide", pos.shape[0]
         tv = get(spec.time_column, "the time").astype(np.float64).ravel()
         jn = [str(s) for s in get(spec.joint_column, "the joint names").ravel()]
