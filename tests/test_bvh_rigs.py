@@ -342,3 +342,37 @@ def test_docs_rig_table_lists_each_rigs_signature_and_joints() -> None:
         left += ["l_ankle", "l_toe"]
         expected = [n for j in left for n in rig.joints[j]]
         assert re.findall(r"`([^`]+)`", joints) == expected, name
+
+
+def test_z_up_file_with_axes_gives_the_upright_walk(tmp_path: Path, cmu_walk) -> None:
+    """The real walk exported z up (the root turned +90 degrees about X: file Y up -> Z up, the
+    subject facing -Y). Read with the default (BVH's y up) the person lies flat, head level with
+    the pelvis; with axes = ['-y', 'x', 'z'] it is the real walk, head 0.5-0.7 m above the
+    pelvis and the same positions."""
+    from scipy.spatial.transform import Rotation
+
+    src = CMU_BVH / "16_21.bvh"
+    b = read_bvh(src)
+    turn = Rotation.from_euler("x", 90, degrees=True)
+    v = b.values.copy()
+    v[:, :3] = turn.apply(v[:, :3])
+    v[:, 3:6] = (turn * Rotation.from_euler("ZYX", v[:, 3:6], degrees=True)).as_euler(
+        "ZYX", degrees=True
+    )
+    hier = src.read_text().split("MOTION")[0]
+    rows = "\n".join(" ".join(f"{x:.9f}" for x in r) for r in v)
+    path = tmp_path / "16_21.bvh"
+    path.write_text(f"{hier}MOTION\nFrames: {len(v)}\nFrame Time: 0.0083333\n{rows}\n")
+    flat = bvh(path).canonical()
+    rise = flat.joint("head")[:, 2] - flat.joint("base")[:, 2]
+    assert np.all(np.abs(rise) < 0.1)
+    m = bvh(path, axes=["-y", "x", "z"])
+    assert m.metadata["axes"] == ["-y", "x", "z"]
+    body, ref = m.canonical(), cmu_walk.canonical()
+    np.testing.assert_allclose(body.positions, ref.positions, atol=1e-6)
+    rise = body.joint("head")[:, 2] - body.joint("base")[:, 2]
+    assert np.all((rise > 0.5) & (rise < 0.7))
+    # the default is unchanged, and axes are validated as for the other sources
+    assert bvh(src).metadata["axes"] == ["z", "x", "y"]
+    with pytest.raises(ValueError, match=r"axes must name x, y and z once each"):
+        BvhConfig(file=src, axes=["x", "x", "z"])

@@ -7,7 +7,8 @@ that is neither known nor mapped stops with the file's joints and the nearest kn
 Units: the rig's (CMU conversions: 1/0.45 inch; Mixamo and Biovision: centimetres) or the
 config's ``unit_m`` (metres per file unit). Axes: BVH is y up; positions map as
 (X, Y, Z)_file -> (Z, X, Y) metres, which puts a rig that faces +Z with its left at +X (all
-four shipped rigs) facing +x with its left at +y.
+four shipped rigs) facing +x with its left at +y; ``axes`` names other file axes (a z-up
+export), as for the other sources (:func:`mdframework.skeleton.reorient`).
 
 Frame rate, in order:
 
@@ -24,6 +25,7 @@ Frame rate, in order:
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, Literal
 
@@ -40,16 +42,19 @@ from mdframework import (
     Skeleton,
 )
 from mdframework.settings import FrameRate
-from mdframework.skeleton import check_canonical_keys
+from mdframework.skeleton import Axis, check_axes, check_canonical_keys, reorient
 
 from .bvh import bvh_forward_kinematics, read_bvh
-from .kinematics import to_project_frame
 from .rigs import RIGS, Rig, RigMismatch, detect_rig, resolve
 
 
 class FrameRateWarning(UserWarning):
     """A file's own frame rate was replaced by a documented correction."""
 
+
+#: The file axes that become the project's x (forward), y (left) and z (up): BVH is y up, and
+#: every shipped rig faces +Z with its left at +X.
+BVH_AXES: tuple[Axis, Axis, Axis] = ("z", "x", "y")
 
 RigName = Literal["auto", "cmu-cgspeed", "cmu-3dsmax", "mixamo", "biovision"]
 
@@ -100,12 +105,14 @@ def load_any_bvh(
     joint_map: dict[str, str] | None = None,
     unit_m: float | None = None,
     keep_first_frame: bool | None = None,
+    axes: Sequence[str] = BVH_AXES,
 ) -> tuple[tuple[str, ...], np.ndarray, dict[str, str], dict[str, Any], Rig | None, float]:
     """Read a BVH file of any rig.
 
     Returns the joint names, positions (n_frames, n_joints, 3) float64 [m] in the project
-    frame, the canonical map, metadata, the rig (None when ``joint_map`` alone maps it) and
-    the header's frame time [s].
+    frame (``axes[i]`` the file axis that becomes project axis i, see
+    :func:`mdframework.skeleton.reorient`; default BVH's y up, facing +Z), the canonical map,
+    metadata, the rig (None when ``joint_map`` alone maps it) and the header's frame time [s].
 
     Raises
     ------
@@ -155,7 +162,7 @@ def load_any_bvh(
     scale = unit_m if unit_m is not None else (rig.unit_m if rig is not None else None)
     if scale is None:
         raise DataFileError(path, "the file's unit is unknown: give motion.unit_m [m per unit]")
-    pos = to_project_frame(bvh_forward_kinematics(bvh, slice(drop, None)), scale)
+    pos = reorient(bvh_forward_kinematics(bvh, slice(drop, None)) * scale, axes)
     meta = {
         "rig": rig.name if rig is not None else "joint_map",
         "unit_m": scale,
@@ -202,6 +209,12 @@ class BvhConfig(MotionConfig):
         description="Keep frame 0; default: dropped for the CMU conversions (an added pose), "
         "kept otherwise.",
     )
+    axes: tuple[Axis, Axis, Axis] = Field(
+        BVH_AXES,
+        description="The file axis (with sign) that becomes x (forward), y (left) and z (up); "
+        "default: BVH's y up with the subject facing +Z and its left at +X. A z-up file "
+        "facing -Y: ['-y', 'x', 'z'].",
+    )
     activity: str = Field("unknown", description="Activity label recorded in the metadata.")
     subject: str | None = Field(
         None,
@@ -214,6 +227,7 @@ class BvhConfig(MotionConfig):
         if Path(self.file).suffix.lower() != ".bvh":
             raise ValueError(f"file must be a .bvh file, got {Path(self.file).name!r}")
         check_canonical_keys(self.joint_map, "joint_map")
+        check_axes(self.axes)
         return self
 
 
@@ -245,6 +259,7 @@ class BvhSource(MotionSource):
             joint_map=c.joint_map,
             unit_m=c.unit_m,
             keep_first_frame=c.keep_first_frame,
+            axes=c.axes,
         )
         subject: Any = c.subject
         trial = None
@@ -276,7 +291,7 @@ class BvhSource(MotionSource):
             frame_rate_from=rate_from,
             n_frames=int(pos.shape[0]),
             units="m",
-            axes="x = file Z, y = file X, z = file Y (up)",
+            axes=list(c.axes),
         )
         if rig is not None and rig.cmu:
             meta["acknowledgement"] = ACKNOWLEDGEMENT
