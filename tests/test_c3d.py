@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import EXAMPLES
 from helpers import pig_markers, write_c3d
 from mdf_c3d import C3dConfig, C3dSource, read_c3d, read_c3d_header
 
@@ -252,3 +253,27 @@ def test_unknown_units_ask_for_unit_m(tmp_path: Path) -> None:
         C3dSource(C3dConfig(file=path)).load()
     m = C3dSource(C3dConfig(file=path, unit_m=0.3048)).load()
     assert m.metadata["unit_from"] == "config"
+
+
+def test_more_than_255_markers_take_their_labels_from_labels2(tmp_path: Path) -> None:
+    """C3D parameters hold at most 255 entries: a file of 300 markers (written by ezc3d) names
+    points 256-300 in POINT:LABELS2. Here 259 static lab markers come first and OpenSim's real
+    41 gait markers last (4 of them in LABELS, 37 in LABELS2): the body is the TRC file's."""
+    import ezc3d
+    from mdf_c3d import TrcConfig, TrcSource, read_trc
+
+    trc = EXAMPLES / "data" / "trc" / "opensim_subject01_walk.trc"
+    m = read_trc(trc)
+    tracks = {f"LAB{k:03d}": np.full((m.n_frames, 3), 0.01 * k) for k in range(259)}
+    tracks.update({name: m.positions[:, k] * m.unit_m for k, name in enumerate(m.labels)})
+    path = tmp_path / "many.c3d"
+    write_c3d(path, tracks, 60.0, "mm", 0.001)
+    raw = ezc3d.c3d(str(path))["parameters"]["POINT"]
+    assert len(raw["LABELS"]["value"]) == 255 and len(raw["LABELS2"]["value"]) == 45
+    data = read_c3d(path)
+    assert data.labels == tuple(tracks) and len(data.labels) == 300
+    np.testing.assert_allclose(data.positions[:, 299] * 1e-3, tracks["Top.Head"], atol=1e-6)
+    body = C3dSource(C3dConfig(file=path, axes=("x", "-z", "y"))).load()
+    ref = TrcSource(TrcConfig(file=trc)).load()
+    assert body.metadata["marker_set"] == "opensim-gait"
+    np.testing.assert_allclose(body.skeleton.positions, ref.skeleton.positions, atol=1e-6)

@@ -637,3 +637,40 @@ def test_registered_in_plugin_registry() -> None:
     from mdframework.plugins import default_registry
 
     assert default_registry().get("motion", "cmu") is CmuSource
+
+
+def test_amc_of_an_unknown_subject_assumes_120_hz_and_says_so(tmp_path: Path) -> None:
+    """An AMC file holds no rate: a name that gives no subject of CMU's index gets CMU's usual
+    120 Hz with a warning naming it and the option; its frames are 1/120 s apart."""
+    import warnings
+
+    ref = load(AMC / "02_01.amc")
+    asf = AMC / "02.asf"
+    for name, who in (
+        ("walk.amc", "no subject is given"),
+        ("200_01.amc", "subject 200 is not in CMU's index"),
+    ):
+        path = tmp_path / name
+        path.write_bytes((AMC / "02_01.amc").read_bytes())
+        with pytest.warns(FrameRateWarning) as caught:
+            m = load(path, asf=asf, allow_other_subject_asf=True)
+        assert [str(w.message) for w in caught] == [
+            f"{path}: an AMC file holds no frame rate and {who}: assuming CMU's usual 120 Hz; "
+            "set motion.frame_rate to the capture rate (or motion.subject to a CMU subject "
+            "number)"
+        ]
+        assert m.metadata["frame_rate_from"] == "default (subject unknown)"
+        np.testing.assert_allclose(np.diff(m.skeleton.time), 1 / 120, rtol=1e-12)
+        np.testing.assert_array_equal(m.skeleton.positions, ref.skeleton.positions)
+    # a known subject or a given rate: no warning
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FrameRateWarning)
+        assert load(path, asf=asf, subject="80", allow_other_subject_asf=True).metadata[
+            "frame_rate_hz"
+        ] == pytest.approx(60.0)
+        assert (
+            load(path, asf=asf, frame_rate=100.0, allow_other_subject_asf=True).metadata[
+                "frame_rate_from"
+            ]
+            == "config"
+        )

@@ -60,11 +60,12 @@ class C3dHeader:
 @dataclass(frozen=True)
 class C3dMarkers:
     """What :func:`read_c3d` returns. ``positions`` (n_frames, n_markers, 3) float64 in the
-    file's unit, NaN where a marker is not seen; ``labels`` the marker names (``POINT:LABELS``,
-    every point of the file); ``rate_hz`` the header's frame rate; ``units`` ``POINT:UNITS``
-    and ``unit_m`` metres per unit; ``subject`` the first of ``SUBJECTS:NAMES`` (or None);
-    ``events`` (label, context, time [s]) from the ``EVENT`` group; ``first_frame`` the
-    header's; ``software`` ``MANUFACTURER:SOFTWARE`` (or None)."""
+    file's unit, NaN where a marker is not seen; ``labels`` the marker names (``POINT:LABELS``
+    then ``LABELS2``, ``LABELS3``... for files of more than 255 points; every point of the
+    file); ``rate_hz`` the header's frame rate; ``units`` ``POINT:UNITS`` and ``unit_m`` metres
+    per unit; ``subject`` the first of ``SUBJECTS:NAMES`` (or None); ``events`` (label, context,
+    time [s]) from the ``EVENT`` group; ``first_frame`` the header's; ``software``
+    ``MANUFACTURER:SOFTWARE`` (or None)."""
 
     path: Path
     labels: tuple[str, ...]
@@ -147,6 +148,22 @@ def _param(params: Any, group: str, name: str) -> Any:
         return None
 
 
+def point_labels(params: Any) -> tuple[str, ...]:
+    """The points' labels: ``POINT:LABELS``, then ``LABELS2``, ``LABELS3``, ... in turn.
+
+    A C3D parameter holds at most 255 entries, so a file of more points continues the labels
+    in ``LABELS2`` (points 256-510), ``LABELS3`` and so on (the C3D User Guide; ezc3d writes
+    them so).
+    """
+    labels: list[str] = []
+    for k in range(1, 10_000):
+        value = _param(params, "POINT", "LABELS" if k == 1 else f"LABELS{k}")
+        if value is None:
+            break
+        labels += [str(s).strip() for s in value]
+    return tuple(labels)
+
+
 def read_c3d(path: Path, unit_m: float | None = None) -> C3dMarkers:
     """Read the 3D points of a C3D file through ezc3d (see the module docstring);
     ``unit_m`` [m per file unit] overrides ``POINT:UNITS``.
@@ -167,7 +184,7 @@ def read_c3d(path: Path, unit_m: float | None = None) -> C3dMarkers:
         text = " ".join(str(exc).split()) or type(exc).__name__
         raise DataFileError(path, f"ezc3d cannot read this C3D file: {text}") from None
     params = c["parameters"]
-    labels = tuple(str(s).strip() for s in (_param(params, "POINT", "LABELS") or []))
+    labels = point_labels(params)
     points = np.asarray(c["data"]["points"], dtype=np.float64)  # (4, n_markers, n_frames)
     if points.ndim != 3 or points.shape[1] != len(labels):
         raise DataFileError(

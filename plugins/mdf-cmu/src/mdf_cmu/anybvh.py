@@ -49,7 +49,8 @@ from .rigs import RIGS, Rig, RigMismatch, detect_rig, resolve
 
 
 class FrameRateWarning(UserWarning):
-    """A file's own frame rate was replaced by a documented correction."""
+    """A file's own frame rate was replaced by a documented correction, or a file without one
+    (AMC of an unknown subject) was given an assumed rate."""
 
 
 #: The file axes that become the project's x (forward), y (left) and z (up): BVH is y up, and

@@ -42,7 +42,9 @@ Frame rate
 ----------
 ASF/AMC holds no rate: it comes from the subject and trial numbers in the file name
 (``80_10.amc``: subject 80, trial 10) through :data:`SUBJECT_60HZ` and :data:`TRIAL_RATES`
-(from CMU's index, ``cmu-index.csv``), or from the config's ``frame_rate``. BVH: the header's
+(from CMU's index, ``cmu-index.csv``), or from the config's ``frame_rate``; for a subject that
+is not in CMU's index (or no subject) :data:`DEFAULT_RATE_HZ` is assumed, with a
+:class:`~mdf_cmu.anybvh.FrameRateWarning` saying so. BVH: the header's
 ``Frame Time``, except that cgspeed wrote ``.0083333`` (120 Hz) into every file, also for the
 subjects captured at 60 Hz: for those the index's rate is used, with a warning naming both
 rates (:func:`mdf_cmu.anybvh.choose_rate`); ``frame_rate`` in the config wins over both.
@@ -58,6 +60,7 @@ bone lengths would be the other subject's.
 from __future__ import annotations
 
 import re
+import warnings
 from pathlib import Path
 from typing import Any, Literal
 
@@ -75,7 +78,7 @@ from mdframework import (
 )
 from mdframework.settings import FrameRate
 
-from .anybvh import choose_rate, load_any_bvh
+from .anybvh import FrameRateWarning, choose_rate, load_any_bvh
 from .asfamc import asf_forward_kinematics, read_amc, read_asf
 from .kinematics import to_project_frame
 
@@ -196,7 +199,8 @@ class CmuConfig(MotionConfig):
     frame_rate: FrameRate | None = Field(
         None,
         description="Capture rate [Hz]. Default: AMC from the subject number (120 Hz, or 60 Hz "
-        "for the subjects CMU's index lists at 60 Hz); BVH from the header's Frame Time, "
+        "for the subjects CMU's index lists at 60 Hz; 120 Hz with a warning for a subject "
+        "not in the index); BVH from the header's Frame Time, "
         "corrected from CMU's index where the header is known to be wrong.",
     )
     cmu_rate_correction: bool = Field(
@@ -306,10 +310,22 @@ class CmuSource(MotionSource):
             meta["format"] = "asf/amc"
             if c.frame_rate is not None:
                 rate, rate_from = float(c.frame_rate), "config"
-            elif subject is not None:
+            elif subject in CMU_SUBJECTS:
                 rate, rate_from = subject_frame_rate(subject, trial), "subject table"
             else:
                 rate, rate_from = DEFAULT_RATE_HZ, "default (subject unknown)"
+                who = (
+                    "no subject is given"
+                    if subject is None
+                    else f"subject {subject} is not in CMU's index"
+                )
+                warnings.warn(
+                    f"{path}: an AMC file holds no frame rate and {who}: assuming "
+                    f"CMU's usual {DEFAULT_RATE_HZ:g} Hz; set motion.frame_rate to the capture "
+                    "rate (or motion.subject to a CMU subject number)",
+                    FrameRateWarning,
+                    stacklevel=2,
+                )
         n = pos_m.shape[0]
         time = np.arange(n, dtype=np.float64) / rate
         check_motion(path, time, pos_m)
