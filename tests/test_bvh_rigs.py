@@ -344,11 +344,9 @@ def test_docs_rig_table_lists_each_rigs_signature_and_joints() -> None:
         assert re.findall(r"`([^`]+)`", joints) == expected, name
 
 
-def test_z_up_file_with_axes_gives_the_upright_walk(tmp_path: Path, cmu_walk) -> None:
-    """The real walk exported z up (the root turned +90 degrees about X: file Y up -> Z up, the
-    subject facing -Y). Read with the default (BVH's y up) the person lies flat, head level with
-    the pelvis; with axes = ['-y', 'x', 'z'] it is the real walk, head 0.5-0.7 m above the
-    pelvis and the same positions."""
+def z_up_copy(tmp_path: Path) -> Path:
+    """The real 16_21 walk exported z up: the root turned +90 degrees about X (file Y up -> Z
+    up), the subject facing -Y."""
     from scipy.spatial.transform import Rotation
 
     src = CMU_BVH / "16_21.bvh"
@@ -363,6 +361,15 @@ def test_z_up_file_with_axes_gives_the_upright_walk(tmp_path: Path, cmu_walk) ->
     rows = "\n".join(" ".join(f"{x:.9f}" for x in r) for r in v)
     path = tmp_path / "16_21.bvh"
     path.write_text(f"{hier}MOTION\nFrames: {len(v)}\nFrame Time: 0.0083333\n{rows}\n")
+    return path
+
+
+def test_z_up_file_with_axes_gives_the_upright_walk(tmp_path: Path, cmu_walk) -> None:
+    """The real walk exported z up (the root turned +90 degrees about X: file Y up -> Z up, the
+    subject facing -Y). Read with the default (BVH's y up) the person lies flat, head level with
+    the pelvis; with axes = ['-y', 'x', 'z'] it is the real walk, head 0.5-0.7 m above the
+    pelvis and the same positions."""
+    path = z_up_copy(tmp_path)
     flat = bvh(path).canonical()
     rise = flat.joint("head")[:, 2] - flat.joint("base")[:, 2]
     assert np.all(np.abs(rise) < 0.1)
@@ -373,6 +380,37 @@ def test_z_up_file_with_axes_gives_the_upright_walk(tmp_path: Path, cmu_walk) ->
     rise = body.joint("head")[:, 2] - body.joint("base")[:, 2]
     assert np.all((rise > 0.5) & (rise < 0.7))
     # the default is unchanged, and axes are validated as for the other sources
-    assert bvh(src).metadata["axes"] == ["z", "x", "y"]
+    assert bvh(CMU_BVH / "16_21.bvh").metadata["axes"] == ["z", "x", "y"]
     with pytest.raises(ValueError, match=r"axes must name x, y and z once each"):
-        BvhConfig(file=src, axes=["x", "x", "z"])
+        BvhConfig(file=path, axes=["x", "x", "z"])
+
+
+def test_lying_body_from_a_wrong_up_axis_is_warned_naming_axes(tmp_path: Path) -> None:
+    """Every run's sanity checks: the z-up export of the real walk read as y up lies flat, its
+    head 0.0 m above the pelvis (the upright walk: 0.52 m): warned, naming motion.axes; as
+    'error' it stops; the upright walk is not flagged."""
+    from mdframework.sanity import MotionSanityWarning, check_motion, head_rise
+    from mdframework.settings import SanityConfig
+
+    src = CMU_BVH / "16_21.bvh"
+    upright = bvh(src, activity="walk")
+    assert head_rise(upright.canonical()) == pytest.approx(0.52, abs=0.01)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", MotionSanityWarning)
+        report = check_motion(upright, SanityConfig(cadence=False)).metadata["sanity"]
+    assert report["upright"]["ok"]
+    path = z_up_copy(tmp_path)
+    flat = bvh(path, activity="walk")  # read as y up
+    rise = head_rise(flat.canonical())
+    assert rise is not None and abs(rise) < 0.1
+    with pytest.warns(MotionSanityWarning) as caught:
+        report = check_motion(flat, SanityConfig(cadence=False)).metadata["sanity"]
+    assert not report["upright"]["ok"]
+    # as docs/motion-formats.md shows it
+    assert [str(w.message) for w in caught] == [
+        "16_21.bvh: the body is not upright: the head is -0.01 m above the pelvis (median over "
+        "the frames; upright bodies 0.2 m or more): if the file's up axis is not the one its "
+        "source assumes, set motion.axes"
+    ]
+    with pytest.raises(DataFileError, match=r"16_21\.bvh: motion sanity: the body is not upright"):
+        check_motion(flat, SanityConfig(cadence=False, upright="error"))

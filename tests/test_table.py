@@ -298,6 +298,14 @@ def test_times_far_from_zero_in_any_unit_count_from_the_first_frame(
     speed = np.linalg.norm(base[-1, :2] - base[0, :2]) / t[-1]
     kin = to_project_frame(ref.positions)[:, KINECT_V1_JOINTS.index("HipCenter")]
     assert speed == pytest.approx(np.linalg.norm(kin[-1, :2] - kin[0, :2]) / 35.0, rel=1e-6)
+    # a segment cut in the column's own unit (epoch seconds were refused above 1e9)
+    per_unit = 30.0 if "frame_rate" in options else per_s
+    cut = (offset + 10.0 * per_unit, offset + 20.0 * per_unit)
+    config = TableConfig(
+        file=path, joint_set="kinect-v1", axes=["z", "x", "y"], time_range=cut, **options
+    )
+    t = TableSource(config).load().skeleton.time
+    assert t[-1] == pytest.approx(10.0, abs=0.1)  # within 3 frames (real Kinect stamps)
 
 
 def test_time_limits_are_in_seconds_and_say_so(tmp_path: Path) -> None:
@@ -312,6 +320,8 @@ def test_time_limits_are_in_seconds_and_say_so(tmp_path: Path) -> None:
         "86400 s: check the time column's unit (motion.time_unit_s or motion.frame_rate)"
     )
     assert read_table(micro, TableLayout(time_unit_s=1e-6)).time[-1] == pytest.approx(35.0)
+    with pytest.raises(ValueError, match=r"time_range: 2e\+10 s is beyond \+-1e\+10 s"):
+        TableConfig(file=micro, time_range=(0.0, 2e13), time_unit_s=1e-3)
     far = _ut_table(tmp_path / "far.csv", 2e10 + ref.time, long=False)
     with pytest.raises(DataFileError, match=r"far\.csv:2: time \[s\] \(motion\.time_unit_s = 1 s"):
         read_table(far)

@@ -29,6 +29,10 @@ Checks, on the canonical 17-joint body:
    left-right height alternation of the ankles, knees and hands (a stride: what running on the
    spot shows); outside ``walk_cadence`` (70-150) or ``run_cadence`` (130-230) the motion is
    flagged: usually a wrong frame rate.
+5. **Upright** (:func:`head_rise`): the median height of the head above the pelvis over the
+   frames; below ``upright_min_m`` (0.2 m; the shipped recordings, boxing and sitting down
+   included, give 0.45-0.8 m) the body lies flat or stands on its head, which a file read with
+   the wrong up axis gives: the message names the sources' ``axes`` option.
 """
 
 from __future__ import annotations
@@ -343,6 +347,14 @@ def cadence_spm(
     return None if found is None else found[0]
 
 
+def head_rise(body: Skeleton) -> float | None:
+    """Median over the frames of the head's height above the pelvis [m] (canonical ``head``
+    z minus ``base`` z, frames where both are valid); None without such a frame."""
+    rise = body.joint("head")[:, 2] - body.joint("base")[:, 2]
+    ok = np.isfinite(rise) & body.valid[:, body.index("head")] & body.valid[:, body.index("base")]
+    return float(np.median(rise[ok])) if ok.any() else None
+
+
 def _activity_kind(activity: str) -> str | None:
     a = activity.lower()
     if "walk" in a:
@@ -453,6 +465,20 @@ def check_motion(motion: Motion, config: SanityConfig) -> Motion:
                     f"{lo:g}-{hi:g}): check the frame rate or time base",
                 )
             )
+
+    rise = head_rise(body)
+    upright = rise is None or rise >= config.upright_min_m
+    report["upright"] = {"median_head_rise_m": rise, "min_m": config.upright_min_m, "ok": upright}
+    if not upright:
+        assert rise is not None
+        notes.append(
+            (
+                config.upright,
+                f"the body is not upright: the head is {rise:.2f} m above the pelvis (median "
+                f"over the frames; upright bodies {config.upright_min_m:g} m or more): if the "
+                "file's up axis is not the one its source assumes, set motion.axes",
+            )
+        )
 
     report["warnings"] = [msg for option, msg in notes if option != "ignore"]
     for option, msg in notes:

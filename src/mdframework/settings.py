@@ -147,6 +147,19 @@ class SanityConfig(StrictModel):
     run_cadence: tuple[Cadence, Cadence] = Field(
         (130.0, 230.0), description="Plausible running or jogging cadence [steps/min]."
     )
+    upright: Literal["warn", "ignore", "error"] = Field(
+        "warn",
+        description="A body whose head is not above its pelvis (median over the frames below "
+        "upright_min_m: lying flat or upside down, usually a file read with the wrong up axis; "
+        "see the sources' axes option): warn, flag silently, or stop.",
+    )
+    upright_min_m: float = Field(
+        0.2,
+        ge=0,
+        le=10,
+        description="Smallest median height [m] of the head above the pelvis of an upright "
+        "body (the shipped recordings give 0.45-0.8 m).",
+    )
 
 
 class MotionConfig(PluginConfig):

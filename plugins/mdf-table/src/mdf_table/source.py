@@ -30,8 +30,10 @@ from mdframework import (
 from mdframework.settings import FrameRate
 from mdframework.skeleton import Axis, check_axes, check_canonical_keys, group_means, reorient
 
-#: A value of a time column in its own unit (frame numbers, milliseconds, seconds).
-ColumnTime = Annotated[float, Field(ge=-limits.MAX_FRAME_NUMBER, le=limits.MAX_FRAME_NUMBER)]
+#: A value of a time column in its own unit (frame numbers, milliseconds, seconds); in seconds
+#: it must lie within +-``limits.MAX_CLOCK_TIME_S``, as the column's times do (checked with the
+#: unit, by :class:`TableConfig`).
+ColumnTime = Annotated[float, Field(allow_inf_nan=False)]
 
 #: Metres per unit of ``units``.
 UNITS_M = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254, "ft": 0.3048}
@@ -77,7 +79,8 @@ class TableConfig(MotionConfig):
     time_range: tuple[ColumnTime, ColumnTime] | None = Field(
         None,
         description="Keep the frames whose time column lies in [first, last], in the column's "
-        "own unit (e.g. frame numbers): a segment of a longer recording.",
+        "own unit (e.g. frame numbers): a segment of a longer recording. Within "
+        f"+-{limits.MAX_CLOCK_TIME_S:g} s once converted to seconds.",
     )
     joint_column: str = Field("joint", description="Long form: the column of joint names.")
     xyz: tuple[str, str, str] = Field(
@@ -115,8 +118,16 @@ class TableConfig(MotionConfig):
             )
         check_canonical_keys(self.joint_map, "joint_map")
         check_axes(self.axes)
-        if self.time_range is not None and self.time_range[0] > self.time_range[1]:
-            raise ValueError(f"time_range: first {self.time_range[0]:g} is after last")
+        if self.time_range is not None:
+            if self.time_range[0] > self.time_range[1]:
+                raise ValueError(f"time_range: first {self.time_range[0]:g} is after last")
+            per_unit = 1.0 / self.frame_rate if self.frame_rate is not None else self.time_unit_s
+            far = max(abs(v) * per_unit for v in self.time_range)
+            if far > limits.MAX_CLOCK_TIME_S:
+                raise ValueError(
+                    f"time_range: {far:g} s is beyond +-{limits.MAX_CLOCK_TIME_S:g} s (in the "
+                    "time column's unit: time_unit_s, or frame numbers at frame_rate)"
+                )
         for name in ("columns", "joints"):
             counts = Counter(getattr(self, name) or [])
             twice = sorted(n for n, k in counts.items() if k > 1)
