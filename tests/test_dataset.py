@@ -377,6 +377,27 @@ def test_corrupt_and_partial_records_are_redone(tmp_path: Path) -> None:
     assert {p.name: p.stat().st_mtime_ns for p in files[3:]} == stamp  # not redone
 
 
+def test_a_record_without_permission_stops_the_resume_and_is_kept(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A record the user may not read is not someone else's corrupt file to delete: the
+    resume stops naming it. (The read is made to fail as the OS would for a file of another
+    user: the suite runs as root in CI, where a chmod does not deny reading.)"""
+    cfg, base = load_dataset_config(write_config(tmp_path / "d.toml"))
+    out = tmp_path / "ds"
+    build_dataset(cfg, base, out, workers=1, progress=False)
+    first = sorted((out / RECORDS).glob("*.npz"))[0]
+
+    def denied(path: Path) -> Any:
+        raise PermissionError(13, "Permission denied", str(path))
+
+    monkeypatch.setattr(dataset, "read_record", denied)
+    with pytest.raises(MdfError) as err:
+        build_dataset(cfg, base, out, workers=1, progress=False)
+    assert str(err.value).startswith(f"{first}: Permission denied: a record of this dataset")
+    assert first.exists()
+
+
 def finished_records(out: Path) -> list[Path]:
     """Record files of a dataset folder (not the hidden temporary files of writes under way)."""
     return [p for p in (out / RECORDS).glob("*.npz") if not p.name.startswith(".")]

@@ -212,7 +212,7 @@ def test_place_record_with_a_motion_conditioning_refuses_is_one_clear_error(
     tmp_path: Path,
 ) -> None:
     """A real Kinect table whose left hand is lost for about 0.7 s, with conditioning told to stop
-    on gaps over 0.1 s: placing each record (``place = "record"``) conditions the recording
+    on gaps over 0.2 s: placing each record (``place = "record"``) conditions the recording
     while planning, and that stop is one clear error, not an internal ValueError."""
     example = EXAMPLES / "table_utkinect_walk.toml"
     source = EXAMPLES / "data" / "kinect" / "utkinect" / "joints_s01_e01.txt"
@@ -242,7 +242,7 @@ radar_position = [0.0, 0.0, 0.0]
 person = {{ position = [2.3, 0.0], aspect_deg = 0.0 }}
 [base.conditioning]
 enabled = true
-max_gap_s = 0.1
+max_gap_s = 0.2
 long_gaps = "error"
 """)
     cfg, base = load_dataset_config(config)

@@ -523,3 +523,27 @@ def test_gate_signal_is_flat_inside_the_gate_and_rejects_outside() -> None:
     prof = fmcw.range_profile(y, "hann", 240)[:, None, :]
     out = fmcw.gate_signal(prof, axis, np.full(2, 3.0), 2.0, "hann", 240)
     assert np.max(np.abs(out)) < 1e-5
+
+
+@pytest.mark.parametrize(
+    ("range_window", "doppler_window"), [("hann", "hann"), ("rect", "blackman")]
+)
+def test_map_noise_power_is_the_mean_noise_of_the_detection_map(
+    range_window: str, doppler_window: str
+) -> None:
+    """Complex white IF noise of power P per sample, through the range and Doppler FFTs of 12
+    virtual antennas: the detection map's mean over the 16 x 240 cells of 200 frames is
+    map_noise_power to 2 %."""
+    rng = np.random.default_rng(5)
+    p, n_frames = 2.5e-9, 200
+    total = 0.0
+    for _ in range(n_frames):
+        shape = (SEQ.chirps_per_frame, 4, SEQ.n_samples)
+        x = (rng.normal(size=shape) + 1j * rng.normal(size=shape)) * np.sqrt(p / 2)
+        prof = fmcw.range_profile(x, range_window, 240)  # type: ignore[arg-type]
+        rd = fmcw.range_doppler(fmcw.virtual_cube(prof, SEQ, 3), doppler_window, 16)  # type: ignore[arg-type]
+        total += float(np.mean(fmcw.detection_map(rd)))
+    expected = fmcw.map_noise_power(p, 12, range_window, 240, doppler_window, 16)  # type: ignore[arg-type]
+    assert total / n_frames == pytest.approx(expected, rel=0.02)
+    if range_window == "hann":  # the coherent gains 2 n / 3 of the docs
+        assert expected == pytest.approx(12 * p / (2 * 240 / 3) / (2 * 16 / 3), rel=1e-12)

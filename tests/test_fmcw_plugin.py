@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -235,11 +236,44 @@ def test_snr_of_a_point_target_follows_the_range_equation(preset: str) -> None:
     floor = np.mean(maps[:, :, 80:])  # every Doppler row, 40 bins and more beyond the target
     measured = 10 * np.log10(np.mean(peak) / floor)
     assert measured == pytest.approx(10 * np.log10(1 + snr), abs=0.1)
-    # the figures of docs/fmcw.md: 44.3 and 44.9 dB here; 10.8 dB for 1 m^2 at 12 m (IWR1443)
+    # the figures of docs/fmcw.md: 44.3 and 44.9 dB here
     documented = {"iwr1443_short_range_3d": 44.3, "iwr6843isk_people_counting_6m": 44.9}
     assert round(10 * np.log10(1 + snr), 1) == documented[preset]
-    if preset == "iwr1443_short_range_3d":
-        assert round(10 * np.log10(snr * (r / 12.0) ** 4), 1) == 10.8
+
+
+def test_a_point_under_the_threshold_near_the_maximum_range_as_documented() -> None:
+    """docs/fmcw.md: a static 1 m^2 point on range bin 235 (10.24 m, inside the IWR1443
+    preset's 10.46 m maximum range) stands 13.8 dB over the noise by the range equation and,
+    measured over 30 frames, to 0.2 dB; under the 15 dB threshold it gives a point in at most
+    3 of the 30 frames (a point 12 m away, the example before, is beyond the maximum range:
+    the run stops)."""
+    from mdframework.physics import fmcw
+
+    wf = FmcwRadar(IWR1443)
+    seq = wf.sequence
+    k = 235
+    r = k * seq.range_resolution
+    assert round(r, 2) == 10.24 and round(seq.max_range, 2) == 10.46
+    res = fmcw_run(
+        [{"position": [r, 0.0, 0.0], "rcs": 1.0}],
+        duration=30 * seq.frame_period,
+        clutter_removal=False,
+    )
+    maps = res.received.products["range_doppler"].astype(np.float64)
+    assert maps.shape[0] == 30
+    amp = IWR1443.amplitudes(np.ones(1), np.array([r]), seq.wavelength)[0]
+    w_r, w_d = fmcw.window("hann", seq.n_samples), fmcw.window("hann", seq.n_loops)
+    gain = np.sum(w_r) ** 2 / np.sum(w_r**2) * np.sum(w_d) ** 2 / np.sum(w_d**2)
+    predicted = 10 * np.log10(1 + amp**2 / wf.noise_power() * gain)
+    assert round(predicted, 1) == 13.8
+    floor = np.mean(maps[:, :, :150])  # 85 bins and more short of the target
+    measured = 10 * np.log10(np.mean(maps[:, seq.n_loops // 2, k]) / floor)
+    assert measured == pytest.approx(predicted, abs=0.2)
+    pts = res.received.products["points"]
+    near = np.abs(np.linalg.norm(pts[:, 2:5], axis=1) - r) < 0.2
+    assert np.unique(pts[near, 0]).size <= 3
+    with pytest.raises(SceneError, match=r"radar\.sample_rate: the farthest scatterer at 12\.00"):
+        fmcw_run([{"position": [12.0, 0.0, 0.0], "rcs": 1.0}], duration=seq.frame_period)
 
 
 @pytest.mark.parametrize("range_window", ["hann", "rect"])
@@ -544,19 +578,23 @@ def test_a_noise_free_detection_has_a_finite_intensity() -> None:
     rd = np.zeros((12, 16, 240), dtype=np.complex128)
     rd[:, 8, 50] = 1e-3  # one target, nothing in its training cells
     axes = radar_.axes()
+    grid = fmcw.angle_grid(radar_.antennas.virtual, radar_.sequence.wavelength)
+    slots = radar_.antennas.slot_of_virtual(radar_.sequence)
+    args = (radar_.sequence.chirp_period, radar_.sequence.wavelength)
     pts = fmcw.detect_points(
-        rd,
-        axes["range_m"],
-        axes["doppler_hz"],
-        fmcw.angle_grid(radar_.antennas.virtual, radar_.sequence.wavelength),
-        radar_.antennas.slot_of_virtual(radar_.sequence),
-        radar_.sequence.chirp_period,
-        radar_.sequence.wavelength,
-        radar_.detection(),
+        rd, axes["range_m"], axes["doppler_hz"], grid, slots, *args, radar_.detection()
     )
     assert pts.shape[0] >= 1 and np.all(np.isfinite(pts))
     expected = 10 * np.log10(12 * 1e-6) - 10 * np.log10(np.finfo(np.float64).tiny)
     assert pts[0, 4] == pytest.approx(expected)
+    # with the receiver's mean noise P as the floor (a run without receiver noise) the lone
+    # target stands at 1 + SNR over it: (12 a^2 + P) / P
+    floor = FmcwRadar(IWR1443).map_noise_power()
+    detection = replace(radar_.detection(), noise_floor=floor)
+    [pt] = fmcw.detect_points(
+        rd, axes["range_m"], axes["doppler_hz"], grid, slots, *args, detection
+    )
+    assert pt[4] == pytest.approx(10 * np.log10(1 + 12 * 1e-6 / floor), abs=1e-5)  # cumsums
 
 
 def test_a_gate_narrower_than_a_range_bin_reads_the_nearest_bin() -> None:
@@ -704,3 +742,93 @@ def test_angles_come_from_the_virtual_antennas_of_the_used_transmitters(
                 assert best[4] == pytest.approx(at[2], abs=0.1)
             else:
                 assert np.all(p[:, 4] == 0.0)
+
+
+def test_without_receiver_noise_points_stand_over_the_receivers_mean_noise() -> None:
+    """The defaults (no preset) add no receiver noise but extract points. A 1 m^2 point 3 m
+    ahead approaching at 0.86 m/s used to give 36 points a frame over 0.98-4.78 m, the window
+    sidelobes over training cells of 0 W, at up to 2905 dB. CFAR now works on the map plus the
+    receiver's mean noise, so the noise-free cloud is the noisy run's: the same cells (range
+    and Doppler bin) in every frame but one at the threshold's edge, all within 0.4 m of the
+    target, the intensities alike (to 2 dB over 30 dB: the noisy smallest-of estimate
+    fluctuates), the strongest at most the on-bin 1 + SNR of the range equation (k T0 F fs
+    through both FFTs, docs/fmcw.md)."""
+    target = [{"position": [3.0, 0.0, 0.0], "velocity": [-0.86, 0.0, 0.0], "rcs": 1.0}]
+    fields = {"kind": "fmcw", "boresight_azimuth_deg": 0.0}
+    runs = {
+        noise: point_run(target, duration=0.2, radar={**fields, "receiver_noise": noise})
+        for noise in (False, True)
+    }
+    quiet, noisy = (runs[n].received.products["points"] for n in (False, True))
+    radar_ = FmcwRadar(FmcwConfig())
+    seq = radar_.sequence
+    cells = []  # (frame, range bin, velocity) -> the strongest intensity there [dB]
+    for pts in (quiet, noisy):
+        rbin = np.round(np.linalg.norm(pts[:, 2:5], axis=1) / seq.range_resolution)
+        best: dict[tuple[int, int, float], float] = {}
+        for f, k, v, db in zip(pts[:, 0], rbin, np.round(pts[:, 5], 3), pts[:, 6], strict=True):
+            key = (int(f), int(k), float(v))
+            best[key] = max(best.get(key, -np.inf), float(db))
+        cells.append(best)
+    assert len(cells[0]) >= 20 and len(cells[0].keys() ^ cells[1].keys()) <= 1
+    both = cells[0].keys() & cells[1].keys()
+    for k in both:
+        assert abs(cells[0][k] - cells[1][k]) < (2.0 if cells[1][k] > 30.0 else 3.0)
+    r = np.linalg.norm(quiet[:, 2:5], axis=1)
+    assert np.all(np.abs(r - (3.0 - 0.86 * quiet[:, 1])) < 0.4)  # 4 range bins
+    a2 = float(radar_.config.amplitudes(np.ones(1), np.full(1, 3.0), seq.wavelength)[0] ** 2)
+    snr = a2 * 12 / radar_.map_noise_power()  # the map sums 12 antennas' signal and noise
+    assert 15.0 < quiet[:, 6].max() <= 10 * np.log10(1 + snr)
+
+
+def test_the_ambiguous_doppler_bin_as_documented() -> None:
+    """docs/fmcw.md: with the IWR1443 preset's 16 Doppler bins the simulated axis runs from
+    -4.92 (the ambiguous bin, read as receding) to +4.30 m/s; the real RadHAR points, their range
+    rate negated by the reader, run from -4.30 to +4.92 m/s (the shipped boxing subset holds
+    points in both end bins)."""
+    from mdf_radhar.source import npz_recordings
+
+    radar_ = FmcwRadar(IWR1443)
+    v = radar_.axes()["velocity_mps"]
+    v_max = radar_.max_unambiguous_velocity
+    assert v[0] == pytest.approx(-v_max, rel=1e-12) and v[0] == pytest.approx(-4.92, abs=5e-3)
+    assert v[-1] == pytest.approx(7 / 8 * v_max, rel=1e-12) and round(v[-1], 2) == 4.30
+    step = 2 * v_max / 16
+    real = np.concatenate(
+        [
+            c.velocity
+            for _, c in npz_recordings(EXAMPLES / "data" / "radhar" / "radhar_boxing_subset.npz")
+        ]
+    )
+    bins = np.round(real / step)
+    assert bins.max() == 8 and bins.min() == -7
+    assert real.max() == pytest.approx(4.92, abs=5e-3) and round(real.min(), 2) == -4.30
+
+
+def test_the_aliasing_advice_names_the_fields_that_set_the_slow_time_rate() -> None:
+    """The default FMCW radar (3 TX, 70 us chirps: loop rate 4762 Hz, v_max 4.58 m/s) and a
+    point approaching at 5.5 m/s: the error names the chirp timing and the TDM order (fmcw has
+    no prf field) with the chirp period that reaches 4 v / lambda; that period, or one TX,
+    runs. The CW radar names its sample_rate."""
+    target = [{"position": [3.0, 0.0, 0.0], "velocity": [-5.5, 0.0, 0.0], "rcs": 1.0}]
+    fields = {"kind": "fmcw", "boresight_azimuth_deg": 0.0, "points": False}
+    error = {"aliasing": "error"}
+    with pytest.raises(SceneError) as info:
+        point_run(target, duration=0.2, radar=fields, processing=error)
+    seq = FmcwConfig().sequence()
+    rate = 4 * 5.5 / seq.wavelength
+    period = 1 / (3 * rate)
+    text = str(info.value)
+    assert "prf" not in text.replace("PRF", "")
+    assert (
+        f"raise the loop rate to at least {np.ceil(rate):.0f} Hz: shorten radar.idle_time + "
+        f"radar.ramp_end_time from 70.00 us to at most {np.floor(period * 1e8) / 100:.2f} us, "
+        "or use fewer "
+        "than 3 TX in radar.tdm_order (processing.aliasing = 'error' stops such runs)"
+    ) in text
+    advised = np.floor(period * 1e8) / 1e8  # as printed, rounded down
+    for change in ({"idle_time": 1e-6, "ramp_end_time": advised - 1e-6}, {"tdm_order": [1]}):
+        point_run(target, duration=0.2, radar={**fields, **change}, processing=error)
+    cw = {"kind": "cw", "carrier_frequency": 24e9, "sample_rate": 1000.0}
+    with pytest.raises(SceneError, match=r"aliases; raise radar\.sample_rate to at least 1762 Hz"):
+        point_run(target, duration=0.2, radar=cw, processing=error)

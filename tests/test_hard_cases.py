@@ -259,7 +259,7 @@ def test_6_5_doppler_aliasing_detected_and_observed_where_predicted() -> None:
     tgt = [{"position": [100.0, 0, 0], "velocity": [-15.0, 0, 0]}]
     # the warning says which PRF would do: 4 v / lambda = 4 * 15 / 0.019986 = 3002.1 Hz
     assert radar.min_prf_for_velocity(15.0, FC) == pytest.approx(3002.08, abs=0.01)
-    with pytest.warns(AliasingWarning, match="aliases; raise the PRF to at least 3003 Hz"):
+    with pytest.warns(AliasingWarning, match="aliases; raise radar.prf to at least 3003 Hz"):
         res = point_run(tgt, duration=1.0)
     f = phase_increment_doppler(res.received.signal, 2400.0)
     assert f == pytest.approx(radar.alias_frequency(2 * 15.0 / LAM, 2400.0), abs=1e-3)

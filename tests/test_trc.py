@@ -311,3 +311,32 @@ def test_skipped_frame_numbers_keep_their_time(tmp_path, lines) -> None:
     assert gap.skeleton.duration == pytest.approx(2.5) and gap.metadata["frames_skipped"] == 30
     full = TrcSource(TrcConfig(file=REAL)).load().skeleton
     np.testing.assert_array_equal(gap.skeleton.positions, full.positions[frame_numbers - 1])
+
+
+def test_missing_frames_are_a_gap_for_conditioning(tmp_path, lines) -> None:
+    """Frames a tracker did not write (Frame# 31..60: 0.517 s between the frames around them)
+    are a gap of every joint: conditioning flags them in its report, and with
+    long_gaps = "error" stops, as it does for a joint lost that long (they were bridged
+    silently: no joint is untracked in the frames that are there)."""
+    from mdframework.conditioning import condition
+    from mdframework.settings import ConditioningConfig
+
+    rows = [r for r in lines[6:] if not 31 <= int(r.split("\t")[0]) <= 60]
+    head = _header(list(lines[:6]), "NumFrames", str(len(rows)))
+    path = _write(tmp_path, [*head, *rows])
+    with pytest.warns(UserWarning, match="Frame# skips 30"):
+        body = TrcSource(TrcConfig(file=path)).load().canonical()
+    _, report = condition(body, ConditioningConfig(enabled=True))
+    assert report["gaps"]["n_gaps"] == 0
+    [hole] = report["gaps"]["missing_frames"]
+    assert hole["after_frame"] == 29 and hole["after_s"] == pytest.approx(29 / 60)
+    assert hole["duration_s"] == pytest.approx(31 / 60)
+    _, report = condition(body, ConditioningConfig(enabled=True, max_gap_s=0.6))
+    assert report["gaps"]["missing_frames"] == []
+    stop = ConditioningConfig(enabled=True, long_gaps="error")
+    with pytest.raises(ValueError) as err:
+        condition(body, stop)
+    assert str(err.value) == (
+        "the recording has no frame for 0.517 s (after frame 29 at 0.483 s), longer than "
+        "conditioning.max_gap_s = 0.2 s"
+    )

@@ -64,6 +64,9 @@ class RunPlan:
     max_joint_radial_speed_mps: float
     aliasing: bool
     prf_needed_hz: float
+    #: what to change in the radar's config to reach ``prf_needed_hz``
+    #: (:meth:`RadarWaveform.faster_sampling`)
+    faster_sampling: str
     memory_mib: float
     memory_terms_mib: dict[str, float] = field(default_factory=dict)
 
@@ -180,6 +183,7 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
         max_joint_radial_speed_mps=speed,
         aliasing=speed > v_max,
         prf_needed_hz=prf * speed / v_max,  # v_max grows in proportion to the PRF
+        faster_sampling=wf.faster_sampling(prf * speed / v_max),
         memory_mib=sum(terms.values()),
         memory_terms_mib=terms,
     )
@@ -215,10 +219,7 @@ def format_plan(plan: RunPlan, source: str) -> str:
     ]
     speed = f"fastest joint {p.max_joint_radial_speed_mps:.3g} m/s radially"
     if p.aliasing:
-        lines.append(
-            f"  {'aliasing':<12}LIKELY: {speed}; raise radar.prf to at least "
-            f"{np.ceil(p.prf_needed_hz):.0f} Hz"
-        )
+        lines.append(f"  {'aliasing':<12}LIKELY: {speed}; {p.faster_sampling}")
     else:
         lines.append(f"  {'aliasing':<12}none expected: {speed}")
     terms = ", ".join(f"{k} {v:.3g}" for k, v in p.memory_terms_mib.items())

@@ -431,6 +431,19 @@ def condition(skeleton: Skeleton, config: ConditioningConfig) -> tuple[Skeleton,
     valid = untracked_mask(skeleton.positions, skeleton.valid, None, 0.0, config.zeros_untracked)
     gaps = find_gaps(time, valid)
     long = [g for g in gaps if g[3] > config.max_gap_s]
+    # frames the recording lacks (a tracker that lost the subject wrote no rows) are a gap of
+    # every joint: the step between the frames around it
+    frame_steps = np.diff(time)
+    holes = [
+        (int(k), float(frame_steps[k])) for k in np.flatnonzero(frame_steps > config.max_gap_s)
+    ]
+    if holes and config.long_gaps == "error":
+        at, d = holes[0]
+        raise ValueError(
+            f"the recording has no frame for {d:.3f} s (after frame {at} at "
+            f"{time[at] - time[0]:.3f} s), longer than conditioning.max_gap_s = "
+            f"{config.max_gap_s:g} s"
+        )
     if long and config.long_gaps == "error":
         j, s, e, d = long[0]
         raise ValueError(
@@ -448,6 +461,10 @@ def condition(skeleton: Skeleton, config: ConditioningConfig) -> tuple[Skeleton,
         "long_gaps": [
             {"joint": names[j], "first_frame": s, "last_frame": e, "duration_s": d}
             for j, s, e, d in long
+        ],
+        "missing_frames": [
+            {"after_frame": at, "after_s": float(time[at] - time[0]), "duration_s": d}
+            for at, d in holes
         ],
     }
 

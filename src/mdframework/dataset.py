@@ -23,7 +23,10 @@ representation simulated records get with ``representation = "histogram"``.
 
 Records are independent pure functions of their spec (including a seed derived from the
 dataset seed and the record's index), so the result is identical whatever the number of workers
-or the scheduler. A killed build, run again, keeps every complete record, removes temp files and
+or the scheduler. A record's id is its index and a digest of what makes its arrays, the
+contents of the motion or recording it is cut from included (:func:`motion_fingerprint`); its
+label, group, subject and dataset are not in it and are rewritten into a kept record when the
+config changes them. A killed build, run again, keeps every complete record, removes temp files and
 redoes records whose file is missing or unreadable. It resumes only into a folder built from the
 same config (the marker ``.mdf-dataset.json`` holds it; a different config is an error naming
 the difference, or with ``force`` a rebuild that keeps the old dataset whole until the new index
@@ -458,9 +461,53 @@ def _preload_motions(config: DatasetConfig, base_dir: Path, workers: int) -> Non
 
 
 def _receive_motions(motions: dict[tuple[str, str], Motion]) -> None:
-    """Keep the motions the planner loaded (run on each Dask worker as a build starts)."""
-    for key, motion in motions.items():
-        _MOTIONS.setdefault(key, motion)
+    """Keep the motions the planner loaded (run on each Dask worker as a build starts): they
+    replace any this worker kept from an earlier build, whose files may have changed since,
+    and so do the recordings it loads afresh."""
+    _load_recordings.cache_clear()
+    _MOTIONS.update(motions)
+
+
+def _forget_loaded() -> None:
+    """Forget the motions and recordings this process loaded: a build reads its files afresh,
+    so a file changed since an earlier build in this process is seen (and fingerprinted)."""
+    _MOTIONS.clear()
+    _PENDING.clear()
+    _load_recordings.cache_clear()
+
+
+def _hash_arrays(digest: Any, *arrays: Any) -> None:
+    """Feed arrays into ``digest``: dtype, shape and bytes of each (None as a marker)."""
+    for a in arrays:
+        if a is None:
+            digest.update(b"none;")
+            continue
+        arr = np.ascontiguousarray(a)
+        digest.update(f"{arr.dtype.str}{arr.shape};".encode())
+        digest.update(arr.tobytes())
+
+
+def motion_fingerprint(motion: Motion) -> str:
+    """A digest (40 hex digits) of everything a loaded motion gives the simulation: its time
+    stamps, joint positions and validity, joint names, canonical map, point RCS and whether its
+    tracks are linear. It covers what was read from every file behind the motion (an ``.asf``
+    beside its ``.amc`` included), whatever their paths, times or copies."""
+    sk = motion.skeleton
+    digest = hashlib.sha1()
+    _hash_arrays(digest, sk.time, sk.positions, sk.valid, motion.point_rcs)
+    cmap = None if motion.canonical_map is None else sorted(motion.canonical_map.items())
+    digest.update(json.dumps([list(sk.joint_names), cmap, bool(motion.linear_tracks)]).encode())
+    return digest.hexdigest()
+
+
+def recording_fingerprint(recording: Recording) -> str:
+    """A digest (40 hex digits) of a real radar's recording: its name, frame period, frame
+    count and every point (frame, position, velocity, intensity)."""
+    cloud = recording.cloud
+    digest = hashlib.sha1()
+    digest.update(json.dumps([recording.name, cloud.frame_period, cloud.n_frames]).encode())
+    _hash_arrays(digest, cloud.frame, cloud.positions, cloud.velocity, cloud.intensity)
+    return digest.hexdigest()
 
 
 def _record_seed(seed: int, index: int) -> int:
@@ -532,6 +579,7 @@ def _plan_recordings(
     hist = config.histogram.model_dump()
     specs: list[RecordSpec] = []
     for rec in recordings:
+        content = recording_fingerprint(rec)
         period = rec.cloud.frame_period
         length_s = entry.record_length or config.record_lengths.get(entry.label)
         length = rec.cloud.n_frames if length_s is None else round(length_s / period)
@@ -553,7 +601,15 @@ def _plan_recordings(
                 break
             run = {"recording": section, "name": rec.name, "first_frame": first, "frames": length}
             spec = _spec(
-                config, first_index + len(specs), entry, section["kind"], run, base_dir, None, hist
+                config,
+                first_index + len(specs),
+                entry,
+                section["kind"],
+                run,
+                base_dir,
+                None,
+                hist,
+                content=content,
             )
             window = (rec.name, first * period, length * period)
             specs.append(
@@ -584,12 +640,19 @@ def _spec(
     draw_origins: dict[str, str] | None = None,
     span: tuple[float, float | None] | None = None,
     aspect_deg: float | None = None,
+    content: str | None = None,
 ) -> RecordSpec:
-    """A record's spec; its id ends with a digest of everything that makes the record.
+    """A record's spec; its id ends with a digest of everything that makes the record's
+    arrays: its run config, the feature and histogram settings, its draws and ``content``, the
+    fingerprint of the motion or recording it is cut from (:func:`motion_fingerprint`), so a
+    file whose contents changed makes new records. Label, group, subject and dataset are not
+    in it: a record whose only change is one of them is kept and relabelled (:func:`_complete`).
     ``meta``: the record's subject, recording and dataset; ``span``: the source's span when
     it gives a start or a duration (:attr:`RecordSpec.span`)."""
     features = config.features.model_dump()
     payload = [run, features] + [x for x in (draws, hist) if x is not None]
+    if content is not None:
+        payload.append({"content": content})
     # where the span ends moves a sped-up or warped record (its start only refuses one)
     if span is not None and span[1] is not None and draws and {"speed", "time_warp"} & set(draws):
         payload.append({"span_end": span[1]})
@@ -799,6 +862,7 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
     specs: list[RecordSpec] = []
     short: list[str] = []
     plan = (config, base_dir)
+    prints: dict[str, str] = {}  # motion key -> fingerprint
     for entry_no, entry in enumerate(config.sources):
         if entry.recording is not None:
             specs += _plan_recordings(config, entry_no, entry, base_dir, len(specs))
@@ -814,6 +878,9 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
             if not text.startswith(f"{_MOTION_WHERE}: "):
                 raise  # names its file already
             raise ConfigError(f"sources[{entry_no}].{text[len(_MOTION_WHERE) + 2 :]}") from None
+        key = _motion_key(motion)
+        if key not in prints:  # once per loaded motion
+            prints[key] = motion_fingerprint(loaded)
         span_start = float(motion.get("start", 0.0))
         span_end = loaded.skeleton.duration
         if motion.get("duration") is not None:
@@ -895,6 +962,7 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                     origins if draws else None,
                     _span(motion, span_start, span_end),
                     asked,
+                    prints[key],
                 )
                 specs.append(replace(spec, length_field=_length_field(config, entry_no, entry)))
                 # every record's run config is valid before any file is written (with
@@ -1259,19 +1327,40 @@ def read_record(path: Path) -> tuple[dict[str, NDArray[Any]], dict[str, Any]]:
     return arrays, meta
 
 
-def _complete(path: Path) -> dict[str, Any] | None:
+def _planned_meta(spec: RecordSpec) -> dict[str, Any]:
+    """What a record stores of its source's naming (label, group and, for simulated records,
+    subject, recording and dataset) as the config now asks for it: not part of the record's
+    id, so a build keeps a record whose only change is one of them and relabels it."""
+    planned = {"label": spec.label, "group": spec.group}
+    if "recording" not in spec.run_config:  # recorded records name their recording themselves
+        planned.update(subject=spec.subject, recording=spec.recording, dataset=spec.dataset)
+    return planned
+
+
+def _complete(path: Path, spec: RecordSpec) -> dict[str, Any] | None:
     """The index row of a finished record, or None if it must be (re)built: a record cut
-    short, corrupt, or whose metadata lacks a field is removed. A record that cannot be read
-    for want of permission is an error (it is not removed)."""
+    short, corrupt, or whose metadata lacks a field is removed. A record whose label, group,
+    subject, recording or dataset differ from ``spec``'s (the config changed only those) is
+    kept and rewritten with the new ones (atomically; its arrays are not recomputed), and so
+    is its row. A record that cannot be read for want of permission is an error (it is not
+    removed)."""
     import zipfile
 
     if not path.exists():
         return None
     try:
         arrays, meta = read_record(path)
+        planned = _planned_meta(spec)
+        if any(meta.get(k) != v for k, v in planned.items()):
+            meta.update(planned)
+            stored: dict[str, Any] = {**arrays, "meta": np.array(json.dumps(meta))}
+            atomic_savez(path, **stored)
         return _row(meta, arrays["features"])
     except PermissionError as exc:
-        raise OutputError(f"{path}: cannot read: {exc.strerror or exc}") from None
+        raise OutputError(
+            f"{path}: {exc.strerror or exc}: a record of this dataset must be readable and "
+            "writable by you to resume it; fix its permissions or build into another --out"
+        ) from None
     except (OSError, EOFError, ValueError, KeyError, TypeError, zipfile.BadZipFile):
         path.unlink(missing_ok=True)
         return None
@@ -1518,6 +1607,27 @@ def _built_from(folder: OutputFolder) -> dict[str, Any] | None:
     return {k: v for k, v in built.items() if k not in BUILD_OPTIONS}
 
 
+def _indexed_configs(folder: OutputFolder, built: dict[str, Any] | None) -> list[dict[str, Any]]:
+    """The configs that the folder's ``index.csv`` (and ``dataset.json``) may have been written
+    from (``built``: the marker's config): the marker's config once its build completed; while
+    a build runs, the configs its marker lists under ``indexed`` (the earlier, complete
+    dataset's, kept whole until the new index is written, then also the new one's, while the
+    new index and manifest are written and the old records removed). Empty for a folder
+    without a complete dataset."""
+    if not folder.previous:
+        return []
+    if folder.marker.get("complete") is True or not folder.marker:  # not folder.marker: legacy
+        return [] if built is None else [built]
+    listed = folder.marker.get("indexed")
+    if not isinstance(listed, list):
+        return []
+    return [
+        {k: v for k, v in c.items() if k not in BUILD_OPTIONS}
+        for c in listed
+        if isinstance(c, dict)
+    ]
+
+
 def config_differences(old: Any, new: Any, where: str = "") -> list[str]:
     """Dotted names of the fields that differ between two JSON-like configs, with both values
     (``"variations.aspect_deg: [0.0, 45.0] -> [0.0, 30.0]"``)."""
@@ -1563,27 +1673,33 @@ def build_dataset(
     check_scheduler_address(scheduler_address(scheduler))
     with dataset_folder(out_dir, force=force) as folder:
         note("planning the records (reading each recording once)", progress)
+        _forget_loaded()  # every file is read afresh: one changed since is seen
         # errors in the config stop before any file
         specs = plan_records(config, base_dir, workers=build_workers(config, workers))
         out = folder.path
         wanted = _comparable(config)
         built = _built_from(folder)
+        indexed = _indexed_configs(folder, built)
         ours = folder.previous  # the folder holds an earlier build: its files are ours
-        if built is not None and built != wanted and not force:
+        # the config of the build under way (resumed), or of the complete dataset that a
+        # stopped rebuild left in place (finished from its records, any missing one recomputed)
+        if built is not None and built != wanted and wanted not in indexed and not force:
             diff = config_differences(built, wanted)
             shown = "; ".join(diff[:3]) + (f" and {len(diff) - 3} more" if len(diff) > 3 else "")
             raise OutputError(
                 f"--out {out}: holds a dataset built from a different config ({shown}); "
                 "choose another folder, or add --force to rebuild it"
             )
-        folder.write_marker(config=wanted, complete=False)
+        # the marker names the config being built and the ones the index in place may be of,
+        # so that a build killed at any moment can be resumed, or undone with the old config
+        folder.write_marker(config=wanted, complete=False, indexed=indexed)
         (out / RECORDS).mkdir(exist_ok=True)
         if ours:
             _remove_partials(out)
         rows: dict[str, dict[str, Any]] = {}
         todo = []
         for spec in specs:
-            row = _complete(out / RECORDS / f"{spec.record_id}.npz")
+            row = _complete(out / RECORDS / f"{spec.record_id}.npz", spec)
             if row is None:
                 todo.append(spec)
             else:
@@ -1622,13 +1738,16 @@ def build_dataset(
             first = next(iter(skipped.values()))["skipped"]
             raise MdfError(f"every record failed; the first: {first}")
         dropped = [skipped[s.record_id] for s in specs if s.record_id in skipped]
+        if wanted not in indexed:  # from now on the index may be the new one
+            indexed = [*indexed, wanted]
+            folder.write_marker(config=wanted, complete=False, indexed=indexed)
         _write_index(out, ordered, config, dropped)
         if ours:  # records of an earlier config, now that the new index is in place
             keep = {f"{s.record_id}.npz" for s in specs}
             for old in (out / RECORDS).glob("*.npz"):
                 if old.name not in keep and _RECORD_NAME.fullmatch(old.name):
                     old.unlink()
-        folder.write_marker(config=wanted, complete=True)
+        folder.write_marker(config=wanted, complete=True, indexed=[wanted])
     return ordered
 
 

@@ -402,6 +402,13 @@ class RadarWaveform(Plugin):
 
         return max_unambiguous_velocity(self.carrier_frequency, self.prf)
 
+    def faster_sampling(self, rate: float) -> str:
+        """What to change in this radar's config so that it samples slow time at ``rate`` [Hz]
+        or faster (e.g. to keep a fast scatterer's Doppler unambiguous): a clause naming the
+        config fields. Default: ``radar.prf``; a radar whose slow-time rate follows from other
+        fields (FMCW timing, CW's sample rate) overrides it."""
+        return f"raise radar.prf to at least {np.ceil(rate):.0f} Hz"
+
     @property
     def shortest_record(self) -> float:
         """Shortest record [s] that :meth:`pulse_times` gives any pulse in (e.g. the chirps of

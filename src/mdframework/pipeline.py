@@ -553,6 +553,7 @@ class _Stream:
         self.gate = np.empty(n, dtype=np.float64)
         self.v_max = wf.max_unambiguous_velocity
         self.prf = wf.prf
+        self.faster_sampling = wf.faster_sampling
         self.speed = 0.0
         self.names: tuple[str, ...] = ()
         self._last: tuple[float, FloatArray] | None = None
@@ -587,8 +588,8 @@ class _Stream:
     def _aliasing_message(self) -> str:
         return (
             f"the fastest scatterer moves at {self.speed:.2f} m/s radially, beyond the "
-            f"unambiguous {self.v_max:.2f} m/s of PRF {self.prf:g} Hz: its Doppler aliases; "
-            f"raise the PRF to at least {np.ceil(self.prf * self.speed / self.v_max):.0f} Hz "
+            f"unambiguous {self.v_max:.2f} m/s of the {self.prf:g} Hz slow-time rate: its "
+            f"Doppler aliases; {self.faster_sampling(self.prf * self.speed / self.v_max)} "
             "(processing.aliasing = 'error' stops such runs)"
         )
 

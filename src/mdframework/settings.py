@@ -359,8 +359,9 @@ class ConditioningConfig(StrictModel):
     )
     max_gap_s: PositiveSeconds = Field(
         0.2,
-        description="Untracked gaps longer than this [s] are flagged (all gaps are bridged by "
-        "the spline); about a fifth of a gait cycle.",
+        description="Untracked gaps, and steps between frames (frames the file lacks), longer "
+        "than this [s] are flagged (all gaps are bridged by the spline); about a fifth of a "
+        "gait cycle.",
     )
     long_gaps: Literal["flag", "error"] = Field(
         "flag", description="A gap longer than max_gap_s: flag it in the metadata, or stop."

@@ -742,7 +742,10 @@ class Detection:
     """Detection settings of :func:`detect_points`: CFAR along range and/or Doppler (both must
     detect a cell when both are given), peak grouping along Doppler and/or range, the range
     interval searched ``[min_range, max_range]`` [m], multi-object beamforming threshold (or
-    None), velocity-induced TDM phase compensation, and the angle grid."""
+    None), velocity-induced TDM phase compensation, and ``noise_floor`` [W in the detection
+    map]: the mean receiver noise added to the map before CFAR (:func:`map_noise_power`, for a
+    simulation without receiver noise, whose training cells hold only window sidelobes or
+    nothing; 0: none)."""
 
     cfar_range: Cfar | None = Cfar("so", 8, 4, 15.0)
     cfar_doppler: Cfar | None = None
@@ -752,6 +755,25 @@ class Detection:
     max_range: float = float("inf")
     multi_peak: float | None = 0.5
     tdm_compensation: bool = True
+    noise_floor: float = 0.0
+
+
+def map_noise_power(
+    noise_power: float,
+    n_virt: int,
+    range_window: WindowName,
+    n_samples: int,
+    doppler_window: WindowName,
+    n_loops: int,
+) -> float:
+    """Mean power [W] of complex white IF noise of ``noise_power`` [W per ADC sample] in one cell
+    of the :func:`detection_map`: ``n_virt`` antennas, each through the range and the Doppler
+    FFTs normalised by their window sums, ``n_virt P_n (sum w_r^2 / (sum w_r)^2)
+    (sum w_d^2 / (sum w_d)^2)`` (zero-padding does not change it)."""
+    wr, wd = window(range_window, n_samples), window(doppler_window, n_loops)
+    gain_r = float(np.sum(wr**2) / np.sum(wr) ** 2)
+    gain_d = float(np.sum(wd**2) / np.sum(wd) ** 2)
+    return n_virt * noise_power * gain_r * gain_d
 
 
 def detect_points(
@@ -771,18 +793,22 @@ def detect_points(
     estimation of each detected cell. Returns (n_points, 5) float64: ``x, y, z`` [m] in the
     sensor frame, radial velocity ``v`` [m/s] (positive approaching) and intensity [dB]: the
     cell's power over its CFAR noise estimate (the range CFAR's, else the Doppler CFAR's;
-    without CFAR, the cell's power in dB re 1 W). A cell without power is never a detection; a
-    noise estimate of 0 (a noise-free simulation whose training cells hold no power) counts as
-    the smallest positive float, so the intensity is large but finite.
+    without CFAR, the cell's power in dB re 1 W). A cell without power is never a detection.
+    With ``settings.noise_floor`` P_n > 0 (a noise-free simulation, whose training cells hold
+    only window sidelobes or nothing) CFAR and intensity work on the map plus P_n, the mean
+    of what a receiver with that noise would measure in each cell: a lone target then stands
+    at ``1 + SNR`` over its estimate, as with noise. A noise estimate of 0 (no floor) counts as
+    the smallest positive float, so the intensity stays finite.
     """
     power = detection_map(rd)
     mask = power > 0
+    level = power + settings.noise_floor if settings.noise_floor > 0 else power
     noise = np.full(power.shape, np.nan)
     if settings.cfar_doppler is not None:
-        det, noise = cfar(power, settings.cfar_doppler, axis=0, cyclic=True)
+        det, noise = cfar(level, settings.cfar_doppler, axis=0, cyclic=True)
         mask &= det
     if settings.cfar_range is not None:
-        det, noise = cfar(power, settings.cfar_range, axis=1, cyclic=False)
+        det, noise = cfar(level, settings.cfar_range, axis=1, cyclic=False)
         mask &= det
     mask &= ((ranges >= settings.min_range) & (ranges <= settings.max_range))[None, :]
     mask = peak_grouping(power, mask, doppler=settings.group_doppler, range_=settings.group_range)
@@ -796,7 +822,7 @@ def detect_points(
     uy = np.sqrt(np.clip(1.0 - ux**2 - uz**2, 0.0, None))
     v = fd[which] * wavelength / 2.0
     ref = np.maximum(np.nan_to_num(noise[di, ri], nan=1.0), np.finfo(np.float64).tiny)
-    snr = 10.0 * (np.log10(power[di, ri]) - np.log10(ref))[which]
+    snr = 10.0 * (np.log10(level[di, ri]) - np.log10(ref))[which]
     return np.column_stack([r * ux, r * uy, r * uz, v, snr]).astype(np.float64)
 
 

@@ -70,6 +70,10 @@ class CwDoppler(RadarWaveform):
         """I/Q sample rate [Hz] (the slow-time rate)."""
         return self.config.sample_rate
 
+    def faster_sampling(self, rate: float) -> str:
+        """The slow-time rate is the I/Q ``sample_rate``."""
+        return f"raise radar.sample_rate to at least {np.ceil(rate):.0f} Hz"
+
     def receive(self, block: PulseBlock) -> Received:
         """I/Q baseband of the block's pulses: the sum of every scatterer's phasor."""
         ranges = block.ranges

@@ -179,8 +179,8 @@ class FmcwConfig(RadarPowerConfig):
     )
     receiver_noise: bool = Field(
         False,
-        description="Add the receiver's thermal noise to the IF samples (the presets do: CFAR "
-        "needs a noise floor).",
+        description="Add the receiver's thermal noise to the IF samples (the presets do; "
+        "without it, CFAR works on the map plus the receiver's mean noise).",
     )
     noise_figure_db: LossDb = Field(
         15.0,
@@ -365,6 +365,27 @@ class FmcwRadar(RadarWaveform):
     def pulse_rate(self) -> float:
         """Chirps per second over whole frames [Hz] (the pulse budget counts chirps)."""
         return self.sequence.chirps_per_frame / self.sequence.frame_period
+
+    def faster_sampling(self, rate: float) -> str:
+        """The loop rate ``1 / (n_tx (idle_time + ramp_end_time))`` is the slow-time rate: the
+        chirp period that reaches ``rate`` [Hz] with this TDM order, and what bounds it (the
+        ramp must outlast the ADC samples)."""
+        seq = self.sequence
+        period = 1.0 / (rate * seq.n_tx)
+        adc = seq.adc_start_time + seq.n_samples / seq.sample_rate
+        advice = (
+            f"raise the loop rate to at least {np.ceil(rate):.0f} Hz: shorten radar.idle_time "
+            f"+ radar.ramp_end_time from {seq.chirp_period * 1e6:.2f} us to at most "
+            f"{np.floor(period * 1e8) / 100:.2f} us"
+        )
+        if period < adc:
+            advice += (
+                f" (the ramp must outlast the ADC's adc_start_time + n_samples / sample_rate "
+                f"= {adc * 1e6:.2f} us: take fewer n_samples or raise sample_rate)"
+            )
+        if seq.n_tx > 1:
+            advice += f", or use fewer than {seq.n_tx} TX in radar.tdm_order"
+        return advice
 
     @property
     def shortest_record(self) -> float:
@@ -553,14 +574,34 @@ class FmcwRadar(RadarWaveform):
             max_range=c.detect_max_range or self.sequence.max_range,
             multi_peak=c.multi_object_threshold,
             tdm_compensation=c.tdm_compensation,
+            noise_floor=0.0 if c.receiver_noise else self.map_noise_power(),
         )
 
-    def noise_power(self) -> float:
-        """Receiver noise power per complex ADC sample, ``k T0 F fs`` [W] (0 without noise)."""
+    def thermal_noise_power(self) -> float:
+        """The receiver's noise power per complex ADC sample, ``k T0 F fs`` [W], whether it is
+        added (``receiver_noise``) or not."""
         c = self.config
-        if not c.receiver_noise:
-            return 0.0
         return KT0 * 10.0 ** (c.noise_figure_db / 10.0) * c.sample_rate
+
+    def noise_power(self) -> float:
+        """Receiver noise power added per complex ADC sample, ``k T0 F fs`` [W] (0 without
+        ``receiver_noise``)."""
+        return self.thermal_noise_power() if self.config.receiver_noise else 0.0
+
+    def map_noise_power(self) -> float:
+        """Mean receiver noise [W] in one cell of the point detection's map (the virtual
+        antennas of the TXs in ``tdm_order``), :func:`mdframework.physics.fmcw.map_noise_power`;
+        without receiver noise, the floor of the CFAR noise estimates."""
+        c = self.config
+        n_virt = self.antennas.used_virtual(self.sequence).size
+        return fmcw.map_noise_power(
+            self.thermal_noise_power(),
+            n_virt,
+            c.range_window,
+            c.n_samples,
+            c.doppler_window,
+            c.n_loops,
+        )
 
     def _noise(self, frame: int, n_rx: int) -> NDArray[np.complex128] | None:
         """Complex white noise of one frame, (chirps_per_frame, n_rx, n_samples), seeded by

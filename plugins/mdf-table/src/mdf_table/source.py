@@ -32,8 +32,8 @@ from mdframework.skeleton import Axis, check_axes, check_canonical_keys, group_m
 
 #: A value of a time column in its own unit (frame numbers, milliseconds, seconds); in seconds
 #: it must lie within +-``limits.MAX_CLOCK_TIME_S``, as the column's times do (checked with the
-#: unit, by :class:`TableConfig`).
-ColumnTime = Annotated[float, Field(allow_inf_nan=False)]
+#: unit, by :class:`TableConfig`; the bound here only keeps it a number of reasonable size).
+ColumnTime = Annotated[float, Field(ge=-1e16, le=1e16)]
 
 #: Metres per unit of ``units``.
 UNITS_M = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254, "ft": 0.3048}
