@@ -538,26 +538,64 @@ def test_check_output_in_the_docs_is_current(capsys: pytest.CaptureFixture[str])
     assert f"```text\n{out}```" in guide
 
 
-@pytest.mark.parametrize("name", ["cmu_walk.toml", "point_target.toml", "boulic_walk.toml"])
-def test_check_predicts_what_the_run_does(
-    name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    """The pulses, frames, axes and aliasing verdict of `mdf check` are those of the run; the
-    fastest joint's radial speed bounds the run's fastest scatterer within the frame-rate
-    differencing (10 %)."""
-    code, out, err = run_cli(["check", str(EXAMPLES / name), "--json"], capsys)
+def check_then_run(
+    config: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> tuple[dict[str, Any], dict[str, Any], Path]:
+    """`mdf check --json` then `mdf run` of ``config``: the plan, the run's metadata and its
+    result.npz. The spectrogram shape and Doppler bin spacing of the plan are the run's."""
+    code, out, err = run_cli(["check", str(config), "--json"], capsys)
     assert code == 0, err
     plan = json.loads(out)
-    assert run_cli(["run", str(EXAMPLES / name), "--out", str(tmp_path / "o")], capsys)[0] == 0
+    code, _, err = run_cli(
+        ["run", str(config), "--out", str(tmp_path / "o"), "--no-figures"], capsys
+    )
+    assert code == 0, err
     meta = json.loads((tmp_path / "o" / "metadata.json").read_text())
     with np.load(tmp_path / "o" / "result.npz") as d:
         assert d["signal"].shape == (plan["n_pulses"],)
         assert d["spectrogram_db"].shape == (plan["nfft"], plan["n_frames"])
         dv = float(np.diff(d["velocity_mps"][:2])[0])
     assert plan["velocity_bin_mps"] == pytest.approx(dv, rel=1e-12)
+    return plan, meta, tmp_path / "o" / "result.npz"
+
+
+@pytest.mark.parametrize(
+    "name",
+    ["cmu_walk.toml", "point_target.toml", "boulic_walk.toml", "cw_walk.toml", "fmcw_walk.toml"],
+)
+def test_check_predicts_what_the_run_does(
+    name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The pulses, spectrogram geometry, axes and aliasing verdict of `mdf check` are those of
+    the run, for pulsed (LFM), CW and FMCW radars (whose spectrogram is one spectrum per frame:
+    75 frames of 1024 bins in 2.5 s of 30 Hz frames); the fastest joint's radial speed bounds
+    the run's fastest scatterer within the frame-rate differencing (10 %)."""
+    plan, meta, _ = check_then_run(EXAMPLES / name, tmp_path, capsys)
     assert plan["max_unambiguous_velocity_mps"] == meta["max_unambiguous_velocity_mps"]
     assert plan["max_joint_radial_speed_mps"] >= 0.9 * meta["max_radial_speed_mps"]
     assert plan["aliasing"] is False
+    if name == "fmcw_walk.toml":
+        assert (plan["nfft"], plan["n_frames"], plan["window_pulses"]) == (1024, 75, 16)
+
+
+def test_check_accepts_an_fmcw_record_shorter_than_the_stft_window(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """FMCW frames with gaps give one spectrum per frame, so 0.15 s (5 frames of 48 chirps, 80
+    samples of the first slot, fewer than the 256 of processing.window_length) runs, and `mdf
+    check` says so (it used to refuse it for the STFT window the run does not use); an LFM
+    record as short is refused by both, naming the field."""
+    text = (EXAMPLES / "fmcw_walk.toml").read_text()
+    text = text.replace("duration = 2.5", "duration = 0.15")
+    text = text.replace('"data/', f'"{EXAMPLES}/data/')
+    (tmp_path / "short.toml").write_text(text)
+    plan, _, _ = check_then_run(tmp_path / "short.toml", tmp_path, capsys)
+    assert (plan["n_pulses"], plan["n_frames"]) == (240, 5)
+    lfm = text.replace('kind = "fmcw"\npreset = "iwr1443_short_range_3d"', 'kind = "lfm"')
+    (tmp_path / "lfm.toml").write_text(lfm.replace("duration = 0.15", "duration = 0.05"))
+    for command in (["check"], ["run", "--out", str(tmp_path / "lfm")]):
+        code, _, err = run_cli([*command, str(tmp_path / "lfm.toml")], capsys)
+        assert code == 2 and "processing.window_length: the record has 121 samples" in err, err
 
 
 def test_check_warns_of_aliasing_and_names_the_prf(
@@ -712,3 +750,34 @@ def test_ctrl_c_wrapped_by_python_is_still_an_interrupt(
     monkeypatch.setattr(cli, "_cmd_plugins", interrupted)
     assert cli.main(["plugins"]) == cli.EXIT_INTERRUPTED
     assert capsys.readouterr().err == "mdf: interrupted\n"
+
+
+@pytest.mark.parametrize("command", ["run", "check"])
+def test_a_bug_in_a_plugins_constructor_is_an_internal_error_naming_the_plugin(
+    command: str,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A KeyError inside a radar's __init__ is the plugin's bug, not the user's input: exit 1,
+    one line naming the exception and the plugin (it used to be `mdf: error: presets`, exit 2,
+    as if the config had named an unknown kind); --debug shows the traceback."""
+    from mdf_lfm import LfmPulseDoppler
+
+    def broken_init(self: Any, config: Any) -> None:
+        self.preset = {}["presets"]  # type: ignore[misc]
+
+    monkeypatch.setattr(LfmPulseDoppler, "__init__", broken_init)
+    args = [command, str(EXAMPLES / "point_target.toml")]
+    if command == "run":
+        args += ["--out", str(tmp_path / "o")]
+    code, _, err = run_cli(args, capsys)
+    assert code == 1, err
+    assert err.strip() == (
+        "mdf: internal error: KeyError: 'presets' (in the radar plugin 'lfm' "
+        "(mdf_lfm.waveform.LfmPulseDoppler) while it was built from its config; run with --debug "
+        "for the traceback)"
+    )
+    assert not (tmp_path / "o").exists()
+    with pytest.raises(KeyError, match="presets"):
+        cli.main([*args, "--debug"])

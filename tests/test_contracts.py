@@ -363,6 +363,20 @@ def test_the_contracts_catch_broken_waveforms() -> None:
     with pytest.raises(AssertionError, match="sum of their returns"):
         check_radar_waveform(Squared(Squared.Config()))
 
+    class Decimated(LfmPulseDoppler):
+        """Takes its spectrogram of every other pulse but keeps the default geometry, so that
+        `mdf check` would report twice the frames the run makes."""
+
+        def spectrogram(self, signal: Any, times: Any, processing: Any) -> Any:
+            from mdframework.physics.spectrogram import spectrogram
+
+            p = processing
+            y = np.asarray(signal)[::2]
+            return spectrogram(y, self.prf / 2, window_length=p.window_length, hop=p.hop)
+
+    with pytest.raises(AssertionError, match=r"spectrogram_geometry\(\) says \(128, "):
+        check_radar_waveform(Decimated(Decimated.Config()))
+
     class Misnamed(LfmPulseDoppler):
         """Registered as 'lfm2' but its config says kind = 'lfm'."""
 

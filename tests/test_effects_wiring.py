@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
 from types import ModuleType
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 import pytest
@@ -49,6 +50,49 @@ class ScaleRcs(Effect):
         return data.replace(rcs=data.rcs * self.config.factor)  # type: ignore[attr-defined]
 
 
+class ApproachConfig(PluginConfig):
+    kind: Literal["approach"] = "approach"
+    speed: float = 2.0
+    how: Literal["dataclasses", "method", "new"] = "dataclasses"
+
+
+class Approach(Effect):
+    """Moves every scatterer toward the radar along the x axis at ``speed`` [m/s], writing the
+    copy in one of three ways an author may choose."""
+
+    name = "approach"
+    Config = ApproachConfig
+    stage = "scatterers"
+
+    def apply(self, data: Scatterers, context: SceneContext) -> Scatterers:
+        c: Any = self.config
+        moved = data.positions.copy()
+        moved[..., 0] += c.speed * context.pulse_times[:, None]
+        if c.how == "dataclasses":
+            return dataclasses.replace(data, positions=moved)
+        if c.how == "method":
+            return data.replace(positions=moved)
+        return Scatterers(moved, data.rcs, data.names, data.semi_axes, data.axes)
+
+
+class ProbeConfig(PluginConfig):
+    kind: Literal["probe"] = "probe"
+    label: str = ""
+
+
+class Probe(Effect):
+    """Draws five normal numbers from its generator and records them under its label."""
+
+    name = "probe"
+    Config = ProbeConfig
+    stage = "received"
+    drawn: ClassVar[dict[str, np.ndarray]] = {}
+
+    def apply(self, data: Received, context: SceneContext) -> Received:
+        Probe.drawn[self.config.label] = context.rng.standard_normal(5)  # type: ignore[attr-defined]
+        return data
+
+
 class NoiseConfig(PluginConfig):
     kind: Literal["unit_noise"] = "unit_noise"
 
@@ -68,7 +112,7 @@ class UnitNoise(Effect):
 
 @hookimpl
 def mdframework_register_effects() -> list[type[Effect]]:
-    return [Explode, ScaleRcs, UnitNoise]
+    return [Explode, ScaleRcs, Approach, Probe, UnitNoise]
 
 
 @pytest.fixture(scope="module")
@@ -78,8 +122,9 @@ def registry() -> Registry:
     return build_registry([synthetic, module], autoload=True)
 
 
-def run(registry: Registry, effects: list[dict[str, Any]], seed: int = 0) -> Any:
+def run(registry: Registry, effects: list[dict[str, Any]], seed: int = 0, **more: Any) -> Any:
     cfg = {"motion": {"kind": "synthetic_walker", "length": 1.0}, "effects": effects, "seed": seed}
+    cfg.update(more)
     return simulate(validate_run_config(cfg, registry=registry), registry)
 
 
@@ -104,3 +149,74 @@ def test_received_effect_is_seeded(registry: Registry) -> None:
     assert np.array_equal(a.received.signal, b.received.signal)
     assert not np.array_equal(a.received.signal, c.received.signal)
     assert [e["kind"] for e in a.metadata["effects"]] == ["unit_noise"]
+
+
+def mean_velocity(result: Any) -> float:
+    """Power-weighted mean radial velocity of a run's spectrogram [m/s]."""
+    p = result.spectrogram.power.astype(np.float64)
+    return float((p * result.velocity[:, None]).sum() / p.sum())
+
+
+@pytest.mark.parametrize("how", ["dataclasses", "method"])
+def test_an_effect_that_moves_scatterers_is_seen_however_it_copies_them(
+    registry: Registry, how: str
+) -> None:
+    """The ellipsoid model hands on the ranges it computed; an effect that moves the scatterers
+    must not get those old ranges back, whether it copies with ``dataclasses.replace`` or
+    ``Scatterers.replace``: the radar sees exactly what a freshly built ``Scatterers`` (no
+    ranges remembered) gives, and the body's mean Doppler velocity rises by the 2 m/s added
+    along x, times the cosine of the radar's elevation (it is 10 m down the x axis, 2 m up). The
+    range gate follows the body, not the moved points, so it passes every range (phase_only)."""
+    radar = {"kind": "lfm", "gate_response": "phase_only"}
+    plain = run(registry, [], radar=radar)
+    fresh = run(registry, [{"kind": "approach", "how": "new"}], radar=radar)
+    moved = run(registry, [{"kind": "approach", "how": how}], radar=radar)
+    assert np.array_equal(moved.received.signal, fresh.received.signal)
+    expected = 2.0 * 10.0 / np.hypot(10.0, 2.0)
+    assert mean_velocity(moved) - mean_velocity(plain) == pytest.approx(expected, abs=0.03)
+
+
+def test_remembered_ranges_belong_to_the_positions_they_were_computed_from() -> None:
+    """Ranges a model hands on are returned for its own positions and radar position only."""
+    rng = np.random.default_rng(3)
+    pos = rng.normal(size=(5, 4, 3))
+    radar = np.array([10.0, 0.0, 2.0])
+    exact = np.linalg.norm(pos - radar, axis=-1)
+    marked = exact + 1.0  # not the true ranges, so that a use of them shows
+    scat = Scatterers(pos, np.ones((5, 4)), tuple("abcd")).with_ranges(radar, marked)
+    assert scat.ranges(radar) is marked
+    assert np.array_equal(dataclasses.replace(scat, rcs=2 * scat.rcs).ranges(radar), marked)
+    assert np.array_equal(scat.ranges(radar + 1.0), np.linalg.norm(pos - radar - 1.0, axis=-1))
+    for copy in (dataclasses.replace(scat, positions=pos.copy()), scat.replace(positions=pos + 0)):
+        assert copy.range_cache is None
+        assert np.allclose(copy.ranges(radar), exact, rtol=0, atol=1e-12)
+
+
+def draws(registry: Registry, labels: list[str], seed: int = 5, **more: Any) -> dict[str, Any]:
+    """What each probe effect drew in a run listing them (after ``more`` effects)."""
+    Probe.drawn = {}
+    effects = [*more.get("before", []), *({"kind": "probe", "label": x} for x in labels)]
+    run(registry, effects, seed=seed)
+    return dict(Probe.drawn)
+
+
+def test_each_effect_draws_from_its_own_stream(registry: Registry) -> None:
+    """Listing an effect before another leaves the other's draws as they were (it used to share
+    one generator, so the second effect drew what the first left); two effects draw different
+    numbers; a scatterer-stage effect before them changes nothing."""
+    alone = draws(registry, ["b"])["b"]
+    both = draws(registry, ["a", "b"])
+    assert np.array_equal(both["b"], alone)
+    assert not np.any(np.isin(both["a"], alone))
+    three = draws(registry, ["c", "a", "b"])
+    assert np.array_equal(three["b"], alone) and np.array_equal(three["a"], both["a"])
+    after_scatterers = draws(registry, ["b"], before=[{"kind": "scale_rcs"}])
+    assert np.array_equal(after_scatterers["b"], alone)
+
+
+def test_a_lone_effect_draws_what_it_always_drew(registry: Registry) -> None:
+    """A run with one effect keeps its stream: the first child of the run seed's SeedSequence,
+    so every published number made with one random effect stays as it was."""
+    for seed in (0, 5, 2**63 + 1):
+        expected = np.random.default_rng(np.random.SeedSequence(seed).spawn(2)[0])
+        assert np.array_equal(draws(registry, ["x"], seed)["x"], expected.standard_normal(5))

@@ -92,6 +92,40 @@ def test_unknown_colormap_is_a_config_error() -> None:
         validate_run_config({**data, "figures": {"dynamic_range_db": 0}})
 
 
+def test_the_colour_maps_a_config_accepts_are_matplotlibs() -> None:
+    """The names figures.colormap accepts without importing matplotlib are exactly the
+    installed matplotlib's colour maps, each also reversed."""
+    from matplotlib import colormaps
+
+    from mdframework.settings import COLORMAPS
+
+    assert {*COLORMAPS, *(f"{name}_r" for name in COLORMAPS)} == set(colormaps)
+    target = {"position": [10.0, 0.0, 0.0], "velocity": [1.0, 0.0, 0.0]}
+    data = {"motion": {"kind": "point_targets", "length": 1.0, "targets": [target]}}
+    for name in ("magma_r", "tab20c", "Greys"):
+        assert validate_run_config({**data, "figures": {"colormap": name}}).figures.colormap == name
+    with pytest.raises(ConfigError, match="unknown colour map 'magma_r_r'"):
+        validate_run_config({**data, "figures": {"colormap": "magma_r_r"}})
+
+
+def test_reading_a_config_without_figures_does_not_import_matplotlib(tmp_path: Path) -> None:
+    """A config that names a colour map but draws no figures is read (and its colour map
+    checked) without importing matplotlib; it used to be imported to check the name."""
+    import subprocess
+    import sys
+
+    config = tmp_path / "arrays.toml"
+    text = (EXAMPLES / "point_target.toml").read_text()
+    config.write_text(text + '\n[figures]\nenabled = false\ncolormap = "magma"\n')
+    probe = (
+        "import sys; from mdframework.config import load_run_config; "
+        f"c = load_run_config({str(config)!r}); "
+        "print(c.figures.colormap, 'matplotlib' in sys.modules)"
+    )
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["magma", "False"], out.stderr
+
+
 def test_auto_span_of_the_cmu_walk() -> None:
     """docs/figures.md: a walker toward a 15 GHz radar at PRF 2400 Hz uses about -1.5..5 m/s of
     the unambiguous -12..12 m/s, and the auto axis shows just that."""

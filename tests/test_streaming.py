@@ -12,9 +12,10 @@ from conftest import EXAMPLES
 
 from mdframework import pipeline
 from mdframework.config import validate_run_config
+from mdframework.output import MAX_SAVED_RANGE_TIME_ROWS, result_arrays
 from mdframework.physics import interpolation, scene
 from mdframework.pipeline import (
-    MAX_RANGE_TIME_ROWS,
+    MAX_KEPT_RANGE_TIME_ROWS,
     build_stages,
     place_body,
     simulate,
@@ -64,10 +65,12 @@ def test_record_uses_only_its_window_of_a_long_recording() -> None:
 
 
 def test_long_raw_records_keep_a_bounded_range_time_map() -> None:
-    """Beyond MAX_RANGE_TIME_ROWS pulses the map keeps evenly spaced rows with their indices."""
+    """Beyond MAX_KEPT_RANGE_TIME_ROWS pulses the map keeps evenly spaced rows with their
+    indices, and the saved map at most MAX_SAVED_RANGE_TIME_ROWS of them with their times: every
+    row, kept or saved, peaks at the target's range at its time."""
     radar = {"kind": "lfm", "path": "raw", "prf": 4000.0, "bandwidth": 50e6}
     targets = [{"position": [0.0, 20.0, 0.0], "velocity": [0.0, 1.0, 0.0]}]
-    seconds = 1.2 * MAX_RANGE_TIME_ROWS / 4000.0
+    seconds = 1.2 * MAX_KEPT_RANGE_TIME_ROWS / 4000.0
     res = simulate(
         validate_run_config(
             {
@@ -80,7 +83,7 @@ def test_long_raw_records_keep_a_bounded_range_time_map() -> None:
     )
     rec = res.received
     assert rec.range_time is not None and rec.range_time_pulses is not None
-    assert rec.range_time.shape[0] <= MAX_RANGE_TIME_ROWS
+    assert rec.range_time.shape[0] <= MAX_KEPT_RANGE_TIME_ROWS
     assert rec.range_time.shape[0] == rec.range_time_pulses.shape[0]
     # each kept row peaks at the target's range at that pulse
     rows = rec.range_time_pulses[:: max(1, rec.range_time_pulses.size // 20)]
@@ -88,6 +91,13 @@ def test_long_raw_records_keep_a_bounded_range_time_map() -> None:
     peak = rec.range_axis[np.argmax(np.abs(rec.range_time[keep]), axis=1)]
     truth = 20.0 + res.pulse_times[rows]
     assert np.max(np.abs(peak - truth)) < 0.5 * 3e8 / (2 * 100e6) + 1e-9  # half a sample
+    # result.npz keeps at most MAX_SAVED_RANGE_TIME_ROWS of the kept rows, each with its time
+    saved = result_arrays(res)
+    db, when = saved["range_time_db"], saved["range_time_time_s"]
+    assert MAX_SAVED_RANGE_TIME_ROWS // 2 < db.shape[0] <= MAX_SAVED_RANGE_TIME_ROWS
+    assert when.shape == (db.shape[0],) and np.all(np.diff(when) > 0)
+    peak = saved["range_m"][np.argmax(db, axis=1)]
+    assert np.max(np.abs(peak - (20.0 + when))) < 0.5 * 3e8 / (2 * 100e6) + 1e-9
 
 
 def test_float32_defaults_match_float64_within_the_ladder() -> None:

@@ -21,7 +21,6 @@ from typing import Any
 import numpy as np
 
 from . import limits
-from .errors import SceneError
 from .physics import radar
 from .pipeline import (
     build_stages,
@@ -31,6 +30,7 @@ from .pipeline import (
     record_pulses,
     record_window,
     refuse_near,
+    spectrogram_geometry,
 )
 from .plugins import Registry, default_registry
 from .settings import RunConfigBase
@@ -51,10 +51,11 @@ class RunPlan:
     carrier_frequency_hz: float
     wavelength_m: float
     n_joints: int
-    window_pulses: int
-    hop_pulses: int
+    window_pulses: int  # slow-time samples per spectrum
+    hop_pulses: float  # slow-time samples from one spectrum to the next
     nfft: int
     n_frames: int
+    spectrum_rate_hz: float  # rate of the slow-time samples the spectra are taken of
     doppler_bin_hz: float
     velocity_bin_mps: float
     window_resolution_hz: float
@@ -133,12 +134,7 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
         t_end - t_start, wf.pulse_rate, body.n_joints, "motion.duration", proc.keep_scatterers
     )
     n_pulses = int(record_pulses(wf, t_start, t_end).shape[0])
-    if n_pulses < proc.window_length:
-        raise SceneError(
-            f"processing.window_length: the record has {n_pulses} pulses "
-            f"({n_pulses / prf:.4f} s) but the STFT window needs {proc.window_length}: use a "
-            "longer record or a shorter window"
-        )
+    geometry = spectrogram_geometry(wf, n_pulses, proc)
 
     inside = (body.time >= t_start - 1e-9) & (body.time <= t_end + 1e-9)
     # a joint nearer than scene.min_range: refused as the run refuses the scatterer there
@@ -150,13 +146,12 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
         body.time[inside], body.positions[inside], body.valid[inside], radar_pos
     )
     v_max = float(wf.max_unambiguous_velocity)
-    n_frames = max(0, 1 + (n_pulses - proc.window_length) // proc.hop)
     n_scatterers = body.n_joints  # the body models have about one scatterer per joint/segment
     terms = memory_estimate(
         n_pulses,
         n_scatterers,
-        proc.nfft,
-        n_frames,
+        geometry.nfft,
+        geometry.n_frames,
         proc.block_pulses,
         proc.keep_scatterers,
         4 if proc.precision == "float32" else 8,
@@ -175,14 +170,15 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
         carrier_frequency_hz=fc,
         wavelength_m=lam,
         n_joints=body.n_joints,
-        window_pulses=proc.window_length,
-        hop_pulses=proc.hop,
-        nfft=proc.nfft,
-        n_frames=n_frames,
-        doppler_bin_hz=prf / proc.nfft,
-        velocity_bin_mps=float(radar.doppler_to_velocity(prf / proc.nfft, fc)),
-        window_resolution_hz=prf / proc.window_length,
-        window_resolution_mps=float(radar.doppler_to_velocity(prf / proc.window_length, fc)),
+        window_pulses=geometry.window,
+        hop_pulses=geometry.hop,
+        nfft=geometry.nfft,
+        n_frames=geometry.n_frames,
+        spectrum_rate_hz=geometry.sample_rate,
+        doppler_bin_hz=geometry.doppler_bin,
+        velocity_bin_mps=float(radar.doppler_to_velocity(geometry.doppler_bin, fc)),
+        window_resolution_hz=geometry.window_resolution,
+        window_resolution_mps=float(radar.doppler_to_velocity(geometry.window_resolution, fc)),
         max_unambiguous_velocity_mps=v_max,
         max_joint_radial_speed_mps=speed,
         aliasing=speed > v_max,
@@ -213,8 +209,8 @@ def format_plan(plan: RunPlan, source: str) -> str:
         f"  {'record':<12}{p.record_length_s:.3f} s from {p.record_start_s:.3f} s: "
         f"{p.n_pulses} pulses; joints: {p.n_joints}",
         f"  {'spectrogram':<12}window {p.window_pulses} pulses "
-        f"({1e3 * p.window_pulses / p.prf_hz:.1f} ms), hop {p.hop_pulses} "
-        f"({1e3 * p.hop_pulses / p.prf_hz:.2f} ms), nfft {p.nfft}: {p.n_frames} frames",
+        f"({1e3 * p.window_pulses / p.spectrum_rate_hz:.1f} ms), hop {p.hop_pulses:.4g} "
+        f"({1e3 * p.hop_pulses / p.spectrum_rate_hz:.2f} ms), nfft {p.nfft}: {p.n_frames} frames",
         f"  {'resolution':<12}Doppler bin {p.doppler_bin_hz:.3g} Hz = "
         f"{p.velocity_bin_mps:.3g} m/s; window {p.window_resolution_hz:.3g} Hz = "
         f"{p.window_resolution_mps:.3g} m/s",

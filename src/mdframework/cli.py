@@ -687,9 +687,10 @@ def _main(argv: list[str], debug: bool) -> int:
             where = f": {exc.filename}" if exc.filename else ""
             print(f"mdf: error: {exc.strerror}{where}", file=sys.stderr)
             return EXIT_USAGE
+        notes = "".join(f"{_one_line(note)}; " for note in getattr(exc, "__notes__", ()))
         print(
             f"mdf: internal error: {type(exc).__name__}: {_one_line(str(exc))} "
-            "(run with --debug for the traceback)",
+            f"({notes}run with --debug for the traceback)",
             file=sys.stderr,
         )
         return 1

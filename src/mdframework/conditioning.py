@@ -521,6 +521,14 @@ def condition(skeleton: Skeleton, config: ConditioningConfig) -> tuple[Skeleton,
             "smoothing_sigma_s": config.smoothing_sigma_s,
             "joints": limited,
         }
+    elif config.smoothing == "all":  # no limit, so no joint violates it: smoothing alone
+        for j in range(len(names)):
+            pos[:, j] = gaussian_smooth(time, pos[:, j], config.smoothing_sigma_s)
+        report["smoothing"] = {
+            "smoothing": "all",
+            "smoothing_sigma_s": config.smoothing_sigma_s,
+            "joints": list(names),
+        }
 
     if config.angle_check:
         checks: dict[str, Any] = {}

@@ -43,7 +43,7 @@ from .pointcloud import PointCloud
 from .skeleton import Skeleton, to_canonical
 
 if TYPE_CHECKING:
-    from .physics.spectrogram import Spectrogram
+    from .physics.spectrogram import Spectrogram, SpectrogramGeometry
     from .settings import ProcessingConfig
 
 FloatArray = NDArray[np.float64]
@@ -246,10 +246,12 @@ class Scatterers:
     #: c-axis (not necessarily unit length). ``None`` for point scatterers.
     semi_axes: FloatArray | None = None
     axes: FloatArray | None = None
-    #: Optional ranges already computed by the model: ``(radar_position, ranges)`` with ranges
-    #: (n_pulses, n_scatterers) [m]; :meth:`ranges` returns them for that radar position. It
-    #: survives :meth:`replace` only when the positions are not replaced.
-    range_cache: tuple[tuple[float, float, float], FloatArray] | None = field(
+    #: Optional ranges already computed by the model (set it with :meth:`with_ranges`):
+    #: ``(positions, radar_position, ranges)``, valid for that very ``positions`` array (by
+    #: identity) and radar position (3 floats) [m], ranges (n_pulses, n_scatterers) [m]. A copy
+    #: whose positions are another array (``replace(positions=...)``, also through
+    #: ``dataclasses.replace``) drops it, so it can never give the ranges of other positions.
+    range_cache: tuple[FloatArray, tuple[float, float, float], FloatArray] | None = field(
         default=None, repr=False, compare=False
     )
 
@@ -262,19 +264,37 @@ class Scatterers:
             raise ValueError(f"rcs must be {self.positions.shape[:2]}, got {self.rcs.shape}")
         if len(self.names) != self.positions.shape[1]:
             raise ValueError("one name per scatterer is required")
+        if self.range_cache is not None and self.range_cache[0] is not self.positions:
+            object.__setattr__(self, "range_cache", None)
 
     def replace(self, **changes: Any) -> Scatterers:
         """A copy with some fields replaced (e.g. ``rcs``)."""
-        if "positions" in changes:
-            changes.setdefault("range_cache", None)
         return dataclasses.replace(self, **changes)
+
+    def with_ranges(self, radar_position: FloatArray, ranges: FloatArray) -> Scatterers:
+        """A copy that remembers ``ranges`` (n_pulses, n_scatterers) [m] of these positions from
+        ``radar_position`` (3,) [m], so that :meth:`ranges` need not compute them again (a
+        model that computed them anyway, for its RCS, passes them on)."""
+        if ranges.shape != self.rcs.shape:
+            raise ValueError(f"ranges must be {self.rcs.shape}, got {ranges.shape}")
+        cache = (self.positions, _position_key(radar_position), ranges)
+        return dataclasses.replace(self, range_cache=cache)
 
     def ranges(self, radar_position: FloatArray) -> FloatArray:
         """Distance of every scatterer to the radar, (n_pulses, n_scatterers) float64 [m]."""
-        key = tuple(float(v) for v in np.asarray(radar_position, dtype=np.float64))
-        if self.range_cache is not None and self.range_cache[0] == key:
-            return self.range_cache[1]
+        cache = self.range_cache
+        if (
+            cache is not None
+            and cache[0] is self.positions
+            and cache[1] == _position_key(radar_position)
+        ):
+            return cache[2]
         return distances(self.positions, radar_position)
+
+
+def _position_key(radar_position: FloatArray) -> tuple[float, float, float]:
+    x, y, z = (float(v) for v in np.asarray(radar_position, dtype=np.float64))
+    return x, y, z
 
 
 class ScattererModel(Plugin):
@@ -337,8 +357,8 @@ class Received:
     ``range_time`` (n_rows, n_bins) complex128 and ``range_axis`` (n_bins,) float64 [m]: the
     compressed output over a window of ranges, when the waveform computes it (else ``None``); a
     waveform returns one row per pulse of a block, and the pipeline keeps every pulse's row of a
-    record up to ``processing.max_range_time_rows`` and evenly spaced rows beyond
-    (``range_time_pulses`` (n_rows,) int64 then gives the pulse index of each row).
+    record up to :data:`mdframework.pipeline.MAX_KEPT_RANGE_TIME_ROWS` (16384) and evenly spaced
+    rows beyond (``range_time_pulses`` (n_rows,) int64 then gives the pulse index of each row).
     ``products``: further arrays a waveform produces (e.g. range-Doppler maps or point clouds),
     each stacked along axis 0 over a record's blocks and saved under its name.
     """
@@ -428,8 +448,24 @@ class RadarWaveform(Plugin):
     ) -> Spectrogram | None:
         """The record's micro-Doppler spectrogram when this radar's slow time is not uniform
         (e.g. FMCW frames with gaps): ``signal`` (n_pulses,), ``times`` (n_pulses,) [s].
-        Default ``None``: the pipeline takes the STFT of ``signal`` at :attr:`prf`."""
+        Default ``None``: the pipeline takes the STFT of ``signal`` at :attr:`prf`. A radar that
+        overrides it overrides :meth:`spectrogram_geometry` to match."""
         return None
+
+    def spectrogram_geometry(
+        self, n_pulses: int, processing: ProcessingConfig
+    ) -> SpectrogramGeometry:
+        """The geometry of the spectrogram of a record of ``n_pulses`` pulses (window, hop, FFT
+        size, number of spectra, slow-time rate), worked out without its pulses: ``mdf check``
+        reports it and the run refuses a record too short for it before the first pulse.
+        :class:`~mdframework.physics.spectrogram.RecordTooShortError` when the record is too
+        short for one spectrum. Default: the pipeline's STFT of ``n_pulses`` samples at
+        :attr:`prf` (``processing`` window length, hop and FFT size); it must describe what
+        :meth:`spectrogram` gives (:func:`mdframework.testing.check_radar_waveform` compares)."""
+        from .physics.spectrogram import stft_geometry
+
+        p = processing
+        return stft_geometry(n_pulses, self.prf, p.window_length, p.hop, p.nfft)
 
     def gate_gain(self, ranges: FloatArray, gate_range: FloatArray) -> FloatArray | None:
         """Power gain (n_pulses, n_scatterers) of each scatterer in the range gate of
@@ -532,9 +568,10 @@ class SceneContext:
     of the whole record for received-stage effects; ``skeleton``: the body at the block's pulse
     times in the scene frame (canonical joints when the scatterer model uses them), ``None`` for
     received-stage effects; ``waveform``: the radar plugin (for its bandwidth, pulse width, range
-    equation); ``rng``: the effect's own seeded generator (derived from the run's seed and the
-    effect's position; received-stage effects only: a scatterer-stage effect must not draw
-    random numbers, so that it is block-invariant); ``block_start``: index of the block's first
+    equation); ``rng``: the effect's own seeded generator (from the run's seed and the number of
+    effects of its stage listed after it: :func:`mdframework.pipeline.effect_generators`;
+    received-stage effects only: a scatterer-stage effect must not draw random numbers, so that
+    it is block-invariant); ``block_start``: index of the block's first
     pulse in the record (0 for received-stage effects).
     """
 

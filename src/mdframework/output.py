@@ -55,7 +55,9 @@ from .physics.spectrogram import power_to_db
 from .pipeline import RunResult
 from .progress import QUIET, Progress
 
-MAX_RANGE_TIME_ROWS = 2000
+#: Range-time rows saved to result.npz (``range_time_db``) and drawn in range_time.png: the
+#: record's kept rows (``pipeline.MAX_KEPT_RANGE_TIME_ROWS``) decimated to at most this many.
+MAX_SAVED_RANGE_TIME_ROWS = 2000
 #: every file a run may write
 OUTPUTS = (
     "result.npz",
@@ -150,7 +152,7 @@ def result_arrays(result: RunResult) -> dict[str, np.ndarray]:
         rows = rec.range_time_pulses
         if rows is None:
             rows = np.arange(rec.range_time.shape[0])
-        step = max(1, int(np.ceil(rec.range_time.shape[0] / MAX_RANGE_TIME_ROWS)))
+        step = max(1, int(np.ceil(rec.range_time.shape[0] / MAX_SAVED_RANGE_TIME_ROWS)))
         power = np.abs(rec.range_time[::step]) ** 2
         arrays["range_time_db"] = power_to_db(power, -80.0).astype(np.float32)
         arrays["range_time_time_s"] = result.pulse_times[rows[::step]]

@@ -36,13 +36,26 @@ from .interfaces import (
     SceneContext,
 )
 from .physics import interpolation, radar, scene
-from .physics.spectrogram import RecordTooShortError, Spectrogram, power_to_db, spectrogram
+from .physics.spectrogram import (
+    RecordTooShortError,
+    Spectrogram,
+    SpectrogramGeometry,
+    power_to_db,
+    spectrogram,
+)
 from .plugins import PluginError, Registry, default_registry
 from .progress import QUIET, Progress
-from .settings import ConditioningConfig, PersonConfig, RunConfigBase, SanityConfig
+from .settings import (
+    ConditioningConfig,
+    PersonConfig,
+    ProcessingConfig,
+    RunConfigBase,
+    SanityConfig,
+)
 from .skeleton import Skeleton
 
 FloatArray = NDArray[np.float64]
+ComplexArray = NDArray[np.complex128]
 
 
 class AliasingWarning(UserWarning):
@@ -53,9 +66,10 @@ class EmptyResultWarning(UserWarning):
     """The record holds (almost) nothing of the target (see :mod:`mdframework.emptiness`)."""
 
 
-#: Range-time rows a record keeps: every pulse's row up to this many pulses, evenly spaced rows
-#: beyond (the map is for display; the slow-time ``signal`` keeps every pulse).
-MAX_RANGE_TIME_ROWS = 16384
+#: Range-time rows a record keeps in memory (``Received.range_time``): every pulse's row up to
+#: this many pulses, evenly spaced rows beyond (the map is for display; the slow-time ``signal``
+#: keeps every pulse). ``output.MAX_SAVED_RANGE_TIME_ROWS`` bounds the rows saved to a file.
+MAX_KEPT_RANGE_TIME_ROWS = 16384
 
 
 @dataclass(frozen=True)
@@ -97,9 +111,17 @@ def build_stages(config: RunConfigBase, registry: Registry | None = None) -> Sta
 
     def make(interface: str, section: Any) -> Any:
         try:
-            return reg.get(interface, section.kind)(section)
+            cls = reg.get(interface, section.kind)
         except KeyError as exc:
             raise SceneError(str(exc.args[0])) from None
+        try:
+            return cls(section)
+        except Exception as exc:  # a bug in the plugin: the CLI's internal error names it
+            exc.add_note(
+                f"in the {interface} plugin {section.kind!r} "
+                f"({cls.__module__}.{cls.__qualname__}) while it was built from its config"
+            )
+            raise
 
     source, model = make("motion", cfg.motion), make("scatterers", cfg.scatterers)
     waveform = make("radar", cfg.radar)
@@ -109,11 +131,33 @@ def build_stages(config: RunConfigBase, registry: Registry | None = None) -> Sta
     return Stages(source, model, waveform, effects)
 
 
-def _apply_effects(stages: Stages, stage: str, data: Any, context: SceneContext) -> Any:
+def effect_generators(seed: int, effects: Sequence[Effect]) -> tuple[np.random.Generator, ...]:
+    """Each effect's own random generator, in the order of ``effects``.
+
+    A received-stage effect with ``k`` received-stage effects listed after it draws from stream
+    ``k`` of the run's seed (``SeedSequence(seed).spawn(n)[k]``): listing an effect before
+    another leaves the other's draws as they were, and a lone effect (the last of its stage)
+    draws from stream 0 as every run always has. A scatterer-stage effect draws nothing (it
+    must be block-invariant); it gets stream ``(k, 1)``, which no received-stage effect has."""
+    streams: list[np.random.Generator] = []
+    for i, effect in enumerate(effects):
+        after = sum(e.stage == effect.stage for e in effects[i + 1 :])
+        key = (after,) if effect.stage == "received" else (after, 1)
+        streams.append(np.random.default_rng(np.random.SeedSequence(seed, spawn_key=key)))
+    return tuple(streams)
+
+
+def _apply_effects(
+    stages: Stages,
+    stage: str,
+    data: Any,
+    context: SceneContext,
+    generators: Sequence[np.random.Generator],
+) -> Any:
     expected = type(data)
-    for effect in stages.effects:
+    for effect, rng in zip(stages.effects, generators, strict=True):
         if effect.stage == stage:
-            data = effect.apply(data, context)
+            data = effect.apply(data, replace(context, rng=rng))
             if not isinstance(data, expected):
                 raise PluginError(
                     f"effect {effect.name!r} ({type(effect).__module__}.{type(effect).__name__}) "
@@ -204,6 +248,51 @@ def load_motion(source: MotionSource) -> Motion:
     return sanity.check_motion(motion, getattr(source.config, "sanity", SanityConfig()))
 
 
+def spectrogram_geometry(
+    wf: RadarWaveform, n_pulses: int, proc: ProcessingConfig
+) -> SpectrogramGeometry:
+    """The geometry of the spectrogram the radar ``wf`` makes of ``n_pulses`` pulses
+    (:meth:`RadarWaveform.spectrogram_geometry`); a record too short for it is a
+    :class:`SceneError` naming ``processing.window_length``. ``mdf check`` reports it."""
+    try:
+        return wf.spectrogram_geometry(n_pulses, proc)
+    except RecordTooShortError as exc:
+        raise SceneError(f"processing.window_length: {exc}") from None
+
+
+def processing_stft(
+    signal: ComplexArray, sample_rate: float, proc: ProcessingConfig
+) -> Spectrogram:
+    """The STFT of ``signal`` (n,) sampled at ``sample_rate`` [Hz] with the ``processing``
+    window, window length, hop, FFT size and precision (:func:`physics.spectrogram.spectrogram`;
+    :class:`RecordTooShortError` for a record shorter than the window)."""
+    return spectrogram(
+        signal,
+        sample_rate,
+        window=proc.window,
+        window_length=proc.window_length,
+        hop=proc.hop,
+        nfft=proc.nfft,
+        precision=proc.precision,
+    )
+
+
+def record_spectrogram(
+    wf: RadarWaveform, signal: ComplexArray, times: FloatArray, proc: ProcessingConfig
+) -> Spectrogram:
+    """The record's spectrogram: the radar's own (:meth:`RadarWaveform.spectrogram`, for a slow
+    time that is not uniform) or the STFT of ``signal`` (n_pulses,) at its PRF with the
+    ``processing`` window; ``times`` (n_pulses,) [s]. Its power is
+    :func:`spectrogram_geometry`'s shape (the radar contract checks this)."""
+    try:
+        spec = wf.spectrogram(signal, times, proc)  # a waveform's own slow time (FMCW)
+        if spec is None:
+            spec = processing_stft(signal, wf.prf, proc)
+    except RecordTooShortError as exc:
+        raise SceneError(f"processing.window_length: {exc}") from None
+    return spec
+
+
 def simulate_motion(
     config: RunConfigBase,
     stages: Stages,
@@ -251,6 +340,7 @@ def _simulate_motion(
         keep_scatterers=proc.keep_scatterers,
     )
     t = record_pulses(wf, t_start, t_end)
+    spectrogram_geometry(wf, t.shape[0], proc)  # a record too short: refused before any pulse
     frames = interpolation.window_frames(body.time, float(t[0]), float(t[-1]))
     near = body.select_frames(frames)
     exact_linear = motion.linear_tracks and body is motion.skeleton
@@ -272,8 +362,9 @@ def _simulate_motion(
     timings["prepare"] = time.perf_counter() - clock
 
     n = t.shape[0]
-    seeds = np.random.SeedSequence(config.seed).spawn(len(stages.effects) + 1)
-    rng = np.random.default_rng(seeds[0])
+    generators = effect_generators(config.seed, stages.effects)
+    # the contexts' generator: _apply_effects gives each effect its own in its place
+    rng = generators[0] if generators else np.random.default_rng(config.seed)
     stream = _Stream(n, proc.keep_scatterers, proc.aliasing, wf, sc.min_range, t)
     losses = emptiness.Losses()
     blocks = _blocks(n, proc.block_pulses, wf.block_multiple)
@@ -293,7 +384,7 @@ def _simulate_motion(
         )
         if early_effects:  # the body itself within scene.min_range: refused before any effect
             stream.check_near(lo, scat, scat.ranges(radar_pos))
-        scat = _apply_effects(stages, "scatterers", scat, context)
+        scat = _apply_effects(stages, "scatterers", scat, context, generators)
         ranges = scat.ranges(radar_pos)
         stream.check(lo, scat, ranges)
         s = slice(None, None, emptiness.SAMPLE_EVERY)
@@ -315,27 +406,14 @@ def _simulate_motion(
         received = replace(received, products={**received.products, **wf.product_axes()})
     echo = received.signal.copy()  # the target's echo, before noise and clutter
     context = SceneContext(radar_pos, wf.prf, wf.carrier_frequency, t, stream.gate, None, wf, rng)
-    received = _apply_effects(stages, "received", received, context)
+    received = _apply_effects(stages, "received", received, context, generators)
     _check_empty(echo, losses, proc, fixed_gate=sc.gate != "track")
     effects_ran = _describe(stages, "scatterers") + _describe(stages, "received")
     timings["received_effects"] = time.perf_counter() - clock
 
     clock = time.perf_counter()
     progress.stage("spectrogram")
-    try:
-        spec = wf.spectrogram(received.signal, t, proc)  # a waveform's own slow time (FMCW)
-        if spec is None:
-            spec = spectrogram(
-                received.signal,
-                wf.prf,
-                window=proc.window,
-                window_length=proc.window_length,
-                hop=proc.hop,
-                nfft=proc.nfft,
-                precision=proc.precision,
-            )
-    except RecordTooShortError as exc:
-        raise SceneError(f"processing.window_length: {exc}") from None
+    spec = record_spectrogram(wf, received.signal, t, proc)
     spec_db = power_to_db(spec.power, proc.floor_db, dtype=np.float32)
     velocity = radar.doppler_to_velocity(spec.doppler, wf.carrier_frequency)
     timings["spectrogram"] = time.perf_counter() - clock
@@ -480,7 +558,7 @@ class _Stream:
         self.names: tuple[str, ...] = ()
         self._last: tuple[float, FloatArray] | None = None
         self._blocks: list[Scatterers] = []
-        self._rt_step = max(1, -(-n // MAX_RANGE_TIME_ROWS))
+        self._rt_step = max(1, -(-n // MAX_KEPT_RANGE_TIME_ROWS))
         self._rt: list[NDArray[np.complex128]] = []
         self._rt_axis: FloatArray | None = None
         self._products: dict[str, list[NDArray[Any]]] = {}

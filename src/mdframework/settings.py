@@ -404,12 +404,30 @@ class ConditioningConfig(StrictModel):
     )
     smoothing: Literal["none", "violating", "all"] = Field(
         "violating",
-        description="Gaussian smoothing after the speed limit: of no joint, of the joints that "
-        "exceeded the limit, or of all joints.",
+        description="Gaussian smoothing of the joint tracks, after the speed limit: of no joint, "
+        "of the joints that exceeded the limit (none when speed_limit is false), or of all "
+        "joints (with or without speed_limit).",
     )
     smoothing_sigma_s: float = Field(
         0.03, ge=0, le=10, description="Standard deviation of the smoothing kernel [s]."
     )
+
+
+#: matplotlib's built-in colour maps (each also reversed, with ``_r``), listed here so that
+#: reading a config never imports matplotlib (a run without figures never does);
+#: tests/test_figures.py checks the list against the installed matplotlib.
+COLORMAPS = frozenset(
+    (
+        "Accent Blues BrBG BuGn BuPu CMRmap Dark2 GnBu Grays Greens Greys OrRd Oranges PRGn "
+        "Paired Pastel1 Pastel2 PiYG PuBu PuBuGn PuOr PuRd Purples RdBu RdGy RdPu RdYlBu RdYlGn "
+        "Reds Set1 Set2 Set3 Spectral Wistia YlGn YlGnBu YlOrBr YlOrRd afmhot autumn berlin "
+        "binary bone brg bwr cividis cool coolwarm copper cubehelix flag gist_earth gist_gray "
+        "gist_grey gist_heat gist_ncar gist_rainbow gist_stern gist_yarg gist_yerg gnuplot "
+        "gnuplot2 gray grey hot hsv inferno jet magma managua nipy_spectral ocean okabe_ito pink "
+        "plasma prism rainbow seismic spring summer tab10 tab20 tab20b tab20c terrain turbo "
+        "twilight twilight_shifted vanimo viridis winter"
+    ).split()
+)
 
 
 class FiguresConfig(StrictModel):
@@ -447,9 +465,7 @@ class FiguresConfig(StrictModel):
     @field_validator("colormap")
     @classmethod
     def _known_colormap(cls, value: str) -> str:
-        from matplotlib import colormaps
-
-        if value not in colormaps:
+        if value.removesuffix("_r") not in COLORMAPS:
             raise ValueError(f"unknown colour map {value!r}; try viridis, magma or cividis")
         return value
 

@@ -315,7 +315,8 @@ def check_radar_waveform(waveform: RadarWaveform) -> None:
     ``receive_signal`` gives the same signal; two scatterers
     give the sum of their separate returns (superposition). The pulses are the radar's own
     ``pulse_times`` and the Doppler is read from the phase steps between consecutive pulses at
-    most 1.5 / prf apart, so radars whose slow time has gaps (FMCW frames) are checked too."""
+    most 1.5 / prf apart, so radars whose slow time has gaps (FMCW frames) are checked too.
+    The spectrogram of the signal has the geometry ``spectrogram_geometry`` reports."""
     who = _label(waveform)
     fc, prf = waveform.carrier_frequency, waveform.prf
     assert fc > 0 and prf > 0, f"{who}: carrier and PRF must be > 0"
@@ -350,6 +351,29 @@ def check_radar_waveform(waveform: RadarWaveform) -> None:
     scale = np.max(np.abs(both)) + 1e-300
     assert np.max(np.abs(both - (y + alone))) <= 1e-6 * scale, (
         f"{who}: the return of two scatterers must be the sum of their returns"
+    )
+    _check_spectrogram_geometry(who, waveform, y, t)
+
+
+def _check_spectrogram_geometry(
+    who: str, waveform: RadarWaveform, signal: np.ndarray, times: np.ndarray
+) -> None:
+    """The run's spectrogram of ``signal`` has the geometry ``spectrogram_geometry`` reports
+    (what ``mdf check`` prints): its shape and the spacing of its Doppler bins."""
+    from .pipeline import record_spectrogram
+    from .settings import ProcessingConfig
+
+    proc = ProcessingConfig(window_length=64, hop=16, nfft=128)
+    geometry = waveform.spectrogram_geometry(times.shape[0], proc)
+    spec = record_spectrogram(waveform, signal, times, proc)
+    assert spec.power.shape == geometry.shape, (
+        f"{who}: the spectrogram is {spec.power.shape} but spectrogram_geometry() says "
+        f"{geometry.shape}: override both together"
+    )
+    step = float(np.mean(np.diff(spec.doppler)))
+    assert abs(step - geometry.doppler_bin) <= 1e-9 * geometry.doppler_bin, (
+        f"{who}: the Doppler bins are {step:.6g} Hz apart but spectrogram_geometry() says "
+        f"{geometry.doppler_bin:.6g} Hz"
     )
 
 

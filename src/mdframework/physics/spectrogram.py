@@ -59,6 +59,59 @@ class RecordTooShortError(ValueError):
 
 
 @dataclass(frozen=True)
+class SpectrogramGeometry:
+    """The spectrogram a radar makes of a record, known before any pulse is simulated.
+
+    ``sample_rate`` [Hz]: the rate of the slow-time samples the spectra are taken of;
+    ``window``: samples per spectrum; ``hop``: samples from one spectrum to the next (at
+    ``sample_rate``; a whole number for an STFT, one frame period for FMCW frames); ``nfft``:
+    the FFT size (the number of Doppler bins); ``n_frames``: the spectra. The power is
+    ``(nfft, n_frames)``."""
+
+    sample_rate: float
+    window: int
+    hop: float
+    nfft: int
+    n_frames: int
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """``(nfft, n_frames)``: the shape of the spectrogram's power."""
+        return self.nfft, self.n_frames
+
+    @property
+    def doppler_bin(self) -> float:
+        """Spacing of the Doppler bins, ``sample_rate / nfft`` [Hz]."""
+        return self.sample_rate / self.nfft
+
+    @property
+    def window_resolution(self) -> float:
+        """Doppler resolution of the window, ``sample_rate / window`` [Hz]."""
+        return self.sample_rate / self.window
+
+
+def stft_geometry(
+    n_samples: int, sample_rate: float, window_length: int, hop: int, nfft: int | None = None
+) -> SpectrogramGeometry:
+    """The geometry of :func:`spectrogram` for ``n_samples`` samples at ``sample_rate`` [Hz]:
+    ``1 + (n_samples - window_length) // hop`` frames of ``nfft`` bins (default: the window
+    length). ``ValueError`` for a window shorter than 2, a hop below 1 or ``nfft`` below the
+    window; :class:`RecordTooShortError` for a record shorter than one window."""
+    nfft = window_length if nfft is None else int(nfft)
+    if window_length < 2 or hop < 1:
+        raise ValueError("window_length must be >= 2 and hop >= 1")
+    if nfft < window_length:
+        raise ValueError(f"nfft ({nfft}) must be >= window_length ({window_length})")
+    if n_samples < window_length:
+        raise RecordTooShortError(
+            f"the record has {n_samples} samples ({n_samples / sample_rate:.4f} s) but the STFT "
+            f"window needs {window_length}: use a longer record or a shorter window"
+        )
+    n_frames = 1 + (n_samples - window_length) // hop
+    return SpectrogramGeometry(float(sample_rate), window_length, hop, nfft, n_frames)
+
+
+@dataclass(frozen=True)
 class Spectrogram:
     """``power`` (n_doppler, n_frames) float32 (float64 with ``precision = "float64"``)
     [W-like, |signal|^2 units];
@@ -91,18 +144,8 @@ def spectrogram(
     thousand at a time, so the only record-sized array is the power itself.
     """
     y = np.asarray(signal)
-    n = y.shape[0]
-    nfft = window_length if nfft is None else int(nfft)
-    if window_length < 2 or hop < 1:
-        raise ValueError("window_length must be >= 2 and hop >= 1")
-    if nfft < window_length:
-        raise ValueError(f"nfft ({nfft}) must be >= window_length ({window_length})")
-    if n < window_length:
-        raise RecordTooShortError(
-            f"the record has {n} samples ({n / sample_rate:.4f} s) but the STFT window needs "
-            f"{window_length}: use a longer record or a shorter window"
-        )
-    n_frames = 1 + (n - window_length) // hop
+    geometry = stft_geometry(y.shape[0], sample_rate, window_length, hop, nfft)
+    nfft, n_frames = geometry.shape
     real, cplx = precision_dtypes(precision)
     w = stft_window(window, window_length)
     if nfft % 2 == 0:

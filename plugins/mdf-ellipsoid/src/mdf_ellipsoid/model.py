@@ -224,6 +224,5 @@ class EllipsoidBody(ScattererModel):
             )
             return Scatterers(pts, sig, tuple(f"{m}#{j}" for m in names for j in range(n)))
         semi_axes = np.stack([a, a, semi_c], axis=1)
-        key = tuple(float(v) for v in rp)
-        cache = (key, np.sqrt(los2, out=los2))
-        return Scatterers(pos, sigma, names, semi_axes, axes, cache)  # type: ignore[arg-type]
+        scat = Scatterers(pos, sigma, names, semi_axes, axes)
+        return scat.with_ranges(rp, np.sqrt(los2, out=los2))

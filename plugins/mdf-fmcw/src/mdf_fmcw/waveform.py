@@ -47,7 +47,7 @@ from .presets import PRESETS
 
 if TYPE_CHECKING:
     from mdframework.interfaces import PulseBlock
-    from mdframework.physics.spectrogram import Spectrogram
+    from mdframework.physics.spectrogram import Spectrogram, SpectrogramGeometry
     from mdframework.settings import ProcessingConfig
 
 FloatArray = NDArray[np.float64]
@@ -508,28 +508,53 @@ class FmcwRadar(RadarWaveform):
             out["points"] = fmcw.as_points(frames)
         return Received(signal, products=out)
 
+    def _gapless(self) -> bool:
+        """Whether the frames follow each other without gaps (then the spectrogram is an STFT
+        over the record, else one spectrum per frame)."""
+        seq = self.sequence
+        return seq.frame_period <= seq.chirps_per_frame * seq.chirp_period * (1 + 1e-9)
+
+    def spectrogram_geometry(
+        self, n_pulses: int, processing: ProcessingConfig
+    ) -> SpectrogramGeometry:
+        """The geometry of :meth:`spectrogram` for ``n_pulses`` chirps (whole frames): the
+        STFT's over the first slot's ``ceil(n_pulses / n_tx)`` chirps at :attr:`prf`, or one
+        spectrum per frame of its ``n_loops`` chirps, one frame period apart, with
+        ``max(processing.nfft, n_loops)`` bins."""
+        from mdframework.physics.spectrogram import (
+            RecordTooShortError,
+            SpectrogramGeometry,
+            stft_geometry,
+        )
+
+        seq, p = self.sequence, processing
+        if self._gapless():
+            n = -(-n_pulses // seq.n_tx)
+            return stft_geometry(n, self.prf, p.window_length, p.hop, p.nfft)
+        n_frames = n_pulses // seq.chirps_per_frame
+        if n_frames < 1:
+            raise RecordTooShortError(
+                f"the record has {n_pulses} chirps but one frame needs {seq.chirps_per_frame}"
+            )
+        hop = seq.frame_period * self.prf
+        return SpectrogramGeometry(self.prf, seq.n_loops, hop, max(p.nfft, seq.n_loops), n_frames)
+
     def spectrogram(
         self, signal: NDArray[np.complex128], times: FloatArray, processing: ProcessingConfig
     ) -> Spectrogram:
         """Micro-Doppler spectrogram from the first TDM slot's chirps (one sample per loop):
         an STFT (``processing`` window, length, hop, FFT size) when the frames follow each other
         without gaps, else one Doppler spectrum per frame (window over the frame's loops, FFT
-        size ``processing.nfft``), at the frame's middle loop; the power in
-        ``processing.precision`` (float32 by default)."""
-        from mdframework.physics.spectrogram import Spectrogram, spectrogram
+        size ``max(processing.nfft, n_loops)``), at the frame's middle loop; the power in
+        ``processing.precision`` (float32 by default). :meth:`spectrogram_geometry` gives its
+        geometry."""
+        from mdframework.physics.spectrogram import Spectrogram
+        from mdframework.pipeline import processing_stft
 
         seq = self.sequence
         p = processing
-        if seq.frame_period <= seq.chirps_per_frame * seq.chirp_period * (1 + 1e-9):
-            return spectrogram(
-                np.asarray(signal)[:: seq.n_tx],
-                self.prf,
-                window=p.window,
-                window_length=p.window_length,
-                hop=p.hop,
-                nfft=p.nfft,
-                precision=p.precision,
-            )
+        if self._gapless():
+            return processing_stft(np.asarray(signal)[:: seq.n_tx], self.prf, p)
         power, doppler, time = fmcw.frame_spectrogram(
             np.asarray(signal), seq, p.window, max(p.nfft, seq.n_loops), p.precision
         )
