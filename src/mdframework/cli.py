@@ -44,10 +44,14 @@ from .plugins import (
     reset_default_registry,
     suggest,
 )
-from .progress import Progress, printed, retract
+from .progress import Progress, printed, retract, safe_stderr, say
 
 EXIT_USAGE = 2
 EXIT_INTERRUPTED = 130
+#: exit code after SIGTERM (what a batch system such as SLURM sends at a job's time limit)
+EXIT_TERMINATED = 143
+#: the signal that ended the command (SIGINT or SIGTERM), set by :func:`_catch_interrupts`
+_ENDED_BY: list[int] = []
 #: options accepted anywhere on the command line (before a lone ``--``)
 GLOBAL_FLAGS = ("--debug",)
 DISABLE_OPTION = "--disable-plugin"
@@ -233,7 +237,7 @@ def _cmd_dataset_build(args: argparse.Namespace) -> int:
             progress=not args.no_progress,
             force=args.force,
         )
-    manifest = json.loads((Path(args.out) / "dataset.json").read_text())
+    manifest = json.loads((Path(args.out) / "dataset.json").read_text(encoding="utf-8"))
     skipped = manifest.get("n_skipped", 0)
     note = f"; {skipped} skipped, see {Path(args.out) / 'skipped.csv'}" if skipped else ""
     print(f"{len(rows)} records in {args.out}{note}")
@@ -262,8 +266,10 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
 
 FORCE_HELP = (
     "write into an existing folder that holds other files (only this command's files are "
-    "replaced; nothing else is deleted), or rebuild a dataset from a different config"
+    "replaced; nothing else is deleted)"
 )
+#: --force of the commands that build a dataset
+FORCE_DATASET_HELP = FORCE_HELP + ", or rebuild a dataset from a different config"
 PROGRESS_HELP = (
     "hide the progress of steps that take more than a second (shown on stderr when it is a "
     "terminal, or with MDF_PROGRESS=1)"
@@ -353,8 +359,10 @@ def build_parser() -> argparse.ArgumentParser:
         "run",
         "run a config: motion -> radar -> spectrogram",
         "Simulate one record from a run config (TOML, YAML or JSON) and write result.npz, "
-        "spectrogram.png, config.resolved.json and metadata.json into the output folder (all "
-        "or nothing). See docs/config-reference.md for every field.",
+        "features.json, config.resolved.json, metadata.json and spectrogram.png into the "
+        "output folder (all or nothing), with range_time.png on the raw path and points.csv, "
+        "range_doppler.png and point_cloud.png for a radar's point products. See "
+        "docs/config-reference.md for every field.",
         [
             "mdf run examples/point_target.toml --out out/pt",
             "mdf run examples/cmu_walk.toml --out out/walk --debug",
@@ -438,7 +446,7 @@ def build_parser() -> argparse.ArgumentParser:
         "MDF_DASK_TIMEOUT seconds, default 10)",
     )
     build.add_argument("--no-progress", action="store_true", help="hide the progress bar")
-    build.add_argument("--force", action="store_true", help=FORCE_HELP)
+    build.add_argument("--force", action="store_true", help=FORCE_DATASET_HELP)
     build.set_defaults(func=_cmd_dataset_build)
 
     experiment = add_command(
@@ -459,7 +467,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="let the config's classifier name any import path (importing runs that module's "
         "code: use only with configs you trust); default: scikit-learn's classifiers only",
     )
-    experiment.add_argument("--force", action="store_true", help=FORCE_HELP)
+    experiment.add_argument("--force", action="store_true", help=FORCE_DATASET_HELP)
     experiment.add_argument("--staging-dir", default=None, help=STAGING_HELP)
     experiment.set_defaults(func=_cmd_experiment)
 
@@ -528,7 +536,7 @@ def split_global_options(argv: Sequence[str]) -> tuple[list[str], bool, list[str
 
 def _show_warning(message: Any, category: Any, *rest: Any, **kw: Any) -> None:
     printed()
-    print(f"mdf: warning: {_one_line(str(message))}", file=sys.stderr)
+    say(f"mdf: warning: {_one_line(str(message))}")
 
 
 def _plugins_off_note() -> str:
@@ -552,15 +560,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point; returns the exit code. Ctrl-C at any moment (plugin loading included) prints
     one line and returns 130."""
     try:
+        _ENDED_BY.clear()
         previous = _catch_interrupts()
         hook = sys.unraisablehook
         sys.unraisablehook = _quiet_unraisable_interrupt(hook)
         try:
-            code = _main_with_options(argv)
+            with safe_stderr():  # printing a line never fails a command
+                code = _main_with_options(argv)
         finally:
             sys.unraisablehook = hook
-            if previous is not None:
-                signal.signal(signal.SIGINT, previous)
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
         # a Ctrl-C that Python could not raise (it arrived in a finaliser or a callback and
         # was reported as unraisable) still ends the command as interrupted
         return _interrupted() if interrupt_seen() else code
@@ -583,29 +593,38 @@ def _quiet_unraisable_interrupt(hook: Any) -> Any:
 
 def _interrupted() -> int:
     retract()
-    print("mdf: interrupted", file=sys.stderr)
+    if _ENDED_BY and _ENDED_BY[0] == signal.SIGTERM:
+        say("mdf: terminated")
+        return EXIT_TERMINATED
+    say("mdf: interrupted")
     return EXIT_INTERRUPTED
 
 
-def _catch_interrupts() -> Any:
-    """The first Ctrl-C raises KeyboardInterrupt (the command cleans up: staging folders, the
-    lock, worker processes) and prints one line; a second one during that clean-up ends the
-    process at once with the same line (the next command on the folder removes what is left).
-    Returns the handler to restore, or None where signals cannot be handled (not the main
-    thread)."""
+def _catch_interrupts() -> dict[int, Any]:
+    """The first Ctrl-C or SIGTERM raises KeyboardInterrupt (the command cleans up: staging
+    folders, the lock, worker processes) and prints one line (``mdf: interrupted``, exit 130;
+    ``mdf: terminated``, exit 143); a second one during that clean-up ends the process at once
+    with the same line (the next command on the folder removes what is left). Returns the
+    handlers to restore (none where signals cannot be handled: not the main thread)."""
     if threading.current_thread() is not threading.main_thread():
-        return None
+        return {}
 
     def again(signum: int, frame: Any) -> None:
-        os.write(2, b"mdf: interrupted\n")
-        os._exit(EXIT_INTERRUPTED)
+        term = _ENDED_BY[:1] == [signal.SIGTERM]
+        try:
+            os.write(2, b"mdf: terminated\n" if term else b"mdf: interrupted\n")
+        except OSError:  # stderr closed or full
+            pass
+        os._exit(EXIT_TERMINATED if term else EXIT_INTERRUPTED)
 
     def first(signum: int, frame: Any) -> None:
         signal.signal(signal.SIGINT, again)
+        signal.signal(signal.SIGTERM, again)
+        _ENDED_BY.append(signum)
         note_interrupt()
         raise KeyboardInterrupt
 
-    return signal.signal(signal.SIGINT, first)
+    return {sig: signal.signal(sig, first) for sig in (signal.SIGINT, signal.SIGTERM)}
 
 
 def _main_with_options(argv: Sequence[str] | None) -> int:
@@ -614,10 +633,9 @@ def _main_with_options(argv: Sequence[str] | None) -> int:
     unknown = sorted(set(disable) - installed_names()) if disable else []
     if unknown:  # a misspelt name would otherwise leave the plugin on without a word
         known = sorted(installed_names())
-        print(
+        say(
             f"mdf: error: {DISABLE_OPTION} {unknown[0]}: no installed plugin has this name"
-            f"{suggest(unknown[0], known)}; `mdf plugins` lists them",
-            file=sys.stderr,
+            f"{suggest(unknown[0], known)}; `mdf plugins` lists them"
         )
         return EXIT_USAGE
     old_env = os.environ.get(DISABLE_PLUGINS_ENV)
@@ -654,14 +672,14 @@ def _main(argv: list[str], debug: bool) -> int:
     except PluginError as exc:
         if debug:
             raise
-        print(f"mdf: error: {_one_line(str(exc))}", file=sys.stderr)
+        say(f"mdf: error: {_one_line(str(exc))}")
         return EXIT_USAGE
     try:
         args = parser.parse_args(argv)
     except UsageError as exc:
         if debug:
             traceback.print_exc()
-        print(f"mdf: error: {_one_line(str(exc))}", file=sys.stderr)
+        say(f"mdf: error: {_one_line(str(exc))}")
         return EXIT_USAGE
     args.debug = debug or args.debug
     try:
@@ -675,7 +693,7 @@ def _main(argv: list[str], debug: bool) -> int:
         if "disabled" not in message:
             message += _plugins_off_note()
         retract()
-        print(f"mdf: error: {message}", file=sys.stderr)
+        say(f"mdf: error: {message}")
         return EXIT_USAGE
     except Exception as exc:
         if caused_by_interrupt(exc):
@@ -685,13 +703,12 @@ def _main(argv: list[str], debug: bool) -> int:
         retract()
         if isinstance(exc, OSError) and exc.errno in _WRITE_ERRNOS:
             where = f": {exc.filename}" if exc.filename else ""
-            print(f"mdf: error: {exc.strerror}{where}", file=sys.stderr)
+            say(f"mdf: error: {exc.strerror}{where}")
             return EXIT_USAGE
         notes = "".join(f"{_one_line(note)}; " for note in getattr(exc, "__notes__", ()))
-        print(
+        say(
             f"mdf: internal error: {type(exc).__name__}: {_one_line(str(exc))} "
-            f"({notes}run with --debug for the traceback)",
-            file=sys.stderr,
+            f"({notes}run with --debug for the traceback)"
         )
         return 1
 

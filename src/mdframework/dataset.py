@@ -1603,7 +1603,7 @@ def _built_from(folder: OutputFolder) -> dict[str, Any] | None:
     built = folder.marker.get("config")
     if built is None and (folder.path / MANIFEST).exists():  # built before markers existed
         try:
-            built = json.loads((folder.path / MANIFEST).read_text()).get("config")
+            built = json.loads((folder.path / MANIFEST).read_text(encoding="utf-8")).get("config")
         except (OSError, ValueError, AttributeError):
             built = None
     if not isinstance(built, dict):
@@ -1850,7 +1850,7 @@ def load_dataset(
             f"{root}: the build stopped while it wrote {INDEX}, {SKIPPED} and {MANIFEST} (they "
             "may not match); run the same `mdf dataset build` again to finish it"
         )
-    with index.open(newline="") as fh:
+    with index.open(newline="", encoding="utf-8") as fh:
         rows = list(csv.DictReader(fh))
     if not rows:
         raise MdfError(f"{index}: the dataset has no records")

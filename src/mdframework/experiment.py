@@ -817,10 +817,12 @@ def _report(
             )
         stem = f"within_{safe_name(group)}"
         (out / f"{stem}_confusion.csv").write_text(
-            _csv(_matrix_rows(classes, res["confusion_mean"]))
+            _csv(_matrix_rows(classes, res["confusion_mean"])),
+            encoding="utf-8",
         )
         (out / f"{stem}_confusion_std.csv").write_text(
-            _csv(_matrix_rows(classes, res["confusion_std"]))
+            _csv(_matrix_rows(classes, res["confusion_std"])),
+            encoding="utf-8",
         )
         (out / f"{stem}_per_class.csv").write_text(
             _csv(
@@ -834,7 +836,8 @@ def _report(
                     }
                     for i, c in enumerate(classes)
                 ]
-            )
+            ),
+            encoding="utf-8",
         )
         figures.append(
             partial(
@@ -873,7 +876,8 @@ def _report(
     if cfg.cross_source is not None:
         res = cross_source(cfg, factory, data, x_all, names)
         (out / "cross_confusion.csv").write_text(
-            _csv(_matrix_rows(res["classes"], res["confusion"]))
+            _csv(_matrix_rows(res["classes"], res["confusion"])),
+            encoding="utf-8",
         )
         figures.append(
             partial(
@@ -905,7 +909,8 @@ def _report(
     if cfg.train_test is not None:
         res = train_test(cfg, factory, data, x_all, names)
         (out / "train_test_confusion.csv").write_text(
-            _csv(_matrix_rows(res["classes"], res["confusion"]))
+            _csv(_matrix_rows(res["classes"], res["confusion"])),
+            encoding="utf-8",
         )
         plot_confusion(
             out / "train_test_confusion.png",
@@ -928,9 +933,9 @@ def _report(
         ]
     note("feature statistics and figures", progress)
     stats = feature_statistics(data)
-    (out / "feature_stats.csv").write_text(_csv(stats))
+    (out / "feature_stats.csv").write_text(_csv(stats), encoding="utf-8")
     md = _stats_markdown(stats)
-    (out / "feature_stats.md").write_text(md)
+    (out / "feature_stats.md").write_text(md, encoding="utf-8")
     report += ["## Feature statistics", "", md, ""]
     for f1, f2 in cfg.report.scatter_pairs:
         name = f"scatter_{f1}_{f2}.png"
@@ -951,8 +956,10 @@ def _report(
         report += [f"![{f1} vs {f2}]({name})", ""]
     for draw in figures:
         draw()
-    (out / "report.md").write_text("\n".join(report))
-    (out / "summary.json").write_text(json.dumps(summary, indent=2, default=str) + "\n")
+    (out / "report.md").write_text("\n".join(report), encoding="utf-8")
+    (out / "summary.json").write_text(
+        json.dumps(summary, indent=2, default=str) + "\n", encoding="utf-8"
+    )
     return summary
 
 

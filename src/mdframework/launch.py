@@ -16,6 +16,9 @@ def run() -> None:
     try:
         from .cli import main
     except KeyboardInterrupt:
-        print("mdf: interrupted", file=sys.stderr)
+        try:
+            print("mdf: interrupted", file=sys.stderr or sys.__stderr__)
+        except (OSError, ValueError, AttributeError):  # stderr closed or full
+            pass
         sys.exit(130)
     sys.exit(main())

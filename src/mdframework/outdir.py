@@ -66,7 +66,7 @@ def marker_name(command: str) -> str:
 def _umask() -> int:
     """The process's umask, read without changing it where the system allows."""
     try:
-        with open("/proc/self/status") as fh:
+        with open("/proc/self/status", encoding="utf-8") as fh:
             for line in fh:
                 if line.startswith("Umask:"):
                     return int(line.split()[1], 8)
@@ -270,9 +270,9 @@ def safe_name(text: str) -> str:
 def _process_start(pid: int) -> str:
     """When the process started (UTC, from /proc where available; else now)."""
     try:
-        with open(f"/proc/{pid}/stat") as fh:
+        with open(f"/proc/{pid}/stat", encoding="utf-8") as fh:
             ticks = int(fh.read().rsplit(")", 1)[1].split()[19])
-        with open("/proc/stat") as fh:
+        with open("/proc/stat", encoding="utf-8") as fh:
             btime = next(int(line.split()[1]) for line in fh if line.startswith("btime"))
         started = btime + ticks / os.sysconf("SC_CLK_TCK")
     except (OSError, ValueError, IndexError, StopIteration):
@@ -283,7 +283,7 @@ def _process_start(pid: int) -> str:
 def _read_holder(path: Path) -> dict[str, Any]:
     for _ in range(20):  # the holder writes its details right after taking the lock
         try:
-            info = json.loads(path.read_text())
+            info = json.loads(path.read_text(encoding="utf-8"))
             if isinstance(info, dict) and "pid" in info:
                 return info
         except (OSError, ValueError):

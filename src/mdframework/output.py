@@ -205,12 +205,17 @@ def _stage_run(
         _plot_run(stage, arrays, title, caption, look, progress)
     products = "points" in arrays
     progress.stage("writing features.json" + (" and points.csv" if products else ""))
-    (stage / "features.json").write_text(json.dumps(features_document(arrays), indent=2) + "\n")
+    (stage / "features.json").write_text(
+        json.dumps(features_document(arrays), indent=2) + "\n", encoding="utf-8"
+    )
     if products:
         write_points_csv(stage / "points.csv", arrays["points"])
-    (stage / "config.resolved.json").write_text(json.dumps(resolved_config, indent=2) + "\n")
+    (stage / "config.resolved.json").write_text(
+        json.dumps(resolved_config, indent=2) + "\n", encoding="utf-8"
+    )
     (stage / "metadata.json").write_text(
-        json.dumps(result.metadata, indent=2, default=_jsonable) + "\n"
+        json.dumps(result.metadata, indent=2, default=_jsonable) + "\n",
+        encoding="utf-8",
     )
 
 

@@ -21,6 +21,7 @@ the only line the command leaves on the terminal.
 
 from __future__ import annotations
 
+import io
 import os
 import sys
 import threading
@@ -60,7 +61,82 @@ def progress_enabled(wanted: bool = True) -> bool:
     forced = _forced()
     if forced is not None:
         return forced
-    return bool(sys.stderr.isatty())
+    return stderr_is_terminal()
+
+
+def stderr_is_terminal() -> bool:
+    """Whether stderr is a terminal (False when it is closed or gone: ``2>&-``)."""
+    try:
+        return sys.stderr is not None and bool(sys.stderr.isatty())
+    except (OSError, ValueError):
+        return False
+
+
+class SafeStream(io.TextIOBase):
+    """A text stream in front of ``stream`` (stderr) that never fails: writes to a closed
+    stream (``None``: ``2>&-``) go nowhere, and a write or flush that fails (``2>/dev/full``, a
+    reader gone) loses its text, never the command. For tqdm's bars and every other writer."""
+
+    def __init__(self, stream: Any) -> None:
+        super().__init__()
+        self.stream = stream
+
+    def write(self, text: str) -> int:
+        if self.stream is not None:
+            try:
+                self.stream.write(text)
+            except (OSError, ValueError):
+                pass
+        return len(text)
+
+    def flush(self) -> None:
+        if self.stream is not None:
+            try:
+                self.stream.flush()
+            except (OSError, ValueError):
+                pass
+
+    def isatty(self) -> bool:
+        try:
+            return self.stream is not None and bool(self.stream.isatty())
+        except (OSError, ValueError):
+            return False
+
+    def fileno(self) -> int:
+        if self.stream is None:
+            raise OSError("stderr is closed")
+        return int(self.stream.fileno())
+
+    @property
+    def encoding(self) -> str:  # type: ignore[override]
+        return str(getattr(self.stream, "encoding", None) or "utf-8")
+
+
+@contextmanager
+def safe_stderr() -> Iterator[None]:
+    """``sys.stderr`` is a :class:`SafeStream` for the block (a command's lifetime)."""
+    saved = sys.stderr
+    if isinstance(saved, SafeStream):
+        yield
+        return
+    sys.stderr = SafeStream(saved)
+    try:
+        yield
+    finally:
+        sys.stderr = saved
+
+
+def say(line: str) -> None:
+    """Print ``line`` on stderr, never failing: a closed stderr (``2>&-``), a full disk
+    (``2>/dev/full``) or a reader gone loses the line, never the command."""
+    stream = sys.stderr
+    if stream is None:
+        return
+    try:
+        stream.write(line + "\n")
+        stream.flush()
+    except (OSError, ValueError):
+        pass
 
 
 def note(message: str, enabled: bool = True) -> None:
@@ -79,9 +155,12 @@ def printed() -> None:
 def retract() -> None:
     """Erase the last status line if nothing was printed on stderr after it and stderr is a
     terminal (called before an error line)."""
-    if _State.open and sys.stderr.isatty():
-        sys.stderr.write(_ERASE_LINE)
-        sys.stderr.flush()
+    if _State.open and stderr_is_terminal():
+        try:
+            sys.stderr.write(_ERASE_LINE)
+            sys.stderr.flush()
+        except (OSError, ValueError):
+            pass
     _State.open = False
 
 
@@ -166,7 +245,7 @@ QUIET = Progress(False)
 
 
 def _print(message: str) -> None:
-    print(f"mdf: {message} ...", file=sys.stderr, flush=True)
+    say(f"mdf: {message} ...")
     _State.open = True
 
 

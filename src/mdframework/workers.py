@@ -55,8 +55,12 @@ def die_with_parent(parent_pid: int | None = None, *, ignore_interrupt: bool = T
     process's main thread, so it is skipped elsewhere.
     """
     parent = os.getppid()
-    if ignore_interrupt and threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if threading.current_thread() is threading.main_thread():
+        if ignore_interrupt:
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+        # SIGTERM ends a worker (the pool's way to stop one), not the handler of the command
+        # it was forked from
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
     _parent_death_signal(signal.SIGKILL)
     if (parent_pid is not None and parent != parent_pid) or os.getppid() != parent:
         os._exit(1)  # the parent died before the request above took effect

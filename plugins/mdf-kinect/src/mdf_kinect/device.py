@@ -229,7 +229,7 @@ def _wait_until_sleeping(tids: set[str], timeout_s: float = 3.0) -> None:
 
     def sleeping(tid: str) -> bool:
         try:
-            with open(f"/proc/self/task/{tid}/syscall") as f:
+            with open(f"/proc/self/task/{tid}/syscall", encoding="utf-8") as f:
                 return f.read().split(" ", 1)[0] in _SLEEP_SYSCALLS
         except OSError:  # the thread has ended
             return True
