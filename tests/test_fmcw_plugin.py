@@ -831,4 +831,4 @@ def test_the_aliasing_advice_names_the_fields_that_set_the_slow_time_rate() -> N
         point_run(target, duration=0.2, radar={**fields, **change}, processing=error)
     cw = {"kind": "cw", "carrier_frequency": 24e9, "sample_rate": 1000.0}
     with pytest.raises(SceneError, match=r"aliases; raise radar\.sample_rate to at least 1762 Hz"):
-        point_run(target, duration=0.2, radar=cw, processing=error)
+        point_run(target, duration=0.3, radar=cw, processing=error)  # 301 > 256-sample window
