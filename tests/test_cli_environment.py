@@ -212,3 +212,36 @@ def test_sigterm_cleans_up_like_ctrl_c(tmp_path: Path) -> None:
     assert proc.returncode == 143, err
     assert err.strip() == "mdf: terminated"
     assert not out.exists() or sorted(p.name for p in out.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("signum", "code", "line"),
+    [(signal.SIGINT, 130, "mdf: interrupted"), (signal.SIGTERM, 143, "mdf: terminated")],
+)
+def test_interrupt_inside_exec_keeps_the_exit_code(
+    tmp_path: Path, signum: int, code: int, line: str
+) -> None:
+    """Hard case (CI saw it once as exit -2 instead of 143): the signal lands while Python runs
+    source text through ``exec`` (as dataclasses do while a module is imported lazily). CPython
+    then marks the KeyboardInterrupt as unhandled, and under ``python -m`` the process would die
+    by SIGINT at exit although ``mdf`` handled it. The command must still end with its own code."""
+    (tmp_path / "signal_in_exec.py").write_text(
+        "import os, signal, sys\n"
+        "from mdframework import cli\n"
+        "def run(argv):\n"
+        f"    exec('import os, signal; os.kill(os.getpid(), {int(signum)})')\n"
+        "    return 0\n"
+        "cli._main_with_options = run\n"
+        "sys.exit(cli.main([]))\n",
+        encoding="utf-8",
+    )
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), *sys.path])}
+    done = subprocess.run(
+        [sys.executable, "-m", "signal_in_exec"],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=tmp_path,
+        timeout=120,
+    )
+    assert (done.returncode, done.stderr.strip()) == (code, line)

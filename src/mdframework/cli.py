@@ -591,7 +591,17 @@ def _quiet_unraisable_interrupt(hook: Any) -> Any:
     return handle
 
 
+def _forget_handled_interrupt() -> None:
+    """CPython marks a KeyboardInterrupt that ends an ``exec`` of source text as unhandled even
+    when a caller handles it (dataclasses and named tuples build their methods that way, so a
+    Ctrl-C or SIGTERM can land in one during a lazy import); under ``python -m`` the process then
+    dies by SIGINT at exit instead of returning our exit code. Running source text once more
+    clears that mark."""
+    exec("None", {})
+
+
 def _interrupted() -> int:
+    _forget_handled_interrupt()
     retract()
     if _ENDED_BY and _ENDED_BY[0] == signal.SIGTERM:
         say("mdf: terminated")
