@@ -258,7 +258,7 @@ def test_range_doppler_map_peaks_at_the_target_amplitude(name: str) -> None:
     delays = np.full((t.size, 1), 2 * k * SEQ.range_resolution / C)  # on range bin k
     prof = fmcw.range_profile(fmcw.if_samples(delays, amp, SEQ), name, 240)  # type: ignore[arg-type]
     rd = fmcw.range_doppler(fmcw.virtual_cube(prof[:, None, :], SEQ, 3), name, 16)  # type: ignore[arg-type]
-    row = 16 // 2 + d
+    row = (16 - 1) // 2 + d  # zero Doppler at row 7 of 16
     assert fmcw.doppler_axis(SEQ, 16)[row] == pytest.approx(fd, rel=1e-12)
     np.testing.assert_allclose(np.abs(rd[:, row, k]), a, rtol=1e-9)
     power = fmcw.detection_map(rd)
@@ -346,17 +346,19 @@ def test_multi_object_beamforming_finds_two_targets_in_one_cell() -> None:
 
 def test_second_peaks_match_a_dense_local_maximum_filter() -> None:
     """The second peak of each beam map, found by testing only the cells above the threshold,
-    is the one a dense 3x3 maximum filter over the whole map finds (edges clamped, cells off
-    the visible grid never chosen, ties to the lower index): 2000 random maps, with plateaus
-    (integer powers, all-zero maps), invisible cells, overflowed and NaN cells, and maps of 1 to
-    8 cells a side."""
-    from scipy.ndimage import maximum_filter
+    is the one a dense 3x3 maximum filter over the whole map finds, among the cells whose whole
+    3x3 neighbourhood lies on the grid and is finite (a map with one u_z row has edges in u_x
+    only; ties to the lower index): 2000 random maps, with plateaus (integer powers, all-zero
+    maps), invisible cells, overflowed and NaN cells, and maps of 1 to 8 cells a side."""
+    from scipy.ndimage import maximum_filter, minimum_filter
 
     def dense(maps: np.ndarray, best: np.ndarray, fraction: float) -> tuple[np.ndarray, ...]:
         n = maps.shape[0]
         det = np.arange(n)
         finite = np.where(np.isfinite(maps), maps, -1.0)
-        local = finite == maximum_filter(finite, size=(1, 3, 3), mode="nearest")
+        size = (1, 3, 3 if maps.shape[2] > 1 else 1)
+        inside = minimum_filter(np.isfinite(maps), size=size, mode="constant", cval=False)
+        local = inside & (finite == maximum_filter(finite, size=size, mode="nearest"))
         peak = maps.reshape(n, -1)[det, best]
         with np.errstate(invalid="ignore"):
             cand = np.where(local & (finite >= fraction * peak[:, None, None]), finite, -np.inf)
@@ -383,7 +385,25 @@ def test_second_peaks_match_a_dense_local_maximum_filter() -> None:
         got = fmcw._second_peaks(maps, best, fraction)
         assert got[0].tolist() == want[0].tolist() and got[1].tolist() == want[1].tolist()
         found += want[0].size
-    assert found > 1000  # most maps have a second peak: the comparison is not vacuous
+    assert found > 600  # many maps have a second peak: the comparison is not vacuous
+
+
+@pytest.mark.parametrize(("az", "el"), [(0.0, 40.0), (20.0, -50.0), (40.0, 60.0), (75.0, 0.0)])
+def test_no_second_point_at_the_edge_of_the_visible_region(az: float, el: float) -> None:
+    """Hard case: one target above 30 deg elevation (or near endfire in azimuth). The two rows
+    of the elevation array are half a wavelength apart, so the beam map along u_z falls from the
+    target to a null one unit of u_z away and then rises again toward a lobe beyond -1, where no
+    direction exists; on the edge of the visible region it is still 0.5-0.9 of the peak. With
+    ``multi_peak`` 0.5 that edge must not become a second point (it did: straight down, at
+    u_z -0.94 to -1); the one point is within a quarter of a cell of the target."""
+    grid = fmcw.angle_grid(ANT.virtual, SEQ.wavelength)
+    ux = np.sin(np.deg2rad(az)) * np.cos(np.deg2rad(el))
+    uz = np.sin(np.deg2rad(el))
+    snap = fmcw.steering(ANT.virtual, np.array([ux]), np.array([uz]), SEQ.wavelength)
+    det, got_ux, got_uz, _ = fmcw.estimate_angles(snap, grid, multi_peak=0.5)
+    assert det.tolist() == [0]
+    assert got_ux[0] == pytest.approx(ux, abs=2 / 8 / 4)
+    assert got_uz[0] == pytest.approx(uz, abs=2 / 2 / 4)
 
 
 def test_tdm_phase_compensation_restores_the_angle_of_a_fast_target() -> None:

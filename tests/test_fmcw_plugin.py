@@ -230,7 +230,7 @@ def test_snr_of_a_point_target_follows_the_range_equation(preset: str) -> None:
     w_r, w_d = fmcw.window("hann", seq.n_samples), fmcw.window("hann", seq.n_loops)
     gain = np.sum(w_r) ** 2 / np.sum(w_r**2) * np.sum(w_d) ** 2 / np.sum(w_d**2)
     snr = amp**2 / noise * gain
-    zero = seq.n_loops // 2
+    zero = (seq.n_loops - 1) // 2  # the zero-Doppler row
     peak = maps[:, zero, 40]
     assert np.all(np.argmax(maps.reshape(6, -1), axis=1) == zero * maps.shape[2] + 40)
     floor = np.mean(maps[:, :, 80:])  # every Doppler row, 40 bins and more beyond the target
@@ -267,7 +267,7 @@ def test_a_point_under_the_threshold_near_the_maximum_range_as_documented() -> N
     predicted = 10 * np.log10(1 + amp**2 / wf.noise_power() * gain)
     assert round(predicted, 1) == 13.8
     floor = np.mean(maps[:, :, :150])  # 85 bins and more short of the target
-    measured = 10 * np.log10(np.mean(maps[:, seq.n_loops // 2, k]) / floor)
+    measured = 10 * np.log10(np.mean(maps[:, (seq.n_loops - 1) // 2, k]) / floor)
     assert measured == pytest.approx(predicted, abs=0.2)
     pts = res.received.products["points"]
     near = np.abs(np.linalg.norm(pts[:, 2:5], axis=1) - r) < 0.2
@@ -303,9 +303,9 @@ def test_range_doppler_map_is_the_received_power_in_watts(
     lam = C / seq.centre_frequency
     gain, loss = 10 ** (6.0 / 10), 10 ** ((3.0 + 1.0) / 10)
     p_r = 2.0 * gain**2 * lam**2 * sigma / ((4 * np.pi) ** 3 * r**4 * loss)
-    for frame in maps:
-        assert np.unravel_index(np.argmax(frame), frame.shape) == (8, 40)
-        assert float(frame[8, 40]) == pytest.approx(12 * p_r, rel=1e-5)
+    for frame in maps:  # zero Doppler is row 7 of 16 (the ambiguous bin is the last row)
+        assert np.unravel_index(np.argmax(frame), frame.shape) == (7, 40)
+        assert float(frame[7, 40]) == pytest.approx(12 * p_r, rel=1e-5)
 
 
 def test_receive_is_block_invariant() -> None:
@@ -492,7 +492,7 @@ def test_outputs_hold_maps_points_and_their_figures(tmp_path: Any) -> None:
         assert maps.shape == (6, 16, 240) and maps.dtype == np.float32
         np.testing.assert_allclose(r["range_doppler_range_m"][1], 0.043577, atol=1e-6)
         np.testing.assert_allclose(
-            r["range_doppler_velocity_mps"][[0, -1]], [-4.918, 4.303], atol=1e-3
+            r["range_doppler_velocity_mps"][[0, -1]], [-4.303, 4.918], atol=1e-3
         )
     lines = (tmp_path / "run" / "points.csv").read_text().splitlines()
     assert lines[0] == POINTS_HEADER
@@ -783,16 +783,18 @@ def test_without_receiver_noise_points_stand_over_the_receivers_mean_noise() -> 
 
 def test_the_ambiguous_doppler_bin_as_documented() -> None:
     """docs/fmcw.md: with the IWR1443 preset's 16 Doppler bins the simulated axis runs from
-    -4.92 (the ambiguous bin, read as receding) to +4.30 m/s; the real RadHAR points, their range
-    rate negated by the reader, run from -4.30 to +4.92 m/s (the shipped boxing subset holds
-    points in both end bins)."""
+    -4.30 to +4.92 m/s (the ambiguous bin last, read as approaching), the same bins as the real
+    RadHAR points, their range rate negated by the reader (the shipped boxing subset holds points
+    in both end bins). Points approaching or receding at 0.97 v_max fall in the ambiguous bin
+    and are both reported at +v_max, as the sensor would; one receding at 0.85 v_max at
+    -7/8 v_max, its nearest bin."""
     from mdf_radhar.source import npz_recordings
 
     radar_ = FmcwRadar(IWR1443)
     v = radar_.axes()["velocity_mps"]
     v_max = radar_.max_unambiguous_velocity
-    assert v[0] == pytest.approx(-v_max, rel=1e-12) and v[0] == pytest.approx(-4.92, abs=5e-3)
-    assert v[-1] == pytest.approx(7 / 8 * v_max, rel=1e-12) and round(v[-1], 2) == 4.30
+    assert v[-1] == pytest.approx(v_max, rel=1e-12) and v[-1] == pytest.approx(4.92, abs=5e-3)
+    assert v[0] == pytest.approx(-7 / 8 * v_max, rel=1e-12) and round(v[0], 2) == -4.30
     step = 2 * v_max / 16
     real = np.concatenate(
         [
@@ -802,7 +804,13 @@ def test_the_ambiguous_doppler_bin_as_documented() -> None:
     )
     bins = np.round(real / step)
     assert bins.max() == 8 and bins.min() == -7
-    assert real.max() == pytest.approx(4.92, abs=5e-3) and round(real.min(), 2) == -4.30
+    assert set(np.unique(bins)) <= set(np.round(v / step))  # every real bin is a simulated one
+    for speed, want in ((0.97, v_max), (-0.97, v_max), (-0.85, -7 / 8 * v_max)):
+        target = [{"position": [3.0, 0.0, 0.0], "velocity": [-speed * v_max, 0.0, 0.0]}]
+        res = fmcw_run(target, duration=2 * 33.333e-3, **QUIET)
+        pts = res.received.products["points"]
+        strongest = pts[np.argmax(pts[:, 6])]
+        assert strongest[5] == pytest.approx(want, rel=1e-9)
 
 
 def test_the_aliasing_advice_names_the_fields_that_set_the_slow_time_rate() -> None:

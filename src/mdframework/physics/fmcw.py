@@ -472,9 +472,19 @@ def _distinct_bins(bins: IntArray, n: int) -> IntArray:
 
 def doppler_axis(seq: ChirpSequence, n_doppler: int) -> FloatArray:
     """Doppler of each bin of :func:`range_doppler` [Hz], ascending, (n_doppler,):
-    ``(d - n/2) / (n T_loop)``; positive = approaching."""
-    k = np.arange(-(n_doppler // 2), n_doppler - n_doppler // 2, dtype=np.float64)
+    ``(d - (n - 1) // 2) / (n T_loop)``; positive = approaching. With an even ``n`` the bin at
+    ``n/2`` (``+-1 / (2 T_loop)``, approaching and receding alike) is read as approaching, last:
+    the axis is TI's range-rate axis (``-n/2 .. n/2 - 1`` bins, positive receding) negated, so
+    simulated points and a TI sensor's negated points fall on the same velocities."""
+    k = np.arange(-((n_doppler - 1) // 2), n_doppler - (n_doppler - 1) // 2, dtype=np.float64)
     return np.asarray(k / (n_doppler * seq.loop_period), np.float64)
+
+
+def doppler_order(spectrum: NDArray[Any], axis: int) -> NDArray[Any]:
+    """An FFT's bins along ``axis`` (``n`` of them, in FFT order) in the ascending order of
+    :func:`doppler_axis`: zero Doppler at index ``(n - 1) // 2``."""
+    n = spectrum.shape[axis]
+    return np.roll(spectrum, (n - 1) // 2, axis=axis)
 
 
 def virtual_cube(profiles: ComplexArray, seq: ChirpSequence, n_tx_total: int) -> ComplexArray:
@@ -496,13 +506,14 @@ def range_doppler(
     cube: ComplexArray, name: WindowName, n_doppler: int, clutter_removal: bool = False
 ) -> ComplexArray:
     """Doppler FFT over loops: (n_virt, n_loops, n_bins) -> (n_virt, n_doppler, n_bins),
-    zero-Doppler in the middle (row ``n_doppler // 2``), normalised so that a lone on-bin
-    target of amplitude ``a`` peaks at ``a``. ``clutter_removal`` subtracts each channel's and
-    bin's mean over the loops first (static clutter removal)."""
+    rows in the order of :func:`doppler_axis` (zero Doppler at ``(n_doppler - 1) // 2``),
+    normalised so that a lone on-bin target of amplitude ``a`` peaks at ``a``.
+    ``clutter_removal`` subtracts each channel's and bin's mean over the loops first (static
+    clutter removal)."""
     x = cube - cube.mean(axis=1, keepdims=True) if clutter_removal else cube
     w = window(name, cube.shape[1])
     spec = np.fft.fft(x * w[None, :, None], n=n_doppler, axis=1) / float(np.sum(w))
-    return np.asarray(np.fft.fftshift(spec, axes=1), dtype=np.complex128)
+    return np.asarray(doppler_order(spec, 1), dtype=np.complex128)
 
 
 def detection_map(rd: ComplexArray) -> FloatArray:
@@ -664,22 +675,27 @@ def _refine(
 def _second_peaks(maps: FloatArray, best: IntArray, fraction: float) -> tuple[IntArray, IntArray]:
     """For each beam map of ``maps`` (n_det, n_x, n_z) (``-inf`` off the visible grid) whose
     strongest cell is ``best`` (n_det,) (flat index), its strongest other local maximum (at
-    least its 8 neighbours, edges clamped) of at least ``fraction`` of that cell's power, if any:
-    the detections that have one and its flat index, (n_found,) each. Ties go to the lower flat
-    index; a cell that is not finite is never chosen and counts as -1 beside one that is. Only
-    the cells above the threshold are tested, not the whole map."""
+    least its 8 neighbours) of at least ``fraction`` of that cell's power, if any: the
+    detections that have one and its flat index, (n_found,) each. Ties go to the lower flat
+    index. Only cells inside the visible region count: a cell with a neighbour off the grid or
+    not visible (``u_x^2 + u_z^2 > 1``) is on its edge, where a beam map may still rise toward
+    a lobe at directions that do not exist (beyond +-90 deg), so it is no target. (An array
+    without vertical extent has one ``u_z`` row, and only ``u_x`` has edges.) Only the cells
+    above the threshold are tested, not the whole map."""
     n_det, n_x, n_z = maps.shape
     peak = maps.reshape(n_det, n_x * n_z)[np.arange(n_det), best]
     with np.errstate(invalid="ignore"):  # 0 x an overflowed peak: NaN, no cell above it
         d, i, k = np.nonzero(maps >= (fraction * peak)[:, None, None])
     value = maps[d, i, k]
-    local = np.isfinite(value)
+    local = np.isfinite(value) & (i > 0) & (i < n_x - 1)
+    if n_z > 1:
+        local &= (k > 0) & (k < n_z - 1)
     for di in (-1, 0, 1):
         ii = np.clip(i + di, 0, n_x - 1)
         for dk in (-1, 0, 1):
             if di or dk:
                 other = maps[d, ii, np.clip(k + dk, 0, n_z - 1)]
-                local &= value >= np.where(np.isfinite(other), other, -1.0)
+                local &= np.isfinite(other) & (value >= other)
     index = i * n_z + k
     keep = local & (index != best[d])
     d, index, value = d[keep], index[keep], value[keep]
@@ -1040,8 +1056,9 @@ def frame_spectrogram(
     samples of slot 0 are windowed (any scipy window, :func:`stft_window`) and transformed with
     ``nfft`` >= n_loops points, in ``precision`` (as the STFT's ``processing.precision``:
     float32 is complex64 FFTs and float32 power). Returns power (nfft, n_frames) [|signal|^2]
-    float32 or float64, Doppler (nfft,) [Hz] ascending and the time of each frame's middle loop
-    (n_frames,) [s from the first chirp].
+    float32 or float64, Doppler (nfft,) [Hz] ascending, ``(k - nfft // 2) / (nfft T_loop)`` as
+    in every radar's spectrogram (not :func:`doppler_axis`), and the time of each frame's middle
+    loop (n_frames,) [s from the first chirp].
     """
     # the cosine windows without importing scipy.signal
     from .spectrogram import precision_dtypes, stft_window
@@ -1057,4 +1074,7 @@ def frame_spectrogram(
         spec = np.fft.fftshift(np.fft.fft(x, n=nfft, axis=1), axes=1)
         power[:, lo:hi] = (spec.real**2 + spec.imag**2).T
     time = np.arange(n_frames) * seq.frame_period + (seq.n_loops - 1) / 2 * seq.loop_period
-    return power, doppler_axis(seq, nfft), np.asarray(time, np.float64)
+    # the micro-Doppler axis of every radar's spectrogram (ambiguous bin first, as receding),
+    # not the range-Doppler map's TI order: FMCW and pulse-Doppler spectrograms compare bin by bin
+    doppler = np.arange(-(nfft // 2), nfft - nfft // 2) / (nfft * seq.loop_period)
+    return power, np.asarray(doppler, np.float64), np.asarray(time, np.float64)
