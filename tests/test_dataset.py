@@ -5,10 +5,12 @@ from __future__ import annotations
 import json
 import os
 import signal
+import socket
 import subprocess
 import sys
 import time
 import warnings
+from contextlib import closing
 from pathlib import Path
 from typing import Any
 
@@ -120,6 +122,30 @@ def test_same_result_with_one_and_two_workers_and_dask(
     monkeypatch.setattr(dataset, "_MOTIONS", {})
     build_dataset(cfg, base, tmp_path / "dask", workers=2, scheduler="local", progress=False)
     assert_same(tmp_path / "one", tmp_path / "dask")
+
+
+def test_a_local_dask_cluster_leaves_port_8787_free(tmp_path: Path) -> None:
+    """A local Dask cluster has no dashboard, and the HTTP server its scheduler still starts
+    (health and metrics routes) runs on a free loopback port, not on Dask's default 8787: a
+    user's own Dask dashboard started during a build keeps its port (and a second build on the
+    machine gives no "port in use" warning)."""
+    pytest.importorskip("distributed")
+    cfg, _ = load_dataset_config(write_config(tmp_path / "d.toml"))
+
+    def port_free() -> bool:
+        with socket.socket() as probe:
+            try:
+                probe.bind(("127.0.0.1", 8787))
+            except OSError:
+                return False
+        return True
+
+    if not port_free():
+        pytest.skip("something else on this machine holds port 8787")
+    executor = dataset._executor(cfg, 1, "local")
+    with closing(executor):
+        next(executor)  # the cluster runs
+        assert port_free()
 
 
 @pytest.mark.parametrize("n_records", [0, 1, 5, 64, 480, 1001])

@@ -1522,13 +1522,17 @@ def _executor(
     import dask
 
     with _quiet_dask_logs() if address == "local" else nullcontext():
-        with dask.config.set(LOCAL_DASK_CONFIG), warnings.catch_warnings():
-            # its scheduler's HTTP server takes another port when 8787 is taken (by another
-            # cluster on the machine): nothing for the user to do
-            warnings.filterwarnings("ignore", message=r"Port \d+ is already in use")
+        with dask.config.set(LOCAL_DASK_CONFIG):
+            # no dashboard; the scheduler's HTTP server (health and metrics routes) still
+            # starts, by default on port 8787 (and warns when another cluster has it): on a free
+            # port of the loopback interface instead
             cluster = (
                 LocalCluster(
-                    n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None
+                    n_workers=n,
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=None,
+                    scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
                 )
                 if address == "local"
                 else None
