@@ -288,9 +288,27 @@ def test_metadata() -> None:
     json.dumps(dict(b.metadata))
 
 
+def test_subjects_and_rates_are_cmus_index() -> None:
+    """CMU_SUBJECTS and the rate of every trial are those of CMU's index (its subject, trial and
+    framerate columns, shipped as examples/data/cmu/cmu-index-rates.csv; see PROVENANCE.md):
+    2435 trials of 109 subjects numbered 1 to 144."""
+    import csv
+
+    from mdf_cmu.source import CMU_SUBJECTS, subject_frame_rate
+
+    with (DATA / "cmu-index-rates.csv").open(newline="", encoding="utf-8") as fh:
+        index = [
+            (int(r["subject"]), int(r["trial"]), float(r["framerate"])) for r in csv.DictReader(fh)
+        ]
+    assert len(index) == 2435 and len({(s, t) for s, t, _ in index}) == 2435
+    assert CMU_SUBJECTS == {s for s, _, _ in index} and len(CMU_SUBJECTS) == 109
+    wrong = [(s, t, hz) for s, t, hz in index if subject_frame_rate(s, t) != hz]
+    assert wrong == []
+
+
 def test_frame_rate_table() -> None:
-    """Rates from CMU's index (cmu-index.csv, framerate column; checked against it when the table
-    was written): 60 Hz subjects, 120 Hz otherwise; subject 136 is 120 Hz except trial 19."""
+    """Rates from CMU's index (the framerate column, checked against it above): 60 Hz subjects,
+    120 Hz otherwise; subject 136 is 120 Hz except trial 19."""
     from mdf_cmu.source import subject_frame_rate
 
     sixty = {33, 34, 42, 60, 61, 62, 74, 75, 77, 79, 80, 87, 88, 89}

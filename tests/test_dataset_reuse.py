@@ -269,3 +269,61 @@ def test_a_stopped_rebuild_leaves_a_folder_that_either_config_resumes(
     third.write_text(new_cfg.read_text().replace("aspect_deg = [0.0]", "aspect_deg = [60.0]"))
     with pytest.raises(dataset.OutputError, match="different config"):
         build(third, again)
+
+
+def two_subjects(path: Path, subjects: tuple[str, str], data_name: str) -> Path:
+    """Two real RadHAR boxing recordings as two sources, each with its subject and a dataset
+    name, one 2 s record each."""
+    sources = "".join(
+        f"""
+[[sources]]
+label = "boxing"
+subject = "{subject}"
+dataset = "{data_name}"
+record_length = 2.0
+max_records = 1
+[sources.recording]
+kind = "radhar"
+file = "{RADHAR / "radhar_boxing_subset.npz"}"
+recordings = ["{name}"]
+"""
+        for subject, name in zip(subjects, ("20_boxing_3.txt", "boxing_20_2.txt"), strict=True)
+    )
+    path.write_text(sources)
+    return path
+
+
+def test_a_recording_source_records_its_subject_and_dataset(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A real radar's recordings carry their source's `subject` and `dataset` into every
+    record, index.csv and load_dataset (they were left empty and 'radhar', so a
+    leave-subjects-out experiment had one subject); the recording column names the recording.
+    Renaming them and rebuilding with --force relabels the records without recomputing them,
+    exactly as a fresh build would."""
+    from mdframework.experiment import group_splits
+
+    out = tmp_path / "ds"
+    rows = build(two_subjects(tmp_path / "a.toml", ("p1", "p2"), "radhar-lab"), out)
+    assert [(r["subject"], r["dataset"], r["recording"], r["source"]) for r in rows] == [
+        ("p1", "radhar-lab", "20_boxing_3.txt", "radhar"),
+        ("p2", "radhar-lab", "boxing_20_2.txt", "radhar"),
+    ]
+    data = load_dataset(out, spectrograms=False)
+    assert list(data.table["subject"]) == ["p1", "p2"]
+    assert [te.tolist() for _, te in group_splits(data.table["subject"], None)] == [[0], [1]]
+    for _, meta in stored(out).values():
+        assert meta["subject"] in ("p1", "p2") and meta["dataset"] == "radhar-lab"
+    renamed = two_subjects(tmp_path / "b.toml", ("alice", "bob"), "mine")
+
+    def no_computing(spec: Any, out_dir: str) -> Any:
+        raise AssertionError(f"record {spec.record_id} was computed again")
+
+    real_build = dataset._build_record
+    monkeypatch.setattr(dataset, "_build_record", no_computing)
+    rows = build(renamed, out, force=True)
+    monkeypatch.setattr(dataset, "_build_record", real_build)
+    assert [(r["subject"], r["dataset"]) for r in rows] == [("alice", "mine"), ("bob", "mine")]
+    fresh = tmp_path / "fresh"
+    build(renamed, fresh)
+    assert_same_dataset(out, fresh)

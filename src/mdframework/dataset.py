@@ -43,7 +43,7 @@ import json
 import os
 import re
 import warnings
-from collections.abc import Callable, Generator, Iterator
+from collections.abc import Callable, Generator, Iterator, Mapping
 from concurrent.futures import as_completed
 from contextlib import AbstractContextManager, closing, contextmanager, nullcontext
 from dataclasses import dataclass, replace
@@ -191,13 +191,14 @@ class SourceEntry(StrictModel):
     )
     subject: str | None = Field(
         None,
-        description="Subject recorded with every record; default: the motion's own (CMU: the "
-        "subject number; UTKinect and MSR: s01 ...), else empty.",
+        description="Subject recorded with every record (of a motion or of a real radar's "
+        "recordings); default: the motion's own (CMU: the subject number; UTKinect and MSR: "
+        "s01 ...), else empty.",
     )
     dataset: str | None = Field(
         None,
         description="Dataset name recorded with every record; default: the motion's format "
-        "(e.g. asf/amc, bvh, utkinect, msr-action3d) or its source.",
+        "(e.g. asf/amc, bvh, utkinect, msr-action3d) or its source (recordings: e.g. radhar).",
     )
     record_length: PositiveSeconds | None = Field(
         None, description="Record length [s]; default: record_lengths[label], else all."
@@ -610,6 +611,7 @@ def _plan_recordings(
                 base_dir,
                 None,
                 hist,
+                _naming(entry, rec.metadata, rec.name, section["kind"]),
                 content=content,
             )
             window = (rec.name, first * period, length * period)
@@ -617,6 +619,20 @@ def _plan_recordings(
                 replace(spec, length_field=_length_field(config, entry_no, entry), window=window)
             )
     return specs
+
+
+def _naming(
+    entry: SourceEntry, md: Mapping[str, Any], recording: str, kind: str
+) -> tuple[str, str, str]:
+    """A record's subject, recording and dataset: the source entry's ``subject`` and
+    ``dataset`` where given, else what the motion's or recording's metadata ``md`` says (its
+    ``subject``; its ``format`` or ``source``, else the source ``kind``)."""
+    subject = entry.subject if entry.subject is not None else md.get("subject")
+    return (
+        "" if subject is None else str(subject),
+        recording,
+        entry.dataset or str(md.get("format") or md.get("source") or kind),
+    )
 
 
 def _length_field(config: DatasetConfig, entry_no: int, entry: SourceEntry) -> str | None:
@@ -899,12 +915,7 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
             short.append(str(where))
             continue
         md = loaded.metadata
-        subject = entry.subject if entry.subject is not None else md.get("subject")
-        meta = (
-            "" if subject is None else str(subject),
-            str(md.get("file") or where),
-            entry.dataset or str(md.get("format") or md.get("source") or motion["kind"]),
-        )
+        meta = _naming(entry, md, str(md.get("file") or where), motion["kind"])
         hop = entry.hop or length
         rz = _randomize(config, entry)
         origins = _draw_origins(config, entry_no, entry)
@@ -1062,6 +1073,8 @@ def _build_recorded(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         "group": spec.group,
         "source": run["recording"]["kind"],
         "file": rec.name,
+        "subject": spec.subject,
+        "dataset": spec.dataset,
         "start_s": run["first_frame"] * cloud.frame_period,
         "duration_s": run["frames"] * cloud.frame_period,
         "aspect_deg": None,
@@ -1332,9 +1345,14 @@ def _planned_meta(spec: RecordSpec) -> dict[str, Any]:
     """What a record stores of its source's naming (label, group and, for simulated records,
     subject, recording and dataset) as the config now asks for it: not part of the record's
     id, so a build keeps a record whose only change is one of them and relabels it."""
-    planned = {"label": spec.label, "group": spec.group}
+    planned = {
+        "label": spec.label,
+        "group": spec.group,
+        "subject": spec.subject,
+        "dataset": spec.dataset,
+    }
     if "recording" not in spec.run_config:  # recorded records name their recording themselves
-        planned.update(subject=spec.subject, recording=spec.recording, dataset=spec.dataset)
+        planned["recording"] = spec.recording
     return planned
 
 

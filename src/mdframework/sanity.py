@@ -16,7 +16,11 @@ Checks, on the canonical 17-joint body:
    ``glitch_min_m`` (2 cm), ``glitch_ratio`` (1.6 x the neighbours) and ``glitch_local_ratio``
    (5 x the median of the 13 frames around). Flagged in the metadata and warned about by
    default; ``glitches = "repair"`` replaces the frame by linear interpolation from the
-   unflagged frames (:func:`repair_glitches`).
+   unflagged frames (:func:`repair_glitches`). Only frames with two valid frames on either
+   side, one frame period apart (no step longer than :data:`GAP_STEP_RATIO` times the median
+   step), are judged, and the local median is taken over such measured deviations: beside a
+   gap (missing samples or missing frames) a neighbour's deviation is unknown or spans the
+   gap, and a real frame there would look like a spike.
 2. **Human limits**: the frame-to-frame speed and the acceleration
    implied by ``e`` (``2 e / (dt1 dt2)``) against :data:`SPEED_LIMITS_MPS` and
    :data:`ACCEL_LIMITS_MPS2` (times ``speed_scale``).
@@ -88,6 +92,13 @@ LIMB_BONES: tuple[tuple[str, str], ...] = (
 
 _MAX_LISTED = 50
 
+#: A step between frames longer than this many times the median step is a gap (frames the
+#: recording lacks): a dropped frame gives 2, timing jitter of a depth camera under 1.2.
+GAP_STEP_RATIO = 1.5
+
+#: Frames in the window of the local median of :func:`find_glitches`.
+_LOCAL_FRAMES = 13
+
 
 class MotionSanityWarning(UserWarning):
     """A motion looks physically implausible (glitch, limit, bone length, cadence)."""
@@ -137,19 +148,49 @@ def find_glitches(
 ) -> BoolArray:
     """Single-frame glitches, (n_frames, n_joints) bool (see the module docstring)."""
     e, _ = deviations(time, positions, valid)
-    return _glitch_mask(e, min_m, ratio, local_ratio)
+    return _glitch_mask(e, _measured(time, valid, e.shape), min_m, ratio, local_ratio)
 
 
-def _glitch_mask(e: FloatArray, min_m: float, ratio: float, local_ratio: float) -> BoolArray:
-    """:func:`find_glitches` from the deviations ``e`` (n_frames, n_joints) [m]."""
-    from scipy.ndimage import median_filter
+def _measured(time: FloatArray, valid: BoolArray | None, shape: tuple[int, ...]) -> BoolArray:
+    """Where :func:`deviations` measures a frame, (n_frames, n_joints) bool: the frame and
+    both its neighbours valid, each step between them at most :data:`GAP_STEP_RATIO` times the
+    median step. ``shape`` is (n_frames, n_joints); ``valid`` None: every sample valid."""
+    t = np.asarray(time, dtype=np.float64)
+    ok = np.zeros(shape[:2], dtype=bool)
+    if t.shape[0] < 3:
+        return ok
+    step = np.diff(t)
+    regular = step <= GAP_STEP_RATIO * float(np.median(step))
+    v = np.ones(shape[:2], dtype=bool) if valid is None else np.asarray(valid, dtype=bool)
+    ok[1:-1] = v[:-2] & v[1:-1] & v[2:] & (regular[:-1] & regular[1:])[:, None]
+    return ok
 
-    if e.shape[0] < 3:
-        return np.zeros(e.shape, dtype=bool)
-    zero = np.zeros((1, e.shape[1]))
-    neighbours = np.maximum(np.vstack([zero, e[:-1]]), np.vstack([e[1:], zero]))
-    local = median_filter(e, size=(13, 1), mode="nearest")
-    return np.asarray((e >= min_m) & (e >= ratio * neighbours) & (e >= local_ratio * local))
+
+def _glitch_mask(
+    e: FloatArray, measured: BoolArray, min_m: float, ratio: float, local_ratio: float
+) -> BoolArray:
+    """:func:`find_glitches` from the deviations ``e`` (n_frames, n_joints) [m] and where they
+    are measured (:func:`_measured`): a frame is judged only where it and both
+    neighbours are measured, against the median of the measured deviations around it."""
+    from scipy.ndimage import maximum_filter, median_filter
+
+    mask = np.zeros(e.shape, dtype=bool)
+    if e.shape[0] < 5:
+        return mask
+    judged = np.zeros(e.shape, dtype=bool)
+    judged[1:-1] = measured[:-2] & measured[1:-1] & measured[2:]
+    neighbours = np.zeros(e.shape)
+    neighbours[1:-1] = np.maximum(e[:-2], e[2:])
+    mask = judged & (e >= min_m) & (e >= ratio * neighbours)
+    local = median_filter(e, size=(_LOCAL_FRAMES, 1), mode="nearest")
+    # a window that reaches an unmeasured deviation (a gap, the record's ends): the median of
+    # the measured ones in it
+    half = _LOCAL_FRAMES // 2
+    holes = maximum_filter(~measured, size=(_LOCAL_FRAMES, 1), mode="constant", cval=True)
+    for f, j in zip(*np.nonzero(mask & holes), strict=True):
+        lo, hi = max(f - half, 0), f + half + 1
+        local[f, j] = np.median(e[lo:hi, j][measured[lo:hi, j]])
+    return np.asarray(mask & (e >= local_ratio * local))
 
 
 def repair_glitches(
@@ -383,7 +424,10 @@ def check_motion(motion: Motion, config: SanityConfig) -> Motion:
     notes: list[tuple[str, str]] = []  # (option, message)
 
     e, acc = deviations(body.time, body.positions, body.valid)  # once for the checks below
-    mask = _glitch_mask(e, config.glitch_min_m, config.glitch_ratio, config.glitch_local_ratio)
+    measured = _measured(body.time, body.valid, e.shape)
+    mask = _glitch_mask(
+        e, measured, config.glitch_min_m, config.glitch_ratio, config.glitch_local_ratio
+    )
     frames, joints = np.nonzero(mask)
     items = [
         {

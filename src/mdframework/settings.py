@@ -32,6 +32,7 @@ from . import limits
 from .interfaces import ConfigSection, FloatArray, PluginConfig
 from .physics import radar
 from .physics.interpolation import Method
+from .skeleton import Axis, check_motion_axes
 
 # ----------------------------------------------------------------- bounded numeric types
 
@@ -83,6 +84,17 @@ def _resolve_path(value: Path, info: ValidationInfo) -> Path:
 
 #: A path to an existing file, relative to the config file's folder (absolute once validated).
 DataPath = Annotated[Path, AfterValidator(_resolve_path)]
+
+
+def _motion_axes(value: tuple[str, str, str]) -> tuple[str, str, str]:
+    check_motion_axes(value)
+    return value
+
+
+#: A motion source's ``axes``: the file axis (with sign) that becomes x (forward), y (left) and
+#: z (up); x, y and z once each, and a rotation, not a mirror
+#: (:func:`mdframework.skeleton.check_motion_axes`).
+MotionAxes = Annotated[tuple[Axis, Axis, Axis], AfterValidator(_motion_axes)]
 
 
 class StrictModel(ConfigSection):

@@ -287,6 +287,23 @@ def check_axes(axes: Sequence[str]) -> None:
         )
 
 
+def check_motion_axes(axes: Sequence[str]) -> None:
+    """A motion source's ``axes`` option (:func:`reorient`): :func:`check_axes`, and
+    ``ValueError`` for a mirror (a determinant of -1), which would turn the body's left into
+    its right: motion files (BVH, C3D, TRC, Kinect, DeepMimic) use right-handed axes, as the
+    project frame does, so only a rotation maps one onto the other."""
+    check_axes(axes)
+    m = np.zeros((3, 3))
+    for row, a in enumerate(axes):
+        m[row, "xyz".index(a[-1])] = -1.0 if a.startswith("-") else 1.0
+    if np.linalg.det(m) < 0:
+        left = axes[1][1:] if axes[1].startswith("-") else f"-{axes[1]}"
+        raise ValueError(
+            f"{list(axes)} mirror the body (its left would become its right): change the sign "
+            f"of one axis, e.g. of the one that becomes y (left): {[axes[0], left, axes[2]]}"
+        )
+
+
 def check_canonical_keys(mapping: Mapping[str, Any] | None, field: str) -> None:
     """``ValueError`` naming ``field`` unless every key of ``mapping`` (a user's joint or
     marker map) is a canonical joint."""

@@ -26,8 +26,8 @@ from mdframework import (
     Skeleton,
     limits,
 )
-from mdframework.settings import FrameRate
-from mdframework.skeleton import Axis, check_axes, check_canonical_keys, group_means, reorient
+from mdframework.settings import FrameRate, MotionAxes
+from mdframework.skeleton import check_canonical_keys, group_means, reorient
 
 MarkerSetName = Literal["auto", "plug-in-gait", "cmu", "opensim-gait"]
 
@@ -62,7 +62,6 @@ class MarkerFileConfig(MotionConfig):
         if Path(self.file).suffix.lower() != self.suffix:
             raise ValueError(f"file must be a {self.suffix} file, got {Path(self.file).name!r}")
         check_canonical_keys(self.marker_map, "marker_map")
-        check_axes(getattr(self, "axes", ("x", "y", "z")))
         return self
 
 
@@ -70,7 +69,7 @@ class C3dConfig(MarkerFileConfig):
     """A C3D marker file (Vicon, Qualisys, Motion Analysis, ...), mapped onto the body."""
 
     kind: Literal["c3d"] = Field("c3d", description="Selects this source: 'c3d'.")
-    axes: tuple[Axis, Axis, Axis] = Field(
+    axes: MotionAxes = Field(
         ("x", "y", "z"),
         description="The file axis (with sign) that becomes x (forward), y (left) and z (up).",
     )
@@ -85,7 +84,7 @@ class TrcConfig(MarkerFileConfig):
     """A TRC marker file (OpenSim's track-row-column text), mapped onto the body."""
 
     kind: Literal["trc"] = Field("trc", description="Selects this source: 'trc'.")
-    axes: tuple[Axis, Axis, Axis] = Field(
+    axes: MotionAxes = Field(
         ("x", "-z", "y"),
         description="The file axis (with sign) that becomes x (forward), y (left) and z (up); "
         "default: OpenSim's lab frame (X forward, Y up, Z right).",

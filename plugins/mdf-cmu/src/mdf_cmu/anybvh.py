@@ -41,8 +41,8 @@ from mdframework import (
     MotionSource,
     Skeleton,
 )
-from mdframework.settings import FrameRate
-from mdframework.skeleton import Axis, check_axes, check_canonical_keys, reorient
+from mdframework.settings import FrameRate, MotionAxes
+from mdframework.skeleton import Axis, check_canonical_keys, reorient
 
 from .bvh import bvh_forward_kinematics, read_bvh
 from .rigs import RIGS, Rig, RigMismatch, detect_rig, resolve
@@ -210,7 +210,7 @@ class BvhConfig(MotionConfig):
         description="Keep frame 0; default: dropped for the CMU conversions (an added pose), "
         "kept otherwise.",
     )
-    axes: tuple[Axis, Axis, Axis] = Field(
+    axes: MotionAxes = Field(
         BVH_AXES,
         description="The file axis (with sign) that becomes x (forward), y (left) and z (up); "
         "default: BVH's y up with the subject facing +Z and its left at +X. A z-up file "
@@ -228,7 +228,6 @@ class BvhConfig(MotionConfig):
         if Path(self.file).suffix.lower() != ".bvh":
             raise ValueError(f"file must be a .bvh file, got {Path(self.file).name!r}")
         check_canonical_keys(self.joint_map, "joint_map")
-        check_axes(self.axes)
         return self
 
 

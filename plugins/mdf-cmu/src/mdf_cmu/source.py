@@ -42,7 +42,8 @@ Frame rate
 ----------
 ASF/AMC holds no rate: it comes from the subject and trial numbers in the file name
 (``80_10.amc``: subject 80, trial 10) through :data:`SUBJECT_60HZ` and :data:`TRIAL_RATES`
-(from CMU's index, ``cmu-index.csv``), or from the config's ``frame_rate``; for a subject that
+(from CMU's index; its part that matters here is shipped as
+``examples/data/cmu/cmu-index-rates.csv``), or from the config's ``frame_rate``; for a subject that
 is not in CMU's index (or no subject) :data:`DEFAULT_RATE_HZ` is assumed, with a
 :class:`~mdf_cmu.anybvh.FrameRateWarning` saying so. BVH: the header's
 ``Frame Time``, except that cgspeed wrote ``.0083333`` (120 Hz) into every file, also for the
@@ -89,18 +90,20 @@ ACKNOWLEDGEMENT = (
 )
 
 #: Subjects captured at 60 Hz; every other subject at 120 Hz. From the ``framerate`` column of
-#: CMU's index (``cmu-index.csv``, a copy of CMU's index with the 2435 trials of 109
-#: subjects). Subject 136 is not here: the index gives 120 Hz for all of its trials except
-#: 136_19 (see :data:`TRIAL_RATES`).
+#: CMU's index of its 2435 trials of 109 subjects, whose subject, trial and rate columns the
+#: repository ships as ``examples/data/cmu/cmu-index-rates.csv`` (provenance beside it; the
+#: tests check these tables against it). Subject 136 is not here: the index gives 120 Hz for
+#: all of its trials except 136_19 (see :data:`TRIAL_RATES`).
 SUBJECT_60HZ: frozenset[int] = frozenset({33, 34, 42, 60, 61, 62, 74, 75, 77, 79, 80, 87, 88, 89})
 
-#: The subjects of CMU's index (``cmu-index.csv``): 109 numbers from 1 to 144.
+#: The subjects of CMU's index (``examples/data/cmu/cmu-index-rates.csv``): 109 numbers from 1
+#: to 144.
 CMU_SUBJECTS: frozenset[int] = frozenset(range(1, 145)) - frozenset(
     {4, 44, 48, 50, 51, 52, 53, 57, 58, 59, 65, 66, 67, 68, 71, 72, 73, 84, 92, 95, 96, 97}
     | {98, 99, 100, 101, 109, 110, 112, 116, 117, 119, 121, 129, 130}
 )
 
-#: Trials whose rate differs from their subject's (``cmu-index.csv``): (subject, trial) -> Hz.
+#: Trials whose rate differs from their subject's (the index): (subject, trial) -> Hz.
 TRIAL_RATES: dict[tuple[int, int], float] = {(136, 19): 60.0}
 
 #: Default rate of the database [Hz].
@@ -177,7 +180,8 @@ def parse_trial_name(path: str | Path) -> tuple[int | None, int | None]:
 
 
 def subject_frame_rate(subject: int, trial: int | None = None) -> float:
-    """Capture rate [Hz] of a CMU subject (and trial), from CMU's index (``cmu-index.csv``)."""
+    """Capture rate [Hz] of a CMU subject (and trial), from CMU's index (:data:`SUBJECT_60HZ`,
+    :data:`TRIAL_RATES`)."""
     if trial is not None and (subject, trial) in TRIAL_RATES:
         return TRIAL_RATES[(subject, trial)]
     return 60.0 if subject in SUBJECT_60HZ else DEFAULT_RATE_HZ

@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import Field, field_validator
+from pydantic import Field
 
 from mdframework import (
     DataFileError,
@@ -32,7 +32,8 @@ from mdframework import (
     Skeleton,
     limits,
 )
-from mdframework.skeleton import Axis, check_axes, reorient
+from mdframework.settings import MotionAxes
+from mdframework.skeleton import reorient
 
 #: Most cycles a ``"wrap"`` clip may be played.
 MAX_CYCLES = 10_000
@@ -57,7 +58,7 @@ class DeepMimicConfig(MotionConfig):
         description='Play a cyclic clip ("Loop": "wrap") this many times, each cycle '
         "shifted by the clip's root displacement; other clips play once.",
     )
-    axes: tuple[Axis, Axis, Axis] = Field(
+    axes: MotionAxes = Field(
         ("x", "-z", "y"),
         description="The clip's axis (with sign) that becomes x (forward), y (left) and z (up); "
         "DeepMimic's world is y up with the character facing +x and its right at +z.",
@@ -68,20 +69,6 @@ class DeepMimicConfig(MotionConfig):
         "'humanoid3d_' ('humanoid3d_walk.txt': 'walk').",
     )
     subject: str | None = Field(None, description="Subject id for the metadata.")
-
-    @field_validator("axes")
-    @classmethod
-    def _axes(cls, v: tuple[str, str, str]) -> tuple[str, str, str]:
-        check_axes(v)
-        m = np.zeros((3, 3))
-        for row, a in enumerate(v):
-            m[row, "xyz".index(a[-1])] = -1.0 if a.startswith("-") else 1.0
-        if np.linalg.det(m) < 0:
-            raise ValueError(
-                f"axes {list(v)} mirror the body (its left would become its right); "
-                "DeepMimic's clips are y up with the right at +z: ['x', '-z', 'y']"
-            )
-        return v
 
 
 class DeepMimicSource(MotionSource):

@@ -27,8 +27,8 @@ from mdframework import (
     Skeleton,
     limits,
 )
-from mdframework.settings import FrameRate
-from mdframework.skeleton import Axis, check_axes, check_canonical_keys, group_means, reorient
+from mdframework.settings import FrameRate, MotionAxes
+from mdframework.skeleton import check_canonical_keys, group_means, reorient
 
 #: A value of a time column in its own unit (frame numbers, milliseconds, seconds); in seconds
 #: it must lie within +-``limits.MAX_CLOCK_TIME_S``, as the column's times do (checked with the
@@ -90,7 +90,7 @@ class TableConfig(MotionConfig):
     unit_m: float | None = Field(
         None, gt=0, le=1000, description="Metres per file unit (overrides units)."
     )
-    axes: tuple[Axis, Axis, Axis] = Field(
+    axes: MotionAxes = Field(
         ("x", "y", "z"),
         description="The file axis (with sign) that becomes x (forward), y (left) and z (up); "
         "a Kinect camera table is ['z', 'x', 'y'].",
@@ -117,7 +117,6 @@ class TableConfig(MotionConfig):
                 f"file must be a .csv, .tsv, .txt, .dat or .npz table, got {Path(self.file).name!r}"
             )
         check_canonical_keys(self.joint_map, "joint_map")
-        check_axes(self.axes)
         if self.time_range is not None:
             if self.time_range[0] > self.time_range[1]:
                 raise ValueError(f"time_range: first {self.time_range[0]:g} is after last")
