@@ -66,6 +66,8 @@ def test_timing(rv: float, dc: float, frac: float) -> None:
     g = Gait(H, rv)
     assert g.cycle_duration == pytest.approx(dc, abs=5e-6)
     assert g.support_fraction == pytest.approx(frac, abs=5e-6)
+    if rv == 1.0:  # section 5: Chen's slow-time rate, nt = 2048 samples per cycle
+        assert g.nt / g.cycle_duration == pytest.approx(1521.545, abs=5e-4)
 
 
 def test_gait_classes() -> None:

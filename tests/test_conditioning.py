@@ -122,6 +122,24 @@ def test_eq7_angle_parallel_and_near_parallel(angle: float) -> None:
         assert theta == 0.0
 
 
+def test_eq7_angle_of_a_typical_leg_agrees_with_arccos() -> None:
+    """Section 5: on a typical standing leg (the foot at 101.4914390881 deg to the shank) the
+    stable atan2 form and the paper's arccos form agree to 1e-10 deg, and both give the angle
+    the leg was built with."""
+    want = np.deg2rad(101.4914390881)
+    ankle = np.array([0.12, 0.31, 0.08])
+    knee = ankle + 0.42 * np.array([0.05, -0.02, 1.0]) / np.linalg.norm([0.05, -0.02, 1.0])
+    shank = (knee - ankle) / np.linalg.norm(knee - ankle)
+    side = np.cross(shank, [1.0, 0.0, 0.0])
+    side /= np.linalg.norm(side)
+    foot = ankle + 0.21 * (np.cos(want) * shank + np.sin(want) * np.cross(side, shank))
+    theta = float(cond.knee_ankle_foot_angle(knee, ankle, foot))
+    v1, v2 = knee - ankle, foot - ankle
+    by_arccos = float(np.arccos(v1 @ v2 / (np.linalg.norm(v1) * np.linalg.norm(v2))))
+    assert abs(np.rad2deg(theta - by_arccos)) < 1e-10
+    assert np.rad2deg(theta) == pytest.approx(101.4914390881, abs=1e-10)
+
+
 def test_foot_length_correction() -> None:
     body = walking_body()
     a, t = body.joint("l_ankle"), body.joint("l_toe")

@@ -7,13 +7,10 @@ from typing import Any
 
 import numpy as np
 import pytest
-from mdf_antenna import AntennaPattern, one_way_gain
+from mdf_antenna import one_way_gain
 from mdf_antenna.antenna import SINC2_HALF_POWER
-from mdf_attenuation import Attenuation
 from mdf_clutter import GroundClutter
 from mdf_lfm import LfmPulseDoppler
-from mdf_mujoco import Shadowing
-from mdf_multipath import GroundMultipath
 from mdf_noise import ReceiverNoise
 
 from mdframework import Received, SceneContext, Skeleton
@@ -22,16 +19,16 @@ from mdframework.constants import BOLTZMANN, SPEED_OF_LIGHT
 from mdframework.physics import radar
 from mdframework.physics.spectrogram import spectrogram
 from mdframework.pipeline import RunResult, simulate
+from mdframework.plugins import default_registry
 
 LAM = SPEED_OF_LIGHT / 15e9
-ALL_EFFECTS = (
-    ReceiverNoise,
-    GroundClutter,
-    GroundMultipath,
-    AntennaPattern,
-    Attenuation,
-    Shadowing,
+#: every installed effect (the built-in ones: noise, clutter, multipath, antenna, attenuation,
+#: shadowing, static scene; and any other on this machine)
+ALL_EFFECTS = tuple(
+    default_registry().get("effects", name) for name in default_registry().names("effects")
 )
+#: the methods through which an effect does work
+EFFECT_METHODS = ("__init__", "start_record", "check_radar", "apply", "describe")
 
 
 def run(
@@ -438,9 +435,12 @@ def _explode(*args: Any, **kwargs: Any) -> None:
 def test_effects_not_called_for_are_never_constructed_or_run(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
+    assert {"noise", "clutter", "multipath", "antenna", "attenuation", "shadowing"} <= {
+        cls.name for cls in ALL_EFFECTS
+    }
     for cls in ALL_EFFECTS:
-        monkeypatch.setattr(cls, "__init__", _explode)
-        monkeypatch.setattr(cls, "apply", _explode)
+        for method in EFFECT_METHODS:
+            monkeypatch.setattr(cls, method, _explode)
     res = run(APPROACHING, [])
     assert res.metadata["effects"] == []
     cfg = {"motion": {"kind": "boulic", "duration": 1.0}, "scatterers": {"kind": "ellipsoid"}}
@@ -450,8 +450,8 @@ def test_effects_not_called_for_are_never_constructed_or_run(
 def test_only_the_named_effect_runs(monkeypatch: pytest.MonkeyPatch) -> None:
     for cls in ALL_EFFECTS:
         if cls is not ReceiverNoise:
-            monkeypatch.setattr(cls, "__init__", _explode)
-            monkeypatch.setattr(cls, "apply", _explode)
+            for method in EFFECT_METHODS:
+                monkeypatch.setattr(cls, method, _explode)
     res = run(APPROACHING, [{"kind": "noise"}])
     assert [e["kind"] for e in res.metadata["effects"]] == ["noise"]
 

@@ -840,3 +840,26 @@ def test_the_aliasing_advice_names_the_fields_that_set_the_slow_time_rate() -> N
     cw = {"kind": "cw", "carrier_frequency": 24e9, "sample_rate": 1000.0}
     with pytest.raises(SceneError, match=r"aliases; raise radar\.sample_rate to at least 1762 Hz"):
         point_run(target, duration=0.3, radar=cw, processing=error)  # 301 > 256-sample window
+
+
+def test_the_noise_effect_is_refused_beside_the_radars_own_receiver_noise() -> None:
+    """The presets add the receiver's thermal noise to the IF samples; the noise effect on top
+    would count it twice (and its snr_db would not be the result's SNR): one error naming both
+    fields. Without receiver_noise the effect runs and is the only noise."""
+    target = [{"position": [3.0, 0.0, 0.0], "velocity": [-1.0, 0.0, 0.0], "rcs": 1.0}]
+    radar_ = {"kind": "fmcw", "preset": "iwr1443_short_range_3d", "boresight_azimuth_deg": 0.0}
+    cfg = {
+        "motion": {"kind": "point_targets", "length": 0.2, "targets": target},
+        "scatterers": {"kind": "points"},
+        "radar": radar_,
+        "scene": {"radar_position": [0.0, 0.0, 0.0]},
+        "effects": [{"kind": "noise", "snr_db": 20.0}],
+    }
+    with pytest.raises(SceneError, match=r"^effects.noise: the 'fmcw' radar adds receiver noise"):
+        simulate(validate_run_config(cfg))
+    cfg["radar"] = {**radar_, "receiver_noise": False, "points": False}
+    quiet = {**cfg, "effects": []}
+    noisy = simulate(validate_run_config(cfg)).received.signal
+    clean = simulate(validate_run_config(quiet)).received.signal
+    snr = np.mean(np.abs(clean) ** 2) / np.mean(np.abs(noisy - clean) ** 2)
+    assert 10 * np.log10(snr) == pytest.approx(20.0, abs=0.5)

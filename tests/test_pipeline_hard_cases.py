@@ -127,6 +127,21 @@ def test_zero_length_segments_stay_finite(
     assert np.all(np.isfinite(res.scatterers.rcs))
     assert np.all(np.isfinite(res.received.signal))
     assert np.all(np.isfinite(res.spectrogram_db))
+    if collapse == "all":
+        # a part whose segment never has a length is a sphere of its radius: pi a^2 at every
+        # pulse; the others keep a spheroid's aspect-dependent RCS
+        from mdframework.physics import body as bodymodel
+
+        parts = bodymodel.body_parts(placement)  # type: ignore[arg-type]
+        a, _ = bodymodel.part_semi_axes(parts, 1.8)
+        motion = synthetic.SyntheticWalker(synthetic.SyntheticConfig(collapse="all")).load()
+        _, axes = bodymodel.part_geometry(parts, motion.skeleton.positions)
+        never = np.all(np.linalg.norm(axes, axis=-1) == 0.0, axis=0)
+        never &= ~np.array([p.sphere for p in parts])
+        assert 3 <= np.sum(never) < len(parts)
+        rcs = res.scatterers.rcs
+        want = np.broadcast_to(np.pi * a[never] ** 2, rcs[:, never].shape)
+        np.testing.assert_allclose(rcs[:, never], want, rtol=1e-12)
 
 
 def test_held_orientation_for_collapsed_forearm(registry: Registry) -> None:

@@ -74,6 +74,18 @@ def test_on_bin_case_exact() -> None:
     assert col[k - 1] == pytest.approx(col[k + 1], rel=1e-6)
 
 
+def test_receding_point_peaks_at_the_nearest_bin_minus_103_125_hz() -> None:
+    """Section 5: with N_fft 256 (bins of 9.375 Hz) 1 m/s receding (-100.069 Hz) peaks at
+    -103.125 Hz, the nearest bin, in every frame (not at -93.75 Hz, a bin toward zero)."""
+    res = point_run(
+        [{"position": [100.0, 0, 0], "velocity": [1.0, 0, 0]}],
+        processing={"window_length": 256, "hop": 64, "nfft": 256},
+    )
+    peaks = peak_frequency_per_frame(res)
+    assert peaks.shape == (72,)
+    assert np.all(peaks == -103.125)
+
+
 def test_sign_convention_end_to_end() -> None:
     """An approaching scatterer is at positive Doppler and velocity in the stored arrays."""
     res = point_run([{"position": [30.0, 0, 0], "velocity": [-2.0, 0, 0]}])
@@ -216,3 +228,33 @@ def test_tracking_gate_constant_and_fixed_gate_decays() -> None:
     # essentially gone one range cell (c/2B = 0.9993 m, t = 0.9993 s) from the gate
     k = int(np.argmin(np.abs(r - 20.0 - SPEED_OF_LIGHT / 2 / 150e6)))
     assert abs(fixed.received.signal[k]) < 0.01 * abs(fixed.received.signal[0])
+
+
+@pytest.mark.parametrize("x", [0.0, 0.25, 0.5, 0.77])
+def test_summing_range_bins_gives_the_phase_only_return(x: float) -> None:
+    """Section 5: sum_k sinc(k - x) = 1 for any sub-bin position x, so summing the sinc-gated
+    return over gates spaced c / 2B (Chen's sum over range bins) reproduces the phase-only
+    return, to 1e-7 over 6001 gates. The raw path agrees in the large-TB limit: its whole
+    compressed range-time row (fs = 2B, so times B / fs), at TB = 1500, is the phase-only
+    return to 2 % in magnitude and 0.01 rad in phase (the exact LFM response is not quite the
+    sinc; at TB = 150 it falls 9 % short)."""
+    bandwidth, tau = 150e6, 1e-5
+    c = SPEED_OF_LIGHT
+    bin_m = c / (2 * bandwidth)
+    r = 100.0 + x * bin_m
+    phase_only = np.exp(-4j * np.pi * FC * r / c)
+    gates = 100.0 + np.arange(-3000, 3001) * bin_m
+    w = radar.gate_weights(
+        np.full((gates.size, 1), r), gates, pulse_width=tau, bandwidth=bandwidth, response="sinc"
+    )
+    assert complex(np.sum(w) * phase_only) == pytest.approx(phase_only, abs=1e-7)
+    fs = 2 * bandwidth
+    k0 = int((2 * r / c - tau) * fs) - 10
+    fast = np.arange(k0, int((2 * r / c + 2 * tau) * fs) + 10) / fs
+    kw = {"pulse_width": tau, "bandwidth": bandwidth}
+    echo = radar.raw_pulse_returns(
+        np.array([[r]]), np.array([[1.0]]), fast, carrier_frequency=FC, **kw
+    )
+    total = complex(np.sum(radar.matched_filter(echo, fs, **kw)) / tau * bandwidth / fs)
+    assert abs(total / phase_only) == pytest.approx(1.0, abs=0.02)
+    assert abs(np.angle(total / phase_only)) < 0.01

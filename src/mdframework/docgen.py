@@ -25,7 +25,11 @@ RUN_PLUGIN_SECTIONS = {
     "motion": ("motion", "`[motion]`: the motion source"),
     "scatterers": ("scatterers", "`[scatterers]`: the scatterer (RCS) model"),
     "radar": ("radar", "`[radar]`: the radar waveform"),
-    "effects": ("effects", "`[[effects]]`: scene effects (only those listed are simulated)"),
+    "effects": (
+        "effects",
+        "`[[effects]]`: scene effects (only those listed are simulated; the FMCW radar's "
+        "`receiver_noise` is the radar's own)",
+    ),
 }
 
 

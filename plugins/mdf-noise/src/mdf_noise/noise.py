@@ -29,6 +29,10 @@ set in one of two ways:
 When the waveform also returns a range-time map (``Received.range_time``, the raw path), noise of
 the same variance is added to every range cell, independently per cell: after pulse compression
 neighbouring cells' noise is in fact correlated over ``1/B``, which this does not model.
+
+A radar that adds its own receiver noise (the FMCW radar's ``receiver_noise``, which its
+presets turn on) refuses this effect: the noise would be counted twice, and ``snr_db`` would
+not be the SNR of the result.
 """
 
 from __future__ import annotations
@@ -40,7 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field, model_validator
 
-from mdframework import Effect, PluginConfig, Received, SceneContext, SceneError
+from mdframework import Effect, PluginConfig, RadarWaveform, Received, SceneContext, SceneError
 from mdframework.constants import BOLTZMANN
 from mdframework.settings import Bandwidth, Decibels, LossDb
 
@@ -132,6 +136,15 @@ class ReceiverNoise(Effect):
     def __init__(self, config: PluginConfig) -> None:
         super().__init__(config)
         self._power: float | None = None
+
+    def check_radar(self, waveform: RadarWaveform) -> None:
+        """Refuse a radar whose config adds receiver noise already (``receiver_noise``)."""
+        if getattr(getattr(waveform, "config", None), "receiver_noise", False):
+            raise SceneError(
+                f"effects.noise: the {waveform.name!r} radar adds receiver noise itself "
+                "(radar.receiver_noise = true, as its presets set it): remove the noise "
+                "effect, or set radar.receiver_noise = false to use the effect's noise instead"
+            )
 
     def _waveform_param(self, context: SceneContext, field: str) -> float:
         given = getattr(self.config, field)
