@@ -363,8 +363,9 @@ class FmcwRadar(RadarWaveform):
 
     @property
     def pulse_rate(self) -> float:
-        """Chirps per second over whole frames [Hz] (the pulse budget counts chirps)."""
-        return self.sequence.chirps_per_frame / self.sequence.frame_period
+        """Chirps per second over whole frames [Hz] (the pulse budget counts chirps):
+        :meth:`FmcwConfig.pulse_rate`."""
+        return self.config.pulse_rate()
 
     def faster_sampling(self, rate: float) -> str:
         """The loop rate ``1 / (n_tx (idle_time + ramp_end_time))`` is the slow-time rate: the
