@@ -171,6 +171,20 @@ class PluginConfig(ConfigSection):
     kind: str
 
 
+class RadarConfig(PluginConfig):
+    """Base of radar configs: a :class:`PluginConfig` that can say how many pulses per second
+    its radar sends, so that a record over the pulse budget (:mod:`mdframework.limits`) is
+    refused when the config is read, before the radar is built. A radar config that derives
+    from :class:`PluginConfig` alone works too; its records are then checked once the run's
+    radar is built."""
+
+    def pulse_rate(self) -> float | None:
+        """Pulses (slow-time samples, FMCW chirps) per second of a record [Hz] for the pulse
+        budget, or ``None`` when the config alone does not fix it. Default ``None``; the
+        radar's :attr:`RadarWaveform.pulse_rate` is this rate when it is given."""
+        return None
+
+
 class Plugin(ABC):
     """Common base: a registered name and a config model."""
 
@@ -390,9 +404,10 @@ class RadarWaveform(Plugin):
     @property
     def pulse_rate(self) -> float:
         """Pulses per second of a record [Hz], for the pulse budget (:mod:`mdframework.limits`).
-        Default: :attr:`prf`; a radar with several pulses per slow-time sample (FMCW chirps of
-        several transmitters) overrides it."""
-        return self.prf
+        Default: the config's :meth:`RadarConfig.pulse_rate` when it gives one (e.g. FMCW chirps
+        of several transmitters, more than one per slow-time sample), else :attr:`prf`."""
+        rate = self.config.pulse_rate() if isinstance(self.config, RadarConfig) else None
+        return self.prf if rate is None else rate
 
     @property
     def max_unambiguous_velocity(self) -> float:

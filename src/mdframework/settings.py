@@ -29,7 +29,7 @@ from pydantic import (
 )
 
 from . import limits
-from .interfaces import ConfigSection, FloatArray, PluginConfig
+from .interfaces import ConfigSection, FloatArray, PluginConfig, RadarConfig
 from .physics import radar
 from .physics.interpolation import Method
 
@@ -182,7 +182,7 @@ class MotionConfig(PluginConfig):
         return self.duration
 
 
-class RadarPowerConfig(PluginConfig):
+class RadarPowerConfig(RadarConfig):
     """Base of radar configs: transmit power, gains and losses, and the amplitude model."""
 
     transmit_power: float = Field(
@@ -196,12 +196,6 @@ class RadarPowerConfig(PluginConfig):
         description="Scatterer amplitude: the radar range equation, or sqrt(rcs) with no range "
         "dependence (Chen's walker code; power, gain and losses unused).",
     )
-
-    def pulse_rate(self) -> float | None:
-        """Pulses (slow-time samples) per second [Hz] for the pulse budget: the ``prf`` field of
-        radars that have one; radars with another timing override this."""
-        prf = getattr(self, "prf", None)
-        return None if prf is None else float(prf)
 
     def amplitudes(self, rcs: FloatArray, ranges: FloatArray, wavelength: float) -> FloatArray:
         """Amplitude [sqrt(W)] of each scatterer (:func:`physics.radar.scatterer_amplitudes`)."""

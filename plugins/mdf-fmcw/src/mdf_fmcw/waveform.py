@@ -361,12 +361,6 @@ class FmcwRadar(RadarWaveform):
         """``lambda_c / (4 n_tx T_chirp)`` [m/s]: one sample per loop on each virtual antenna."""
         return self.sequence.max_velocity
 
-    @property
-    def pulse_rate(self) -> float:
-        """Chirps per second over whole frames [Hz] (the pulse budget counts chirps):
-        :meth:`FmcwConfig.pulse_rate`."""
-        return self.config.pulse_rate()
-
     def faster_sampling(self, rate: float) -> str:
         """The loop rate ``1 / (n_tx (idle_time + ramp_end_time))`` is the slow-time rate: the
         chirp period that reaches ``rate`` [Hz] with this TDM order, and what bounds it (the
