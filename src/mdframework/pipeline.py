@@ -79,7 +79,9 @@ class RunResult:
     ``spectrogram_db`` (n_doppler, n_frames) float32 [dB re peak]; ``velocity`` (n_doppler,)
     [m/s]; ``body``: the placed body at the source's own frame times within the record, times
     [s from the first pulse]; ``scatterers``: every pulse's scatterers, only when
-    ``processing.keep_scatterers`` (else ``None``: the pipeline streams them block by block)."""
+    ``processing.keep_scatterers`` (else ``None``: the pipeline streams them block by block);
+    ``metadata``: what the run did, saved as ``metadata.json`` (``metadata["scatterers"]``: the
+    scatterers' names, in their order in the arrays)."""
 
     pulse_times: FloatArray
     gate_range: FloatArray
@@ -87,7 +89,6 @@ class RunResult:
     spectrogram: Spectrogram
     spectrogram_db: NDArray[np.float32]
     velocity: FloatArray
-    scatterer_names: tuple[str, ...]
     body: Skeleton
     scatterers: Scatterers | None = None
     metadata: dict[str, Any] = field(default_factory=dict)
@@ -445,7 +446,6 @@ def _simulate_motion(
         spec,
         spec_db,
         velocity,
-        stream.names,
         shifted,
         stream.scatterers(),
         metadata,
