@@ -8,6 +8,7 @@ import sys
 import textwrap
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 import numpy as np
 import pytest
@@ -558,3 +559,47 @@ def test_a_radar_config_declares_the_pulse_rate_that_the_budget_counts() -> None
         SceneError, match=r"motion\.duration: .* at PRF 1000 Hz is 5\.05e\+06 pulses"
     ):
         simulate(config, bare)
+
+
+def test_a_radar_spectrogram_gets_the_pulse_times_its_radar_gave() -> None:
+    """RadarWaveform.spectrogram receives the record's pulse instants as the radar's own
+    pulse_times gave them (here jittered pulses), for a radar whose spectrogram follows them."""
+    from mdframework.config import validate_run_config
+    from mdframework.pipeline import simulate
+    from mdframework.testing import ReferenceRadar
+
+    given: list[np.ndarray] = []
+    seen: list[np.ndarray] = []
+
+    class Jittered(ReferenceRadar):
+        """Pulses up to 50 us off the uniform grid."""
+
+        def pulse_times(self, start: float, end: float) -> np.ndarray:
+            t = super().pulse_times(start, end)
+            t[1:-1] += 50e-6 * np.sin(np.arange(t.size - 2))  # the ends stay in the record
+            given.append(t)
+            return t
+
+        def spectrogram(self, signal: Any, times: Any, processing: Any) -> None:
+            seen.append(np.array(times))
+            return None  # the pipeline's STFT
+
+    module = ModuleType("jittered_radar")
+    module.mdframework_register_radar_waveforms = synthetic.hookimpl(  # type: ignore[attr-defined]
+        lambda: [Jittered]
+    )
+    reg = build_registry([module])
+    cfg = {
+        "motion": {
+            "kind": "point_targets",
+            "length": 1.0,
+            "start": 0.25,  # the scene clock: the record starts at 0.25 s
+            "targets": [{"position": [50, 0, 0]}],
+        },
+        "scatterers": {"kind": "points"},
+        "radar": {"kind": "reference"},
+    }
+    res = simulate(validate_run_config(cfg, registry=reg), reg)
+    assert len(seen) == 1 and np.array_equal(seen[0], given[-1]) and seen[0][0] == 0.25
+    assert np.ptp(np.diff(seen[0])) > 50e-6  # not the uniform grid
+    np.testing.assert_allclose(res.pulse_times, seen[0] - seen[0][0], atol=1e-12)

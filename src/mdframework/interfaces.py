@@ -462,9 +462,12 @@ class RadarWaveform(Plugin):
         self, signal: ComplexArray, times: FloatArray, processing: ProcessingConfig
     ) -> Spectrogram | None:
         """The record's micro-Doppler spectrogram when this radar's slow time is not uniform
-        (e.g. FMCW frames with gaps): ``signal`` (n_pulses,), ``times`` (n_pulses,) [s].
-        Default ``None``: the pipeline takes the STFT of ``signal`` at :attr:`prf`. A radar that
-        overrides it overrides :meth:`spectrogram_geometry` to match."""
+        (e.g. FMCW frames with gaps): ``signal`` (n_pulses,) complex128; ``times`` (n_pulses,)
+        float64 [s], the record's pulse instants as :meth:`pulse_times` gave them (scene clock),
+        for a radar whose spectrogram follows them (staggered or jittered pulses, say); a radar
+        whose timing its config fixes (FMCW) may ignore them. Default ``None``: the pipeline
+        takes the STFT of ``signal`` at :attr:`prf`. A radar that overrides it overrides
+        :meth:`spectrogram_geometry` to match."""
         return None
 
     def spectrogram_geometry(

@@ -542,7 +542,7 @@ class FmcwRadar(RadarWaveform):
         without gaps, else one Doppler spectrum per frame (window over the frame's loops, FFT
         size ``max(processing.nfft, n_loops)``), at the frame's middle loop; the power in
         ``processing.precision`` (float32 by default). :meth:`spectrogram_geometry` gives its
-        geometry."""
+        geometry. ``times`` is not needed: the config fixes the chirp timing."""
         from mdframework.physics.spectrogram import Spectrogram
         from mdframework.pipeline import processing_stft
 
