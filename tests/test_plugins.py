@@ -19,7 +19,6 @@ from mdframework import cli, errors
 from mdframework.plugins import (
     DISABLE_ENV,
     DISABLE_PLUGINS_ENV,
-    PluginError,
     PluginWarning,
     build_registry,
     default_registry,
@@ -448,8 +447,15 @@ def test_an_effect_returning_none_is_named_in_one_line(
         "scatterers": {"kind": "points"},
         "effects": [{"kind": "forgetful"}],
     }
-    with pytest.raises(PluginError, match=r"effect 'forgetful' \(.*Forgetful\) returned NoneType"):
+    with pytest.raises(
+        TypeError, match=r"^apply\(\) returned NoneType instead of Received\n"
+    ) as exc:
         simulate(validate_run_config(cfg, registry=reg), reg)
+    assert exc.value.__notes__ == [
+        "in the effects plugin 'forgetful' "
+        "(test_plugins.test_an_effect_returning_none_is_named_in_one_line.<locals>.Forgetful) on "
+        "the 'received' stage; check it with mdframework.testing.check_effect"
+    ]
 
 
 def test_an_interrupt_python_could_not_raise_ends_the_command_as_interrupted(
