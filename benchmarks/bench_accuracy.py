@@ -280,7 +280,7 @@ def run_benchmark(quick: bool, repeats: int) -> tuple[list[dict[str, Any]], list
                     "spec_err_db": spec_err,
                     "feat_err_mps": feat_err,
                     "n_pulses": res.metadata["n_pulses"],
-                    "n_scatterers": len(res.scatterer_names),
+                    "n_scatterers": len(res.metadata["scatterers"]),
                 }
             )
     return rows, notes

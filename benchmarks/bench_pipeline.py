@@ -87,7 +87,7 @@ def time_path(path: str, motion: Motion, repeats: int) -> tuple[list[float], int
         t0 = time.perf_counter()
         res = simulate_motion(cfg, stages, motion)
         times.append(time.perf_counter() - t0)
-    n_pulses, n_scat = res.pulse_times.shape[0], len(res.scatterer_names)
+    n_pulses, n_scat = res.pulse_times.shape[0], len(res.metadata["scatterers"])
     return times[1:], n_pulses, n_scat  # the first run warms caches and is dropped
 
 

@@ -406,9 +406,9 @@ def test_lying_body_from_a_wrong_up_axis_is_warned_naming_axes(tmp_path: Path) -
     with pytest.warns(MotionSanityWarning) as caught:
         report = check_motion(flat, SanityConfig(cadence=False)).metadata["sanity"]
     assert not report["upright"]["ok"]
-    # as docs/motion-formats.md shows it
+    # as docs/motion-formats.md shows it, naming the file as the config resolves it
     assert [str(w.message) for w in caught] == [
-        "16_21.bvh: the body is not upright: the head is -0.01 m above the pelvis (median over "
+        f"{path}: the body is not upright: the head is -0.01 m above the pelvis (median over "
         "the frames; upright bodies 0.2 m or more): if the file's up axis is not the one its "
         "source assumes, set motion.axes"
     ]

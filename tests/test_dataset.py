@@ -346,7 +346,8 @@ def test_motions_loaded_in_parallel_plan_the_same_records(
         assert m1.metadata == m2.metadata and m1.canonical_map == m2.canonical_map
     assert shown1 == shown2
     glitches = [text for category, text in shown2 if category is MotionSanityWarning]
-    assert [t.split(":")[0] for t in glitches] == ["13_18.amc", "80_10.bvh"], shown2
+    files = [str(CMU / "asf-amc" / "13_18.amc"), str(CMU / "bvh" / "80_10.bvh")]
+    assert [t.split(": ")[0] for t in glitches] == files, shown2
 
 
 def test_parallel_loading_keeps_errors_and_warning_filters(
@@ -376,7 +377,8 @@ def test_parallel_loading_keeps_errors_and_warning_filters(
             warnings.simplefilter("error", MotionSanityWarning)
             plan_records(cfg, base, workers=workers)
         errors.append(str(warn.value))
-    assert errors[0] == errors[1] and errors[0].startswith("13_18.amc: 3 single-frame glitch")
+    glitch = f"{CMU / 'asf-amc' / '13_18.amc'}: 3 single-frame glitch"
+    assert errors[0] == errors[1] and errors[0].startswith(glitch)
 
 
 def test_corrupt_and_partial_records_are_redone(tmp_path: Path) -> None:

@@ -92,6 +92,21 @@ def test_unknown_colormap_is_a_config_error() -> None:
         validate_run_config({**data, "figures": {"dynamic_range_db": 0}})
 
 
+def test_every_allowed_matplotlib_draws_the_colour_maps_a_config_accepts() -> None:
+    """The list of colour maps is matplotlib 3.11's; pyproject.toml allowed 3.8, which lacks
+    some of them (berlin, vanimo, grey_r ...): a config accepted them and the figure failed.
+    The lowest matplotlib allowed is the one the list comes from."""
+    import tomllib
+
+    from conftest import ROOT
+
+    from mdframework.settings import COLORMAPS_MATPLOTLIB
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    wanted = [d for d in project["dependencies"] if d.startswith("matplotlib")]
+    assert wanted == [f"matplotlib>={COLORMAPS_MATPLOTLIB}"]
+
+
 def test_the_colour_maps_a_config_accepts_are_matplotlibs() -> None:
     """The names figures.colormap accepts without importing matplotlib are exactly the
     installed matplotlib's colour maps, each also reversed."""

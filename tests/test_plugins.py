@@ -8,6 +8,7 @@ import sys
 import textwrap
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 import numpy as np
 import pytest
@@ -18,7 +19,6 @@ from mdframework import cli, errors
 from mdframework.plugins import (
     DISABLE_ENV,
     DISABLE_PLUGINS_ENV,
-    PluginError,
     PluginWarning,
     build_registry,
     default_registry,
@@ -447,8 +447,15 @@ def test_an_effect_returning_none_is_named_in_one_line(
         "scatterers": {"kind": "points"},
         "effects": [{"kind": "forgetful"}],
     }
-    with pytest.raises(PluginError, match=r"effect 'forgetful' \(.*Forgetful\) returned NoneType"):
+    with pytest.raises(
+        TypeError, match=r"^apply\(\) returned NoneType instead of Received\n"
+    ) as exc:
         simulate(validate_run_config(cfg, registry=reg), reg)
+    assert exc.value.__notes__ == [
+        "in the effects plugin 'forgetful' "
+        "(test_plugins.test_an_effect_returning_none_is_named_in_one_line.<locals>.Forgetful) on "
+        "the 'received' stage; check it with mdframework.testing.check_effect"
+    ]
 
 
 def test_an_interrupt_python_could_not_raise_ends_the_command_as_interrupted(
@@ -472,3 +479,133 @@ def test_an_interrupt_python_could_not_raise_ends_the_command_as_interrupted(
     assert passed_on == [other] and errors.interrupt_seen()
     assert cli.main(["plugins"]) == 130
     assert capsys.readouterr().err.strip().splitlines()[-1] == "mdf: interrupted"
+
+
+def _radar_module(declared: bool) -> ModuleType:
+    """A third-party radar with a PRF of 1 kHz and four pulses per slow-time sample (say four
+    transmitters in turn): its config declares that pulse rate (a ``RadarConfig``), or is a bare
+    ``PluginConfig`` that declares nothing."""
+    from typing import Literal
+
+    from pydantic import Field
+
+    from mdframework import PluginConfig, RadarConfig, RadarWaveform, Received
+
+    base = RadarConfig if declared else PluginConfig
+
+    class QuadConfig(base):  # type: ignore[valid-type,misc]
+        """Four pulses per slow-time sample."""
+
+        kind: Literal["quad"] = "quad"
+        prf: float = Field(1000.0, gt=0, description="Slow-time rate [Hz].")
+
+        def pulse_rate(self) -> float:
+            return 4.0 * self.prf
+
+    class Quad(RadarWaveform):
+        """Sums the scatterers' phasors."""
+
+        name = "quad"
+        Config = QuadConfig
+
+        @property
+        def carrier_frequency(self) -> float:
+            return 10e9
+
+        @property
+        def prf(self) -> float:
+            return float(self.config.prf)  # type: ignore[attr-defined]
+
+        def receive(self, block: object) -> Received:
+            r = block.ranges  # type: ignore[attr-defined]
+            return Received(np.exp(-4j * np.pi * r / 0.03).sum(axis=1).astype(np.complex128))
+
+    module = ModuleType("quad_radar")
+    module.mdframework_register_radar_waveforms = synthetic.hookimpl(  # type: ignore[attr-defined]
+        lambda: [Quad]
+    )
+    return module
+
+
+def test_a_radar_config_declares_the_pulse_rate_that_the_budget_counts() -> None:
+    """The pulse budget counts the rate a radar's config declares (RadarConfig.pulse_rate), both
+    when the config is read and in the run: the radar's pulse_rate is the config's, with no
+    override of its own. A third party's radar config that derives from PluginConfig alone
+    declares nothing (a method of the same name is not read): the budget then counts its prf,
+    and the run, not the config check, refuses a record over it."""
+    from mdframework import limits
+    from mdframework.config import validate_run_config
+    from mdframework.errors import ConfigError, SceneError
+    from mdframework.pipeline import simulate
+
+    seconds = limits.MAX_PULSES / 4000.0 * 1.01  # over the budget in pulses, not in samples
+    cfg = {
+        "motion": {
+            "kind": "point_targets",
+            "length": seconds,
+            "targets": [{"position": [50, 0, 0]}],
+        },
+        "scatterers": {"kind": "points"},
+        "radar": {"kind": "quad"},
+    }
+    declared = build_registry([_radar_module(declared=True)])
+    wf = declared.get("radar", "quad")(declared.get("radar", "quad").Config())  # type: ignore[call-arg]
+    assert wf.pulse_rate == 4000.0 and wf.prf == 1000.0
+    with pytest.raises(
+        ConfigError, match=r"motion\.duration: .* at PRF 4000 Hz is 5\.05e\+06 pulses"
+    ):
+        validate_run_config(cfg, registry=declared)
+
+    bare = build_registry([_radar_module(declared=False)])
+    wf = bare.get("radar", "quad")(bare.get("radar", "quad").Config())  # type: ignore[call-arg]
+    assert wf.pulse_rate == 1000.0
+    cfg["motion"]["length"] = limits.MAX_PULSES / 1000.0 * 1.01  # type: ignore[index]
+    config = validate_run_config(cfg, registry=bare)  # not known from the config
+    with pytest.raises(
+        SceneError, match=r"motion\.duration: .* at PRF 1000 Hz is 5\.05e\+06 pulses"
+    ):
+        simulate(config, bare)
+
+
+def test_a_radar_spectrogram_gets_the_pulse_times_its_radar_gave() -> None:
+    """RadarWaveform.spectrogram receives the record's pulse instants as the radar's own
+    pulse_times gave them (here jittered pulses), for a radar whose spectrogram follows them."""
+    from mdframework.config import validate_run_config
+    from mdframework.pipeline import simulate
+    from mdframework.testing import ReferenceRadar
+
+    given: list[np.ndarray] = []
+    seen: list[np.ndarray] = []
+
+    class Jittered(ReferenceRadar):
+        """Pulses up to 50 us off the uniform grid."""
+
+        def pulse_times(self, start: float, end: float) -> np.ndarray:
+            t = super().pulse_times(start, end)
+            t[1:-1] += 50e-6 * np.sin(np.arange(t.size - 2))  # the ends stay in the record
+            given.append(t)
+            return t
+
+        def spectrogram(self, signal: Any, times: Any, processing: Any) -> None:
+            seen.append(np.array(times))
+            return None  # the pipeline's STFT
+
+    module = ModuleType("jittered_radar")
+    module.mdframework_register_radar_waveforms = synthetic.hookimpl(  # type: ignore[attr-defined]
+        lambda: [Jittered]
+    )
+    reg = build_registry([module])
+    cfg = {
+        "motion": {
+            "kind": "point_targets",
+            "length": 1.0,
+            "start": 0.25,  # the scene clock: the record starts at 0.25 s
+            "targets": [{"position": [50, 0, 0]}],
+        },
+        "scatterers": {"kind": "points"},
+        "radar": {"kind": "reference"},
+    }
+    res = simulate(validate_run_config(cfg, registry=reg), reg)
+    assert len(seen) == 1 and np.array_equal(seen[0], given[-1]) and seen[0][0] == 0.25
+    assert np.ptp(np.diff(seen[0])) > 50e-6  # not the uniform grid
+    np.testing.assert_allclose(res.pulse_times, seen[0] - seen[0][0], atol=1e-12)

@@ -57,6 +57,23 @@ def load(section: dict[str, Any], **sanity: Any) -> tuple[Motion, list[str]]:
     return motion, [str(w.message) for w in caught if w.category is MotionSanityWarning]
 
 
+def test_the_sanity_warnings_name_the_file_as_the_sources_warnings_do() -> None:
+    """Every warning about one motion names its file the same way, as the config resolves it
+    (the sanity checks named only the file's name, which a dataset build of many folders
+    cannot tell apart), and so does an option set to error."""
+    cfg = validate_run_config({"motion": CMU["80_10"]}, source="test", base_dir=EXAMPLES)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        load_motion(build_stages(cfg).source)
+    path = str((EXAMPLES / CMU["80_10"]["file"]).absolute())
+    named = {type(w.message).__name__: str(w.message) for w in caught}
+    assert set(named) == {"FrameRateWarning", "MotionSanityWarning"}, named
+    assert all(text.startswith(f"{path}: ") for text in named.values()), named
+    with pytest.raises(DataFileError) as exc:
+        load(CMU["80_10"], glitches="error")
+    assert str(exc.value).startswith(f"{path}: motion sanity: 3 single-frame glitch")
+
+
 def test_80_10_one_frame_arm_glitch_is_flagged_and_confirmed_in_the_raw_channels() -> None:
     motion, msgs = load(CMU["80_10"])
     items = motion.metadata["sanity"]["glitches"]["items"]

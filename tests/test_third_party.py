@@ -306,3 +306,36 @@ def test_the_project_registry_loads_only_this_trees_plugins(
     assert "noise" in reg.names("effects") and "xyzzy_ok" not in reg.names("effects")
     assert not {"mdf_test_xyzzy", "mdf_test_xyzzy_ok"} & set(sys.modules)
     assert not [w for w in recwarn if "xyzzy" in str(w.message)]
+
+
+@pytest.mark.parametrize(
+    ("returned", "why"),
+    [
+        ("[data]", "TypeError: apply() returned list instead of Scatterers"),
+        (
+            "data.replace(positions=data.positions[1:], rcs=data.rcs[1:])",
+            "ValueError: apply() returned 4095 pulses' scatterers, not 4096",  # the first block,
+        ),
+    ],
+    ids=["type", "pulses"],
+)
+def test_an_effect_that_returns_the_wrong_thing_is_an_internal_error_naming_it(
+    returned: str, why: str, installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An effect whose apply() breaks its contract is the plugin's bug, not the user's: exit 1
+    with one internal-error line naming the plugin (a wrong type was exit 2 as a user error; a
+    wrong number of pulses failed later, naming nobody)."""
+    body = EFFECT.replace("return data", f"return {returned}") + registering("[XyzzyFx]")
+    _make_distribution(installed, "xyzzy-fx", "mdf_test_xyzzy", HEADER + body, "xyzzy_fx")
+    config = tmp_path / "fx.toml"
+    config.write_text(
+        'effects = [{ kind = "xyzzy_fx" }]\n' + (EXAMPLES / "point_target.toml").read_text()
+    )
+    capsys.readouterr()
+    assert cli.main(["run", str(config), "--out", str(tmp_path / "fx")]) == 1
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert lines == [
+        f"mdf: internal error: {why} (in the effects plugin 'xyzzy_fx' "
+        "(mdf_test_xyzzy.XyzzyFx) on the 'scatterers' stage; check it with "
+        "mdframework.testing.check_effect; run with --debug for the traceback)"
+    ]

@@ -25,7 +25,7 @@ from pydantic import BaseModel, Field, ValidationError, create_model, model_vali
 
 from . import limits
 from .errors import ConfigError, SceneError
-from .interfaces import PluginConfig
+from .interfaces import PluginConfig, RadarConfig
 from .plugins import Registry, default_registry, suggest
 from .settings import RunConfigBase
 from .skeleton import CANONICAL_JOINTS
@@ -580,8 +580,7 @@ def _check_pulse_budget(config: RunConfigBase, source: str) -> None:
     loaded)."""
     cfg: Any = config
     length = cfg.motion.known_length() if hasattr(cfg.motion, "known_length") else None
-    rate = getattr(cfg.radar, "pulse_rate", None)
-    prf = rate() if callable(rate) else getattr(cfg.radar, "prf", None)
+    prf = cfg.radar.pulse_rate() if isinstance(cfg.radar, RadarConfig) else None
     if length is None or prf is None:
         return
     n_points = len(getattr(cfg.motion, "targets", ())) or len(CANONICAL_JOINTS)

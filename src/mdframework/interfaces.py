@@ -171,6 +171,20 @@ class PluginConfig(ConfigSection):
     kind: str
 
 
+class RadarConfig(PluginConfig):
+    """Base of radar configs: a :class:`PluginConfig` that can say how many pulses per second
+    its radar sends, so that a record over the pulse budget (:mod:`mdframework.limits`) is
+    refused when the config is read, before the radar is built. A radar config that derives
+    from :class:`PluginConfig` alone works too; its records are then checked once the run's
+    radar is built."""
+
+    def pulse_rate(self) -> float | None:
+        """Pulses (slow-time samples, FMCW chirps) per second of a record [Hz] for the pulse
+        budget, or ``None`` when the config alone does not fix it. Default ``None``; the
+        radar's :attr:`RadarWaveform.pulse_rate` is this rate when it is given."""
+        return None
+
+
 class Plugin(ABC):
     """Common base: a registered name and a config model."""
 
@@ -390,9 +404,10 @@ class RadarWaveform(Plugin):
     @property
     def pulse_rate(self) -> float:
         """Pulses per second of a record [Hz], for the pulse budget (:mod:`mdframework.limits`).
-        Default: :attr:`prf`; a radar with several pulses per slow-time sample (FMCW chirps of
-        several transmitters) overrides it."""
-        return self.prf
+        Default: the config's :meth:`RadarConfig.pulse_rate` when it gives one (e.g. FMCW chirps
+        of several transmitters, more than one per slow-time sample), else :attr:`prf`."""
+        rate = self.config.pulse_rate() if isinstance(self.config, RadarConfig) else None
+        return self.prf if rate is None else rate
 
     @property
     def max_unambiguous_velocity(self) -> float:
@@ -447,9 +462,12 @@ class RadarWaveform(Plugin):
         self, signal: ComplexArray, times: FloatArray, processing: ProcessingConfig
     ) -> Spectrogram | None:
         """The record's micro-Doppler spectrogram when this radar's slow time is not uniform
-        (e.g. FMCW frames with gaps): ``signal`` (n_pulses,), ``times`` (n_pulses,) [s].
-        Default ``None``: the pipeline takes the STFT of ``signal`` at :attr:`prf`. A radar that
-        overrides it overrides :meth:`spectrogram_geometry` to match."""
+        (e.g. FMCW frames with gaps): ``signal`` (n_pulses,) complex128; ``times`` (n_pulses,)
+        float64 [s], the record's pulse instants as :meth:`pulse_times` gave them (scene clock),
+        for a radar whose spectrogram follows them (staggered or jittered pulses, say); a radar
+        whose timing its config fixes (FMCW) may ignore them. Default ``None``: the pipeline
+        takes the STFT of ``signal`` at :attr:`prf`. A radar that overrides it overrides
+        :meth:`spectrogram_geometry` to match."""
         return None
 
     def spectrogram_geometry(

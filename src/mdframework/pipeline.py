@@ -43,7 +43,7 @@ from .physics.spectrogram import (
     power_to_db,
     spectrogram,
 )
-from .plugins import PluginError, Registry, default_registry
+from .plugins import Registry, default_registry
 from .progress import QUIET, Progress
 from .settings import (
     ConditioningConfig,
@@ -79,7 +79,9 @@ class RunResult:
     ``spectrogram_db`` (n_doppler, n_frames) float32 [dB re peak]; ``velocity`` (n_doppler,)
     [m/s]; ``body``: the placed body at the source's own frame times within the record, times
     [s from the first pulse]; ``scatterers``: every pulse's scatterers, only when
-    ``processing.keep_scatterers`` (else ``None``: the pipeline streams them block by block)."""
+    ``processing.keep_scatterers`` (else ``None``: the pipeline streams them block by block);
+    ``metadata``: what the run did, saved as ``metadata.json`` (``metadata["scatterers"]``: the
+    scatterers' names, in their order in the arrays)."""
 
     pulse_times: FloatArray
     gate_range: FloatArray
@@ -87,7 +89,6 @@ class RunResult:
     spectrogram: Spectrogram
     spectrogram_db: NDArray[np.float32]
     velocity: FloatArray
-    scatterer_names: tuple[str, ...]
     body: Skeleton
     scatterers: Scatterers | None = None
     metadata: dict[str, Any] = field(default_factory=dict)
@@ -154,17 +155,43 @@ def _apply_effects(
     context: SceneContext,
     generators: Sequence[np.random.Generator],
 ) -> Any:
-    expected = type(data)
     for effect, rng in zip(stages.effects, generators, strict=True):
         if effect.stage == stage:
-            data = effect.apply(data, replace(context, rng=rng))
-            if not isinstance(data, expected):
-                raise PluginError(
-                    f"effect {effect.name!r} ({type(effect).__module__}.{type(effect).__name__}) "
-                    f"returned {type(data).__name__} from apply() on the {stage!r} stage instead "
-                    f"of {expected.__name__}; check it with mdframework.testing.check_effect"
+            try:
+                out = effect.apply(data, replace(context, rng=rng))
+                _check_effect_output(out, data)
+            except Exception as exc:  # a bug in the plugin: the CLI's internal error names it
+                cls = type(effect)
+                exc.add_note(
+                    f"in the effects plugin {effect.name!r} ({cls.__module__}.{cls.__qualname__})"
+                    f" on the {stage!r} stage; check it with mdframework.testing.check_effect"
                 )
+                raise
+            data = out
     return data
+
+
+def _check_effect_output(out: Any, data: Scatterers | Received) -> None:
+    """Refuse what an effect's ``apply`` returned for ``data`` when it breaks the contract:
+    another type, another number of pulses, or values that are not finite (RCS below 0)."""
+    if not isinstance(out, type(data)):
+        raise TypeError(f"apply() returned {type(out).__name__} instead of {type(data).__name__}")
+    if isinstance(out, Scatterers) and isinstance(data, Scatterers):
+        n = data.positions.shape[0]
+        if out.positions.shape[0] != n:
+            raise ValueError(
+                f"apply() returned {out.positions.shape[0]} pulses' scatterers, not {n}"
+            )
+        if not (np.all(np.isfinite(out.positions)) and np.all(out.rcs >= 0)):
+            raise ValueError("apply() returned positions that are not finite or RCS not >= 0")
+    elif isinstance(out, Received) and isinstance(data, Received):
+        shape = np.shape(data.signal)
+        if not isinstance(out.signal, np.ndarray) or out.signal.shape != shape:
+            raise ValueError(
+                f"apply() returned a signal of shape {np.shape(out.signal)} instead of {shape}"
+            )
+        if not np.all(np.isfinite(out.signal)):
+            raise ValueError("apply() returned a signal that is not finite")
 
 
 def _describe(stages: Stages, stage: str) -> list[dict[str, Any]]:
@@ -445,7 +472,6 @@ def _simulate_motion(
         spec,
         spec_db,
         velocity,
-        stream.names,
         shifted,
         stream.scatterers(),
         metadata,

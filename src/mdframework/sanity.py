@@ -419,7 +419,8 @@ def check_motion(motion: Motion, config: SanityConfig) -> Motion:
     if not config.enabled or motion.canonical_map is None:
         return motion
     body = motion.canonical()
-    where = str(motion.metadata.get("file") or motion.metadata.get("source", "motion"))
+    md = motion.metadata  # the file as the config resolves it, as the sources' warnings name it
+    where = str(md.get("path") or md.get("file") or md.get("source", "motion"))
     report: dict[str, Any] = {}
     notes: list[tuple[str, str]] = []  # (option, message)
 

@@ -29,7 +29,7 @@ from pydantic import (
 )
 
 from . import limits
-from .interfaces import ConfigSection, FloatArray, PluginConfig
+from .interfaces import ConfigSection, FloatArray, PluginConfig, RadarConfig
 from .physics import radar
 from .physics.interpolation import Method
 from .skeleton import Axis, check_motion_axes
@@ -194,7 +194,7 @@ class MotionConfig(PluginConfig):
         return self.duration
 
 
-class RadarPowerConfig(PluginConfig):
+class RadarPowerConfig(RadarConfig):
     """Base of radar configs: transmit power, gains and losses, and the amplitude model."""
 
     transmit_power: float = Field(
@@ -208,12 +208,6 @@ class RadarPowerConfig(PluginConfig):
         description="Scatterer amplitude: the radar range equation, or sqrt(rcs) with no range "
         "dependence (Chen's walker code; power, gain and losses unused).",
     )
-
-    def pulse_rate(self) -> float | None:
-        """Pulses (slow-time samples) per second [Hz] for the pulse budget: the ``prf`` field of
-        radars that have one; radars with another timing override this."""
-        prf = getattr(self, "prf", None)
-        return None if prf is None else float(prf)
 
     def amplitudes(self, rcs: FloatArray, ranges: FloatArray, wavelength: float) -> FloatArray:
         """Amplitude [sqrt(W)] of each scatterer (:func:`physics.radar.scatterer_amplitudes`)."""
@@ -424,6 +418,11 @@ class ConditioningConfig(StrictModel):
         0.03, ge=0, le=10, description="Standard deviation of the smoothing kernel [s]."
     )
 
+
+#: The matplotlib release whose colour maps :data:`COLORMAPS` lists: the lowest that
+#: pyproject.toml allows, so that every name a config accepts draws (3.8 to 3.10 lack berlin,
+#: managua, vanimo and okabe_ito, and the ``_r`` of Grays, grey, gist_grey and gist_yerg).
+COLORMAPS_MATPLOTLIB = "3.11"
 
 #: matplotlib's built-in colour maps (each also reversed, with ``_r``), listed here so that
 #: reading a config never imports matplotlib (a run without figures never does);

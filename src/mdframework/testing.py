@@ -45,6 +45,7 @@ from .interfaces import (
     Plugin,
     PluginConfig,
     PulseBlock,
+    RadarConfig,
     RadarWaveform,
     Received,
     Recording,
@@ -129,13 +130,17 @@ def walking_motion(duration: float = 1.0, rate: float = 2000.0) -> Motion:
     )
 
 
-class ReferenceRadarConfig(PluginConfig):
+class ReferenceRadarConfig(RadarConfig):
     """The reference radar of the checks."""
 
     kind: Literal["reference"] = "reference"
     carrier_frequency: float = Field(10e9, gt=0, description="Carrier [Hz].")
     prf: float = Field(2000.0, gt=0, description="Pulse repetition frequency [Hz].")
     bandwidth: float = Field(100e6, gt=0, description="Bandwidth [Hz] (for effects that ask).")
+
+    def pulse_rate(self) -> float:
+        """One pulse per 1/PRF [Hz]."""
+        return self.prf
 
 
 class ReferenceRadar(RadarWaveform):

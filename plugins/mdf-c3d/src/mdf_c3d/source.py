@@ -143,6 +143,7 @@ def markers_motion(
     meta = {
         **meta,
         "file": path.name,
+        "path": str(path),
         "activity": c.activity,
         "frame_rate_hz": rate,
         "frame_rate_from": "config" if c.frame_rate is not None else "header",
@@ -171,7 +172,7 @@ class C3dSource(MotionSource):
         Motion
             ``skeleton``: time (n_frames,) [s] from 0 at the header's rate; positions
             (n_frames, 17, 3) [m] of the canonical joints (each the mean of its markers, NaN
-            and invalid where one of them is not seen). ``metadata``: source, format, file,
+            and invalid where one of them is not seen). ``metadata``: source, format, file, path,
             subject, activity, frame_rate_hz and frame_rate_from, units, unit_m, unit_from,
             axes, marker_set, markers (joint -> markers), n_frames, first_frame, software,
             events.
@@ -218,9 +219,9 @@ class TrcSource(MotionSource):
             ``skeleton``: time (n_frames,) [s] ``(Frame# - first Frame#) / DataRate`` (or
             ``/ frame_rate``), so frames the file skips leave a gap in time; positions
             (n_frames, 17, 3) [m] of the canonical joints (each the mean of its markers, NaN and
-            invalid where one of them is not seen). ``metadata``: source, format, file, subject,
-            activity, frame_rate_hz and frame_rate_from, units, unit_m, unit_from, axes, marker_set,
-            markers (joint -> markers), n_frames, first_frame (the first ``Frame#``),
+            invalid where one of them is not seen). ``metadata``: source, format, file, path,
+            subject, activity, frame_rate_hz and frame_rate_from, units, unit_m, unit_from, axes,
+            marker_set, markers (joint -> markers), n_frames, first_frame (the first ``Frame#``),
             frames_skipped (frame numbers missing between the first and last), camera_rate_hz
             (``CameraRate``, when given).
 

@@ -246,7 +246,7 @@ class BvhSource(MotionSource):
         Motion
             ``skeleton``: time (n_frames,) [s] from 0; positions (n_frames, n_joints, 3) [m],
             z up; every joint and End Site (``<joint>_end``). ``metadata``: source, format,
-            file, rig, unit_m, frame_rate_hz and frame_rate_from, subject, activity, the
+            file, path, rig, unit_m, frame_rate_hz and frame_rate_from, subject, activity, the
             header's frame time.
         """
         from .source import ACKNOWLEDGEMENT, check_motion, parse_trial_name
@@ -284,6 +284,7 @@ class BvhSource(MotionSource):
             source="bvh",
             format="bvh",
             file=path.name,
+            path=str(path),
             subject=subject,
             trial=trial,
             activity=c.activity,

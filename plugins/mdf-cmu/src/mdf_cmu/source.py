@@ -275,7 +275,7 @@ class CmuSource(MotionSource):
         Motion
             ``skeleton``: time (n_frames,) [s] from 0; positions (n_frames, n_joints, 3) [m],
             z up; every source joint (see the module docstring). ``canonical_map`` maps all 17
-            canonical joints. ``metadata``: source, format, file, subject, trial, activity,
+            canonical joints. ``metadata``: source, format, file, path, subject, trial, activity,
             frame_rate_hz, frame_rate_from, n_frames, units, acknowledgement, and the format's
             details.
 
@@ -291,7 +291,7 @@ class CmuSource(MotionSource):
         subject, trial = parse_trial_name(path)
         if c.subject is not None:
             subject = int(c.subject)
-        meta: dict[str, Any] = {"source": "cmu", "file": path.name}
+        meta: dict[str, Any] = {"source": "cmu", "file": path.name, "path": str(path)}
         if path.suffix.lower() == ".bvh":
             names, pos_m, canonical, extra, rig, frame_time = load_any_bvh(
                 path, keep_first_frame=c.keep_first_frame

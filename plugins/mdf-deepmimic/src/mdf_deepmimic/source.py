@@ -87,7 +87,7 @@ class DeepMimicSource(MotionSource):
             ``skeleton``: time (n_frames,) [s] from 0; positions (n_frames, n_joints + 3, 3)
             [m], z up: the character's joints (15 for ``humanoid3d``) and the points
             ``head_centre``, ``right_toe_tip``, ``left_toe_tip``. ``canonical_map`` maps all
-            17 canonical joints. ``metadata``: source, format, file, character,
+            17 canonical joints. ``metadata``: source, format, file, path, character,
             character_file, loop, cycles, activity, subject, frame_rate_hz (median),
             n_frames, clip_frames, clip_duration_s, loop_closure_m, axes, estimated
             (canonical joints placed from body shapes), quaternions_renormalised,
@@ -143,6 +143,7 @@ class DeepMimicSource(MotionSource):
             "source": "deepmimic",
             "format": "DeepMimic clip (JSON)",
             "file": path.name,
+            "path": str(path),
             "character": character.name,
             "character_file": None if c.character is None else Path(c.character).name,
             "loop": clip.loop,

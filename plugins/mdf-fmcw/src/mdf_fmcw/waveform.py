@@ -361,11 +361,6 @@ class FmcwRadar(RadarWaveform):
         """``lambda_c / (4 n_tx T_chirp)`` [m/s]: one sample per loop on each virtual antenna."""
         return self.sequence.max_velocity
 
-    @property
-    def pulse_rate(self) -> float:
-        """Chirps per second over whole frames [Hz] (the pulse budget counts chirps)."""
-        return self.sequence.chirps_per_frame / self.sequence.frame_period
-
     def faster_sampling(self, rate: float) -> str:
         """The loop rate ``1 / (n_tx (idle_time + ramp_end_time))`` is the slow-time rate: the
         chirp period that reaches ``rate`` [Hz] with this TDM order, and what bounds it (the
@@ -547,7 +542,7 @@ class FmcwRadar(RadarWaveform):
         without gaps, else one Doppler spectrum per frame (window over the frame's loops, FFT
         size ``max(processing.nfft, n_loops)``), at the frame's middle loop; the power in
         ``processing.precision`` (float32 by default). :meth:`spectrogram_geometry` gives its
-        geometry."""
+        geometry. ``times`` is not needed: the config fixes the chirp timing."""
         from mdframework.physics.spectrogram import Spectrogram
         from mdframework.pipeline import processing_stft
 

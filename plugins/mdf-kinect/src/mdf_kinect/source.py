@@ -161,7 +161,7 @@ class KinectSource(MotionSource):
         Motion
             ``skeleton``: time (n,) [s] from 0; positions (n, n_joints, 3) [m], z up, floor at
             z = 0, sensor at x = y = 0; ``valid`` from the format's tracking information.
-            ``canonical_map``: the 17 canonical joints. ``metadata``: source, format, file,
+            ``canonical_map``: the 17 canonical joints. ``metadata``: source, format, file, path,
             activity, frame rate, frames, segment, floor and sensor height, format details.
 
         Raises
@@ -172,7 +172,12 @@ class KinectSource(MotionSource):
         c = self.config
         path = Path(c.file)
         rec = self.read()
-        meta: dict[str, Any] = {"source": "kinect", "file": path.name, **rec.metadata}
+        meta: dict[str, Any] = {
+            "source": "kinect",
+            "file": path.name,
+            "path": str(path),
+            **rec.metadata,
+        }
         keep = np.ones(rec.time.shape, dtype=bool)
         if c.segment is not None:
             first, last = self._segment(rec, path)

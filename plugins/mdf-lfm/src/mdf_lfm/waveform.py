@@ -75,6 +75,10 @@ class LfmConfig(RadarPowerConfig):
         3.0, ge=0, le=1000, description="Raw path: range-time window beyond the scatterers [m]."
     )
 
+    def pulse_rate(self) -> float:
+        """One pulse per 1/PRF [Hz]: the rate of the pulse budget."""
+        return self.prf
+
     @model_validator(mode="after")
     def _check(self) -> LfmConfig:
         if self.bandwidth >= 2 * self.carrier_frequency:

@@ -152,7 +152,7 @@ class TableSource(MotionSource):
         Motion
             ``skeleton``: time (n_frames,) [s] from 0; positions (n_frames, 17, 3) [m] of the
             canonical joints (each the mean of its file joints; NaN and invalid where one is
-            missing). ``metadata``: source, format, file, layout, subject, activity,
+            missing). ``metadata``: source, format, file, path, layout, subject, activity,
             frame_rate_hz (median), time_from, units, unit_m, axes, joint_set, joints
             (canonical -> file joints), n_frames, rows, frames_out_of_order,
             duplicate_frames_dropped.
@@ -224,6 +224,7 @@ class TableSource(MotionSource):
             "source": "table",
             "format": "npz" if path.suffix.lower() == ".npz" else "text table",
             "file": path.name,
+            "path": str(path),
             "layout": table.layout,
             "subject": c.subject,
             "activity": c.activity,
