@@ -145,19 +145,33 @@ def spheroid_specular_from_products(
     axis is taken as broadside, as in :func:`spheroid_rcs_from_products` (offset ``a u``); a
     zero line of sight gives a zero offset."""
     dot = np.asarray(dot, dtype=np.float64)
-    n2 = np.asarray(np.multiply(axis_norm2, los_norm2, dtype=np.float64))
+    axis_norm2 = np.asarray(axis_norm2, dtype=np.float64)
+    n2 = np.multiply(axis_norm2, los_norm2, dtype=np.float64)
     good = n2 > 0
-    cos2 = np.divide(dot * dot, n2, out=np.zeros(n2.shape), where=good)
-    np.clip(cos2, 0.0, 1.0, out=cos2)
+    h = np.asarray(dot * dot)  # cos^2, then h, in one buffer
+    np.divide(h, n2, out=h, where=good)
+    if not np.all(good):
+        h[~good] = 0.0
+    np.minimum(h, 1.0, out=h)
     a2 = np.asarray(a, dtype=np.float64) ** 2
-    c2 = np.asarray(c, dtype=np.float64) ** 2
-    h = np.sqrt(a2 + (c2 - a2) * cos2)
-    los_norm = np.sqrt(np.asarray(los_norm2, dtype=np.float64))
-    hb = h * los_norm
-    alpha = np.divide(a2, hb, out=np.zeros(hb.shape), where=hb > 0)
+    d2 = np.asarray(c, dtype=np.float64) ** 2 - a2
+    h *= d2
+    h += a2
+    np.sqrt(h, out=h)
+    inv = np.asarray(np.sqrt(los_norm2, dtype=np.float64))  # 1 / (h |B|)
+    inv *= h
+    ok = inv > 0
+    np.divide(1.0, inv, out=inv, where=ok)
+    if not np.all(ok):
+        inv[~ok] = 0.0
+    alpha = a2 * inv
     # (c^2 - a^2)(z.u) z / h = (c^2 - a^2) (A.B) A / (|A|^2 |B| h)
-    den = hb * np.asarray(axis_norm2, dtype=np.float64)
-    beta = np.divide((c2 - a2) * dot, den, out=np.zeros(den.shape), where=good & (den > 0))
+    beta = np.asarray(d2 * dot)
+    beta *= inv
+    has_axis = axis_norm2 > 0
+    np.divide(beta, axis_norm2, out=beta, where=has_axis)
+    if not np.all(has_axis):
+        beta[~has_axis] = 0.0
     return h, alpha, beta
 
 
