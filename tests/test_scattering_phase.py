@@ -307,3 +307,20 @@ def test_end_to_end_with_shadowing_and_multipath(registry: Registry) -> None:
     front = [k for k in f_cen if not k.endswith(("ankle", "hand", "elbow"))]
     assert len(front) == 11
     assert all(f_cen[k] == 0.0 and f_spec[k] == 0.0 for k in front)
+
+
+def test_specular_is_block_invariant() -> None:
+    """The streaming contract holds with specular scatterers through shadowing and multipath."""
+    from mdf_lfm.waveform import LfmPulseDoppler
+
+    from mdframework.testing import check_block_invariance
+
+    n = 240
+    t = np.arange(n) / PRF
+    stand = synthetic.standing()
+    joints = np.stack([stand @ rotation(np.array([0, 0, 1.0]), 0.5 * s).T for s in t])
+    skel = Skeleton(t, joints, CANONICAL_JOINTS)
+    model = EllipsoidBody(EllipsoidConfig(scattering_phase="specular"))
+    effects = (Shadowing(ShadowingConfig()), GroundMultipath(MultipathConfig()))
+    radar = LfmPulseDoppler(LfmPulseDoppler.Config())
+    check_block_invariance(model, radar, skel, None, effects)  # type: ignore[arg-type]
