@@ -268,6 +268,16 @@ class Scatterers:
     range_cache: tuple[FloatArray, tuple[float, float, float], FloatArray] | None = field(
         default=None, repr=False, compare=False
     )
+    #: Optional centres of the body-part shapes (n_pulses, n_scatterers, 3) [m], given when the
+    #: scatterers do not sit at them (e.g. the ``ellipsoid`` model's ``scattering_phase =
+    #: "specular"`` puts each on its part's surface): effects that need the shapes' geometry
+    #: (shadowing, multipath) use these. ``None``: the positions are the centres.
+    centres: FloatArray | None = None
+    #: Optional (n_scatterers,) bool: which scatterers sit at their shape's geometric-optics
+    #: specular point for the radar (from ``centres``, ``semi_axes`` and ``axes``), a point that
+    #: moves over the surface with the direction of view. Effects that look from elsewhere (the
+    #: multipath image radar) take their own specular point from the centre. ``None``: none.
+    specular: NDArray[np.bool_] | None = None
 
     def __post_init__(self) -> None:
         if self.positions.ndim != 3 or self.positions.shape[2] != 3:
@@ -278,6 +288,15 @@ class Scatterers:
             raise ValueError(f"rcs must be {self.positions.shape[:2]}, got {self.rcs.shape}")
         if len(self.names) != self.positions.shape[1]:
             raise ValueError("one name per scatterer is required")
+        if self.centres is not None and self.centres.shape != self.positions.shape:
+            raise ValueError(f"centres must be {self.positions.shape}, got {self.centres.shape}")
+        if self.specular is not None:
+            if self.specular.shape != (self.positions.shape[1],):
+                raise ValueError(f"specular must be ({self.positions.shape[1]},) bool")
+            if np.any(self.specular) and (
+                self.centres is None or self.semi_axes is None or self.axes is None
+            ):
+                raise ValueError("specular scatterers need centres, semi_axes and axes")
         if self.range_cache is not None and self.range_cache[0] is not self.positions:
             object.__setattr__(self, "range_cache", None)
 

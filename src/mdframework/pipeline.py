@@ -661,7 +661,18 @@ class _Stream:
         axes = None
         if first.axes is not None:
             axes = np.concatenate([b.axes for b in self._blocks if b.axes is not None])
-        return Scatterers(cat[0], cat[1], first.names, first.semi_axes, axes)
+        centres = None
+        if first.centres is not None:
+            centres = np.concatenate([b.centres for b in self._blocks if b.centres is not None])
+        return Scatterers(
+            cat[0],
+            cat[1],
+            first.names,
+            first.semi_axes,
+            axes,
+            centres=centres,
+            specular=first.specular,
+        )
 
 
 def refuse_near(

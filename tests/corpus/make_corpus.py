@@ -889,6 +889,18 @@ def _field_cases(c: _Corpus) -> None:
         "scatterers.surface_points",
     )
     body_case(
+        "ellipsoid-specular-surface-points",
+        {
+            "motion": body,
+            "scatterers": {
+                "kind": "ellipsoid",
+                "scattering_phase": "specular",
+                "surface_points": 8,
+            },
+        },
+        "scatterers: scattering_phase = 'specular' needs surface_points = 0",
+    )
+    body_case(
         "ellipsoid-height-inf",
         {"motion": body, "scatterers": {"kind": "ellipsoid", "height": inf}},
         "scatterers.height",

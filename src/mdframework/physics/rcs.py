@@ -122,3 +122,69 @@ def spheroid_rcs_from_products(
 def _dot(x: FloatArray, y: FloatArray) -> FloatArray:
     """Dot product over the last axis of length 3 (faster than einsum for small last axes)."""
     return np.asarray(x[..., 0] * y[..., 0] + x[..., 1] * y[..., 1] + x[..., 2] * y[..., 2])
+
+
+def spheroid_specular_from_products(
+    a: ArrayLike,
+    c: ArrayLike,
+    dot: FloatArray,
+    axis_norm2: FloatArray,
+    los_norm2: FloatArray,
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Geometric-optics specular point of a spheroid (``a = b``, semi-axis ``c`` along its
+    symmetry axis ``A``) for a far radar seen along ``B`` (part -> radar), from the same
+    products as :func:`spheroid_rcs_from_products` (arrays of one shape, any layout).
+
+    With ``u = B/|B|`` and ``z = A/|A|`` the support function is
+    ``h = sqrt(a^2 + (c^2 - a^2)(z.u)^2)`` [m], the distance from the centre to the tangent plane
+    facing the radar, and the surface point whose outward normal is ``u`` lies at
+    ``centre + (a^2 u + (c^2 - a^2)(z.u) z) / h`` (``R diag(a^2, a^2, c^2) R^T u / h``), a
+    distance ``h`` nearer the radar along ``u``: its echo has the phase ``exp(+j 2 k h)``
+    relative to the centre's. Returns ``(h, alpha, beta)``, each of the inputs' shape, such that
+    the offset from the centre is ``alpha B + beta A`` (no normalised vectors needed). A zero
+    axis is taken as broadside, as in :func:`spheroid_rcs_from_products` (offset ``a u``); a
+    zero line of sight gives a zero offset."""
+    dot = np.asarray(dot, dtype=np.float64)
+    axis_norm2 = np.asarray(axis_norm2, dtype=np.float64)
+    n2 = np.multiply(axis_norm2, los_norm2, dtype=np.float64)
+    good = n2 > 0
+    h = np.asarray(dot * dot)  # cos^2, then h, in one buffer
+    np.divide(h, n2, out=h, where=good)
+    if not np.all(good):
+        h[~good] = 0.0
+    np.minimum(h, 1.0, out=h)
+    a2 = np.asarray(a, dtype=np.float64) ** 2
+    d2 = np.asarray(c, dtype=np.float64) ** 2 - a2
+    h *= d2
+    h += a2
+    np.sqrt(h, out=h)
+    inv = np.asarray(np.sqrt(los_norm2, dtype=np.float64))  # 1 / (h |B|)
+    inv *= h
+    ok = inv > 0
+    np.divide(1.0, inv, out=inv, where=ok)
+    if not np.all(ok):
+        inv[~ok] = 0.0
+    alpha = a2 * inv
+    # (c^2 - a^2)(z.u) z / h = (c^2 - a^2) (A.B) A / (|A|^2 |B| h)
+    beta = np.asarray(d2 * dot)
+    beta *= inv
+    has_axis = axis_norm2 > 0
+    np.divide(beta, axis_norm2, out=beta, where=has_axis)
+    if not np.all(has_axis):
+        beta[~has_axis] = 0.0
+    return h, alpha, beta
+
+
+def spheroid_specular_point(
+    a: ArrayLike, c: ArrayLike, axis: FloatArray, line_of_sight: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """Specular point of a spheroid (see :func:`spheroid_specular_from_products`) with the
+    vectors' coordinates last: ``axis`` and ``line_of_sight`` (..., 3) (part -> radar; neither
+    needs unit length). Returns the offset from the centre (..., 3) [m] and the support
+    function ``h`` (...) [m]."""
+    axis = np.asarray(axis, dtype=np.float64)
+    los = np.asarray(line_of_sight, dtype=np.float64)
+    h, alpha, beta = spheroid_specular_from_products(
+        a, c, _dot(axis, los), _dot(axis, axis), _dot(los, los)
+    )
+    return alpha[..., None] * los + beta[..., None] * axis, h

@@ -17,6 +17,19 @@ points on the shadowed side carry nothing and the weights sum to one: the *incoh
 equals the single-point RCS, while the coherent sum now spreads each limb's return over the
 Doppler of its surface (points far from a joint move faster). The points are independent point
 scatterers (no surface-integral phase), so ``semi_axes``/``axes`` are not given in this mode.
+
+``scattering_phase`` (single-scatterer mode): ``centre`` (default, Chen's code) puts each part's
+scatterer at its position, the centre of its spheroid; ``specular`` puts it at the part's
+geometric-optics specular point for the line of sight to the radar, the surface point whose
+normal points at the radar: with ``u`` the unit vector from the centre to the radar and ``z``
+the unit segment axis, ``x_s = centre + (a^2 u + (c^2 - a^2)(z.u) z) / h(u)``, with the support
+function ``h(u) = sqrt(a^2 + (c^2 - a^2)(z.u)^2)``. Its range is ``R - h(u)`` in the far field, so
+the echo gets the GO phase ``exp(+j 2 k h)``; as a limb turns, ``h`` changes (from ``a``
+broadside to ``c`` end-on) and adds the Doppler ``+(2/lambda) dh/dt`` (positive approaching:
+the range ``R - h`` falls as ``h`` grows). The sphere head's front
+surface is ``a`` nearer (a constant phase). The RCS is unchanged; the spheroids' centres are
+given as ``Scatterers.centres`` for the effects that need the shapes (shadowing, multipath).
+Surface points already sit on the surface, so ``specular`` with ``surface_points > 0`` is refused.
 """
 
 from __future__ import annotations
@@ -24,7 +37,7 @@ from __future__ import annotations
 from typing import Literal
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, model_validator
 
 from mdframework import Motion, PluginConfig, ScattererModel, Scatterers, Skeleton
 from mdframework.physics import body as bodymodel
@@ -63,6 +76,20 @@ class EllipsoidConfig(PluginConfig):
         lt=2.5,
         description="Body height [m] for segment sizes; default: estimated from the legs.",
     )
+    scattering_phase: Literal["centre", "specular"] = Field(
+        "centre",
+        description="centre: each part's scatterer at its centre (Chen); specular: at its "
+        "specular point for the radar, h(u) nearer (the GO phase of the spheroid's echo).",
+    )
+
+    @model_validator(mode="after")
+    def _one_placement(self) -> EllipsoidConfig:
+        if self.scattering_phase == "specular" and self.surface_points > 0:
+            raise ValueError(
+                "scattering_phase = 'specular' needs surface_points = 0: surface points "
+                "already lie on the surface"
+            )
+        return self
 
 
 def _usable(length2: np.ndarray, semi_c: np.ndarray) -> np.ndarray:
@@ -203,7 +230,8 @@ class EllipsoidBody(ScattererModel):
         rp = np.asarray(radar_position, dtype=np.float64)
         los_t = rp[:, None, None] - pos_t
         los2 = _plane_dot(los_t, los_t)
-        sigma = rcs.spheroid_rcs_from_products(a, semi_c, _plane_dot(axes_t, los_t), norm2, los2)
+        dot = _plane_dot(axes_t, los_t)
+        sigma = rcs.spheroid_rcs_from_products(a, semi_c, dot, norm2, los2)
         spheres = np.array([p.sphere for p in parts])
         if np.any(spheres):
             if c.sphere_rcs == "mie":
@@ -224,5 +252,16 @@ class EllipsoidBody(ScattererModel):
             )
             return Scatterers(pts, sig, tuple(f"{m}#{j}" for m in names for j in range(n)))
         semi_axes = np.stack([a, a, semi_c], axis=1)
+        if c.scattering_phase == "specular":
+            _, alpha, beta = rcs.spheroid_specular_from_products(a, semi_c, dot, norm2, los2)
+            spec_t = alpha * los_t
+            spec_t += beta * axes_t
+            spec_t += pos_t
+            los_t = rp[:, None, None] - spec_t
+            ranges = np.sqrt(_plane_dot(los_t, los_t))
+            spec = np.ascontiguousarray(np.moveaxis(spec_t, 0, -1))
+            mask = np.ones(len(names), dtype=bool)
+            scat = Scatterers(spec, sigma, names, semi_axes, axes, centres=pos, specular=mask)
+            return scat.with_ranges(rp, ranges)
         scat = Scatterers(pos, sigma, names, semi_axes, axes)
         return scat.with_ranges(rp, np.sqrt(los2, out=los2))

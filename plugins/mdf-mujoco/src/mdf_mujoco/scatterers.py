@@ -52,10 +52,9 @@ MAX_PLACEMENT_RESIDUAL = 5e-3
 @dataclass(frozen=True)
 class BodyScatterers(Scatterers):
     """:class:`~mdframework.Scatterers` with the full ellipsoid frames: ``centres``
-    (n_pulses, n_scat, 3) [m] and ``rotations`` (n_pulses, n_scat, 3, 3), whose columns are the
-    a-, b- and c-axes (unit vectors, scene frame)."""
+    (n_pulses, n_scat, 3) [m] (the base class's field) and ``rotations`` (n_pulses, n_scat,
+    3, 3), whose columns are the a-, b- and c-axes (unit vectors, scene frame)."""
 
-    centres: FloatArray | None = None
     rotations: FloatArray | None = None
 
 

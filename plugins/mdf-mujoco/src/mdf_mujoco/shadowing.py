@@ -11,7 +11,9 @@ Bodies:
 
 - ``ellipsoids`` (default when the scatterers carry ``semi_axes`` and ``axes``, as the
   ``ellipsoid`` and ``mujoco_body`` models do): one ellipsoid per scatterer centred at its
-  position (at the geom centre for ``mujoco_body``, whose full frames are used). When only the
+  position, or at ``Scatterers.centres`` when given (the geom centre for ``mujoco_body``, whose
+  full frames are used; the spheroid centre for the ``ellipsoid`` model's specular points). The
+  ray goes to the scatterer's position itself. When only the
   c-axis is known the a/b orientation about it is arbitrary, exact for Chen's ``a = b``.
 - ``capsules`` (default otherwise, e.g. point scatterers on a canonical body): a capsule around
   each of the 16 canonical segments of ``context.skeleton``, with the part's radius from the
@@ -151,10 +153,12 @@ class Shadowing(Effect):
                 "effects.shadowing: bodies = 'ellipsoids' needs a scatterer model that gives "
                 "body-part shapes (ellipsoid, mujoco_body)"
             )
-        centres = getattr(scat, "centres", None)
+        # the shapes' centres, when the scatterers are not at them (the ellipsoid model's
+        # specular points lie on their own part's surface: the own part never blocks)
+        centres = scat.centres if scat.centres is not None else scat.positions
         rotations = getattr(scat, "rotations", None)
-        if centres is None or rotations is None:
-            centres, rotations = scat.positions, _frames_from_axis(scat.axes)
+        if rotations is None:
+            rotations = _frames_from_axis(scat.axes)
         n_s = scat.positions.shape[1]
         types = [int(mujoco.mjtGeom.mjGEOM_ELLIPSOID)] * n_s
         own = np.eye(n_s, dtype=bool)

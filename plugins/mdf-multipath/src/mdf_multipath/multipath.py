@@ -34,6 +34,14 @@ the ``ellipsoid`` and ``mujoco_body`` models) ``sigma_b = sigma x sigma_GO(r' - 
 (spheroid RCS ratio of the two aspects); otherwise ``sigma_b = sigma``. Scatterers below the
 plane get no images. ``paths = "image"`` keeps only the double-bounce image.
 
+Scatterers that sit at their shapes' specular points (``Scatterers.specular``: the ``ellipsoid``
+model's ``scattering_phase = "specular"``) keep their direct echo; the bounced paths are built
+from their ``centres`` ``p``, each with its own specular point: the image at the range
+``R_b - h(u_b)`` (``u_b`` toward the image radar, ``h`` the spheroid's support function), the
+bistatic single bounce at ``(R_d + R_b)/2 - |u_d + u_b|/2 h((u_d + u_b)/|u_d + u_b|)`` (the
+stationary point of the path length over the surface), and the spreading corrections take these
+path lengths. The virtual scatterers' ``centres`` are where they would sit without the shift.
+
 Put ``multipath`` after ``shadowing`` and ``antenna`` in the effects list when combining them:
 images are then made from the shadowed RCS and the antenna weights the direct path. (Placed
 after ``multipath``, the antenna weights each virtual scatterer by its own direction, an
@@ -108,14 +116,17 @@ class GroundMultipath(Effect):
         super().__init__(config)
         self._stats: dict[str, Any] = {}
 
-    def _aspect_ratio(self, data: Scatterers, r: FloatArray, r_img: FloatArray) -> FloatArray:
-        """``sigma_GO(seen from r') / sigma_GO(seen from r)`` per (pulse, scatterer)."""
+    def _aspect_ratio(
+        self, data: Scatterers, p: FloatArray, r: FloatArray, r_img: FloatArray
+    ) -> FloatArray:
+        """``sigma_GO(seen from r') / sigma_GO(seen from r)`` per (pulse, scatterer) of shapes
+        centred at ``p`` (n_pulses, n_scatterers, 3) [m]."""
         if not self.config.image_aspect or data.semi_axes is None or data.axes is None:
             return np.ones(data.rcs.shape)
         a = data.semi_axes[:, 0]
         c = data.semi_axes[:, 2]
-        direct = rcs.spheroid_rcs(a, c, data.axes, r - data.positions)
-        bounced = rcs.spheroid_rcs(a, c, data.axes, r_img - data.positions)
+        direct = rcs.spheroid_rcs(a, c, data.axes, r - p)
+        bounced = rcs.spheroid_rcs(a, c, data.axes, r_img - p)
         return np.asarray(bounced / direct, dtype=np.float64)
 
     def apply(self, data: Scatterers, context: SceneContext) -> Scatterers:
@@ -131,34 +142,58 @@ class GroundMultipath(Effect):
         lam = radar.wavelength(context.carrier_frequency)
         gamma = c.reflection_magnitude
         phi = np.deg2rad(c.reflection_phase_deg)
+        mask = data.specular if data.specular is not None else np.zeros(0, dtype=bool)
         p = data.positions
+        if np.any(mask) and data.centres is not None:  # those at specular points: their centres
+            p = np.where(mask[:, None], data.centres, data.positions)
         above = p[..., 2] > h
         p_img = mirror(p, h)
         r_img = mirror(r, h)
         r_d = np.linalg.norm(p - r, axis=-1)
         r_b = np.linalg.norm(p_img - r, axis=-1)
-        sigma_b = data.rcs * self._aspect_ratio(data, r, r_img)
+        sigma_b = data.rcs * self._aspect_ratio(data, p, r, r_img)
+        # scatterers at their specular points (centres given): each path's echo comes from
+        # the specular point for its own directions, at the path length less the support
+        # function: h(u_b) seen from the image radar, |u_d + u_b|/2 h(bisector) bistatic
+        spec_b = spec_m = np.zeros(0)
+        if np.any(mask) and data.semi_axes is not None and data.axes is not None:
+            a, semi_c = data.semi_axes[:, 0], data.semi_axes[:, 2]
+            _, h_b = rcs.spheroid_specular_point(a, semi_c, data.axes, r_img - p)
+            bisector = _unit(r - p) + _unit(r_img - p)
+            _, h_m = rcs.spheroid_specular_point(a, semi_c, data.axes, bisector)
+            spec_b = np.where(mask, h_b, 0.0)
+            spec_m = np.where(mask, 0.5 * np.linalg.norm(bisector, axis=-1) * h_m, 0.0)
 
         # double bounce: image scatterer at p', range R_b + delta_2
         delta2 = _phase_offset(2.0 * phi, lam)
         u_img = _unit(p_img - r)
         r_v2 = r_b + delta2
+        r_b_go = r_b  # the path's own length, for its spreading
+        if spec_b.size:
+            r_v2 = r_v2 - spec_b
+            r_b_go = r_b - spec_b
         pos_img = r + u_img * r_v2[..., None]
-        rcs_img = gamma**4 * sigma_b * (r_v2 / r_b) ** 4
-        parts_pos = [p, pos_img]
+        rcs_img = gamma**4 * sigma_b * (r_v2 / r_b_go) ** 4
+        parts_pos = [data.positions, pos_img]
         parts_rcs = [data.rcs, np.where(above, rcs_img, 0.0)]
         names = [*data.names, *(f"{n}~image" for n in data.names)]
+        virtual = [r + u_img * (r_b + delta2)[..., None]]  # the copies' unshifted places
         n_copies = 2
         if c.paths == "all":
             delta1 = _phase_offset(phi, lam)
             r_v1 = 0.5 * (r_d + r_b) + delta1
+            r_d_go = r_d
+            if spec_m.size:
+                r_v1 = r_v1 - spec_m
+                r_d_go = np.linalg.norm(data.positions - r, axis=-1)
             u_mid = _unit(_unit(p - r) + u_img)
             pos_mid = r + u_mid * r_v1[..., None]
             sigma_db = np.sqrt(data.rcs * sigma_b)
-            rcs_mid = 4.0 * gamma**2 * sigma_db * r_v1**4 / (r_d**2 * r_b**2)
+            rcs_mid = 4.0 * gamma**2 * sigma_db * r_v1**4 / (r_d_go**2 * r_b_go**2)
             parts_pos.append(pos_mid)
             parts_rcs.append(np.where(above, rcs_mid, 0.0))
             names += [f"{n}~bounce" for n in data.names]
+            virtual.append(r + u_mid * (0.5 * (r_d + r_b) + delta1)[..., None])
             n_copies = 3
         semi_axes = axes = None
         if data.semi_axes is not None and data.axes is not None:
@@ -179,6 +214,12 @@ class GroundMultipath(Effect):
             tuple(names),
             semi_axes,
             axes,
+            centres=None
+            if data.centres is None
+            else np.concatenate([data.centres, *virtual], axis=1),
+            specular=None
+            if data.specular is None
+            else np.concatenate([data.specular, np.zeros(len(names) - len(data.names), bool)]),
         )
 
     def describe(self) -> dict[str, Any]:

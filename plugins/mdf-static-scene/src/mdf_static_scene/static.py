@@ -121,4 +121,10 @@ class StaticScene(Effect):
             semi = np.concatenate([data.semi_axes, np.full((k, 3), SPHERE_M)])
             up = np.broadcast_to(np.array([0.0, 0.0, 1.0]), (n, k, 3))
             axes = np.concatenate([data.axes, up], axis=1)
-        return Scatterers(positions, rcs, names, semi, axes)
+        centres = None
+        if data.centres is not None:
+            centres = np.concatenate([data.centres, positions[:, -k:]], axis=1)
+        specular = None
+        if data.specular is not None:
+            specular = np.concatenate([data.specular, np.zeros(k, dtype=bool)])
+        return Scatterers(positions, rcs, names, semi, axes, centres=centres, specular=specular)
