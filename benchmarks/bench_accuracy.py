@@ -24,6 +24,8 @@ the error of that knob alone:
   image radar's aspect (ref, the options' defaults), at the direct aspect
   (``image_aspect = false``), or the double-bounce image alone (``paths = "image"``);
 - ``sphere rcs``: the head sphere's optical RCS (default) or the exact Mie series (ref);
+- ``scattering phase``: each part's echo phase from its centre (default, Chen's) or from its
+  specular point (ref, the geometric-optics phase);
 - ``analytic margin`` (FMCW scene only): range bins the analytic path keeps on each side of a
   scatterer, 1, 2, 8 (default), 32 and 240 (ref: every bin of the range profile).
 
@@ -237,6 +239,19 @@ def ladders(scene: str, quick: bool) -> list[Setting]:
                 {"scatterers": sc},
                 default=rcs == "optical",
                 ref=rcs == "mie",
+            )
+        )
+    # each part's echo phase: from its centre (default, Chen's code) or from its specular point
+    # (ref: the geometric-optics phase, h(u) nearer along the line of sight)
+    for phase in ("centre", "specular"):
+        sc = {"kind": "ellipsoid", "placement": "joints17", "scattering_phase": phase}
+        s.append(
+            Setting(
+                "scattering phase",
+                phase,
+                {"scatterers": sc},
+                default=phase == "centre",
+                ref=phase == "specular",
             )
         )
     return s
