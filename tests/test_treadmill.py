@@ -163,3 +163,25 @@ def test_untracked_frames_at_the_ends_do_not_move_the_placement(mode: str) -> No
     assert scene.travel_heading(gappy) == pytest.approx(scene.travel_heading(base[tracked]))
     with pytest.raises(ValueError, match="not tracked in any frame"):
         scene.placement(time, np.full_like(base, np.nan), **kw)
+
+
+def test_a_body_never_tracked_is_refused_naming_its_file() -> None:
+    """A body whose hip centre is tracked in no frame (other joints tracked) has nowhere to be
+    placed: one error naming the motion's file (a SceneError without one)."""
+    from mdframework import DataFileError
+    from mdframework.errors import SceneError
+    from mdframework.pipeline import body_placement
+    from mdframework.settings import PersonConfig
+    from mdframework.skeleton import CANONICAL_JOINTS, Skeleton
+
+    n, j = 10, len(CANONICAL_JOINTS)
+    pos = np.random.default_rng(2).normal(0.0, 0.3, (n, j, 3)) + np.array([2.0, 0.0, 1.0])
+    valid = np.ones((n, j), dtype=bool)
+    valid[:, CANONICAL_JOINTS.index("base")] = False
+    pos[:, CANONICAL_JOINTS.index("base")] = np.nan
+    body = Skeleton(np.arange(n) / 30.0, pos, CANONICAL_JOINTS, valid)
+    radar = np.zeros(3)
+    with pytest.raises(DataFileError, match=r"^cap\.nite\.txt: the hip centre .* in no frame"):
+        body_placement(body, PersonConfig(), radar, "cap.nite.txt")
+    with pytest.raises(SceneError, match="in no frame"):
+        body_placement(body, PersonConfig(), radar)
