@@ -13,6 +13,7 @@ import struct
 import subprocess
 import sys
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 import pytest
@@ -214,6 +215,12 @@ def test_nite_missing_message(monkeypatch: pytest.MonkeyPatch, tmp_path: Path, c
     assert "skeleton tracking needs NiTE2" in capsys.readouterr().err
 
 
+#: The Kinect v1 joints that stand for NiTE's 15 (NITE_JOINTS order).
+PICK_V1 = ["Head", "ShoulderCenter", "ShoulderLeft", "ShoulderRight", "ElbowLeft", "ElbowRight",
+           "HandLeft", "HandRight", "Spine", "HipLeft", "HipRight", "KneeLeft", "KneeRight",
+           "AnkleLeft", "AnkleRight"]  # fmt: skip
+
+
 def _nite_user(user_id: int, joints_mm: np.ndarray, conf: float, tracked: bool = True):
     """A binding NiteUserData as NiTE2 would fill it (NiTE2 itself cannot be installed here)."""
     from openni import _nite2
@@ -231,9 +238,7 @@ def _nite_user(user_id: int, joints_mm: np.ndarray, conf: float, tracked: bool =
 def test_nite_structures_to_skeleton(tmp_path: Path) -> None:
     body = read_utkinect(UT)  # a real Kinect body to fill the NiTE joints with
     v1 = {n: i for i, n in enumerate(KINECT_V1_JOINTS)}
-    pick = ["Head", "ShoulderCenter", "ShoulderLeft", "ShoulderRight", "ElbowLeft", "ElbowRight",
-            "HandLeft", "HandRight", "Spine", "HipLeft", "HipRight", "KneeLeft", "KneeRight",
-            "AnkleLeft", "AnkleRight"]  # fmt: skip
+    pick = PICK_V1
     frames = []
     for k in range(10):
         p = body.positions[k, [v1[n] for n in pick]]
@@ -442,6 +447,9 @@ def bad_files(tmp_path: Path) -> dict[str, list[tuple[str, bytes, str]]]:
             ("truncated", trunc(ut, 5), ":6: .*fields"),
             ("columns", b"".join(ut[:3]) + b"300 1 2 3\n", ":4: 4 fields"),
             ("nonnumeric", nonnum(ut, 2, b"abc"), ":3: field \\d+ is not a number: 'abc'"),
+            # a frame number within its own limit whose time (/ 60 per s) is beyond a day
+            ("frame 1e9", b"".join([*ut[:4], b"1000000000" + ut[4][3:], *ut[5:]]),
+             ":5: time stamp .* is beyond"),
         ],
         "msr-action3d": [
             *common,
@@ -488,3 +496,304 @@ def test_bad_input_one_clear_error(fmt: str, tmp_path: Path, capsys) -> None:
     assert cli.main(["run", str(cfg), "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "garbage.txt" in err[0]
+
+
+# --------------------------------------------------------------------------- handedness
+
+
+def test_utkinect_walk_is_not_mirrored() -> None:
+    """Left and right survive the Kinect -> project frame conversion (a mirrored y passed every
+    other test). Project frame: right-handed, z up, so for a person walking along v with the
+    right -> left shoulder vector L, (v x L) points up. On the real UTKinect walk (a person
+    walking across the room, checked on the data: 35 of 39 moving frames) most frames where
+    the hip centre moves faster than 0.3 m/s have (v x L)_z > 0; mirrored, most would be < 0."""
+    c = KinectSource(KinectConfig(format="utkinect", file=UT, segment="walk")).load().canonical()
+    v = np.gradient(c.joint("base")[:, :2], c.time, axis=0)
+    left = (c.joint("l_shoulder") - c.joint("r_shoulder"))[:, :2]
+    up = v[:, 0] * left[:, 1] - v[:, 1] * left[:, 0]
+    moving = np.hypot(v[:, 0], v[:, 1]) > 0.3
+    assert moving.sum() > 30
+    assert np.mean(up[moving] > 0) > 0.8
+
+
+def test_msr_punching_hand_is_the_right_one_on_the_right() -> None:
+    """MSR Action3D a05 (forward punch, subject 1, facing the sensor): the right hand moves most
+    (path 3.0 m against 1.2 m for the left on this file) and sits on the subject's right. The
+    sensor is at the origin and the subject at +x facing it (-x), so with z up the subject's
+    right is +y: the right hand's median y lies 0.1-0.3 m above the hip centre's (0.20 m on the
+    data), the left hand's as far below; mirrored, both would swap sides."""
+    path = DATA / "msr-action3d" / "a05_s01_e01_skeleton3D.txt"
+    c = KinectSource(KinectConfig(format="msr-action3d", file=path)).load().canonical()
+    base = c.joint("base")
+    assert np.median(base[:, 0]) > 1.5  # in front of the sensor, along +x
+
+    def path_length(j: str) -> float:
+        return float(np.sum(np.linalg.norm(np.diff(c.joint(j), axis=0), axis=1)))
+
+    assert path_length("r_hand") > 2 * path_length("l_hand")
+    assert 0.1 < np.median(c.joint("r_hand")[:, 1] - base[:, 1]) < 0.3
+    assert -0.3 < np.median(c.joint("l_hand")[:, 1] - base[:, 1]) < -0.1
+
+
+# --------------------------------------------------------------------------- untracked frames
+
+
+def utkinect_as_nite_users(n_untracked: int = 0) -> list[tuple[int, int, list]]:
+    """NiTE user-tracker frames (the binding's structures) of the real UTKinect recording,
+    after ``n_untracked`` frames (33.3 ms apart) where NiTE sees the user but does not track
+    the skeleton, as a capture starts."""
+    body = read_utkinect(UT)
+    v1 = {n: i for i, n in enumerate(KINECT_V1_JOINTS)}
+    frames = [
+        (k * 33_333, k + 1, [_nite_user(1, np.zeros((15, 3)), 0.0, tracked=False)])
+        for k in range(n_untracked)
+    ]
+    for k in range(body.time.size):
+        p = body.positions[k, [v1[n] for n in PICK_V1]]
+        mm = np.stack([-p[:, 0], p[:, 1], p[:, 2]], 1) * 1000.0  # NiTE: mm, x to the right
+        stamp = n_untracked * 33_333 + int(body.time[k] * 1e6)
+        frames.append((stamp, n_untracked + k + 1, [_nite_user(1, mm, 1.0)]))
+    return frames
+
+
+RUN_CONFIG = """[motion]
+kind = "kinect"
+format = "{fmt}"
+file = "{file}"
+[scatterers]
+kind = "ellipsoid"
+placement = "joints17"
+[radar]
+kind = "lfm"
+[scene]
+radar_position = [0.0, 0.0, 1.0]
+person = {{ motion = "recorded", position = [2.3, 0.0], aspect_deg = 0.0 }}
+"""
+
+
+def test_capture_starting_untracked_runs(tmp_path: Path, capsys) -> None:
+    """A real capture starts with frames where NiTE has not tracked anyone yet: 20 such frames
+    before the real UTKinect walk crashed ``mdf run`` (internal error: the placement's origin
+    came from the first frame, NaN). The reader leaves the untracked frames at the ends out,
+    and the run works; so does an NTU file whose first frame has no body."""
+    t, pos, conf, idx, user = nite_frames_to_arrays(utkinect_as_nite_users(20))
+    assert user == 1 and np.all(np.isnan(pos[:20]))
+    path = tmp_path / "late.nite.txt"
+    with path.open("w") as fh:
+        write_nite(fh, t, idx, user, pos, conf, {"device": "test"})
+    rec = read_nite(path)
+    n = read_utkinect(UT).time.size
+    assert rec.time.size == n and rec.metadata["untracked_frames_trimmed"] == 20
+    assert rec.frame_numbers[0] == 21 and rec.valid[0].all()
+    cfg = tmp_path / "nite.toml"
+    cfg.write_text(RUN_CONFIG.format(fmt="nite", file=path))
+    assert cli.main(["run", str(cfg), "--out", str(tmp_path / "out"), "--no-figures"]) == 0
+    ntu = tmp_path / "S001C001P001R001A001.skeleton"
+    ntu.write_text(ntu_text(read_utkinect(UT), drop_frame=0))
+    cfg.write_text(RUN_CONFIG.format(fmt="ntu", file=ntu))
+    assert cli.main(["run", str(cfg), "--out", str(tmp_path / "out2"), "--no-figures"]) == 0
+    # no frame tracked at all: one line naming the file
+    with path.open("w") as fh:
+        write_nite(fh, t[:20], idx[:20], user, pos[:20], conf[:20], {"device": "test"})
+    cfg.write_text(RUN_CONFIG.format(fmt="nite", file=path))
+    capsys.readouterr()
+    assert cli.main(["run", str(cfg), "--out", str(tmp_path / "out3"), "--no-figures"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "late.nite.txt" in err[0] and "no joint is tracked" in err[0]
+
+
+# --------------------------------------------------------------------------- mdf capture
+
+
+class FakeUserTracker:
+    """Stands in for ``nite2.UserTracker`` (NiTE2 cannot be installed here; the real path in
+    ``cmd_capture`` stays as it is). Like NiTE2 it loads ``NiTE2/s.dat`` relative to the
+    current directory when it is created, and tracks on the device's depth stream, read here
+    through the real OpenNI2 from the real test.oni: each depth frame gives the user frame of
+    the same index from :func:`utkinect_as_nite_users` (the binding's own ctypes structures),
+    3 untracked, then the UTKinect body."""
+
+    events: ClassVar[list[str]] = []
+
+    def __init__(self, dev) -> None:
+        from openni import openni2
+
+        if not Path("NiTE2/s.dat").is_file():
+            raise RuntimeError("(OniStatus.ONI_STATUS_ERROR, 'Could not find data file', None)")
+        self.cwd = Path.cwd()
+        self.openni2, self.dev = openni2, dev
+        self.stream = dev.create_stream(openni2.SENSOR_DEPTH)
+        self.stream.start()
+        self.users = utkinect_as_nite_users(3)
+        self.seen: set[int] = set()
+        self.read: list[int] = []
+        FakeUserTracker.events.append("tracker created")
+        FakeUserTracker.last = self
+
+    def read_frame(self):
+        from types import SimpleNamespace
+
+        if self.openni2.wait_for_any_stream([self.stream], 2.0) is None:
+            raise RuntimeError("no depth frame in 2 s")  # NiTE2 would wait for ever
+        f = self.stream.read_frame()
+        index, stamp = int(f.frameIndex), int(f.timestamp)
+        f.close()
+        self.read.append(index)
+        users = []
+        for ud in self.users[(index - 1) % len(self.users)][2]:
+            new = ud.id not in self.seen
+            self.seen.add(ud.id)
+            users.append(SimpleNamespace(id=ud.id, _userdata=ud, is_new=lambda new=new: new))
+        return SimpleNamespace(timestamp=stamp, frameIndex=index, users=users, close=lambda: None)
+
+    def start_skeleton_tracking(self, user_id: int) -> None:
+        pass
+
+    def close(self) -> None:
+        """Stopped and closed as device._playback does with its streams."""
+        from mdf_kinect.device import _wait_until_sleeping
+
+        self.stream.stop()
+        self.dev.playback.set_speed(0.0)
+        _wait_until_sleeping(FakeUserTracker.player)
+        self.stream.close()
+        FakeUserTracker.events.append("tracker closed")
+
+
+@pytest.fixture
+def fake_nite(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> Path:
+    """``mdf capture`` with :class:`FakeUserTracker` for NiTE2; a Redist folder holding
+    NiTE2/s.dat (returned); the device's closing is recorded in FakeUserTracker.events."""
+    from types import SimpleNamespace
+
+    import mdf_kinect.cli as kcli
+    from mdf_kinect.device import _task_ids
+    from openni import openni2
+
+    redist = tmp_path / "Redist"
+    (redist / "NiTE2").mkdir(parents=True)
+    (redist / "NiTE2" / "s.dat").write_bytes(b"fake")
+    fake = SimpleNamespace(UserTracker=FakeUserTracker, get_version=lambda: "2.2 (fake)")
+    monkeypatch.setattr(kcli, "initialize_nite", lambda redist=None: fake)
+    real_open = kcli.open_device
+
+    def open_device(o, uri=None):
+        before = _task_ids()
+        dev = real_open(o, uri)
+        FakeUserTracker.player = _task_ids() - before
+        return dev
+
+    monkeypatch.setattr(kcli, "open_device", open_device)
+    real_close = openni2.Device.close
+
+    def close(self):
+        if self:  # an open handle (the binding also closes on opening)
+            FakeUserTracker.events.append("device closed")
+        real_close(self)
+
+    monkeypatch.setattr(openni2.Device, "close", close)
+    FakeUserTracker.events = []
+    return redist
+
+
+def test_capture_from_oni_file(fake_nite: Path, tmp_path: Path, monkeypatch, capsys) -> None:
+    """``mdf capture --device rec.oni`` (NiTE2 faked, see FakeUserTracker; OpenNI2 and the file
+    real), run from another folder with relative paths:
+
+    - the user tracker is created inside NiTE2's Redist folder (NiTE2 loads NiTE2/s.dat from
+      the current directory; elsewhere it failed as "cannot track on this device"), and the
+      relative --out and --device still mean the user's folder, which is restored;
+    - the file is played once: 12 depth frames, then the capture stops (OpenNI2 repeats a file
+      by default: the capture looped until --duration);
+    - the 3 leading untracked frames are left out: 9 frames at 30 Hz;
+    - the tracker is closed before the device."""
+    work = tmp_path / "work"
+    work.mkdir()
+    (work / "rec.oni").write_bytes(ONI.read_bytes())
+    monkeypatch.chdir(work)
+    args = ["capture", "--out", "walk.nite.txt", "--device", "rec.oni", "--duration", "3"]
+    assert cli.main([*args, "--nite2", str(fake_nite)]) == 0
+    assert Path.cwd() == work and FakeUserTracker.last.cwd == fake_nite
+    assert FakeUserTracker.last.read == list(range(1, 13))
+    rec = read_nite(work / "walk.nite.txt")
+    assert list(rec.frame_numbers) == list(range(4, 13))
+    assert rec.metadata["untracked_frames_trimmed"] == 0
+    out = capsys.readouterr().out
+    assert "9 frames (9 with user 1 tracked; 3 untracked at the ends left out)" in out
+    assert re.search(r"0\.26\d s measured, 29\.9\d Hz actual", out), out
+    assert FakeUserTracker.events == ["tracker created", "tracker closed", "device closed"]
+    # no NiTE2 data where the tracker is created: the error, the device closed, cwd restored
+    (fake_nite / "NiTE2" / "s.dat").unlink()
+    FakeUserTracker.events = []
+    assert cli.main([*args, "--nite2", str(fake_nite)]) == 2
+    assert "NiTE2 cannot track on this device" in capsys.readouterr().err
+    assert Path.cwd() == work and FakeUserTracker.events == ["device closed"]
+
+
+def test_nite2_redist64_is_read(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """NiTE 2.2's install.sh exports only NITE2_REDIST64 on x86_64: it is read (before
+    NITE2_REDIST, as the openni binding does). An empty libNiTE2.so there fails to load,
+    naming that folder; it was '(neither is set)'."""
+    (tmp_path / "r64").mkdir()
+    (tmp_path / "r64" / "libNiTE2.so").write_bytes(b"")
+    monkeypatch.delenv("NITE2_REDIST", raising=False)
+    monkeypatch.setenv("NITE2_REDIST64", str(tmp_path / "r64"))
+    with pytest.raises(NiteMissingError, match=r"loading .*r64/libNiTE2\.so failed"):
+        initialize_nite()
+    monkeypatch.setenv("NITE2_REDIST", str(tmp_path / "other"))
+    with pytest.raises(NiteMissingError, match=r"loading .*r64/libNiTE2\.so failed"):
+        initialize_nite()
+
+
+# --------------------------------------------------------------------------- bad .oni files
+
+
+def oni_records(data: bytes) -> list[tuple[int, int]]:
+    """(byte, record type) of every record of an .oni file."""
+    out, pos = [], 24
+    while pos < len(data):
+        _, typ, _, fsize, psize, _ = struct.unpack_from("<4sIIIIQ", data, pos)
+        out.append((pos, typ))
+        if typ == 11:
+            break
+        pos += fsize + psize
+    return out
+
+
+def test_bad_oni_named_before_openni2(tmp_path: Path, capsys) -> None:
+    """Files OpenNI2 refuses with its bare ONI_STATUS_ERROR are refused by scan_oni first,
+    naming the file and record: cut exactly at a record boundary (the end, node-removed and
+    seek-table records missing), a record of unknown type 99, a node-added record whose name
+    length is garbage or whose codec is unknown, a seek table missing. Through the CLI: one
+    line, exit 2, no 'is a Kinect connected' hint for a file."""
+    data = ONI.read_bytes()
+    recs = oni_records(data)
+    frames = [p for p, t in recs if t == 10]
+    depth_added = [p for p, t in recs if t == 13][1]
+    seek = next(p for p, t in recs if t == 14)
+    type99 = bytearray(data)
+    struct.pack_into("<I", type99, recs[5][0] + 4, 99)
+    name = bytearray(data)
+    struct.pack_into("<I", name, depth_added + 28, 1000)
+    codec = bytearray(data)
+    codec[depth_added + 32 + 7 + 4 : depth_added + 32 + 7 + 8] = b"XXXX"
+    no_seek = data[:seek] + data[seek + 28 + 260 :]
+    cases = {
+        "cut": (data[: frames[10]], r"ends after record \d+ \(new data\) at byte \d+ without"),
+        "type99": (bytes(type99), r"record 6 at byte \d+: unknown record type 99"),
+        "name": (bytes(name), r"record \d+ \(node added\) at byte 1587: node name length 1000"),
+        "codec": (bytes(codec), r"node 'Depth1' of type 2 with codec b'XXXX'"),
+        "noseek": (no_seek, r"'Depth1'\): its seek table at byte \d+ is not a seek table"),
+    }
+    for case, (content, pattern) in cases.items():
+        path = tmp_path / f"{case}.oni"
+        path.write_bytes(content)
+        with pytest.raises(DataFileError, match=rf"{case}\.oni: .*{pattern}"):
+            scan_oni(path)
+        assert cli.main(["kinect", "info", str(path)]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and f"{case}.oni" in err[0] and "Kinect" not in err[0], err
+    # the library's own error on a file: no hint about a Kinect
+    with pytest.raises(DeviceError, match=r"type99\.oni.*cannot play") as exc:
+        open_device(initialize_openni(), str(tmp_path / "type99.oni"))
+    assert "Kinect connected" not in str(exc.value)

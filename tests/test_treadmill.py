@@ -134,3 +134,54 @@ def test_drift_rate_is_the_least_squares_slope() -> None:
     expected = [np.polyfit(time, track[:, k], 1)[0] for k in range(2)]
     assert np.max(np.abs(scene.linear_drift_rate(time, track) - expected)) < 1e-12
     assert np.array_equal(scene.linear_drift_rate(time[:1], track[:1]), np.zeros(2))
+
+
+@pytest.mark.parametrize("mode", ["recorded", "treadmill", "straight"])
+def test_untracked_frames_at_the_ends_do_not_move_the_placement(mode: str) -> None:
+    """A capture's first frames come before the tracker finds the person (base NaN): the
+    placement is the one of the tracked frames alone (origin from the first tracked frame,
+    drift and travel fitted to the tracked frames), to 1e-12 m on every tracked frame; it was
+    NaN everywhere (origin from frame 0). A base tracked in no frame is refused."""
+    from mdframework.physics import scene
+
+    rng = np.random.default_rng(8)
+    time = np.cumsum(rng.uniform(0.02, 0.04, 200))
+    base = np.column_stack([1.1 * time, 0.2 * np.sin(time), 1.0 + 0.02 * np.cos(3 * time)])
+    joints = base[:, None, :] + rng.normal(0.0, 0.3, (200, 4, 3))
+    gappy, gappy_joints = base.copy(), joints.copy()
+    gappy[:20] = np.nan
+    gappy[-5:] = np.nan
+    gappy_joints[:20] = np.nan
+    kw: dict[str, Any] = dict(
+        heading_now=0.3, heading=2.0, position=np.array([4.0, -1.0]), mode=mode, speed=1.4
+    )
+    whole = scene.placement(time, gappy, **kw).apply(time, gappy_joints)
+    tracked = slice(20, 195)
+    alone = scene.placement(time[tracked], base[tracked], **kw)
+    assert np.max(np.abs(whole[tracked] - alone.apply(time[tracked], joints[tracked]))) < 1e-12
+    assert np.all(np.isnan(whole[:20]))
+    assert scene.travel_heading(gappy) == pytest.approx(scene.travel_heading(base[tracked]))
+    with pytest.raises(ValueError, match="not tracked in any frame"):
+        scene.placement(time, np.full_like(base, np.nan), **kw)
+
+
+def test_a_body_never_tracked_is_refused_naming_its_file() -> None:
+    """A body whose hip centre is tracked in no frame (other joints tracked) has nowhere to be
+    placed: one error naming the motion's file (a SceneError without one)."""
+    from mdframework import DataFileError
+    from mdframework.errors import SceneError
+    from mdframework.pipeline import body_placement
+    from mdframework.settings import PersonConfig
+    from mdframework.skeleton import CANONICAL_JOINTS, Skeleton
+
+    n, j = 10, len(CANONICAL_JOINTS)
+    pos = np.random.default_rng(2).normal(0.0, 0.3, (n, j, 3)) + np.array([2.0, 0.0, 1.0])
+    valid = np.ones((n, j), dtype=bool)
+    valid[:, CANONICAL_JOINTS.index("base")] = False
+    pos[:, CANONICAL_JOINTS.index("base")] = np.nan
+    body = Skeleton(np.arange(n) / 30.0, pos, CANONICAL_JOINTS, valid)
+    radar = np.zeros(3)
+    with pytest.raises(DataFileError, match=r"^cap\.nite\.txt: the hip centre .* in no frame"):
+        body_placement(body, PersonConfig(), radar, "cap.nite.txt")
+    with pytest.raises(SceneError, match="in no frame"):
+        body_placement(body, PersonConfig(), radar)

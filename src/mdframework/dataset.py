@@ -995,6 +995,7 @@ def _place_record(run: dict[str, Any], config: RunConfigBase, motion: Motion) ->
     ``config``: ``run`` validated."""
     from .physics.scene import scene_heading_deg
     from .pipeline import body_placement, condition_body
+    from .sanity import motion_file
 
     scene: dict[str, Any] = json.loads(json.dumps(run.get("scene", {})))
     if motion.canonical_map is None:
@@ -1002,7 +1003,8 @@ def _place_record(run: dict[str, Any], config: RunConfigBase, motion: Motion) ->
     body, _ = condition_body(motion.canonical(), config.conditioning)
     person = config.scene.person
     # only the hip centre's track is placed: the placement comes from the whole recording
-    where = body_placement(body, person, np.asarray(config.scene.radar_position, np.float64))
+    radar = np.asarray(config.scene.radar_position, np.float64)
+    where = body_placement(body, person, radar, motion_file(motion))
     base = where.apply(body.time, body.joint("base"))
     start = body.time[0] + float(run["motion"].get("start", 0.0))
     at = np.array([np.interp(start, body.time, base[:, k]) for k in (0, 1)])

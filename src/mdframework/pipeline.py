@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import conditioning, emptiness, limits, sanity
-from .errors import SceneError
+from .errors import DataFileError, SceneError
 from .interfaces import (
     Effect,
     Motion,
@@ -216,11 +216,16 @@ def placed(body: Skeleton, where: scene.Placement | None) -> Skeleton:
 
 
 def body_placement(
-    body: Skeleton, person: PersonConfig, radar_position: FloatArray
+    body: Skeleton, person: PersonConfig, radar_position: FloatArray, source: str | None = None
 ) -> scene.Placement:
     """How ``person`` places a canonical body (the whole recording) in the scene: apply it to
-    any of its frames (:meth:`physics.scene.Placement.apply`)."""
+    any of its frames (:meth:`physics.scene.Placement.apply`). The placement starts at the
+    first frame whose hip centre is tracked; a body tracked in no frame is refused, naming
+    ``source`` (the motion's file) where given."""
     base = body.joint("base")
+    if not np.any(np.all(np.isfinite(base), axis=1)):
+        message = "the hip centre (base) is tracked in no frame: no body to place"
+        raise DataFileError(source, message) if source else SceneError(message)
     try:
         heading_now = scene.body_heading(
             base, body.joint("l_hip"), body.joint("r_hip"), rule=person.facing
@@ -509,7 +514,7 @@ def prepare_body(
     body = motion.canonical() if stages.model.needs_canonical else motion.skeleton
     body, conditioning_report = condition_body(body, config.conditioning)
     if stages.model.needs_canonical:
-        where = body_placement(body, sc.person, radar_pos)
+        where = body_placement(body, sc.person, radar_pos, sanity.motion_file(motion))
         return body, conditioning_report, sc.person.model_dump(), where
     if not _is_default_placement(sc.person):
         raise SceneError(

@@ -107,6 +107,13 @@ class MotionSanityWarning(UserWarning):
 # --------------------------------------------------------------------------- building blocks
 
 
+def motion_file(motion: Motion) -> str:
+    """The motion's file as the config resolves it (``metadata['path']``), else its name or
+    source: how messages about a motion name it."""
+    md = motion.metadata
+    return str(md.get("path") or md.get("file") or md.get("source", "motion"))
+
+
 def deviations(
     time: FloatArray, positions: FloatArray, valid: BoolArray | None = None
 ) -> tuple[FloatArray, FloatArray]:
@@ -419,8 +426,7 @@ def check_motion(motion: Motion, config: SanityConfig) -> Motion:
     if not config.enabled or motion.canonical_map is None:
         return motion
     body = motion.canonical()
-    md = motion.metadata  # the file as the config resolves it, as the sources' warnings name it
-    where = str(md.get("path") or md.get("file") or md.get("source", "motion"))
+    where = motion_file(motion)  # as the config resolves it, as the sources' warnings name it
     report: dict[str, Any] = {}
     notes: list[tuple[str, str]] = []  # (option, message)
 

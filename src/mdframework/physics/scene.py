@@ -26,8 +26,12 @@ def facing_heading(left_hip: FloatArray, right_hip: FloatArray) -> float:
 
 def travel_heading(base: FloatArray) -> tuple[float, float]:
     """Heading [rad] of the straight line from the first to the last hip-centre position
-    (n_frames, 3) [m], and the horizontal distance [m] travelled along it."""
-    d = base[-1, :2] - base[0, :2]
+    (n_frames, 3) [m] that is tracked (finite), and the horizontal distance [m] travelled
+    along it (0 when no two frames are tracked)."""
+    tracked = base[np.all(np.isfinite(base[:, :2]), axis=1), :2]
+    if tracked.shape[0] < 2:
+        return 0.0, 0.0
+    d = tracked[-1] - tracked[0]
     return float(np.arctan2(d[1], d[0])), float(np.hypot(d[0], d[1]))
 
 
@@ -92,7 +96,8 @@ class Placement:
     ``x`` at time ``t`` [s] goes to ``Rz(turn) (x - origin) + offset + (t - t0) velocity``,
     the last two horizontal. ``turn`` [rad] about +z; ``origin`` (3,) [m]; ``offset`` (2,)
     [m]; ``velocity`` (2,) [m/s] (the treadmill's drift removed and a straight path's travel
-    added; zero for a recorded path); ``t0`` [s], the recording's first frame."""
+    added; zero for a recorded path); ``t0`` [s], the recording's first frame whose base is
+    tracked."""
 
     turn: float
     origin: FloatArray
@@ -139,15 +144,24 @@ def placement(
     - ``straight``: as ``treadmill``, then the body moves along ``heading`` at ``speed`` [m/s].
 
     The drift is fitted to the whole recording, so any window of it is placed as the whole is.
+    Frames whose base is not tracked (NaN: a capture's first frames before the tracker found
+    the person) are left out: "first" means the first tracked frame, and the drift is fitted
+    to the tracked frames. Raises ValueError when no frame's base is tracked.
     """
     if mode not in ("recorded", "treadmill", "straight"):
         raise ValueError(f"unknown motion mode {mode!r}")
-    origin = np.array([base[0, 0], base[0, 1], 0.0])
+    tracked = np.flatnonzero(np.all(np.isfinite(base[:, :2]), axis=1))
+    if tracked.size == 0:
+        raise ValueError("the hip centre (base) is not tracked in any frame")
+    first = int(tracked[0])
+    origin = np.array([base[first, 0], base[first, 1], 0.0])
     velocity = np.zeros(2)
-    turned = Placement(heading - heading_now, origin, np.zeros(2), float(time[0]), velocity)
+    t0 = float(time[first])
+    turned = Placement(heading - heading_now, origin, np.zeros(2), t0, velocity)
     if mode in ("treadmill", "straight"):
-        velocity = -linear_drift_rate(time, turned.apply(time, base)[:, :2])
+        t_ok = time[tracked]
+        velocity = -linear_drift_rate(t_ok, turned.apply(t_ok, base[tracked])[:, :2])
         if mode == "straight":
             velocity += speed * np.array([np.cos(heading), np.sin(heading)])
     offset = np.asarray(position, dtype=np.float64)[:2]
-    return Placement(heading - heading_now, origin, offset, float(time[0]), velocity)
+    return Placement(heading - heading_now, origin, offset, t0, velocity)

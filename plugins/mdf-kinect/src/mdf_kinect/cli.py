@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import io
 import json
 import math
@@ -21,8 +22,10 @@ from .device import (
     DeviceError,
     initialize_nite,
     initialize_openni,
+    nite_redist,
     oni_info,
     open_device,
+    scan_oni,
 )
 from .nitefile import nite_frames_to_arrays, write_nite
 
@@ -72,7 +75,11 @@ def add_commands(subparsers: argparse._SubParsersAction[Any]) -> None:
         help="seconds to record (default: until Ctrl-C)",
     )
     cap.add_argument("--device", default=None, help="device URI or .oni file (default: first)")
-    cap.add_argument("--nite2", default=None, help="NiTE2 Redist folder (else $NITE2_REDIST)")
+    cap.add_argument(
+        "--nite2",
+        default=None,
+        help="NiTE2 Redist folder (else $NITE2_REDIST64, else $NITE2_REDIST)",
+    )
     cap.set_defaults(func=cmd_capture)
 
 
@@ -108,16 +115,30 @@ def cmd_info(args: argparse.Namespace) -> int:
 
 
 def cmd_capture(args: argparse.Namespace) -> int:
-    """Record skeletons until the duration is over or Ctrl-C; write the NiTE file (checked
-    before the device starts, written whole or not at all)."""
-    out = check_output_file(args.out)
+    """Record skeletons until the duration is over, Ctrl-C, or the end of an ``.oni`` file;
+    write the NiTE file (checked before the device starts, written whole or not at all)."""
+    # absolute first: the user tracker is created inside NiTE2's Redist folder
+    out = check_output_file(Path(args.out).absolute())
+    device = args.device
+    n_file_frames = None
+    if device is not None and Path(device).is_file():
+        device = str(Path(device).absolute())
+        n_file_frames = scan_oni(Path(device)).depth_frames()
     nite2 = initialize_nite(args.nite2)
     openni2 = initialize_openni()
-    dev = open_device(openni2, args.device)
+    dev = open_device(openni2, device)
     try:
-        tracker = nite2.UserTracker(dev)
-    except Exception as exc:
-        raise DeviceError(f"NiTE2 cannot track on this device: {exc}") from None
+        if n_file_frames is not None:
+            dev.playback.set_repeat_enabled(False)  # OpenNI2 plays a file in a loop by default
+        try:
+            # NiTE2 loads NiTE2/s.dat... relative to the current directory when it starts
+            with contextlib.chdir(str(nite_redist(args.nite2))):
+                tracker = nite2.UserTracker(dev)
+        except Exception as exc:
+            raise DeviceError(f"NiTE2 cannot track on this device: {exc}") from None
+    except BaseException:
+        dev.close()
+        raise
     from openni import _nite2
 
     frames: list[tuple[int, int, list[Any]]] = []
@@ -135,16 +156,27 @@ def cmd_capture(args: argparse.Namespace) -> int:
                 users.append(_nite2.NiteUserData.from_buffer_copy(u._userdata))
             frames.append((int(f.timestamp), int(f.frameIndex), users))
             f.close()
+            # the file's last depth frame (NiTE2 tracks on depth; OpenNI2 numbers a recorded
+            # stream's frames 1..n, and NiTE2 may skip some)
+            if n_file_frames is not None and max(len(frames), frames[-1][1]) >= n_file_frames:
+                break
     finally:
         signal.signal(signal.SIGINT, old)
         wall = time.monotonic() - t0
         dev_info = dev.get_device_info()
+        # the tracker (and its depth stream) first: closing the device under a live stream
+        # crashes OpenNI2's file player
+        tracker.close()
         dev.close()
     if len(frames) < 2:
         raise DeviceError(f"only {len(frames)} frame(s) recorded")
     t, pos, conf, idx, user = nite_frames_to_arrays(frames)
     if user is None:
         raise DeviceError("no user's skeleton was tracked; stand 2-3 m in front of the sensor")
+    # frames before NiTE found the user and after it lost them for good hold no skeleton
+    tracked = np.flatnonzero(np.all(np.isfinite(pos), axis=(1, 2)))
+    span = slice(int(tracked[0]), int(tracked[-1]) + 1)
+    t, pos, conf, idx = t[span] - t[span][0], pos[span], conf[span], idx[span]
     info = {
         "device": f"{dev_info.vendor.decode()} {dev_info.name.decode()} ({dev_info.uri.decode()})",
         "software": f"mdf-kinect 0.1.0, OpenNI {openni2.get_version()}, NiTE {nite2.get_version()}",
@@ -155,9 +187,10 @@ def cmd_capture(args: argparse.Namespace) -> int:
     write_nite(text, t, idx, user, pos, conf, info)
     atomic_write_text(out, text.getvalue())
     rate = (len(t) - 1) / t[-1] if t[-1] > 0 else float("nan")
-    tracked = int(np.all(np.isfinite(pos), axis=(1, 2)).sum())
+    n_tracked = int(np.all(np.isfinite(pos), axis=(1, 2)).sum())
     print(
-        f"{out}: {len(t)} frames ({tracked} with user {user} tracked), "
-        f"{t[-1]:.3f} s measured, {rate:.2f} Hz actual sampling frequency"
+        f"{out}: {len(t)} frames ({n_tracked} with user {user} tracked; {len(frames) - len(t)} "
+        f"untracked at the ends left out), {t[-1]:.3f} s measured, {rate:.2f} Hz actual "
+        "sampling frequency"
     )
     return 0

@@ -4,9 +4,11 @@ binding and the system libraries.
 - OpenNI2 (Debian ``libopenni2-0``): the library folder comes from ``OPENNI2_REDIST`` or the
   Debian location ``/usr/lib/x86_64-linux-gnu``; the binding wants byte-string paths.
 - NiTE2 (proprietary, not in any package registry): its ``Redist`` folder (holding
-  ``libNiTE2.so`` and ``NiTE2/``) comes from the ``nite2_redist`` argument or the ``NITE2_REDIST``
-  environment variable. Without it, skeleton tracking stops with :class:`NiteMissingError`; there
-  is no fallback.
+  ``libNiTE2.so`` and ``NiTE2/``) comes from the ``nite2_redist`` argument, else the
+  ``NITE2_REDIST64`` environment variable (NiTE 2.2's install.sh exports only this one on x86_64),
+  else ``NITE2_REDIST``. Without it, skeleton tracking stops with :class:`NiteMissingError`;
+  there is no fallback. NiTE2 loads its data (``NiTE2/s.dat``...) relative to the current
+  directory when a user tracker is created: create it there (``contextlib.chdir``).
 
 ``.oni`` files are checked in Python first (:func:`scan_oni`: the 24-byte ``NI10`` header, then
 records with a 28-byte header, ``NIR\\0`` magic, type, node id, fields size (header included),
@@ -21,7 +23,7 @@ import os
 import struct
 from collections.abc import Iterator
 from contextlib import closing, contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -50,6 +52,14 @@ RECORD_TYPES: dict[int, str] = {
     14: "seek table",
 }
 NEW_DATA = 10
+NODE_ADDED = (2, 12, 13)
+NODE_REMOVED = 7
+END = 11
+SEEK_TABLE = 14
+#: Node types OpenNI2's file player plays (XnProductionNodeType): device, depth, image, IR.
+NODE_TYPES: dict[int, str] = {1: "device", 2: "depth", 3: "image", 5: "IR"}
+#: Codecs of recorded streams (XnCodecIDs).
+CODECS = (b"NONE", b"16zP", b"16zT", b"Im8z", b"JPEG")
 FILE_HEADER = struct.Struct(
     "<4sBBHIQI"
 )  # magic, version (major, minor, maint, build), max ts, max node
@@ -67,8 +77,8 @@ class NiteMissingError(MdfError):
 NITE_HELP = (
     "skeleton tracking needs NiTE2 (PrimeSense's proprietary user tracker; it is not in any "
     "package registry): install NiTE 2.2 from your vendor's download and point to its Redist "
-    "folder (the one holding libNiTE2.so) with the environment variable NITE2_REDIST or "
-    "the --nite2 option of mdf capture"
+    "folder (the one holding libNiTE2.so) with the environment variable NITE2_REDIST64 or "
+    "NITE2_REDIST or the --nite2 option of mdf capture"
 )
 
 
@@ -80,13 +90,22 @@ class OniScan:
     by_type: dict[str, int]
     frames_per_node: dict[int, int]
     nodes: dict[int, str]
+    #: node id -> node type (:data:`NODE_TYPES`: 2 is depth)
+    node_types: dict[int, int] = field(default_factory=dict)
+
+    def depth_frames(self) -> int:
+        """Frames of the depth stream(s)."""
+        return sum(n for node, n in self.frames_per_node.items() if self.node_types.get(node) == 2)
 
 
 def scan_oni(path: Path) -> OniScan:
     """Check an ``.oni`` file's structure (header and record chain) without the library.
 
     Raises :class:`~mdframework.DataFileError` naming the file and record (number and byte
-    offset) for a wrong magic, a truncated record, or a file without any frame.
+    offset) for a wrong magic, a truncated record, an unknown record type, a node-added record
+    that does not hold a name, a known node type and codec and (for a stream with frames) the
+    place of its seek table, a file without any frame, or a file that ends without the records
+    a complete recording closes with (a node-removed record for every node, then the end).
     """
     try:
         data = path.read_bytes()
@@ -102,6 +121,12 @@ def scan_oni(path: Path) -> OniScan:
     by_type: dict[str, int] = {}
     frames: dict[int, int] = {}
     nodes: dict[int, str] = {}
+    node_types: dict[int, int] = {}
+    seek_at: dict[int, tuple[int, int]] = {}  # node -> (its seek table's byte, record number)
+    records: dict[int, tuple[int, int]] = {}  # byte -> (type, node)
+    removed: set[int] = set()
+    last = "the header"
+    ended = False
     while pos < len(data):
         n += 1
         if pos + RECORD_HEADER.size > len(data):
@@ -115,14 +140,24 @@ def scan_oni(path: Path) -> OniScan:
             raise DataFileError(
                 path, f"record {n} at byte {pos}: truncated (sizes run past the end)"
             )
-        name = RECORD_TYPES.get(rtype, f"type {rtype}")
+        if rtype not in RECORD_TYPES:
+            raise DataFileError(
+                path, f"record {n} at byte {pos}: unknown record type {rtype} (after {last})"
+            )
+        name = RECORD_TYPES[rtype]
         by_type[name] = by_type.get(name, 0) + 1
-        if rtype in (2, 12, 13):
-            (ln,) = struct.unpack_from("<I", data, pos + 28)
-            nodes[node] = data[pos + 32 : pos + 32 + ln].rstrip(b"\0").decode("latin-1")
+        records[pos] = (rtype, node)
+        if rtype in NODE_ADDED:
+            nodes[node], node_types[node], seek = _node_added(path, data, pos, n, fsize)
+            if seek is not None:
+                seek_at[node] = (seek, n)
         if rtype == NEW_DATA:
             frames[node] = frames.get(node, 0) + 1
-        if rtype == 11:
+        if rtype == NODE_REMOVED:
+            removed.add(node)
+        last = f"record {n} ({name}) at byte {pos}"
+        if rtype == END:
+            ended = True
             break
         pos += fsize + psize
     if not frames:
@@ -131,7 +166,45 @@ def scan_oni(path: Path) -> OniScan:
             f"the recording holds no frame: {n} records ({', '.join(sorted(by_type))}) with the "
             "header and stream properties only",
         )
-    return OniScan(n, by_type, frames, nodes)
+    if not ended or set(nodes) - removed:
+        raise DataFileError(
+            path,
+            f"the recording ends after {last} without the records a complete recording closes "
+            "with (node removed for every stream, seek tables, end): cut short?",
+        )
+    for node, (seek, k) in seek_at.items():
+        if node in frames and records.get(seek) != (SEEK_TABLE, node):
+            raise DataFileError(
+                path,
+                f"record {k} (node added, {nodes[node]!r}): its seek table at byte {seek} is "
+                "not a seek table record of that stream",
+            )
+    return OniScan(n, by_type, frames, nodes, node_types)
+
+
+def _node_added(
+    path: Path, data: bytes, pos: int, n: int, fsize: int
+) -> tuple[str, int, int | None]:
+    """A node-added record's node name, node type and (newest layout, type 13) the byte of its
+    seek table (None before); a record that does not hold them is an error naming it."""
+    end = pos + fsize
+    where = f"record {n} (node added) at byte {pos}"
+    (ln,) = struct.unpack_from("<I", data, pos + 28) if pos + 32 <= end else (0,)
+    if not 0 < ln <= end - pos - 40:
+        raise DataFileError(path, f"{where}: node name length {ln} does not fit the record")
+    name = data[pos + 32 : pos + 32 + ln].rstrip(b"\0").decode("latin-1")
+    ntype, codec = struct.unpack_from("<I4s", data, pos + 32 + ln)
+    if ntype not in NODE_TYPES or codec not in CODECS:
+        raise DataFileError(
+            path,
+            f"{where}: node {name!r} of type {ntype} with codec {codec!r} (a recording holds "
+            f"types {sorted(NODE_TYPES)} with codecs {', '.join(c.decode() for c in CODECS)})",
+        )
+    rtype = struct.unpack_from("<I", data, pos + 4)[0]
+    if rtype != 13 or pos + 32 + ln + 36 > end:
+        return name, ntype, None
+    seek = struct.unpack_from("<Q", data, pos + 32 + ln + 28)[0]
+    return name, ntype, int(seek)
 
 
 def initialize_openni(redist: str | None = None) -> Any:
@@ -151,9 +224,16 @@ def initialize_openni(redist: str | None = None) -> Any:
     return openni2
 
 
+def nite_redist(redist: str | None = None) -> str | None:
+    """NiTE2's Redist folder: ``redist``, else ``NITE2_REDIST64`` (what NiTE 2.2's install.sh
+    exports on x86_64, and what the ``openni`` binding reads first), else ``NITE2_REDIST``;
+    None when none is set."""
+    return redist or os.environ.get("NITE2_REDIST64") or os.environ.get("NITE2_REDIST") or None
+
+
 def initialize_nite(redist: str | None = None) -> Any:
-    """Load NiTE2 from ``redist`` or ``NITE2_REDIST``; :class:`NiteMissingError` otherwise."""
-    folder = redist or os.environ.get("NITE2_REDIST")
+    """Load NiTE2 from :func:`nite_redist`'s folder; :class:`NiteMissingError` otherwise."""
+    folder = nite_redist(redist)
     if not folder:
         raise NiteMissingError(NITE_HELP + " (neither is set)")
     lib = Path(folder) / "libNiTE2.so"
@@ -185,9 +265,13 @@ def open_device(openni2: Any, uri: str | None = None) -> Any:
         raise
     except Exception as exc:
         what = uri or "the first OpenNI2 device"
+        hint = (
+            " (OpenNI2 cannot play this recording)"
+            if uri is not None and Path(uri).is_file()
+            else " (is a Kinect connected, powered and readable by this user?)"
+        )
         raise DeviceError(
-            f"cannot open {what}: {' '.join(str(exc).split()) or type(exc).__name__} "
-            "(is a Kinect connected, powered and readable by this user?)"
+            f"cannot open {what}: {' '.join(str(exc).split()) or type(exc).__name__}{hint}"
         ) from None
 
 

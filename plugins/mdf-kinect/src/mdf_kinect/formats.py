@@ -234,12 +234,19 @@ def _finish(
     t, p, ok, rep = sort_timestamps(time, pos, valid)
     keep = order[np.concatenate(([True], np.diff(time[order]) > 0))]
     ok = untracked_mask(p, ok)
+    # frames before the tracker found the person and after it lost them for good hold no
+    # body (a capture records from the sensor's first frame): trimmed
+    tracked = np.flatnonzero(ok.any(axis=1))
+    if tracked.size == 0:
+        raise DataFileError(path, f"no joint is tracked in any of the {t.shape[0]} frames")
+    span = slice(int(tracked[0]), int(tracked[-1]) + 1)
     meta.update(
         frames_in_file=int(time.shape[0]),
         frames_out_of_order=rep["out_of_order"],
         duplicate_frames_dropped=rep["duplicates_dropped"],
+        untracked_frames_trimmed=int(t.shape[0] - (span.stop - span.start)),
     )
-    return Recording(names, t, p, ok, frames[keep], dict(canonical), meta)
+    return Recording(names, t[span], p[span], ok[span], frames[keep][span], dict(canonical), meta)
 
 
 # --------------------------------------------------------------------------- UTKinect
@@ -250,6 +257,7 @@ def read_utkinect(path: Path, rate_hz: float = UTKINECT_RATE_HZ) -> Recording:
     lines = read_text(path)
     rows: list[FloatArray] = []
     frames: list[int] = []
+    line_numbers: list[int] = []
     for i, line in enumerate(lines, start=1):
         fields = line.split()
         if not fields:
@@ -266,7 +274,11 @@ def read_utkinect(path: Path, rate_hz: float = UTKINECT_RATE_HZ) -> Recording:
         check_joint_values(path, vals[1:], i)
         frames.append(int(vals[0]))
         rows.append(vals[1:])
+        line_numbers.append(i)
     fr = np.asarray(frames, dtype=np.int64)
+    # the time a frame number stands for, checked per line (a frame number passes its own
+    # check up to limits.MAX_FRAME_NUMBER, far beyond a day at this rate)
+    limits.check_values(path, fr / rate_hz, limits.MAX_DURATION_S, "time stamp", line_numbers, " s")
     pos = np.asarray(rows, dtype=np.float64).reshape(-1, 20, 3)
     meta = {
         "format": "utkinect",
