@@ -609,3 +609,37 @@ def test_a_radar_spectrogram_gets_the_pulse_times_its_radar_gave() -> None:
     assert len(seen) == 1 and np.array_equal(seen[0], given[-1]) and seen[0][0] == 0.25
     assert np.ptp(np.diff(seen[0])) > 50e-6  # not the uniform grid
     np.testing.assert_allclose(res.pulse_times, seen[0] - seen[0][0], atol=1e-12)
+
+
+def test_every_effect_contract_breach_is_refused_and_a_valid_output_passes() -> None:
+    """What the pipeline checks after an effect's ``apply`` (docs/plugins.md): another type,
+    another number of pulses, positions or a signal that are not finite, a negative RCS, a
+    signal of another shape are each refused with a message saying which; the input itself
+    (a valid output) passes."""
+    from mdframework.interfaces import Received, Scatterers
+    from mdframework.pipeline import _check_effect_output
+
+    pos = np.zeros((4, 2, 3))
+    pos[..., 0] = 5.0
+    scat = Scatterers(pos, np.ones((4, 2)), ("a", "b"))
+    rec = Received(np.ones(4, dtype=np.complex128))
+    _check_effect_output(scat, scat)
+    _check_effect_output(rec, rec)
+    nan_pos = pos.copy()
+    nan_pos[2, 1, 0] = np.nan
+    bad_rcs = np.ones((4, 2))
+    bad_rcs[1, 0] = -1e-3
+    nan_signal = np.ones(4, dtype=np.complex128)
+    nan_signal[3] = np.nan
+    cases: list[tuple[Any, Any, type[Exception], str]] = [
+        ([], scat, TypeError, "returned list instead of Scatterers"),
+        (scat, rec, TypeError, "returned Scatterers instead of Received"),
+        (Scatterers(pos[:3], np.ones((3, 2)), ("a", "b")), scat, ValueError, "3 pulses"),
+        (Scatterers(nan_pos, np.ones((4, 2)), ("a", "b")), scat, ValueError, "not finite"),
+        (Scatterers(pos, bad_rcs, ("a", "b")), scat, ValueError, "RCS not >= 0"),
+        (Received(np.ones(5, dtype=np.complex128)), rec, ValueError, r"shape \(5,\)"),
+        (Received(nan_signal), rec, ValueError, "signal that is not finite"),
+    ]
+    for out, data, error, text in cases:
+        with pytest.raises(error, match=text):
+            _check_effect_output(out, data)

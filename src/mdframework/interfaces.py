@@ -429,6 +429,13 @@ class RadarWaveform(Plugin):
         return self.prf if rate is None else rate
 
     @property
+    def adds_receiver_noise(self) -> bool:
+        """Whether the radar adds receiver noise to its returns itself (the FMCW radar's
+        ``receiver_noise``); the ``noise`` effect is then refused, since it would count that
+        noise twice. Default: False."""
+        return False
+
+    @property
     def max_unambiguous_velocity(self) -> float:
         """Largest |radial velocity| [m/s] the slow-time sampling represents without aliasing.
         Default: ``lambda * prf / 4`` (complex samples at ``prf``)."""

@@ -420,8 +420,9 @@ class ConditioningConfig(StrictModel):
 
 
 #: The matplotlib release whose colour maps :data:`COLORMAPS` lists: the lowest that
-#: pyproject.toml allows, so that every name a config accepts draws (3.8 to 3.10 lack berlin,
-#: managua, vanimo and okabe_ito, and the ``_r`` of Grays, grey, gist_grey and gist_yerg).
+#: pyproject.toml allows, so that every name a config accepts draws (3.10 lacks okabe_ito; 3.8
+#: and 3.9 also lack berlin, managua and vanimo, and the ``_r`` of Grays, grey, gist_grey and
+#: gist_yerg).
 COLORMAPS_MATPLOTLIB = "3.11"
 
 #: matplotlib's built-in colour maps (each also reversed, with ``_r``), listed here so that

@@ -578,6 +578,11 @@ class FmcwRadar(RadarWaveform):
         c = self.config
         return KT0 * 10.0 ** (c.noise_figure_db / 10.0) * c.sample_rate
 
+    @property
+    def adds_receiver_noise(self) -> bool:
+        """True with ``receiver_noise``: the IF samples carry the receiver's thermal noise."""
+        return self.config.receiver_noise
+
     def noise_power(self) -> float:
         """Receiver noise power added per complex ADC sample, ``k T0 F fs`` [W] (0 without
         ``receiver_noise``)."""

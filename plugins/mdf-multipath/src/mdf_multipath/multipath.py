@@ -177,7 +177,10 @@ class GroundMultipath(Effect):
         parts_pos = [data.positions, pos_img]
         parts_rcs = [data.rcs, np.where(above, rcs_img, 0.0)]
         names = [*data.names, *(f"{n}~image" for n in data.names)]
-        virtual = [r + u_img * (r_b + delta2)[..., None]]  # the copies' unshifted places
+        # the copies' unshifted places, the centres of their ellipsoids (only if the scatterers
+        # carry centres: the default path builds nothing it does not return)
+        keep_centres = data.centres is not None
+        virtual = [r + u_img * (r_b + delta2)[..., None]] if keep_centres else []
         n_copies = 2
         if c.paths == "all":
             delta1 = _phase_offset(phi, lam)
@@ -193,7 +196,8 @@ class GroundMultipath(Effect):
             parts_pos.append(pos_mid)
             parts_rcs.append(np.where(above, rcs_mid, 0.0))
             names += [f"{n}~bounce" for n in data.names]
-            virtual.append(r + u_mid * (0.5 * (r_d + r_b) + delta1)[..., None])
+            if keep_centres:
+                virtual.append(r + u_mid * (0.5 * (r_d + r_b) + delta1)[..., None])
             n_copies = 3
         semi_axes = axes = None
         if data.semi_axes is not None and data.axes is not None:

@@ -138,12 +138,14 @@ class ReceiverNoise(Effect):
         self._power: float | None = None
 
     def check_radar(self, waveform: RadarWaveform) -> None:
-        """Refuse a radar whose config adds receiver noise already (``receiver_noise``)."""
-        if getattr(getattr(waveform, "config", None), "receiver_noise", False):
+        """Refuse a radar that adds receiver noise itself (``RadarWaveform.adds_receiver_noise``:
+        the FMCW radar's ``receiver_noise``)."""
+        if waveform.adds_receiver_noise:
             raise SceneError(
                 f"effects.noise: the {waveform.name!r} radar adds receiver noise itself "
-                "(radar.receiver_noise = true, as its presets set it): remove the noise "
-                "effect, or set radar.receiver_noise = false to use the effect's noise instead"
+                "(for fmcw: radar.receiver_noise = true, as its presets set it): remove the "
+                "noise effect, or turn the radar's own noise off (radar.receiver_noise = false) "
+                "to use the effect's noise instead"
             )
 
     def _waveform_param(self, context: SceneContext, field: str) -> float:
