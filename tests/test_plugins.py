@@ -552,7 +552,7 @@ def test_a_radar_config_declares_the_pulse_rate_that_the_budget_counts() -> None
     wf = declared.get("radar", "quad")(declared.get("radar", "quad").Config())  # type: ignore[call-arg]
     assert wf.pulse_rate == 4000.0 and wf.prf == 1000.0
     with pytest.raises(
-        ConfigError, match=r"motion\.duration: .* at PRF 4000 Hz is 5\.05e\+06 pulses"
+        ConfigError, match=r"motion\.duration: .* at 4000 pulses/s is 5\.05e\+06 pulses"
     ):
         validate_run_config(cfg, registry=declared)
 
@@ -562,7 +562,7 @@ def test_a_radar_config_declares_the_pulse_rate_that_the_budget_counts() -> None
     cfg["motion"]["length"] = limits.MAX_PULSES / 1000.0 * 1.01  # type: ignore[index]
     config = validate_run_config(cfg, registry=bare)  # not known from the config
     with pytest.raises(
-        SceneError, match=r"motion\.duration: .* at PRF 1000 Hz is 5\.05e\+06 pulses"
+        SceneError, match=r"motion\.duration: .* at 1000 pulses/s is 5\.05e\+06 pulses"
     ):
         simulate(config, bare)
 

@@ -27,7 +27,7 @@ from . import limits
 from .errors import ConfigError, SceneError
 from .interfaces import PluginConfig, RadarConfig
 from .plugins import Registry, default_registry, suggest
-from .settings import RunConfigBase
+from .settings import MotionConfig, RunConfigBase
 from .skeleton import CANONICAL_JOINTS
 
 #: (interface, ((plugin name, its Config model), ...)) for every interface, sorted by name
@@ -579,7 +579,7 @@ def _check_pulse_budget(config: RunConfigBase, source: str) -> None:
     ``limits.MAX_PULSES`` pulses now (the pipeline checks the others once the motion is
     loaded)."""
     cfg: Any = config
-    length = cfg.motion.known_length() if hasattr(cfg.motion, "known_length") else None
+    length = cfg.motion.known_length() if isinstance(cfg.motion, MotionConfig) else None
     prf = cfg.radar.pulse_rate() if isinstance(cfg.radar, RadarConfig) else None
     if length is None or prf is None:
         return

@@ -129,9 +129,9 @@ def check_pulses(
         need = _size(memory_estimate_bytes(n, n_scatterers, keep_scatterers))
         kept = f", keeping {n_scatterers} scatterer(s) per pulse" if keep_scatterers else ""
         raise SceneError(
-            f"{where}: a record of {duration_s:g} s at PRF {prf_hz:g} Hz is {n:.4g} pulses "
+            f"{where}: a record of {duration_s:g} s at {prf_hz:g} pulses/s is {n:.4g} pulses "
             f"(about {need} of memory{kept}); the limit is {MAX_PULSES:,} pulses: shorten the "
-            "record or lower the PRF"
+            "record or lower the pulse rate (the PRF; FMCW: the chirps per second)"
         )
 
 
