@@ -149,3 +149,9 @@ def test_part_geometry_in_coordinate_planes(placement: str) -> None:
     assert pos_t.shape == axes_t.shape == (3, 40, len(parts))
     assert np.allclose(np.moveaxis(pos_t, 0, -1), pos, rtol=0, atol=1e-15)
     assert np.array_equal(np.moveaxis(axes_t, 0, -1), axes)
+    # a joint that is not finite (e.g. untracked) reaches only the parts whose axis uses it
+    planes[:, 7, CANONICAL_JOINTS.index("l_knee")] = np.nan
+    _, axes_nan = body.part_geometry(parts, planes, joint_axis=-1)
+    bad = ~np.isfinite(axes_nan)
+    uses = [i for i, p in enumerate(parts) if "l_knee" in p.axis]
+    assert bad[:, 7, uses].all() and not np.delete(bad, uses, axis=2).any()
