@@ -201,16 +201,6 @@ def _part_index(
     return index, weight, tail, tip, identity
 
 
-@functools.lru_cache(maxsize=8)
-def _axis_matrix(tail: tuple[int, ...], tip: tuple[int, ...]) -> FloatArray:
-    """(17, n_parts): +1 at each part's tip joint, -1 at its tail (joints @ it: the axes)."""
-    m = np.zeros((len(CANONICAL_JOINTS), len(tip)))
-    parts = np.arange(len(tip))
-    m[list(tip), parts] += 1.0
-    m[list(tail), parts] -= 1.0
-    return m
-
-
 def part_geometry(
     parts: tuple[BodyPart, ...], joints: FloatArray, joint_axis: int = 1
 ) -> tuple[FloatArray, FloatArray]:
@@ -224,18 +214,8 @@ def part_geometry(
     ``joints`` (when the parts are the joints themselves).
     """
     index, weight, tail, tip, identity = _part_index(parts)
-    axes = None
-    if joint_axis in (-1, joints.ndim - 1):
-        # tip - tail as one product with a matrix of +1 and -1: exactly the differences (each
-        # sum has one rounding, the others' terms are zeros), several times faster than two
-        # gathers; a joint that is not finite would spread through the zeros to every part,
-        # so then the gathers decide
-        axes = joints @ _axis_matrix(tuple(tail), tuple(tip))
-        if not np.isfinite(axes).all():
-            axes = None
-    if axes is None:
-        axes = np.take(joints, tip, axis=joint_axis)
-        axes -= np.take(joints, tail, axis=joint_axis)
+    axes = np.take(joints, tip, axis=joint_axis)
+    axes -= np.take(joints, tail, axis=joint_axis)
     if identity:
         return joints, axes
     shape = [1] * joints.ndim
