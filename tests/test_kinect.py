@@ -575,7 +575,8 @@ def test_capture_starting_untracked_runs(tmp_path: Path, capsys) -> None:
     """A real capture starts with frames where NiTE has not tracked anyone yet: 20 such frames
     before the real UTKinect walk crashed ``mdf run`` (internal error: the placement's origin
     came from the first frame, NaN). The reader leaves the untracked frames at the ends out,
-    and the run works; so does an NTU file whose first frame has no body."""
+    and the run works (saying that time 0 is now the first tracked frame); so does an NTU file
+    whose first frame has no body."""
     t, pos, conf, idx, user = nite_frames_to_arrays(utkinect_as_nite_users(20))
     assert user == 1 and np.all(np.isnan(pos[:20]))
     path = tmp_path / "late.nite.txt"
@@ -587,7 +588,12 @@ def test_capture_starting_untracked_runs(tmp_path: Path, capsys) -> None:
     assert rec.frame_numbers[0] == 21 and rec.valid[0].all()
     cfg = tmp_path / "nite.toml"
     cfg.write_text(RUN_CONFIG.format(fmt="nite", file=path))
+    capsys.readouterr()
     assert cli.main(["run", str(cfg), "--out", str(tmp_path / "out"), "--no-figures"]) == 0
+    # time 0 moved to the first tracked frame: said, since motion.start counts from it
+    said = capsys.readouterr().err
+    assert "its first 20 frame(s) track no body" in said
+    assert f"{t[20] - t[0]:.3f} s into the file" in said
     ntu = tmp_path / "S001C001P001R001A001.skeleton"
     ntu.write_text(ntu_text(read_utkinect(UT), drop_frame=0))
     cfg.write_text(RUN_CONFIG.format(fmt="ntu", file=ntu))
@@ -758,6 +764,40 @@ def oni_records(data: bytes) -> list[tuple[int, int]]:
             break
         pos += fsize + psize
     return out
+
+
+def test_oni_in_openni1_record_order_is_played(tmp_path: Path, capsys) -> None:
+    """OpenNI 1.x's recorder writes the end record before the node-removed records and seek
+    tables (OpenNI2's after them), and OpenNI2 plays both: the shipped test.oni rewritten in
+    1.x order (the end record moved before the first node-removed record, the seek tables'
+    positions in the node-added records moved with it) passes scan_oni with the same frames,
+    and the real OpenNI2 reads it (mdf kinect info). A node-added record whose seek table
+    position is 0 (OpenNI2: none) is no error either."""
+    data = ONI.read_bytes()
+    recs = oni_records(data)
+    end = next(p for p, t in recs if t == 11)
+    first_removed = next(p for p, t in recs if t == 7)  # node removed
+    size = 28  # the end record is a bare record header
+    assert end + size == len(data)
+    moved = bytearray(data[:first_removed] + data[end:] + data[first_removed:end])
+    zero_seek = bytearray(data)
+    for p, t in recs:
+        if t == 13:
+            ln = struct.unpack_from("<I", data, p + 28)[0]
+            at = p + 32 + ln + 28
+            seek = struct.unpack_from("<Q", data, at)[0]
+            if seek:
+                struct.pack_into("<Q", moved, at, seek + size)
+                struct.pack_into("<Q", zero_seek, at, 0)
+    want = scan_oni(ONI)
+    for case, content in {"openni1": moved, "zero_seek": zero_seek}.items():
+        path = tmp_path / f"{case}.oni"
+        path.write_bytes(bytes(content))
+        got = scan_oni(path)
+        assert (got.frames_per_node, got.nodes) == (want.frames_per_node, want.nodes)
+    capsys.readouterr()
+    assert cli.main(["kinect", "info", str(tmp_path / "openni1.oni")]) == 0
+    assert "depth: 640x480 DEPTH_1_MM, 12 frames" in capsys.readouterr().out
 
 
 def test_bad_oni_named_before_openni2(tmp_path: Path, capsys) -> None:

@@ -613,9 +613,9 @@ def test_a_radar_spectrogram_gets_the_pulse_times_its_radar_gave() -> None:
 
 def test_every_effect_contract_breach_is_refused_and_a_valid_output_passes() -> None:
     """What the pipeline checks after an effect's ``apply`` (docs/plugins.md): another type,
-    another number of pulses, positions or a signal that are not finite, a negative RCS, a
-    signal of another shape are each refused with a message saying which; the input itself
-    (a valid output) passes."""
+    another number of pulses, positions or a signal that are not finite, an RCS that is
+    negative or not finite, a signal of another shape are each refused with a message saying
+    which; the input itself (a valid output) passes."""
     from mdframework.interfaces import Received, Scatterers
     from mdframework.pipeline import _check_effect_output
 
@@ -629,6 +629,8 @@ def test_every_effect_contract_breach_is_refused_and_a_valid_output_passes() -> 
     nan_pos[2, 1, 0] = np.nan
     bad_rcs = np.ones((4, 2))
     bad_rcs[1, 0] = -1e-3
+    inf_rcs = np.ones((4, 2))
+    inf_rcs[3, 1] = np.inf
     nan_signal = np.ones(4, dtype=np.complex128)
     nan_signal[3] = np.nan
     cases: list[tuple[Any, Any, type[Exception], str]] = [
@@ -636,7 +638,8 @@ def test_every_effect_contract_breach_is_refused_and_a_valid_output_passes() -> 
         (scat, rec, TypeError, "returned Scatterers instead of Received"),
         (Scatterers(pos[:3], np.ones((3, 2)), ("a", "b")), scat, ValueError, "3 pulses"),
         (Scatterers(nan_pos, np.ones((4, 2)), ("a", "b")), scat, ValueError, "not finite"),
-        (Scatterers(pos, bad_rcs, ("a", "b")), scat, ValueError, "RCS not >= 0"),
+        (Scatterers(pos, bad_rcs, ("a", "b")), scat, ValueError, "RCS not finite and >= 0"),
+        (Scatterers(pos, inf_rcs, ("a", "b")), scat, ValueError, "RCS not finite and >= 0"),
         (Received(np.ones(5, dtype=np.complex128)), rec, ValueError, r"shape \(5,\)"),
         (Received(nan_signal), rec, ValueError, "signal that is not finite"),
     ]

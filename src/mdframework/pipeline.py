@@ -182,8 +182,11 @@ def _check_effect_output(out: Any, data: Scatterers | Received) -> None:
             raise ValueError(
                 f"apply() returned {out.positions.shape[0]} pulses' scatterers, not {n}"
             )
-        if not (np.all(np.isfinite(out.positions)) and np.all(out.rcs >= 0)):
-            raise ValueError("apply() returned positions that are not finite or RCS not >= 0")
+        rcs = np.asarray(out.rcs)
+        if not (np.all(np.isfinite(out.positions)) and np.all(np.isfinite(rcs) & (rcs >= 0))):
+            raise ValueError(
+                "apply() returned positions that are not finite or RCS not finite and >= 0"
+            )
     elif isinstance(out, Received) and isinstance(data, Received):
         shape = np.shape(data.signal)
         if not isinstance(out.signal, np.ndarray) or out.signal.shape != shape:

@@ -105,7 +105,9 @@ def scan_oni(path: Path) -> OniScan:
     offset) for a wrong magic, a truncated record, an unknown record type, a node-added record
     that does not hold a name, a known node type and codec and (for a stream with frames) the
     place of its seek table, a file without any frame, or a file that ends without the records
-    a complete recording closes with (a node-removed record for every node, then the end).
+    a complete recording closes with (an end record and a node-removed record for every node,
+    in either order: OpenNI2's recorder writes the end last, OpenNI 1.x's first). Files before
+    version 1.0.1.0 have 24-byte record headers, later ones 28 (as OpenNI2's player reads them).
     """
     try:
         data = path.read_bytes()
@@ -116,6 +118,8 @@ def scan_oni(path: Path) -> OniScan:
     magic = data[:4]
     if magic != b"NI10":
         raise DataFileError(path, f"not an OpenNI recording: header magic {magic!r}, not b'NI10'")
+    version = FILE_HEADER.unpack_from(data, 0)[1:5]
+    header = 24 if version < (1, 0, 1, 0) else RECORD_HEADER.size
     pos = FILE_HEADER.size
     n = 0
     by_type: dict[str, int] = {}
@@ -128,6 +132,8 @@ def scan_oni(path: Path) -> OniScan:
     last = "the header"
     ended = False
     while pos < len(data):
+        if ended and data[pos : pos + 4] != b"NIR\0":
+            break  # bytes after the end record that are no record: not read, as by OpenNI2
         n += 1
         if pos + RECORD_HEADER.size > len(data):
             raise DataFileError(path, f"record {n} at byte {pos}: truncated record header")
@@ -148,7 +154,7 @@ def scan_oni(path: Path) -> OniScan:
         by_type[name] = by_type.get(name, 0) + 1
         records[pos] = (rtype, node)
         if rtype in NODE_ADDED:
-            nodes[node], node_types[node], seek = _node_added(path, data, pos, n, fsize)
+            nodes[node], node_types[node], seek = _node_added(path, data, pos, n, fsize, header)
             if seek is not None:
                 seek_at[node] = (seek, n)
         if rtype == NEW_DATA:
@@ -156,9 +162,7 @@ def scan_oni(path: Path) -> OniScan:
         if rtype == NODE_REMOVED:
             removed.add(node)
         last = f"record {n} ({name}) at byte {pos}"
-        if rtype == END:
-            ended = True
-            break
+        ended = ended or rtype == END
         pos += fsize + psize
     if not frames:
         raise DataFileError(
@@ -183,17 +187,19 @@ def scan_oni(path: Path) -> OniScan:
 
 
 def _node_added(
-    path: Path, data: bytes, pos: int, n: int, fsize: int
+    path: Path, data: bytes, pos: int, n: int, fsize: int, header: int = RECORD_HEADER.size
 ) -> tuple[str, int, int | None]:
     """A node-added record's node name, node type and (newest layout, type 13) the byte of its
-    seek table (None before); a record that does not hold them is an error naming it."""
+    seek table (None before, or where it is 0: no seek table); a record that does not hold them
+    is an error naming it. ``header``: the record header's size (24 or 28 bytes)."""
     end = pos + fsize
     where = f"record {n} (node added) at byte {pos}"
-    (ln,) = struct.unpack_from("<I", data, pos + 28) if pos + 32 <= end else (0,)
-    if not 0 < ln <= end - pos - 40:
+    at = pos + header + 4  # the name, after its length
+    (ln,) = struct.unpack_from("<I", data, at - 4) if at <= end else (0,)
+    if not 0 < ln <= end - at - 8:
         raise DataFileError(path, f"{where}: node name length {ln} does not fit the record")
-    name = data[pos + 32 : pos + 32 + ln].rstrip(b"\0").decode("latin-1")
-    ntype, codec = struct.unpack_from("<I4s", data, pos + 32 + ln)
+    name = data[at : at + ln].rstrip(b"\0").decode("latin-1")
+    ntype, codec = struct.unpack_from("<I4s", data, at + ln)
     if ntype not in NODE_TYPES or codec not in CODECS:
         raise DataFileError(
             path,
@@ -201,10 +207,10 @@ def _node_added(
             f"types {sorted(NODE_TYPES)} with codecs {', '.join(c.decode() for c in CODECS)})",
         )
     rtype = struct.unpack_from("<I", data, pos + 4)[0]
-    if rtype != 13 or pos + 32 + ln + 36 > end:
+    if rtype != 13 or at + ln + 36 > end:
         return name, ntype, None
-    seek = struct.unpack_from("<Q", data, pos + 32 + ln + 28)[0]
-    return name, ntype, int(seek)
+    seek = struct.unpack_from("<Q", data, at + ln + 28)[0]
+    return name, ntype, int(seek) or None
 
 
 def initialize_openni(redist: str | None = None) -> Any:

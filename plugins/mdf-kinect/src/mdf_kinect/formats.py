@@ -245,6 +245,8 @@ def _finish(
         frames_out_of_order=rep["out_of_order"],
         duplicate_frames_dropped=rep["duplicates_dropped"],
         untracked_frames_trimmed=int(t.shape[0] - (span.stop - span.start)),
+        untracked_frames_leading=span.start,
+        first_tracked_s=float(t[span.start] - t[0]),
     )
     return Recording(names, t[span], p[span], ok[span], frames[keep][span], dict(canonical), meta)
 

@@ -22,6 +22,7 @@ actions such as ``walk``; PRECOG's action names such as ``right punch``), then `
 from __future__ import annotations
 
 import re
+import warnings
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -53,6 +54,11 @@ from .formats import (
     to_project_frame,
 )
 from .nitefile import read_nite
+
+
+class TrackingWarning(UserWarning):
+    """A recording's frames before the tracker found the person were left out."""
+
 
 #: A coordinate in the Kinect's camera space [m].
 SensorCoordinate = Annotated[
@@ -220,6 +226,15 @@ class KinectSource(MotionSource):
             units="m",
             axes="x = Kinect Z (away from the sensor), y = Kinect X, z = Kinect Y (up)",
         )
+        leading = int(rec.metadata.get("untracked_frames_leading", 0))
+        if leading and c.segment is None:
+            warnings.warn(
+                f"{path}: its first {leading} frame(s) track no body and are left out, so time "
+                f"0 (what motion.start counts from) is its first tracked frame, "
+                f"{rec.metadata['first_tracked_s']:.3f} s into the file",
+                TrackingWarning,
+                stacklevel=2,
+            )
         skeleton = Skeleton(t - t[0], pos, rec.joint_names, valid)
         return Motion(skeleton, meta, dict(rec.canonical_map))
 
