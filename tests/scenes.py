@@ -322,6 +322,7 @@ def body_scenes(draw: st.DrawFn) -> dict[str, Any]:
                     "head": st.sampled_from(["sphere", "spheroid"]),
                     "sphere_rcs": st.sampled_from(["optical", "mie"]),
                     "surface_points": st.integers(0, 3),
+                    "scattering_phase": st.sampled_from(["centre", "specular"]),
                 }
             ),
             st.fixed_dictionaries({"kind": st.just("points"), "body": st.just(True)}),

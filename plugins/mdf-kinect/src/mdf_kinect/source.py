@@ -38,7 +38,7 @@ from mdframework import (
     Skeleton,
     limits,
 )
-from mdframework.settings import FrameRate
+from mdframework.settings import FrameRate, Seconds
 
 from .formats import (
     MSR_RATE_HZ,
@@ -86,6 +86,11 @@ class KinectConfig(MotionConfig):
         "15 joints) or ntu (NTU RGB+D .skeleton, Kinect v2, 25 joints)."
     )
     file: DataPath = Field(description="The recording, relative to the config file's folder.")
+    start: Seconds = Field(
+        0.0,
+        description="Start of the window, s from the first frame in which a joint is tracked "
+        "(the frames before it are left out, with a warning), or from the segment's first.",
+    )
     segment: str | None = Field(
         None,
         description="A labelled segment: a UTKinect action (e.g. 'walk') or a PRECOG action "

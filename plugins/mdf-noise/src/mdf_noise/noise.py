@@ -143,9 +143,10 @@ class ReceiverNoise(Effect):
         if waveform.adds_receiver_noise:
             raise SceneError(
                 f"effects.noise: the {waveform.name!r} radar adds receiver noise itself "
-                "(for fmcw: radar.receiver_noise = true, as its presets set it): remove the "
-                "noise effect, or turn the radar's own noise off (radar.receiver_noise = false) "
-                "to use the effect's noise instead"
+                "(for fmcw: radar.receiver_noise = true, as its presets set it), in its maps, "
+                "points and spectrogram: remove the noise effect (or set "
+                "radar.receiver_noise = false to have the effect's noise, which reaches the "
+                "spectrogram only)"
             )
 
     def _waveform_param(self, context: SceneContext, field: str) -> float:
