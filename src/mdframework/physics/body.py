@@ -214,17 +214,21 @@ def part_geometry(
     ``joints`` (when the parts are the joints themselves).
     """
     index, weight, tail, tip, identity = _part_index(parts)
-    axes = np.take(joints, tip, axis=joint_axis)
-    axes -= np.take(joints, tail, axis=joint_axis)
+    # mode "clip": the indices are the canonical joints' own, and numpy's default ("raise")
+    # gathers through a buffer, a fifth slower here
+    axes = np.take(joints, tip, axis=joint_axis, mode="clip")
+    axes -= np.take(joints, tail, axis=joint_axis, mode="clip")
     if identity:
         return joints, axes
     shape = [1] * joints.ndim
     shape[joint_axis] = len(parts)
-    positions = np.take(joints, index[0], axis=joint_axis)
+    positions = np.take(joints, index[0], axis=joint_axis, mode="clip")
     if not np.all(weight[0] == 1.0):
         positions *= weight[0].reshape(shape)
     for k in range(1, index.shape[0]):
-        positions += weight[k].reshape(shape) * np.take(joints, index[k], axis=joint_axis)
+        positions += weight[k].reshape(shape) * np.take(
+            joints, index[k], axis=joint_axis, mode="clip"
+        )
     return positions, axes
 
 
