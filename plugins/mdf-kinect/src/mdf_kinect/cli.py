@@ -173,8 +173,11 @@ def cmd_capture(args: argparse.Namespace) -> int:
     t, pos, conf, idx, user = nite_frames_to_arrays(frames)
     if user is None:
         raise DeviceError("no user's skeleton was tracked; stand 2-3 m in front of the sensor")
-    # frames before NiTE found the user and after it lost them for good hold no skeleton
-    tracked = np.flatnonzero(np.all(np.isfinite(pos), axis=(1, 2)))
+    # frames before NiTE found the user and after it lost them for good hold no joint (as the
+    # readers trim them)
+    tracked = np.flatnonzero(np.any(np.isfinite(pos), axis=(1, 2)))
+    if tracked.size < 2:
+        raise DeviceError(f"user {user}'s skeleton was tracked in {tracked.size} frame(s) only")
     span = slice(int(tracked[0]), int(tracked[-1]) + 1)
     t, pos, conf, idx = t[span] - t[span][0], pos[span], conf[span], idx[span]
     info = {
