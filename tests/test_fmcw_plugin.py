@@ -433,8 +433,8 @@ def test_spectrogram_follows_processing_precision(gapless: bool) -> None:
 
 def test_fmcw_and_lfm_spectrograms_of_the_same_walk_agree() -> None:
     """The side-by-side examples (matched carrier, bandwidth, slow-time rate, amplitudes and
-    STFT): the dB spectrograms over the common time span correlate above 0.98 (0.991 measured)
-    and the
+    STFT, the FMCW gate four range resolutions wide): the dB spectrograms over the common time
+    span correlate above 0.995 (0.9997 measured; 0.991 with a gate of two resolutions) and the
     strongest velocity of each column agrees within 0.1 m/s in 95 % of the columns."""
     lfm = simulate(load_run_config(EXAMPLES / "walk_side_by_side_lfm.toml"))
     fm = simulate(load_run_config(EXAMPLES / "walk_side_by_side_fmcw.toml"))
@@ -442,7 +442,7 @@ def test_fmcw_and_lfm_spectrograms_of_the_same_walk_agree() -> None:
     np.testing.assert_allclose(fm.spectrogram.time[:n], lfm.spectrogram.time[:n], atol=1e-9)
     a, b = lfm.spectrogram_db[:, :n], fm.spectrogram_db[:, :n]
     corr = float(np.corrcoef(a.ravel(), b.ravel())[0, 1])
-    assert corr > 0.98
+    assert corr > 0.995
     va = lfm.velocity[np.argmax(a, axis=0)]
     vb = fm.velocity[np.argmax(b, axis=0)]
     assert np.mean(np.abs(va - vb) <= 0.1) >= 0.95
@@ -863,3 +863,31 @@ def test_the_noise_effect_is_refused_beside_the_radars_own_receiver_noise() -> N
     clean = simulate(validate_run_config(quiet)).received.signal
     snr = np.mean(np.abs(clean) ** 2) / np.mean(np.abs(noisy - clean) ** 2)
     assert 10 * np.log10(snr) == pytest.approx(20.0, abs=0.5)
+
+
+def test_a_gate_of_four_range_resolutions_is_flat_and_a_narrower_one_warns() -> None:
+    """The side-by-side example's radar (1 m range resolution): with its 4 m gate a point
+    target anywhere within 1 m of the gate's centre comes through at its amplitude to 2 %
+    (sqrt_rcs: |y| = 1 for 1 m^2); a 2 m gate (two resolutions) weighed the same target
+    0.76 on the gate and 0.85 half a bin off, and is warned about, naming the field and the
+    width that is flat."""
+    radar_ = load_run_config(EXAMPLES / "walk_side_by_side_fmcw.toml").radar.model_dump()
+
+    def level(offset: float, width: float) -> float:
+        cfg = {
+            "motion": {
+                "kind": "point_targets",
+                "length": 0.5,
+                "targets": [{"position": [30.0 + offset, 0.0, 0.0], "rcs": 1.0}],
+            },
+            "scatterers": {"kind": "points"},
+            "radar": {**radar_, "gate_width": width},
+            "scene": {"radar_position": [0.0, 0.0, 0.0], "gate": 30.0},
+        }
+        return float(np.median(np.abs(simulate(validate_run_config(cfg)).received.signal)))
+
+    for offset in (0.0, 0.25, 0.5, 0.8, 1.0):
+        assert level(offset, 4.0) == pytest.approx(1.0, abs=0.02)
+    with pytest.warns(UserWarning, match=r"radar.gate_width: 2 m spans 2\.0 range resolutions"):
+        narrow = level(0.0, 2.0)
+    assert narrow < 0.8

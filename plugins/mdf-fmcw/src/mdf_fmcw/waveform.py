@@ -8,7 +8,7 @@ and the wiring:
 - ``receive(block)``, frame by frame: the range profiles of every chirp and receive antenna
   (``path = "raw"``: sampled de-chirped IF with exact delays per antenna, then the range FFT;
   ``"analytic"``: the same profile in closed form near the scatterers), optional receiver noise,
-  then the slow-time signal (first RX, summed over the range bins within ``gate_width`` of the
+  then the slow-time signal (first RX, summed over the range bins within ``gate_width / 2`` of the
   gate), the range-Doppler map and the point cloud. Products: ``range_doppler`` (n_frames,
   n_doppler, n_range) float32 [W], the power summed over the virtual antennas, and ``points``
   (n_points, 7) float64 with columns frame, t [s from the first chirp], x, y, z [m, sensor
@@ -23,6 +23,7 @@ the scene origin (the default person position), or along +x for a radar above th
 
 from __future__ import annotations
 
+import warnings
 from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import numpy as np
@@ -297,6 +298,11 @@ def _cfar(c: CfarConfig | None) -> fmcw.Cfar | None:
     return None if c is None else fmcw.Cfar(c.mode, c.train, c.guard, c.threshold_db)
 
 
+#: The slow-time signal's range gate is flat (every scatterer well inside it weighed alike, to
+#: about 2 %) when it spans at least this many range resolutions ``c / (2 B)``.
+FLAT_GATE_RESOLUTIONS = 4.0
+
+
 class FmcwRadar(RadarWaveform):
     """Chirp-sequence FMCW radar (TDM-MIMO): slow-time signal, range-Doppler maps, points."""
 
@@ -390,8 +396,21 @@ class FmcwRadar(RadarWaveform):
 
     def start_record(self, times: FloatArray, range_span: tuple[float, float]) -> None:
         """Stop before any block when the body's farthest joint is beyond the maximum range,
-        or when the record's range-Doppler maps would not fit the product limit."""
+        or when the record's range-Doppler maps would not fit the product limit; warn when the
+        range gate is narrower than :data:`FLAT_GATE_RESOLUTIONS` range resolutions."""
         self._check_ranges(np.asarray([range_span[1]]))
+        resolution = self.sequence.range_resolution
+        if self.config.gate_width < FLAT_GATE_RESOLUTIONS * resolution:
+            warnings.warn(
+                f"radar.gate_width: {self.config.gate_width:g} m spans "
+                f"{self.config.gate_width / resolution:.1f} range resolutions of "
+                f"{resolution:.3g} m; the gate weighs scatterers evenly only over "
+                f"{FLAT_GATE_RESOLUTIONS:g} or more (narrower, it weighs the body unevenly and "
+                "its level steps as the gate moves): widen it to at least "
+                f"{FLAT_GATE_RESOLUTIONS * resolution:.2f} m",
+                UserWarning,
+                stacklevel=2,
+            )
         if self.config.save_range_doppler:
             n_frames = times.shape[0] // self.sequence.chirps_per_frame
             size = 4.0 * n_frames * self.n_doppler * self.n_range  # float32 maps
