@@ -12,6 +12,7 @@ import re
 import struct
 import subprocess
 import sys
+import warnings
 from pathlib import Path
 from typing import ClassVar
 
@@ -39,6 +40,7 @@ from mdf_kinect import (
     scan_oni,
     write_nite,
 )
+from mdf_kinect.source import TrackingWarning
 
 from mdframework import CANONICAL_SEGMENTS, DataFileError, cli
 
@@ -800,6 +802,66 @@ def test_oni_in_openni1_record_order_is_played(tmp_path: Path, capsys) -> None:
     assert "depth: 640x480 DEPTH_1_MM, 12 frames" in capsys.readouterr().out
 
 
+def as_old_oni(data: bytes) -> bytes:
+    """An .oni file rewritten as file version 1.0.0.6, the layout before 1.0.1.0: 24-byte record
+    headers with a 32-bit undo position, a 32-bit seek-table position in node-added records,
+    16-byte seek-table entries (64-bit time stamp, 32-bit frame and position); every position
+    moved to the new layout."""
+    recs = []
+    pos = 24
+    while pos < len(data):
+        _, typ, node, fsize, psize, undo = struct.unpack_from("<4sIIIIQ", data, pos)
+        recs.append((pos, typ, node, fsize, psize, undo))
+        pos += fsize + psize
+    moved, at = {}, 24
+    for pos, typ, _, fsize, psize, _ in recs:
+        moved[pos] = at
+        at += 24 + fsize - 28 - (4 if typ == 13 else 0) + (psize // 20 * 16 if typ == 14 else psize)
+    out = bytearray(
+        struct.pack("<4sBBHIQI", b"NI10", 1, 0, 0, 6, *struct.unpack_from("<QI", data, 12))
+    )
+    for pos, typ, node, fsize, psize, undo in recs:
+        fields = data[pos + 28 : pos + fsize]
+        if typ == 13:
+            ln = struct.unpack_from("<I", fields, 0)[0]
+            seek = struct.unpack_from("<Q", fields, 4 + ln + 28)[0]
+            fields = fields[: 4 + ln + 28] + struct.pack("<I", moved.get(seek, 0))
+        payload = data[pos + fsize : pos + fsize + psize]
+        if typ == 14:
+            entries = [struct.unpack_from("<QIQ", payload, 20 * i) for i in range(psize // 20)]
+            payload = b"".join(struct.pack("<QII", t, f, moved.get(p, 0)) for t, f, p in entries)
+        header = struct.pack(
+            "<4sIIIII", b"NIR\0", typ, node, 24 + len(fields), len(payload), moved.get(undo, 0)
+        )
+        out += header + fields + payload
+    return bytes(out)
+
+
+def test_old_oni_versions_are_scanned_with_their_own_layout(tmp_path: Path, capsys) -> None:
+    """A recording in the layout before file version 1.0.1.0 (24-byte record headers, 32-bit
+    positions), which OpenNI2 plays: scan_oni finds the same frames and streams as in the shipped
+    file, and the real OpenNI2 reads all 12 depth frames (mdf kinect info). A frame after an end
+    record (OpenNI2 plays nothing after it) is refused, naming the record."""
+    old = tmp_path / "old.oni"
+    old.write_bytes(as_old_oni(ONI.read_bytes()))
+    want, got = scan_oni(ONI), scan_oni(old)
+    assert (got.frames_per_node, got.nodes) == (want.frames_per_node, want.nodes)
+    capsys.readouterr()
+    assert cli.main(["kinect", "info", str(old)]) == 0
+    assert "depth: 640x480 DEPTH_1_MM, 12 frames" in capsys.readouterr().out
+    data = ONI.read_bytes()
+    recs = oni_records(data)
+    end = next(p for p, t in recs if t == 11)
+    ninth = [p for p, t in recs if t == 10][8]
+    early = tmp_path / "early_end.oni"
+    early.write_bytes(data[:ninth] + data[end:] + data[ninth:end])
+    with pytest.raises(
+        DataFileError,
+        match=r"early_end\.oni: record \d+ \(new data\) at byte \d+ follows the end record",
+    ):
+        scan_oni(early)
+
+
 def test_bad_oni_named_before_openni2(tmp_path: Path, capsys) -> None:
     """Files OpenNI2 refuses with its bare ONI_STATUS_ERROR are refused by scan_oni first,
     naming the file and record: cut exactly at a record boundary (the end, node-removed and
@@ -837,3 +899,30 @@ def test_bad_oni_named_before_openni2(tmp_path: Path, capsys) -> None:
     with pytest.raises(DeviceError, match=r"type99\.oni.*cannot play") as exc:
         open_device(initialize_openni(), str(tmp_path / "type99.oni"))
     assert "Kinect connected" not in str(exc.value)
+
+
+def test_a_segment_whose_first_frames_are_untracked_says_where_time_0_is(tmp_path: Path) -> None:
+    """UTKinect's walk segment with the file's frames before 262 untracked (all joints zero):
+    the reader leaves them out, so the segment (labelled from 252) starts at frame 262, and a
+    warning says so (motion.start counts from there); the shipped file itself gives none."""
+    lines = UT.read_text().splitlines()
+    cut = []
+    for line in lines:
+        cells = line.split()
+        if int(cells[0]) < 262:
+            cells[1:] = ["0"] * (len(cells) - 1)
+        cut.append(" ".join(cells))
+    late = tmp_path / "joints_s01_e01.txt"
+    late.write_text("\n".join(cut) + "\n")
+    (tmp_path / "actionLabel.txt").write_bytes((UT.parent / "actionLabel.txt").read_bytes())
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        KinectSource(KinectConfig(format="utkinect", file=UT, segment="walk")).load()
+        assert not [w for w in caught if issubclass(w.category, TrackingWarning)]
+        m = KinectSource(KinectConfig(format="utkinect", file=late, segment="walk")).load()
+    said = [str(w.message) for w in caught if issubclass(w.category, TrackingWarning)]
+    assert said == [
+        f"{late}: segment 'walk' starts at frame 252, but its first tracked frame is 262: time 0 "
+        "(what motion.start counts from) is that frame"
+    ]
+    assert m.metadata["segment"]["first_frame"] == 252

@@ -155,3 +155,8 @@ def test_part_geometry_in_coordinate_planes(placement: str) -> None:
     bad = ~np.isfinite(axes_nan)
     uses = [i for i, p in enumerate(parts) if "l_knee" in p.axis]
     assert bad[:, 7, uses].all() and not np.delete(bad, uses, axis=2).any()
+    # joints that are not the 17 canonical ones along the given axis: refused, not clipped
+    with pytest.raises(ValueError, match="15 along axis 1, not the 17 canonical joints"):
+        body.part_geometry(parts, joints[:, :15])
+    with pytest.raises(ValueError, match="3 along axis -1"):
+        body.part_geometry(parts, joints, joint_axis=-1)

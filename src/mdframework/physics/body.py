@@ -213,9 +213,14 @@ def part_geometry(
     normalised and may be zero for coincident joints. Positions may share memory with
     ``joints`` (when the parts are the joints themselves).
     """
+    if joints.shape[joint_axis] != len(CANONICAL_JOINTS):
+        raise ValueError(
+            f"joints: {joints.shape[joint_axis]} along axis {joint_axis}, not the "
+            f"{len(CANONICAL_JOINTS)} canonical joints"
+        )
     index, weight, tail, tip, identity = _part_index(parts)
-    # mode "clip": the indices are the canonical joints' own, and numpy's default ("raise")
-    # gathers through a buffer, a fifth slower here
+    # mode "clip": the indices are the canonical joints' own (checked above), and numpy's
+    # default ("raise") gathers through a buffer, a fifth slower here
     axes = np.take(joints, tip, axis=joint_axis, mode="clip")
     axes -= np.take(joints, tail, axis=joint_axis, mode="clip")
     if identity:

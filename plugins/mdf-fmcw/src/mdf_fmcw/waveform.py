@@ -299,7 +299,8 @@ def _cfar(c: CfarConfig | None) -> fmcw.Cfar | None:
 
 
 #: The slow-time signal's range gate is flat (every scatterer well inside it weighed alike, to
-#: about 2 %) when it spans at least this many range resolutions ``c / (2 B)``.
+#: about 2 %) when it spans at least this many range resolutions ``c / (2 B)``, with the default
+#: Hann range window (the rectangular window's ripple is +-8 % even at eight).
 FLAT_GATE_RESOLUTIONS = 4.0
 
 
@@ -405,8 +406,9 @@ class FmcwRadar(RadarWaveform):
                 f"radar.gate_width: {self.config.gate_width:g} m spans "
                 f"{self.config.gate_width / resolution:.1f} range resolutions of "
                 f"{resolution:.3g} m; the gate weighs scatterers evenly only over "
-                f"{FLAT_GATE_RESOLUTIONS:g} or more (narrower, it weighs the body unevenly and "
-                "its level steps as the gate moves): widen it to at least "
+                f"{FLAT_GATE_RESOLUTIONS:g} or more, with the Hann range window (narrower, it "
+                "weighs the body unevenly and its level steps as the gate moves): widen it to "
+                "at least "
                 f"{FLAT_GATE_RESOLUTIONS * resolution:.2f} m",
                 UserWarning,
                 stacklevel=2,

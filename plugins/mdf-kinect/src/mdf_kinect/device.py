@@ -12,9 +12,10 @@ binding and the system libraries.
 
 ``.oni`` files are checked in Python first (:func:`scan_oni`: the 24-byte ``NI10`` header, then
 records with a 28-byte header, ``NIR\\0`` magic, type, node id, fields size (header included),
-payload size, 64-bit undo position), so that a bad file gets an error naming the record rather
-than the library's bare ``ONI_STATUS_ERROR``; frames are then read through OpenNI2, in order
-(seeking is unreliable in that library).
+payload size, 64-bit undo position; 24 bytes and 32-bit positions before file version 1.0.1.0),
+so that a bad file gets an error naming the record rather than the library's bare
+``ONI_STATUS_ERROR``; frames are then read through OpenNI2, in order (seeking is unreliable in
+that library).
 """
 
 from __future__ import annotations
@@ -64,6 +65,8 @@ FILE_HEADER = struct.Struct(
     "<4sBBHIQI"
 )  # magic, version (major, minor, maint, build), max ts, max node
 RECORD_HEADER = struct.Struct("<4sIIIIQ")
+#: The record header of files before version 1.0.1.0 (a 32-bit undo position).
+OLD_RECORD_HEADER = struct.Struct("<4sIIIII")
 
 
 class DeviceError(MdfError):
@@ -107,7 +110,9 @@ def scan_oni(path: Path) -> OniScan:
     place of its seek table, a file without any frame, or a file that ends without the records
     a complete recording closes with (an end record and a node-removed record for every node,
     in either order: OpenNI2's recorder writes the end last, OpenNI 1.x's first). Files before
-    version 1.0.1.0 have 24-byte record headers, later ones 28 (as OpenNI2's player reads them).
+    version 1.0.1.0 have 24-byte record headers and 32-bit positions, later ones 28 and 64 (as
+    OpenNI2's player reads them). After the end record only node-removed records and seek tables
+    may follow (OpenNI2 plays nothing after it).
     """
     try:
         data = path.read_bytes()
@@ -119,7 +124,8 @@ def scan_oni(path: Path) -> OniScan:
     if magic != b"NI10":
         raise DataFileError(path, f"not an OpenNI recording: header magic {magic!r}, not b'NI10'")
     version = FILE_HEADER.unpack_from(data, 0)[1:5]
-    header = 24 if version < (1, 0, 1, 0) else RECORD_HEADER.size
+    layout = OLD_RECORD_HEADER if version < (1, 0, 1, 0) else RECORD_HEADER
+    header = layout.size
     pos = FILE_HEADER.size
     n = 0
     by_type: dict[str, int] = {}
@@ -135,14 +141,14 @@ def scan_oni(path: Path) -> OniScan:
         if ended and data[pos : pos + 4] != b"NIR\0":
             break  # bytes after the end record that are no record: not read, as by OpenNI2
         n += 1
-        if pos + RECORD_HEADER.size > len(data):
+        if pos + header > len(data):
             raise DataFileError(path, f"record {n} at byte {pos}: truncated record header")
-        rmagic, rtype, node, fsize, psize, _undo = RECORD_HEADER.unpack_from(data, pos)
+        rmagic, rtype, node, fsize, psize, _undo = layout.unpack_from(data, pos)
         if rmagic != b"NIR\0":
             raise DataFileError(
                 path, f"record {n} at byte {pos}: record magic {rmagic!r}, not b'NIR\\x00'"
             )
-        if fsize < RECORD_HEADER.size or pos + fsize + psize > len(data):
+        if fsize < header or pos + fsize + psize > len(data):
             raise DataFileError(
                 path, f"record {n} at byte {pos}: truncated (sizes run past the end)"
             )
@@ -151,6 +157,12 @@ def scan_oni(path: Path) -> OniScan:
                 path, f"record {n} at byte {pos}: unknown record type {rtype} (after {last})"
             )
         name = RECORD_TYPES[rtype]
+        if ended and rtype not in (NODE_REMOVED, SEEK_TABLE):
+            raise DataFileError(
+                path,
+                f"record {n} ({name}) at byte {pos} follows the end record (after {last}): "
+                "OpenNI2 plays nothing after it",
+            )
         by_type[name] = by_type.get(name, 0) + 1
         records[pos] = (rtype, node)
         if rtype in NODE_ADDED:
@@ -207,9 +219,10 @@ def _node_added(
             f"types {sorted(NODE_TYPES)} with codecs {', '.join(c.decode() for c in CODECS)})",
         )
     rtype = struct.unpack_from("<I", data, pos + 4)[0]
-    if rtype != 13 or at + ln + 36 > end:
+    wide = header == RECORD_HEADER.size  # 64-bit positions (else 32-bit, before 1.0.1.0)
+    if rtype != 13 or at + ln + (36 if wide else 32) > end:
         return name, ntype, None
-    seek = struct.unpack_from("<Q", data, at + ln + 28)[0]
+    seek = struct.unpack_from("<Q" if wide else "<I", data, at + ln + 28)[0]
     return name, ntype, int(seek) or None
 
 

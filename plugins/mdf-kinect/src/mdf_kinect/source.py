@@ -89,7 +89,8 @@ class KinectConfig(MotionConfig):
     start: Seconds = Field(
         0.0,
         description="Start of the window, s from the first frame in which a joint is tracked "
-        "(the frames before it are left out, with a warning), or from the segment's first.",
+        "(the frames before it are left out, with a warning), within a segment from its first "
+        "tracked frame.",
     )
     segment: str | None = Field(
         None,
@@ -200,6 +201,19 @@ class KinectSource(MotionSource):
                     "recording: check its labels against the file",
                 )
             meta["segment"] = {"label": c.segment, "first_frame": first, "last_frame": last}
+            kept = int(rec.frame_numbers[keep][0])
+            # the file's untracked first frames (left out) reach into the segment
+            if (
+                rec.metadata.get("untracked_frames_leading", 0)
+                and int(rec.frame_numbers[0]) > first
+            ):
+                warnings.warn(
+                    f"{path}: segment {c.segment!r} starts at frame {first}, but its first "
+                    f"tracked frame is {kept}: time 0 (what motion.start counts from) is that "
+                    "frame",
+                    TrackingWarning,
+                    stacklevel=2,
+                )
         t = rec.time[keep]
         pos = to_project_frame(rec.positions[keep])
         valid = rec.valid[keep]
