@@ -807,12 +807,7 @@ def as_old_oni(data: bytes) -> bytes:
     headers with a 32-bit undo position, a 32-bit seek-table position in node-added records,
     16-byte seek-table entries (64-bit time stamp, 32-bit frame and position); every position
     moved to the new layout."""
-    recs = []
-    pos = 24
-    while pos < len(data):
-        _, typ, node, fsize, psize, undo = struct.unpack_from("<4sIIIIQ", data, pos)
-        recs.append((pos, typ, node, fsize, psize, undo))
-        pos += fsize + psize
+    recs = [(p, *struct.unpack_from("<4sIIIIQ", data, p)[1:]) for p, _ in oni_records(data)]
     moved, at = {}, 24
     for pos, typ, _, fsize, psize, _ in recs:
         moved[pos] = at
