@@ -3,6 +3,7 @@ the rule that an effect the scene does not call for does no work."""
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 import numpy as np
@@ -153,6 +154,41 @@ def test_clutter_sits_at_zero_doppler_with_requested_spread(spread: float, fract
     std_v = np.sqrt(np.sum((f - mean_f) ** 2 * psd) / np.sum(psd)) * LAM / 2
     assert abs(mean_f) * LAM / 2 < 0.1 * spread  # centred on zero Doppler
     assert std_v == pytest.approx(spread, rel=0.1)
+
+
+def velocity_spread(x: np.ndarray, rate: float) -> float:
+    """Standard deviation [m/s] of the velocity spectrum (15 GHz) of samples ``x`` at ``rate``."""
+    f = np.fft.fftfreq(x.shape[-1], 1 / rate)
+    w = np.hanning(x.shape[-1])  # a short record's leakage would widen the spectrum
+    psd = np.sum(np.abs(np.fft.fft(x * w, axis=-1)) ** 2, axis=tuple(range(x.ndim - 1)))
+    mean_f = np.sum(f * psd) / np.sum(psd)
+    return float(np.sqrt(np.sum((f - mean_f) ** 2 * psd) / np.sum(psd)) * LAM / 2)
+
+
+def test_wind_blown_clutter_spread_holds_for_tdm_chirps_and_frame_gaps() -> None:
+    """The wind-blown process follows the pulse times, not the pulse count at ``prf``: with
+    three transmitters in turn (chirps at 3 x 2400 Hz, each virtual antenna's slow time, every
+    third chirp, at the 2400 Hz ``prf``) that slow time has the requested spread (it had three
+    times it); with gaps between frames, each frame's samples have the requested spread and
+    frames 0.64 s apart are decorrelated (they were as correlated as neighbouring chirps)."""
+    spread = 0.3  # 30.0 Hz at 15 GHz: correlated over a few ms
+    eff = GroundClutter(GroundClutter.Config(csr_db=0.0, wind_fraction=1.0, spread_mps=spread))
+    n = 3 * 4 * 2400
+    ctx = clutter_context(15.0, n)
+    tdm = dataclasses.replace(ctx, pulse_times=np.arange(n) / (3 * 2400.0))
+    out = eff.apply(Received(np.ones(n, complex)), tdm).signal - 1.0
+    assert velocity_spread(out[::3], 2400.0) == pytest.approx(spread, rel=0.1)
+    # frames of 512 chirps at 2400 Hz, one every 4 x 512 / 2400 s
+    frame_t = (np.arange(30)[:, None] * 2048 + np.arange(512)[None, :]) / 2400.0
+    n = frame_t.size
+    ctx = clutter_context(15.0, n)
+    gaps = dataclasses.replace(ctx, pulse_times=frame_t.ravel())
+    out = (eff.apply(Received(np.ones(n, complex)), gaps).signal - 1.0).reshape(30, 512)
+    assert velocity_spread(out, 2400.0) == pytest.approx(spread, rel=0.15)
+    across = np.mean(out[1:, 0] * np.conj(out[:-1, -1])) / np.mean(np.abs(out) ** 2)
+    within = np.mean(out[:, 1:] * np.conj(out[:, :-1])) / np.mean(np.abs(out) ** 2)
+    assert abs(within) > 0.99
+    assert abs(across) < 0.5  # true: exp(-2 pi^2 (30 Hz)^2 (0.64 s)^2) ~ 0
 
 
 def test_clutter_rcs_mode_follows_the_range_equation() -> None:

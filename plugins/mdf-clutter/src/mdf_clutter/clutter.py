@@ -18,7 +18,10 @@ Patch ``k`` contributes ``g_k(n) (alpha_k + beta_k u_k(n))``:
   ``S(f) ∝ exp(-f^2 / (2 s_f^2))``, ``s_f = 2 spread_mps / lambda``: ``spread_mps`` is the
   standard deviation of the wind-blown clutter's radial-velocity spectrum [m/s] (about 0.05 m/s
   in light air to 0.3 m/s in gale for trees). It is made by shaping white noise in the frequency
-  domain over the record (a circular process), unit mean power.
+  domain over the record (a circular process), unit mean power, on a uniform grid at the
+  shortest pulse interval and read at the pulse times: at the pulses themselves for evenly
+  spaced pulses, at each chirp's own instant for an FMCW radar (several transmitters in turn,
+  gaps between frames), so each virtual antenna's slow time has the requested spread.
 
 Power: the summed clutter ``c(n)`` is scaled so that its mean power over the record,
 ``P_c = mean_n |c(n)|^2``, is exactly ``(1 - wind_fraction) P_c`` for the stationary part and
@@ -117,6 +120,35 @@ def gaussian_doppler_process(
     return np.asarray(shaped / np.sqrt(np.where(power > 0, power, 1.0)), dtype=np.complex128)
 
 
+#: Grid values the wind-blown processes are made with at a time (unless one series at the
+#: pulses is already larger): bounds their memory when the pulses have gaps between them.
+WIND_GRID_VALUES = 1 << 22
+
+
+def wind_processes(
+    rng: np.random.Generator, n_series: int, times: FloatArray, prf: float, spread_hz: float
+) -> ComplexArray:
+    """:func:`gaussian_doppler_process` read at the pulse ``times`` (n_pulses,) [s]: made on a
+    uniform grid at the shortest pulse interval from the first pulse, each pulse taking the grid
+    point nearest to it. Pulses evenly spaced (a pulse-Doppler or CW radar) are the grid itself;
+    an FMCW radar's chirps (several transmitters in turn, gaps between frames) get the process
+    at their own instants, so the slow time of each virtual antenna (every ``n_tx``-th chirp)
+    sees the requested spread and frames apart in time are as decorrelated as that time makes
+    them. ``prf`` [Hz] serves fewer than two pulses. Returns (n_series, n_pulses)."""
+    t = np.asarray(times, dtype=np.float64)
+    step = float(np.min(np.diff(t))) if t.size > 1 else 0.0
+    if not step > 0.0:
+        return gaussian_doppler_process(rng, n_series, t.size, prf, spread_hz)
+    idx = np.rint((t - t[0]) / step).astype(np.int64)
+    n_grid = int(idx[-1]) + 1
+    per_call = max(1, max(WIND_GRID_VALUES, n_series * t.size) // n_grid)
+    out = np.empty((n_series, t.size), dtype=np.complex128)
+    for lo in range(0, n_series, per_call):
+        hi = min(lo + per_call, n_series)
+        out[lo:hi] = gaussian_doppler_process(rng, hi - lo, n_grid, 1.0 / step, spread_hz)[:, idx]
+    return out
+
+
 class GroundClutter(Effect):
     """Adds ground clutter at zero Doppler plus wind-blown clutter to the compressed return."""
 
@@ -181,7 +213,7 @@ class GroundClutter(Effect):
         res = self.resolution(context)
         spacing = c.patch_spacing_m if c.patch_spacing_m is not None else res / 2.0
         ranges, resp = self.patch_responses(context)
-        n_patch, n_p = resp.shape
+        n_patch = resp.shape[0]
         sigma_k = c.rcs_m2 * spacing / res
         if c.power == "csr":
             p_sig = float(np.mean(np.abs(data.signal) ** 2))
@@ -193,7 +225,7 @@ class GroundClutter(Effect):
         stationary = alpha @ resp
         lam = radar.wavelength(context.carrier_frequency)
         spread_hz = 2.0 * c.spread_mps / lam
-        u = gaussian_doppler_process(rng, n_patch, n_p, context.prf, spread_hz)
+        u = wind_processes(rng, n_patch, context.pulse_times, context.prf, spread_hz)
         wind = np.sum(resp * u, axis=0)
         clutter = _scaled(stationary, (1.0 - c.wind_fraction) * p_c) + _scaled(
             wind, c.wind_fraction * p_c
