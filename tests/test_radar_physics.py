@@ -154,6 +154,21 @@ def test_compressed_envelope_peak_and_minus_3db_width() -> None:
     assert null == pytest.approx(SPEED_OF_LIGHT / (2 * bw), rel=0.01)
 
 
+def test_sinc_gate_response_large_tb_minus_3db_width_and_first_null() -> None:
+    """Section 5, large-TB limit (``gate_response = "sinc"``): the -3 dB full width is
+    0.885893 c/(2B) = 0.88528 m at 150 MHz and the first null sits at c/(2B) = 0.99931 m."""
+    bw = 150e6
+    dr = np.linspace(-1.5, 1.5, 3_000_001)
+    w = radar.gate_weights(
+        dr[:, None], np.zeros(dr.size), pulse_width=1.0, bandwidth=bw, response="sinc"
+    )[:, 0]
+    above = dr[w**2 >= 0.5]
+    assert above[-1] - above[0] == pytest.approx(0.88528, abs=2e-5)
+    assert above[-1] - above[0] == pytest.approx(0.885893 * SPEED_OF_LIGHT / (2 * bw), abs=2e-6)
+    null = dr[(dr > 0) & (w <= 0)][0]
+    assert null == pytest.approx(0.99931, abs=1e-5)
+
+
 def test_sampled_matched_filter_peak_value_position_and_phase() -> None:
     """Raw chirp echo, pulse-compressed: the peak is a*tau at the target range with phase
     -4 pi f_c R / c mod 2 pi (-2.414527 rad for R = 150 m)."""
