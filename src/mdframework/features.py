@@ -11,7 +11,7 @@ All features are radial velocities in m/s (positive = approaching):
 7. ``lower_mean``: mean of ``L(m)``.
 
 The paper only says the envelopes are "curves connecting the maxima and minima of the
-spectrogram", so the method is an option ([L] in the reference):
+spectrogram", so the method is an option:
 
 - ``threshold`` (default): per time column, the highest and lowest velocity bins whose power is
   within ``threshold_db`` (default -20 dB) of that column's peak, ignoring bins more than

@@ -2,7 +2,7 @@
 
 Segment lengths are Boulic's proportions of the height ``H`` as coded by Chen; each body part is a
 spheroid (``a = b``) whose long semi-axis ``c`` is half the segment length and whose axis follows
-the segment. Two placements are offered ([L] in the reference):
+the segment. Two placements are offered (a modelling choice the paper leaves open):
 
 - ``chen16``: Chen's 16 parts, placed as in ``RadarReturnsFromWalkingHuman.m`` (the lower leg uses
   its own length, not the upper leg's as Chen's code does).

@@ -4,7 +4,7 @@ Sign convention: the slow-time return is proportional to
 ``exp(-j 4 pi f_c R / c)``, so an approaching target (R falling) has positive Doppler
 ``f_D = 2 v_r / lambda`` with ``v_r > 0`` when approaching.
 
-Numerics (section 6.1): ranges stay float64 and the carrier phase is reduced to a fraction of a
+Numerics: ranges stay float64 and the carrier phase is reduced to a fraction of a
 cycle in float64 before any complex exponential is formed, so 10 km ranges keep the same Doppler as
 10 m ranges.
 """
