@@ -290,7 +290,7 @@ def _apply(r: FloatArray, v: FloatArray) -> FloatArray:
 
 
 def chain_positions(gait: Gait, time: FloatArray) -> FloatArray:
-    """Canonical joints (n, 17, 3) [m] at ``time`` (n,) [s] by Chen's chain (section 3.3),
+    """Canonical joints (n, 17, 3) [m] at ``time`` (n,) [s] by Chen's kinematic chain,
     evaluated step by step with his passive matrices, in the walker frame.
 
     This is the reference evaluation; the MuJoCo model must reproduce it (in chen-compatible
