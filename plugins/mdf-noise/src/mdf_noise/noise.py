@@ -23,8 +23,11 @@ set in one of two ways:
     matched filter raises the SNR by the time-bandwidth product ``tau B``, so in the normalised
     output ``sigma^2 = k_B T F B_n / (tau B)``, which is ``k_B T F / tau`` when ``B_n = B``.
     Paired with the waveform's range-equation amplitudes this gives the physical SNR of a target
-    at any range. ``tau`` and ``B`` are read from the waveform's config (``pulse_width``,
-    ``bandwidth``) or given here.
+    at any range. A matched filter's output noise is ``k_B T F / tau`` whatever the receiver's
+    bandwidth (white noise of density ``k_B T F``), so ``B_n`` other than ``B`` does not model a
+    wider IF filter: it scales the noise by ``B_n / B``, a receiver that falls short of the
+    matched filter by that factor (a mismatch loss). ``tau`` and ``B`` are read from the
+    waveform's config (``pulse_width``, ``bandwidth``) or given here.
 
 When the waveform also returns a range-time map (``Received.range_time``, the raw path), noise of
 the same variance is added to every range cell, independently per cell: after pulse compression
@@ -70,7 +73,9 @@ class NoiseConfig(PluginConfig):
         290.0, gt=0, le=1e5, description="mode thermal: system noise temperature T [K]."
     )
     noise_bandwidth: Bandwidth | None = Field(
-        None, description="mode thermal: noise bandwidth B_n [Hz]; default: chirp bandwidth."
+        None,
+        description="mode thermal: noise bandwidth B_n [Hz]; default: chirp bandwidth. The "
+        "noise is k T F B_n / (tau B): B_n other than B acts as a mismatch loss B_n / B.",
     )
     pulse_width: float | None = Field(
         None,
