@@ -15,7 +15,7 @@ from sklearn.model_selection import StratifiedShuffleSplit
 
 from mdframework import experiment as exp
 from mdframework.dataset import load_dataset_config
-from mdframework.errors import ConfigError
+from mdframework.errors import ConfigError, MdfError
 
 
 @pytest.mark.parametrize("path", sorted(EXAMPLES.glob("experiment_*.toml")), ids=lambda p: p.stem)
@@ -331,15 +331,45 @@ def test_more_folds_than_subjects_warns_on_stderr(
 ) -> None:
     from mdframework.cli import main
 
-    e = _experiment(
-        kinect_dataset,
-        tmp_path,
-        '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\nfolds = 5\n',
-    )
+    body = '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\nfolds = 5\n'
+    tt = '[train_test]\ntrain = { subject = ["s01", "s02"] }\ntest = { subject = "s03" }\n'
+    e = _experiment(kinect_dataset, tmp_path, body + tt)
     assert main(["experiment", str(e), "--out", str(tmp_path / "o")]) == 0
     err = capsys.readouterr().err
     assert "warning: within-source kinect: not evaluated: evaluation.folds = 5 exceeds" in err
     assert "Not evaluated: evaluation.folds = 5" in (tmp_path / "o" / "report.md").read_text()
+
+
+def test_an_experiment_that_evaluates_nothing_is_an_error(
+    kinect_dataset: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Every group skipped and no cross-source or train/test part: one error line, exit 2,
+    no report (it used to write an empty report and exit 0)."""
+    from mdframework.cli import main
+
+    body = '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\nfolds = 5\n'
+    e = _experiment(kinect_dataset, tmp_path, body)
+    out = tmp_path / "o"
+    assert main(["experiment", str(e), "--out", str(out), "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        f"mdf: error: {e}: evaluation.split = 'groups': nothing could be evaluated (within-source "
+        "kinect: evaluation.folds = 5 exceeds the 3 groups ['s01', 's02', 's03']: lower "
+        "evaluation.folds, or leave it out for one fold per group)"
+    ]
+    assert not out.exists() or not any(out.iterdir())  # nothing half-written
+
+
+def test_leave_subjects_out_refuses_records_without_a_subject() -> None:
+    """Records of unknown subjects are not held out together as if they were one person."""
+    x, y, subjects = _one_class_per_subject()
+    subjects[-4:] = ""  # s5's records lost their subject
+    cfg = _cfg({"split": "groups", "by": "subject"})
+    factory = exp.classifier_factory(cfg.classifier, "t")
+    with pytest.raises(
+        MdfError, match=r"^evaluation.by = 'subject': 4 of 20 records have no subject; give"
+    ):
+        exp.within_source(cfg, factory, x, y, subjects)
 
 
 @pytest.mark.parametrize(

@@ -488,6 +488,12 @@ def within_source(
     if ev.split == "groups":
         if recordings is None:
             raise MdfError(f"evaluation.split = 'groups' needs each record's {ev.by}")
+        blank = int(np.sum(recordings == ""))
+        if blank:  # records of unknown people would be held out together as one subject
+            raise MdfError(
+                f"evaluation.by = {ev.by!r}: {blank} of {len(recordings)} records have no "
+                f"{ev.by}; give their dataset sources a {ev.by}"
+            )
         splits = group_splits(recordings, ev.folds)
         untested = _not_testable(ev, classes, y, recordings)
     elif ev.split == "recording":
@@ -779,6 +785,7 @@ def _report(
         f"dataset {source} ({len(data.labels)} records); classifier "
         f"{json.dumps(cfg.classifier)}; selection {cfg.selection.method}"
     )
+    skipped: list[str] = []  # warnings, given once something else is evaluated
     for group in sorted(set(data.groups.tolist())):
         mask = data.groups == group
         if len(set(data.labels[mask].tolist())) < 2:
@@ -801,9 +808,7 @@ def _report(
         except ConfigError:  # the config is wrong for every source: the experiment fails
             raise
         except MdfError as exc:  # e.g. more folds than subjects
-            warnings.warn(
-                f"within-source {group}: not evaluated: {exc}", ExperimentWarning, stacklevel=2
-            )
+            skipped.append(f"within-source {group}: not evaluated: {exc}")
             report += [f"## Within-source: {group}", "", f"Not evaluated: {exc}.", ""]
             summary["within"][group] = {"skipped": str(exc)}
             continue
@@ -931,6 +936,11 @@ def _report(
             "![train/test](train_test_confusion.png)",
             "",
         ]
+    evaluated = [g for g, res in summary["within"].items() if "skipped" not in res]
+    if not evaluated and cfg.cross_source is None and cfg.train_test is None:
+        raise ConfigError(_nothing_evaluated(cfg.evaluation, summary["within"]))
+    for message in skipped:
+        warnings.warn(message, ExperimentWarning, stacklevel=2)
     note("feature statistics and figures", progress)
     stats = feature_statistics(data)
     (out / "feature_stats.csv").write_text(_csv(stats), encoding="utf-8")
@@ -961,6 +971,19 @@ def _report(
         json.dumps(summary, indent=2, default=str) + "\n", encoding="utf-8"
     )
     return summary
+
+
+def _nothing_evaluated(ev: EvaluationConfig, within: dict[str, dict[str, Any]]) -> str:
+    """The error of an experiment with nothing to report: no group could be evaluated within
+    its source (``within``: group -> its result or its reason), and there is no cross-source or
+    train/test part."""
+    if not within:
+        return (
+            "nothing to evaluate: no group of the dataset has two or more classes, and there is "
+            "no [cross_source] or [train_test]"
+        )
+    reasons = "; ".join(f"{g}: {res['skipped']}" for g, res in within.items())
+    return f"evaluation.split = {ev.split!r}: nothing could be evaluated (within-source {reasons})"
 
 
 def _spread_words(res: dict[str, Any], splits: str) -> str:
