@@ -159,6 +159,43 @@ def test_recording_split_holds_out_whole_recordings(rng: np.random.Generator) ->
         exp.recording_splits(labels, np.where(labels == "a", "one", recordings), 1, 0.4, 0)
 
 
+def test_two_recordings_of_one_name_are_held_out_as_two(tmp_path: Path) -> None:
+    """alice/walk.bvh and bob/walk.bvh are two recordings: split = 'recording' holds out one
+    of them (the class used to count one recording and was not evaluated)."""
+    import shutil
+
+    from mdframework.dataset import build_dataset
+
+    bvh = EXAMPLES / "data" / "cmu" / "bvh"
+    for person, walk, box in (("alice", "16_21", "13_41"), ("bob", "09_03", "80_10")):
+        (tmp_path / person).mkdir()
+        shutil.copyfile(bvh / f"{walk}.bvh", tmp_path / person / "walk.bvh")
+        shutil.copyfile(bvh / f"{box}.bvh", tmp_path / person / "box.bvh")
+    sources = "".join(
+        f'[[sources]]\nlabel = "{label}"\nmax_records = 3\nhop = 0.05\n'
+        f'motion = {{ kind = "cmu", file = "{person}/{name}.bvh" }}\n'
+        for person in ("alice", "bob")
+        for label, name in (("walk", "walk"), ("boxing", "box"))
+    )
+    (tmp_path / "d.toml").write_text(
+        sources + "[record_lengths]\nwalk = 0.5\nboxing = 0.5\n[base.processing]\nnfft = 256\n"
+    )
+    build_dataset(*load_dataset_config(tmp_path / "d.toml"), tmp_path / "ds", progress=False)
+    with (tmp_path / "ds" / "index.csv").open() as fh:
+        recordings = sorted({r["recording"] for r in csv.DictReader(fh)})
+    assert recordings == ["alice/box.bvh", "alice/walk.bvh", "bob/box.bvh", "bob/walk.bvh"]
+    e = _experiment(
+        tmp_path / "ds",
+        tmp_path,
+        '[selection]\nmethod = "none"\n[classifier]\nkind = "knn"\nk = 1\n'
+        '[evaluation]\nsplit = "recording"\nrepeats = 2\n',
+    )
+    summary = exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+    within = summary["within"]["cmu"]
+    assert within["not_evaluated"] == {}
+    assert within["splits_scored"] == {"boxing": 2, "walk": 2}
+
+
 # --------------------------------------------------------------------------- evaluation protocols
 
 MSR = EXAMPLES / "data" / "kinect" / "msr-action3d"

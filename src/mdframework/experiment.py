@@ -790,7 +790,9 @@ def _report(
         mask = data.groups == group
         if len(set(data.labels[mask].tolist())) < 2:
             continue
-        column = cfg.evaluation.by if cfg.evaluation.split == "groups" else "file"
+        column = cfg.evaluation.by if cfg.evaluation.split == "groups" else "recording"
+        if column == "recording" and column not in data.table:  # built before the column
+            column = "file"
         if column not in data.table:
             raise MdfError(
                 f"evaluation.by = {column!r}: the dataset has no such column; rebuild it"
