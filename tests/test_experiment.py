@@ -361,6 +361,11 @@ def test_leave_subjects_out_report_states_the_protocol(
     with (tmp_path / "o" / "within_kinect_per_class.csv").open() as fh:
         rows = {r["class"]: r for r in csv.DictReader(fh)}
     assert rows["punch"]["rate_mean"] == "nan" and rows["punch"]["splits_scored"] == "0"
+    # summary.json is strict JSON: the class not evaluated reads null, not NaN
+    text = (tmp_path / "o" / "summary.json").read_text()
+    written = json.loads(text, parse_constant=lambda c: pytest.fail(f"{c} in summary.json"))
+    punch = written["within"]["kinect"]["classes"].index("punch")
+    assert written["within"]["kinect"]["confusion_mean"][punch] == [None, None, None]
 
 
 def test_more_folds_than_subjects_warns_on_stderr(

@@ -970,9 +970,22 @@ def _report(
         draw()
     (out / "report.md").write_text("\n".join(report), encoding="utf-8")
     (out / "summary.json").write_text(
-        json.dumps(summary, indent=2, default=str) + "\n", encoding="utf-8"
+        json.dumps(_strict_json(summary), indent=2, default=str, allow_nan=False) + "\n",
+        encoding="utf-8",
     )
     return summary
+
+
+def _strict_json(value: Any) -> Any:
+    """``value`` with every NaN or infinite number (a matrix row of a class not evaluated) as
+    None, so that summary.json is JSON that every reader takes (null), not Python's NaN."""
+    if isinstance(value, float):
+        return value if np.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: _strict_json(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_strict_json(v) for v in value]
+    return value
 
 
 def _nothing_evaluated(ev: EvaluationConfig, within: dict[str, dict[str, Any]]) -> str:
