@@ -276,6 +276,30 @@ def test_leave_subjects_out_accuracy_is_the_mean_recall_of_the_matrix() -> None:
     assert res["splits_tested"] == {"a": 3, "b": 2} and res["not_evaluated"] == {}
 
 
+def test_the_optimistic_bound_is_scored_as_the_result_is() -> None:
+    """Leave-subjects-out with a class of one subject (c): the optimistic variant leaves out,
+    as the result does, the rows of classes a fold tests without training on them. It used to
+    average each fold's balanced accuracy, counting c's fold as 0 and weighting a by its three
+    subjects: (1 + 1 + 1 + 1 + 0 + 0) / 6 = 0.667, an 'upper bound' below the result (0.75)."""
+    x, y, subjects = _one_class_per_subject()
+    x = np.concatenate([x, np.full((4, 7), 0.0)])
+    x[-4:, 0] = -20.0 + np.arange(4) * 0.01
+    y = np.concatenate([y, ["c"] * 4])
+    subjects = np.concatenate([subjects, ["s6"] * 4])
+    cfg = exp.ExperimentConfig.model_validate(
+        {
+            "dataset": {"path": "unused"},
+            "evaluation": {"split": "groups", "by": "subject"},
+            "selection": {"method": "wrapper", "sizes": [1], "folds": 2, "optimistic": True},
+            "classifier": {"kind": "knn", "k": 1},
+        }
+    )
+    res = exp.within_source(cfg, exp.classifier_factory(cfg.classifier, "t"), x, y, subjects)
+    assert list(res["not_evaluated"]) == ["c"]
+    assert res["balanced_accuracy_mean"] == pytest.approx(0.75, abs=1e-12)
+    assert res["optimistic_accuracy_mean"] == pytest.approx(0.75, abs=1e-12)
+
+
 @pytest.mark.parametrize("split", ["record", "recording"])
 def test_stratified_splits_keep_the_mean_of_per_split_scores(
     rng: np.random.Generator, split: str

@@ -526,9 +526,9 @@ def within_source(
     for rep, (train, test) in enumerate(bar):
         sel = _select(cfg, factory, x[train], y[train], cfg.seed + rep, counts)
         pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
+        untrained = [i for i, c in enumerate(classes) if c not in set(y[train].tolist())]
         mat = confusion_matrix(y[test], pred, classes)
-        trained = set(y[train].tolist())
-        mat[[i for i, c in enumerate(classes) if c not in trained]] = np.nan
+        mat[untrained] = np.nan
         mats.append(mat)
         tested.append(np.isin(classes, y[test]))
         subsets.append([names[i] for i in sel.subset])
@@ -536,7 +536,11 @@ def within_source(
             opt = optimistic_select(
                 x[train], y[train], x[test], y[test], factory, sizes=cfg.selection.sizes
             )
-            optimistic.append(opt.score)
+            # scored as the result is: its matrix, rows of classes not trained on left out
+            best = _fit_predict(factory, x[train], y[train], x[test], opt.subset)
+            opt_mat = confusion_matrix(y[test], best, classes)
+            opt_mat[untrained] = np.nan
+            optimistic.append(opt_mat)
     stack = np.stack(mats)  # (n_splits, n_classes, n_classes); NaN rows: class not scored
     scored: NDArray[np.bool_] = ~np.isnan(stack[:, :, 0])  # (n_splits, n_classes)
     rows: NDArray[np.bool_] = np.any(scored, axis=0)
@@ -553,6 +557,10 @@ def within_source(
     mean[rows] = np.nanmean(stack[:, rows], axis=0)
     std[rows] = np.nanstd(stack[:, rows], axis=0)
     recall = np.diagonal(mean)[rows]
+    opt_mean = None
+    if optimistic:  # the same measure as the result: mean per-class recall of the mean matrix
+        opt_stack = np.stack(optimistic)[:, rows]
+        opt_mean = float(np.mean(np.diagonal(np.nanmean(opt_stack, axis=0)[:, rows])))
     if scored[:, rows].all():  # every split scores every class: spread over splits
         per_split = np.diagonal(stack, axis1=1, axis2=2)[:, rows].mean(axis=1)
         spread, over = float(np.std(per_split)), "splits"
@@ -569,7 +577,7 @@ def within_source(
         "splits_tested": {c: int(n) for c, n in zip(classes, np.sum(tested, axis=0), strict=True)},
         "splits_scored": {c: int(scored[:, i].sum()) for i, c in enumerate(classes)},
         "not_evaluated": {c: untested[c] for c in classes if c in untested},
-        "optimistic_accuracy_mean": float(np.mean(optimistic)) if optimistic else None,
+        "optimistic_accuracy_mean": opt_mean,
         "subsets": subsets,
         "n_records": len(y),
         "class_counts": counts,
