@@ -44,6 +44,17 @@ def test_bad_experiment_config(tmp_path: Path) -> None:
     p.write_text('[dataset]\npath = "x"\nconfig = "y"\n')
     with pytest.raises(ConfigError, match=r"exactly one of dataset\.config and dataset\.path"):
         exp.load_experiment_config(p)
+    # the same group on both sides would test on the training records themselves
+    p.write_text('[dataset]\npath = "x"\n[cross_source]\ntrain = "cmu"\ntest = "cmu"\n')
+    with pytest.raises(
+        ConfigError, match=r"e\.toml: cross_source: train and test are the same group 'cmu';"
+    ):
+        exp.load_experiment_config(p)
+    # a [classifier] without kind is not a plugin named 'None'
+    with pytest.raises(
+        ConfigError, match=r"^t: classifier\.kind: required \(installed: knn, sklearn"
+    ):
+        exp.classifier_factory({"k": 3}, "t")
 
 
 def _toy(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:

@@ -201,6 +201,12 @@ def load_experiment_config(path: str | Path) -> ExperimentConfig:
         cfg = ExperimentConfig.model_validate(data)
     except ValidationError as exc:
         raise ConfigError(format_validation_error(exc, str(p), data, ExperimentConfig)) from None
+    cs = cfg.cross_source
+    if cs is not None and cs.train == cs.test:  # it would test on its own training records
+        raise ConfigError(
+            f"{p}: cross_source: train and test are the same group {cs.train!r}; name two "
+            "groups (a within-source result of one group is always in the report)"
+        )
     if cfg.input == "histogram" and cfg.selection.method != "none":
         raise ConfigError(f"{p}: input = 'histogram' needs selection.method = 'none'")
     for pair in cfg.report.scatter_pairs:
@@ -225,6 +231,9 @@ def classifier_factory(
     experiment's seed) is set as :attr:`Classifier.seed` on every classifier made."""
     reg = registry or default_registry()
     kind = section.get("kind")
+    if kind is None:
+        installed = ", ".join(reg.names("classifier"))
+        raise ConfigError(f"{source}: classifier.kind: required (installed: {installed})")
     try:
         cls = reg.get("classifier", str(kind))
     except KeyError as exc:
