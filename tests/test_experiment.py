@@ -417,6 +417,34 @@ def test_more_folds_than_subjects_warns_on_stderr(
     assert "Not evaluated: evaluation.folds = 5" in (tmp_path / "o" / "report.md").read_text()
 
 
+def test_a_feature_that_is_not_a_number_names_the_index_line(
+    kinect_dataset: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An index.csv edited by hand with an empty or NaN feature: one line naming the file,
+    line and record, exit 2 (it was an internal error from the wrapper's input check)."""
+    import shutil
+
+    from mdframework.cli import main
+
+    data = tmp_path / "data"
+    shutil.copytree(kinect_dataset, data)
+    lines = (data / "index.csv").read_text().splitlines()
+    header = lines[0].split(",")
+    cells = lines[3].split(",")
+    cells[header.index("upper_max")] = ""
+    lines[3] = ",".join(cells)
+    (data / "index.csv").write_text("\n".join(lines) + "\n")
+    e = _experiment(data, tmp_path, '[selection]\nmethod = "none"\n[evaluation]\nrepeats = 2\n')
+    out = tmp_path / "o"
+    assert main(["experiment", str(e), "--out", str(out), "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        f"mdf: error: {data / 'index.csv'}:4: record {cells[0]}: upper_max is nan, not a finite "
+        "number (1 such values); rebuild the dataset or remove the record"
+    ]
+    assert not out.exists() or not any(out.iterdir())
+
+
 def test_an_experiment_that_evaluates_nothing_is_an_error(
     kinect_dataset: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -47,8 +47,8 @@ from .classify import (
     wrapper_select,
 )
 from .config import format_validation_error, read_config_file
-from .dataset import Dataset, build_dataset, load_dataset, load_dataset_config
-from .errors import ConfigError, MdfError
+from .dataset import INDEX, Dataset, build_dataset, load_dataset, load_dataset_config
+from .errors import ConfigError, DataFileError, MdfError
 from .features import FEATURE_NAMES
 from .interfaces import Classifier
 from .outdir import output_folder, safe_name
@@ -694,6 +694,16 @@ def classifier_inputs(
     """The dataset, the classifier input (n_records, n_columns) and the columns' names."""
     if cfg.input == "features":
         data = load_dataset(data_dir, spectrograms=False)
+        bad = np.argwhere(~np.isfinite(data.features))
+        if bad.size:  # an index.csv edited by hand: one line naming it, not an internal error
+            row, col = (int(v) for v in bad[0])
+            raise DataFileError(
+                Path(data_dir) / INDEX,
+                f"record {data.table['id'][row]}: {FEATURE_NAMES[col]} is "
+                f"{data.features[row, col]}, not a finite number ({len(bad)} such values); "
+                "rebuild the dataset or remove the record",
+                row + 2,
+            )
         return data, data.features, list(FEATURE_NAMES)
     data = load_dataset(data_dir, spectrograms=False, histograms=True)
     hists = data.histograms or []
