@@ -424,8 +424,6 @@ def test_a_feature_that_is_not_a_number_names_the_index_line(
     line and record, exit 2 (it was an internal error from the wrapper's input check)."""
     import shutil
 
-    from mdframework.cli import main
-
     data = tmp_path / "data"
     shutil.copytree(kinect_dataset, data)
     lines = (data / "index.csv").read_text().splitlines()
@@ -435,14 +433,25 @@ def test_a_feature_that_is_not_a_number_names_the_index_line(
     lines[3] = ",".join(cells)
     (data / "index.csv").write_text("\n".join(lines) + "\n")
     e = _experiment(data, tmp_path, '[selection]\nmethod = "none"\n[evaluation]\nrepeats = 2\n')
-    out = tmp_path / "o"
-    assert main(["experiment", str(e), "--out", str(out), "--no-progress"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert err == [
+    _fails_with_one_line(
+        e,
+        tmp_path / "o",
+        capsys,
         f"mdf: error: {data / 'index.csv'}:4: record {cells[0]}: upper_max is nan, not a finite "
-        "number (1 such values); rebuild the dataset or remove the record"
-    ]
-    assert not out.exists() or not any(out.iterdir())
+        "number (1 such values); rebuild the dataset or remove the record",
+    )
+
+
+def _fails_with_one_line(
+    config: Path, out: Path, capsys: pytest.CaptureFixture[str], line: str
+) -> None:
+    """``mdf experiment config --out out`` exits 2 with ``line`` as its only stderr line and
+    leaves nothing in ``out``."""
+    from mdframework.cli import main
+
+    assert main(["experiment", str(config), "--out", str(out), "--no-progress"]) == 2
+    assert capsys.readouterr().err.strip().splitlines() == [line]
+    assert not out.exists() or not any(out.iterdir())  # nothing half-written
 
 
 def test_an_experiment_that_evaluates_nothing_is_an_error(
@@ -450,19 +459,16 @@ def test_an_experiment_that_evaluates_nothing_is_an_error(
 ) -> None:
     """Every group skipped and no cross-source or train/test part: one error line, exit 2,
     no report (it used to write an empty report and exit 0)."""
-    from mdframework.cli import main
-
     body = '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\nfolds = 5\n'
     e = _experiment(kinect_dataset, tmp_path, body)
-    out = tmp_path / "o"
-    assert main(["experiment", str(e), "--out", str(out), "--no-progress"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert err == [
+    _fails_with_one_line(
+        e,
+        tmp_path / "o",
+        capsys,
         f"mdf: error: {e}: evaluation.split = 'groups': nothing could be evaluated (within-source "
         "kinect: evaluation.folds = 5 exceeds the 3 groups ['s01', 's02', 's03']: lower "
-        "evaluation.folds, or leave it out for one fold per group)"
-    ]
-    assert not out.exists() or not any(out.iterdir())  # nothing half-written
+        "evaluation.folds, or leave it out for one fold per group)",
+    )
 
 
 def test_leave_subjects_out_refuses_records_without_a_subject() -> None:
