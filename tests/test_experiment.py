@@ -403,6 +403,47 @@ def test_leave_subjects_out_report_states_the_protocol(
     assert written["within"]["kinect"]["confusion_mean"][punch] == [None, None, None]
 
 
+def test_per_record_predictions_match_the_matrices(kinect_dataset: Path, tmp_path: Path) -> None:
+    """within_<group>_predictions.csv: every record once under leave-subjects-out, each fold
+    one subject, and the folds' matrices from its rows average to the reported matrix;
+    train_test_predictions.csv gives the train/test matrix."""
+    body = (
+        '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\n'
+        '[train_test]\ntrain = { subject = ["s01", "s02"] }\ntest = { subject = "s03" }\n'
+    )
+    e = _experiment(kinect_dataset, tmp_path, body)
+    with pytest.warns(exp.ExperimentWarning):  # punch: one subject
+        summary = exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+    with (kinect_dataset / "index.csv").open() as fh:
+        subject = {r["id"]: r["subject"] for r in csv.DictReader(fh)}
+    with (tmp_path / "o" / "within_kinect_predictions.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    assert sorted(r["id"] for r in rows) == sorted(subject)  # each record tested once
+    within = summary["within"]["kinect"]
+    classes = within["classes"]
+    mats = []
+    for split in sorted({r["split"] for r in rows}):
+        fold = [r for r in rows if r["split"] == split]
+        assert len({subject[r["id"]] for r in fold}) == 1  # a fold holds out one subject
+        mat = exp.confusion_matrix(
+            np.array([r["true"] for r in fold]), np.array([r["predicted"] for r in fold]), classes
+        )
+        mat[classes.index("punch")] = np.nan  # tested only when its one subject is held out
+        mats.append(mat)
+    mean = np.nanmean(np.stack(mats)[:, :2], axis=0)  # boxing, jog
+    assert np.allclose(mean, np.array(within["confusion_mean"])[:2])
+    with (tmp_path / "o" / "train_test_predictions.csv").open() as fh:
+        tt = list(csv.DictReader(fh))
+    assert {subject[r["id"]] for r in tt} == {"s03"}
+    got = exp.confusion_matrix(
+        np.array([r["true"] for r in tt]),
+        np.array([r["predicted"] for r in tt]),
+        summary["train_test"]["classes"],
+    )
+    assert np.allclose(got, summary["train_test"]["confusion"])
+    assert "predicted" not in summary["train_test"] and "predictions" not in within
+
+
 def test_more_folds_than_subjects_warns_on_stderr(
     kinect_dataset: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

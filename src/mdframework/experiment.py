@@ -19,7 +19,9 @@
   and scatter plots of feature pairs (like Figure 12).
 
 Outputs in DIR: ``report.md``; ``within_<group>_confusion.csv/png`` (mean and std);
-``within_<group>_per_class.csv``; ``cross_confusion.csv/png``; ``feature_stats.csv/md``;
+``within_<group>_per_class.csv``; ``within_<group>_predictions.csv`` (split, record id, true and
+predicted label of every test record); ``cross_confusion.csv/png``, ``cross_predictions.csv``;
+``train_test_confusion.csv/png``, ``train_test_predictions.csv``; ``feature_stats.csv/md``;
 ``scatter_<f1>_<f2>.png``; ``summary.json``; and ``dataset/`` when the experiment built it.
 """
 
@@ -63,6 +65,8 @@ EXPERIMENT_FILES = (
     "summary.json",
     "within_*",
     "cross_confusion.*",
+    "cross_predictions.csv",
+    "train_test_predictions.csv",
     "train_test_confusion.*",
     "feature_stats.*",
     "scatter_*.png",
@@ -522,6 +526,7 @@ def within_source(
     if len(classes) - len(untested) < 2:
         raise _too_few_classes(untested)
     mats, optimistic, subsets, tested = [], [], [], []
+    predictions: list[tuple[int, NDArray[np.intp], NDArray[Any]]] = []
     from tqdm import tqdm
 
     bar = tqdm(
@@ -535,6 +540,7 @@ def within_source(
     for rep, (train, test) in enumerate(bar):
         sel = _select(cfg, factory, x[train], y[train], cfg.seed + rep, counts)
         pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
+        predictions.append((rep, test, pred))
         untrained = [i for i, c in enumerate(classes) if c not in set(y[train].tolist())]
         mat = confusion_matrix(y[test], pred, classes)
         mat[untrained] = np.nan
@@ -590,6 +596,7 @@ def within_source(
         "subsets": subsets,
         "n_records": len(y),
         "class_counts": counts,
+        "predictions": predictions,
     }
 
 
@@ -643,6 +650,9 @@ def _train_then_test(
         "subset": [names[i] for i in sel.subset],
         "train_counts": {c: int(np.sum(labels[train] == c)) for c in shared},
         "test_counts": {c: int(np.sum(labels[test] == c)) for c in shared},
+        "test_index": np.flatnonzero(test),
+        "true": labels[test],
+        "predicted": pred,
     }
 
 
@@ -884,8 +894,21 @@ def _report(
                 caption=f"{caption}; mean ± std over {splits}",
             )
         )
+        ids, truth = data.table["id"][mask], data.labels[mask]
+        (out / f"{stem}_predictions.csv").write_text(
+            _csv(
+                [
+                    {"split": split, "id": ids[i], "true": truth[i], "predicted": p}
+                    for split, test, pred in res["predictions"]
+                    for i, p in zip(test, pred, strict=True)
+                ]
+            ),
+            encoding="utf-8",
+        )
         summary["within"][group] = {
-            k: v for k, v in res.items() if k not in ("confusion_mean", "confusion_std")
+            k: v
+            for k, v in res.items()
+            if k not in ("confusion_mean", "confusion_std", "predictions")
         }
         summary["within"][group]["confusion_mean"] = res["confusion_mean"].tolist()
         opt = res["optimistic_accuracy_mean"]
@@ -924,7 +947,8 @@ def _report(
                 caption=f"{caption}; features {res['subset']}",
             )
         )
-        summary["cross"] = {**res, "confusion": res["confusion"].tolist()}
+        _write_predictions(out / "cross_predictions.csv", data, res)
+        summary["cross"] = _without_predictions(res)
         report += [
             f"## Cross-source: train {cfg.cross_source.train}, test {cfg.cross_source.test}",
             "",
@@ -953,7 +977,8 @@ def _report(
             None,
             title=f"train {cfg.train_test.train} -> test {cfg.train_test.test}",
         )
-        summary["train_test"] = {**res, "confusion": res["confusion"].tolist()}
+        _write_predictions(out / "train_test_predictions.csv", data, res)
+        summary["train_test"] = _without_predictions(res)
         report += [
             f"## Train on {cfg.train_test.train}, test on {cfg.train_test.test}",
             "",
@@ -1001,6 +1026,24 @@ def _report(
         encoding="utf-8",
     )
     return summary
+
+
+def _write_predictions(path: Path, data: Dataset, res: dict[str, Any]) -> None:
+    """One row per test record of a train/test result: its id, true (mapped) and predicted
+    label."""
+    ids = data.table["id"][res["test_index"]]
+    rows = [
+        {"id": i, "true": t, "predicted": p}
+        for i, t, p in zip(ids, res["true"], res["predicted"], strict=True)
+    ]
+    path.write_text(_csv(rows), encoding="utf-8")
+
+
+def _without_predictions(res: dict[str, Any]) -> dict[str, Any]:
+    """A train/test result for summary.json: the matrix as lists, the per-record predictions
+    left to their CSV file."""
+    kept = {k: v for k, v in res.items() if k not in ("test_index", "true", "predicted")}
+    return {**kept, "confusion": res["confusion"].tolist()}
 
 
 def _strict_json(value: Any) -> Any:
