@@ -166,6 +166,13 @@ def test_recording_split_holds_out_whole_recordings(rng: np.random.Generator) ->
         cfg, exp.classifier_factory({"kind": "knn"}, "t"), x, labels, recordings
     )
     assert np.allclose(res["confusion_mean"].sum(axis=1), 1.0)
+    # 40 % of 3 recordings is 1.2: one is held out (33 %), and the report says so
+    assert res["recordings_held_out"] == {"a": [1, 3], "b": [1, 3]}
+    assert all(len(set(recordings[te])) == 2 for _, te in splits)
+    assert (
+        exp._held_out_markdown(res)[0] == "Recordings held out in every split: a 1 of 3, b 1 of 3."
+    )
+    assert [exp.recordings_held_out(n, 0.4) for n in (2, 3, 5, 12)] == [1, 1, 2, 5]
     with pytest.raises(exp.MdfError, match="class 'a' has only one recording"):
         exp.recording_splits(labels, np.where(labels == "a", "one", recordings), 1, 0.4, 0)
 

@@ -311,11 +311,17 @@ def recording_splits(
                 raise MdfError(
                     f"evaluation.split = 'recording': class {label!r} has only one recording"
                 )
-            n_test = min(len(files) - 1, max(1, round(test_fraction * len(files))))
+            n_test = recordings_held_out(len(files), test_fraction)
             held = set(rng.permutation(files)[:n_test].tolist())
             test_mask |= (labels == label) & np.isin(recordings, list(held))
         splits.append((np.flatnonzero(~test_mask), np.flatnonzero(test_mask)))
     return splits
+
+
+def recordings_held_out(n_recordings: int, test_fraction: float) -> int:
+    """How many of a class's ``n_recordings`` a split holds out: ``test_fraction`` of them,
+    rounded, at least one and never all."""
+    return min(n_recordings - 1, max(1, round(test_fraction * n_recordings)))
 
 
 def group_splits(
@@ -398,7 +404,10 @@ def protocol(ev: EvaluationConfig) -> str:
         folds = f"one fold per {ev.by}" if ev.folds is None else f"{ev.folds} folds"
         return f"leave-{ev.by}s-out cross-validation ({folds}, each testing unseen {ev.by}s)"
     if ev.split == "recording":
-        return f"{ev.repeats} random splits holding out {pct} % of every class's recordings"
+        return (
+            f"{ev.repeats} random splits holding out {pct} % of every class's recordings "
+            "(rounded, at least one, never all)"
+        )
     return f"{ev.repeats} stratified random splits of the records, {100 - pct}/{pct}"
 
 
@@ -498,6 +507,7 @@ def within_source(
     classes = sorted(set(y.tolist()))
     ev = cfg.evaluation
     untested: dict[str, str] = {}
+    held: dict[str, tuple[int, int]] = {}  # split = 'recording': class -> (held out, of)
     if ev.split == "groups":
         if recordings is None:
             raise MdfError(f"evaluation.split = 'groups' needs each record's {ev.by}")
@@ -521,6 +531,9 @@ def within_source(
         splits = [
             (np.sort(np.concatenate([testable[tr], always])), testable[te]) for tr, te in some
         ]
+        for c in sorted(set(y[testable].tolist())):
+            n = len(set(recordings[y == c].tolist()))
+            held[c] = (recordings_held_out(n, ev.test_fraction), n)
     else:
         splits = _record_splits(ev, x, y, cfg.seed)
     if len(classes) - len(untested) < 2:
@@ -597,6 +610,7 @@ def within_source(
         "n_records": len(y),
         "class_counts": counts,
         "predictions": predictions,
+        "recordings_held_out": {c: list(v) for c, v in held.items()},
     }
 
 
@@ -919,6 +933,7 @@ def _report(
             f"({_spread_words(res, splits)}); classes and records: {res['class_counts']}.",
             "",
             *_not_evaluated_markdown(res, splits),
+            *_held_out_markdown(res),
             _markdown_matrix(classes, res["confusion_mean"], res["confusion_std"]),
             "",
             *selected_features_markdown(res["subsets"], cfg.selection.method),
@@ -1080,6 +1095,16 @@ def _spread_words(res: dict[str, Any], splits: str) -> str:
         f"std {std:.3f} over the classes' recalls, as not every split scores every class; the "
         f"mean per-class recall of the matrix below, mean ± std over {splits}"
     )
+
+
+def _held_out_markdown(res: dict[str, Any]) -> list[str]:
+    """The report line saying how many recordings of each class a split held out (the share
+    ``test_fraction`` asks for, rounded, at least one and never all)."""
+    held = res.get("recordings_held_out") or {}
+    if not held:
+        return []
+    words = ", ".join(f"{c} {k} of {n}" for c, (k, n) in held.items())
+    return [f"Recordings held out in every split: {words}.", ""]
 
 
 def _not_evaluated_markdown(res: dict[str, Any], splits: str) -> list[str]:
