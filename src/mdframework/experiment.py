@@ -554,7 +554,8 @@ def within_source(
         sel = _select(cfg, factory, x[train], y[train], cfg.seed + rep, counts)
         pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
         predictions.append((rep, test, pred))
-        untrained = [i for i, c in enumerate(classes) if c not in set(y[train].tolist())]
+        trained = set(y[train].tolist())
+        untrained = [i for i, c in enumerate(classes) if c not in trained]
         mat = confusion_matrix(y[test], pred, classes)
         mat[untrained] = np.nan
         mats.append(mat)
