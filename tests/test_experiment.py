@@ -15,7 +15,7 @@ from sklearn.model_selection import StratifiedShuffleSplit
 
 from mdframework import experiment as exp
 from mdframework.dataset import load_dataset_config
-from mdframework.errors import ConfigError
+from mdframework.errors import ConfigError, MdfError
 
 
 @pytest.mark.parametrize("path", sorted(EXAMPLES.glob("experiment_*.toml")), ids=lambda p: p.stem)
@@ -44,6 +44,17 @@ def test_bad_experiment_config(tmp_path: Path) -> None:
     p.write_text('[dataset]\npath = "x"\nconfig = "y"\n')
     with pytest.raises(ConfigError, match=r"exactly one of dataset\.config and dataset\.path"):
         exp.load_experiment_config(p)
+    # the same group on both sides would test on the training records themselves
+    p.write_text('[dataset]\npath = "x"\n[cross_source]\ntrain = "cmu"\ntest = "cmu"\n')
+    with pytest.raises(
+        ConfigError, match=r"e\.toml: cross_source: train and test are the same group 'cmu';"
+    ):
+        exp.load_experiment_config(p)
+    # a [classifier] without kind is not a plugin named 'None'
+    with pytest.raises(
+        ConfigError, match=r"^t: classifier\.kind: required \(installed: knn, sklearn"
+    ):
+        exp.classifier_factory({"k": 3}, "t")
 
 
 def _toy(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
@@ -155,8 +166,52 @@ def test_recording_split_holds_out_whole_recordings(rng: np.random.Generator) ->
         cfg, exp.classifier_factory({"kind": "knn"}, "t"), x, labels, recordings
     )
     assert np.allclose(res["confusion_mean"].sum(axis=1), 1.0)
+    # 40 % of 3 recordings is 1.2: one is held out (33 %), and the report says so
+    assert res["recordings_held_out"] == {"a": [1, 3], "b": [1, 3]}
+    assert all(len(set(recordings[te])) == 2 for _, te in splits)
+    assert (
+        exp._held_out_markdown(res)[0] == "Recordings held out in every split: a 1 of 3, b 1 of 3."
+    )
+    assert [exp.recordings_held_out(n, 0.4) for n in (2, 3, 5, 12)] == [1, 1, 2, 5]
     with pytest.raises(exp.MdfError, match="class 'a' has only one recording"):
         exp.recording_splits(labels, np.where(labels == "a", "one", recordings), 1, 0.4, 0)
+
+
+def test_two_recordings_of_one_name_are_held_out_as_two(tmp_path: Path) -> None:
+    """alice/walk.bvh and bob/walk.bvh are two recordings: split = 'recording' holds out one
+    of them (the class used to count one recording and was not evaluated)."""
+    import shutil
+
+    from mdframework.dataset import build_dataset
+
+    bvh = EXAMPLES / "data" / "cmu" / "bvh"
+    for person, walk, box in (("alice", "16_21", "13_41"), ("bob", "09_03", "80_10")):
+        (tmp_path / person).mkdir()
+        shutil.copyfile(bvh / f"{walk}.bvh", tmp_path / person / "walk.bvh")
+        shutil.copyfile(bvh / f"{box}.bvh", tmp_path / person / "box.bvh")
+    sources = "".join(
+        f'[[sources]]\nlabel = "{label}"\nmax_records = 3\nhop = 0.05\n'
+        f'motion = {{ kind = "cmu", file = "{person}/{name}.bvh" }}\n'
+        for person in ("alice", "bob")
+        for label, name in (("walk", "walk"), ("boxing", "box"))
+    )
+    (tmp_path / "d.toml").write_text(
+        sources + "[record_lengths]\nwalk = 0.5\nboxing = 0.5\n[base.processing]\nnfft = 256\n"
+    )
+    build_dataset(*load_dataset_config(tmp_path / "d.toml"), tmp_path / "ds", progress=False)
+    with (tmp_path / "ds" / "index.csv").open() as fh:
+        recordings = sorted({r["recording"] for r in csv.DictReader(fh)})
+    assert recordings == ["alice/box.bvh", "alice/walk.bvh", "bob/box.bvh", "bob/walk.bvh"]
+    e = _experiment(
+        tmp_path / "ds",
+        tmp_path,
+        '[selection]\nmethod = "none"\n[classifier]\nkind = "knn"\nk = 1\n'
+        '[evaluation]\nsplit = "recording"\nrepeats = 2\n',
+    )
+    summary = exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+    within = summary["within"]["cmu"]
+    assert within["not_evaluated"] == {}
+    assert within["splits_scored"] == {"boxing": 2, "walk": 2}
 
 
 # --------------------------------------------------------------------------- evaluation protocols
@@ -237,6 +292,30 @@ def test_leave_subjects_out_accuracy_is_the_mean_recall_of_the_matrix() -> None:
     assert res["balanced_accuracy_std_over"] == "classes"
     assert res["balanced_accuracy_std"] == pytest.approx(0.25, abs=1e-12)
     assert res["splits_tested"] == {"a": 3, "b": 2} and res["not_evaluated"] == {}
+
+
+def test_the_optimistic_bound_is_scored_as_the_result_is() -> None:
+    """Leave-subjects-out with a class of one subject (c): the optimistic variant leaves out,
+    as the result does, the rows of classes a fold tests without training on them. It used to
+    average each fold's balanced accuracy, counting c's fold as 0 and weighting a by its three
+    subjects: (1 + 1 + 1 + 1 + 0 + 0) / 6 = 0.667, an 'upper bound' below the result (0.75)."""
+    x, y, subjects = _one_class_per_subject()
+    x = np.concatenate([x, np.full((4, 7), 0.0)])
+    x[-4:, 0] = -20.0 + np.arange(4) * 0.01
+    y = np.concatenate([y, ["c"] * 4])
+    subjects = np.concatenate([subjects, ["s6"] * 4])
+    cfg = exp.ExperimentConfig.model_validate(
+        {
+            "dataset": {"path": "unused"},
+            "evaluation": {"split": "groups", "by": "subject"},
+            "selection": {"method": "wrapper", "sizes": [1], "folds": 2, "optimistic": True},
+            "classifier": {"kind": "knn", "k": 1},
+        }
+    )
+    res = exp.within_source(cfg, exp.classifier_factory(cfg.classifier, "t"), x, y, subjects)
+    assert list(res["not_evaluated"]) == ["c"]
+    assert res["balanced_accuracy_mean"] == pytest.approx(0.75, abs=1e-12)
+    assert res["optimistic_accuracy_mean"] == pytest.approx(0.75, abs=1e-12)
 
 
 @pytest.mark.parametrize("split", ["record", "recording"])
@@ -324,6 +403,52 @@ def test_leave_subjects_out_report_states_the_protocol(
     with (tmp_path / "o" / "within_kinect_per_class.csv").open() as fh:
         rows = {r["class"]: r for r in csv.DictReader(fh)}
     assert rows["punch"]["rate_mean"] == "nan" and rows["punch"]["splits_scored"] == "0"
+    # summary.json is strict JSON: the class not evaluated reads null, not NaN
+    text = (tmp_path / "o" / "summary.json").read_text()
+    written = json.loads(text, parse_constant=lambda c: pytest.fail(f"{c} in summary.json"))
+    punch = written["within"]["kinect"]["classes"].index("punch")
+    assert written["within"]["kinect"]["confusion_mean"][punch] == [None, None, None]
+
+
+def test_per_record_predictions_match_the_matrices(kinect_dataset: Path, tmp_path: Path) -> None:
+    """within_<group>_predictions.csv: every record once under leave-subjects-out, each fold
+    one subject, and the folds' matrices from its rows average to the reported matrix;
+    train_test_predictions.csv gives the train/test matrix."""
+    body = (
+        '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\n'
+        '[train_test]\ntrain = { subject = ["s01", "s02"] }\ntest = { subject = "s03" }\n'
+    )
+    e = _experiment(kinect_dataset, tmp_path, body)
+    with pytest.warns(exp.ExperimentWarning):  # punch: one subject
+        summary = exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+    with (kinect_dataset / "index.csv").open() as fh:
+        subject = {r["id"]: r["subject"] for r in csv.DictReader(fh)}
+    with (tmp_path / "o" / "within_kinect_predictions.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    assert sorted(r["id"] for r in rows) == sorted(subject)  # each record tested once
+    within = summary["within"]["kinect"]
+    classes = within["classes"]
+    mats = []
+    for split in sorted({r["split"] for r in rows}):
+        fold = [r for r in rows if r["split"] == split]
+        assert len({subject[r["id"]] for r in fold}) == 1  # a fold holds out one subject
+        mat = exp.confusion_matrix(
+            np.array([r["true"] for r in fold]), np.array([r["predicted"] for r in fold]), classes
+        )
+        mat[classes.index("punch")] = np.nan  # tested only when its one subject is held out
+        mats.append(mat)
+    mean = np.nanmean(np.stack(mats)[:, :2], axis=0)  # boxing, jog
+    assert np.allclose(mean, np.array(within["confusion_mean"])[:2])
+    with (tmp_path / "o" / "train_test_predictions.csv").open() as fh:
+        tt = list(csv.DictReader(fh))
+    assert {subject[r["id"]] for r in tt} == {"s03"}
+    got = exp.confusion_matrix(
+        np.array([r["true"] for r in tt]),
+        np.array([r["predicted"] for r in tt]),
+        summary["train_test"]["classes"],
+    )
+    assert np.allclose(got, summary["train_test"]["confusion"])
+    assert "predicted" not in summary["train_test"] and "predictions" not in within
 
 
 def test_more_folds_than_subjects_warns_on_stderr(
@@ -331,15 +456,79 @@ def test_more_folds_than_subjects_warns_on_stderr(
 ) -> None:
     from mdframework.cli import main
 
-    e = _experiment(
-        kinect_dataset,
-        tmp_path,
-        '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\nfolds = 5\n',
-    )
+    body = '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\nfolds = 5\n'
+    tt = '[train_test]\ntrain = { subject = ["s01", "s02"] }\ntest = { subject = "s03" }\n'
+    e = _experiment(kinect_dataset, tmp_path, body + tt)
     assert main(["experiment", str(e), "--out", str(tmp_path / "o")]) == 0
     err = capsys.readouterr().err
     assert "warning: within-source kinect: not evaluated: evaluation.folds = 5 exceeds" in err
     assert "Not evaluated: evaluation.folds = 5" in (tmp_path / "o" / "report.md").read_text()
+
+
+def test_a_feature_that_is_not_a_number_names_the_index_line(
+    kinect_dataset: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An index.csv edited by hand with an empty or NaN feature: one line naming the file,
+    line and record, exit 2 (it was an internal error from the wrapper's input check)."""
+    import shutil
+
+    data = tmp_path / "data"
+    shutil.copytree(kinect_dataset, data)
+    lines = (data / "index.csv").read_text().splitlines()
+    header = lines[0].split(",")
+    cells = lines[3].split(",")
+    cells[header.index("upper_max")] = ""
+    lines[3] = ",".join(cells)
+    (data / "index.csv").write_text("\n".join(lines) + "\n")
+    e = _experiment(data, tmp_path, '[selection]\nmethod = "none"\n[evaluation]\nrepeats = 2\n')
+    _fails_with_one_line(
+        e,
+        tmp_path / "o",
+        capsys,
+        f"mdf: error: {data / 'index.csv'}:4: record {cells[0]}: upper_max is nan, not a finite "
+        "number (1 such values); rebuild the dataset or remove the record",
+    )
+
+
+def _fails_with_one_line(
+    config: Path, out: Path, capsys: pytest.CaptureFixture[str], line: str
+) -> None:
+    """``mdf experiment config --out out`` exits 2 with ``line`` as its only stderr line and
+    leaves nothing in ``out``."""
+    from mdframework.cli import main
+
+    assert main(["experiment", str(config), "--out", str(out), "--no-progress"]) == 2
+    assert capsys.readouterr().err.strip().splitlines() == [line]
+    assert not out.exists() or not any(out.iterdir())  # nothing half-written
+
+
+def test_an_experiment_that_evaluates_nothing_is_an_error(
+    kinect_dataset: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Every group skipped and no cross-source or train/test part: one error line, exit 2,
+    no report (it used to write an empty report and exit 0)."""
+    body = '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\nfolds = 5\n'
+    e = _experiment(kinect_dataset, tmp_path, body)
+    _fails_with_one_line(
+        e,
+        tmp_path / "o",
+        capsys,
+        f"mdf: error: {e}: evaluation.split = 'groups': nothing could be evaluated (within-source "
+        "kinect: evaluation.folds = 5 exceeds the 3 groups ['s01', 's02', 's03']: lower "
+        "evaluation.folds, or leave it out for one fold per group)",
+    )
+
+
+def test_leave_subjects_out_refuses_records_without_a_subject() -> None:
+    """Records of unknown subjects are not held out together as if they were one person."""
+    x, y, subjects = _one_class_per_subject()
+    subjects[-4:] = ""  # s5's records lost their subject
+    cfg = _cfg({"split": "groups", "by": "subject"})
+    factory = exp.classifier_factory(cfg.classifier, "t")
+    with pytest.raises(
+        MdfError, match=r"^evaluation.by = 'subject': 4 of 20 records have no subject; give"
+    ):
+        exp.within_source(cfg, factory, x, y, subjects)
 
 
 @pytest.mark.parametrize(

@@ -97,3 +97,31 @@ def test_identical_predictions_on_real_features(
     assert n_distance_ties > 100
     if k > 1:
         assert n_vote_ties > 100
+
+
+@pytest.mark.parametrize("algorithm", ["brute", "kd_tree"])
+@pytest.mark.parametrize("k", [1, 5])
+def test_lowest_rule_equals_scikit_learn_except_at_distance_ties(
+    cmu: tuple[NDArray[np.float64], NDArray[np.str_]], k: int, algorithm: str
+) -> None:
+    """``tie_rule = "lowest"`` predicts what scikit-learn's KNeighborsClassifier predicts on the
+    same standardised inputs (its vote ties go to the first class in sorted order too), except
+    where the k-th and (k+1)-th neighbours are equidistant: scikit-learn keeps either of them,
+    depending on its algorithm, the plugin the earlier training record."""
+    from sklearn.neighbors import KNeighborsClassifier
+
+    x, y = cmu
+    n_same = n_differ = 0
+    for cols in [*itertools.combinations(range(7), 2), tuple(range(7))]:
+        for train, test in StratifiedKFold(3, shuffle=True, random_state=k).split(x, y):
+            xt, xs = x[train][:, list(cols)], x[test][:, list(cols)]
+            scaler = Standardizer.fit(xt)
+            sk = KNeighborsClassifier(k, algorithm=algorithm).fit(scaler.transform(xt), y[train])
+            want = sk.predict(scaler.transform(xs))
+            got = Knn(Knn.Config(k=k, tie_rule="lowest")).fit(xt, y[train]).predict(xs)  # type: ignore[arg-type]
+            dist, _ = Knn(Knn.Config(k=k + 1)).fit(xt, y[train]).neighbours(xs)  # type: ignore[arg-type]
+            at_cut = np.isclose(dist[:, k - 1], dist[:, k], rtol=1e-9, atol=1e-12)
+            np.testing.assert_array_equal(got[~at_cut], want[~at_cut])
+            n_same += int(np.sum(~at_cut))
+            n_differ += int(np.sum(got[at_cut] != want[at_cut]))
+    assert n_same > 5000 and n_differ > 0  # the rule differs where it is documented to

@@ -985,7 +985,26 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
         raise ConfigError(
             f"no records: every source is shorter than its record length ({', '.join(short)})"
         )
-    return specs
+    return _distinct_recordings(specs)
+
+
+def _distinct_recordings(specs: list[RecordSpec]) -> list[RecordSpec]:
+    """Simulated records named by distinct recordings: where two different motion files share
+    a name (``alice/walk.bvh``, ``bob/walk.bvh``), their records' ``recording`` is the file as
+    the config gives it, so that experiments holding out recordings do not take them for one."""
+    files: dict[str, set[Path]] = {}
+    for spec in specs:
+        file = spec.run_config["motion"].get("file") if "motion" in spec.run_config else None
+        if file is not None:
+            path = (Path(spec.base_dir) / str(file)).resolve()
+            files.setdefault(spec.recording, set()).add(path)
+    shared = {name for name, paths in files.items() if len(paths) > 1}
+    return [
+        replace(spec, recording=str(spec.run_config["motion"]["file"]))
+        if spec.recording in shared and "motion" in spec.run_config
+        else spec
+        for spec in specs
+    ]
 
 
 def _place_record(run: dict[str, Any], config: RunConfigBase, motion: Motion) -> dict[str, Any]:

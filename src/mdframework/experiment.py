@@ -19,7 +19,9 @@
   and scatter plots of feature pairs (like Figure 12).
 
 Outputs in DIR: ``report.md``; ``within_<group>_confusion.csv/png`` (mean and std);
-``within_<group>_per_class.csv``; ``cross_confusion.csv/png``; ``feature_stats.csv/md``;
+``within_<group>_per_class.csv``; ``within_<group>_predictions.csv`` (split, record id, true and
+predicted label of every test record); ``cross_confusion.csv/png``, ``cross_predictions.csv``;
+``train_test_confusion.csv/png``, ``train_test_predictions.csv``; ``feature_stats.csv/md``;
 ``scatter_<f1>_<f2>.png``; ``summary.json``; and ``dataset/`` when the experiment built it.
 """
 
@@ -47,8 +49,8 @@ from .classify import (
     wrapper_select,
 )
 from .config import format_validation_error, read_config_file
-from .dataset import Dataset, build_dataset, load_dataset, load_dataset_config
-from .errors import ConfigError, MdfError
+from .dataset import INDEX, Dataset, build_dataset, load_dataset, load_dataset_config
+from .errors import ConfigError, DataFileError, MdfError
 from .features import FEATURE_NAMES
 from .interfaces import Classifier
 from .outdir import output_folder, safe_name
@@ -63,6 +65,8 @@ EXPERIMENT_FILES = (
     "summary.json",
     "within_*",
     "cross_confusion.*",
+    "cross_predictions.csv",
+    "train_test_predictions.csv",
     "train_test_confusion.*",
     "feature_stats.*",
     "scatter_*.png",
@@ -201,6 +205,12 @@ def load_experiment_config(path: str | Path) -> ExperimentConfig:
         cfg = ExperimentConfig.model_validate(data)
     except ValidationError as exc:
         raise ConfigError(format_validation_error(exc, str(p), data, ExperimentConfig)) from None
+    cs = cfg.cross_source
+    if cs is not None and cs.train == cs.test:  # it would test on its own training records
+        raise ConfigError(
+            f"{p}: cross_source: train and test are the same group {cs.train!r}; name two "
+            "groups (a within-source result of one group is always in the report)"
+        )
     if cfg.input == "histogram" and cfg.selection.method != "none":
         raise ConfigError(f"{p}: input = 'histogram' needs selection.method = 'none'")
     for pair in cfg.report.scatter_pairs:
@@ -225,6 +235,9 @@ def classifier_factory(
     experiment's seed) is set as :attr:`Classifier.seed` on every classifier made."""
     reg = registry or default_registry()
     kind = section.get("kind")
+    if kind is None:
+        installed = ", ".join(reg.names("classifier"))
+        raise ConfigError(f"{source}: classifier.kind: required (installed: {installed})")
     try:
         cls = reg.get("classifier", str(kind))
     except KeyError as exc:
@@ -298,11 +311,17 @@ def recording_splits(
                 raise MdfError(
                     f"evaluation.split = 'recording': class {label!r} has only one recording"
                 )
-            n_test = min(len(files) - 1, max(1, round(test_fraction * len(files))))
+            n_test = recordings_held_out(len(files), test_fraction)
             held = set(rng.permutation(files)[:n_test].tolist())
             test_mask |= (labels == label) & np.isin(recordings, list(held))
         splits.append((np.flatnonzero(~test_mask), np.flatnonzero(test_mask)))
     return splits
+
+
+def recordings_held_out(n_recordings: int, test_fraction: float) -> int:
+    """How many of a class's ``n_recordings`` a split holds out: ``test_fraction`` of them,
+    rounded, at least one and never all."""
+    return min(n_recordings - 1, max(1, round(test_fraction * n_recordings)))
 
 
 def group_splits(
@@ -385,7 +404,10 @@ def protocol(ev: EvaluationConfig) -> str:
         folds = f"one fold per {ev.by}" if ev.folds is None else f"{ev.folds} folds"
         return f"leave-{ev.by}s-out cross-validation ({folds}, each testing unseen {ev.by}s)"
     if ev.split == "recording":
-        return f"{ev.repeats} random splits holding out {pct} % of every class's recordings"
+        return (
+            f"{ev.repeats} random splits holding out {pct} % of every class's recordings "
+            "(rounded, at least one, never all)"
+        )
     return f"{ev.repeats} stratified random splits of the records, {100 - pct}/{pct}"
 
 
@@ -485,9 +507,16 @@ def within_source(
     classes = sorted(set(y.tolist()))
     ev = cfg.evaluation
     untested: dict[str, str] = {}
+    held: dict[str, tuple[int, int]] = {}  # split = 'recording': class -> (held out, of)
     if ev.split == "groups":
         if recordings is None:
             raise MdfError(f"evaluation.split = 'groups' needs each record's {ev.by}")
+        blank = int(np.sum(recordings == ""))
+        if blank:  # records of unknown people would be held out together as one subject
+            raise MdfError(
+                f"evaluation.by = {ev.by!r}: {blank} of {len(recordings)} records have no "
+                f"{ev.by}; give their dataset sources a {ev.by}"
+            )
         splits = group_splits(recordings, ev.folds)
         untested = _not_testable(ev, classes, y, recordings)
     elif ev.split == "recording":
@@ -502,11 +531,15 @@ def within_source(
         splits = [
             (np.sort(np.concatenate([testable[tr], always])), testable[te]) for tr, te in some
         ]
+        for c in sorted(set(y[testable].tolist())):
+            n = len(set(recordings[y == c].tolist()))
+            held[c] = (recordings_held_out(n, ev.test_fraction), n)
     else:
         splits = _record_splits(ev, x, y, cfg.seed)
     if len(classes) - len(untested) < 2:
         raise _too_few_classes(untested)
     mats, optimistic, subsets, tested = [], [], [], []
+    predictions: list[tuple[int, NDArray[np.intp], NDArray[Any]]] = []
     from tqdm import tqdm
 
     bar = tqdm(
@@ -520,9 +553,11 @@ def within_source(
     for rep, (train, test) in enumerate(bar):
         sel = _select(cfg, factory, x[train], y[train], cfg.seed + rep, counts)
         pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
-        mat = confusion_matrix(y[test], pred, classes)
+        predictions.append((rep, test, pred))
         trained = set(y[train].tolist())
-        mat[[i for i, c in enumerate(classes) if c not in trained]] = np.nan
+        untrained = [i for i, c in enumerate(classes) if c not in trained]
+        mat = confusion_matrix(y[test], pred, classes)
+        mat[untrained] = np.nan
         mats.append(mat)
         tested.append(np.isin(classes, y[test]))
         subsets.append([names[i] for i in sel.subset])
@@ -530,7 +565,11 @@ def within_source(
             opt = optimistic_select(
                 x[train], y[train], x[test], y[test], factory, sizes=cfg.selection.sizes
             )
-            optimistic.append(opt.score)
+            # scored as the result is: its matrix, rows of classes not trained on left out
+            best = _fit_predict(factory, x[train], y[train], x[test], opt.subset)
+            opt_mat = confusion_matrix(y[test], best, classes)
+            opt_mat[untrained] = np.nan
+            optimistic.append(opt_mat)
     stack = np.stack(mats)  # (n_splits, n_classes, n_classes); NaN rows: class not scored
     scored: NDArray[np.bool_] = ~np.isnan(stack[:, :, 0])  # (n_splits, n_classes)
     rows: NDArray[np.bool_] = np.any(scored, axis=0)
@@ -547,6 +586,10 @@ def within_source(
     mean[rows] = np.nanmean(stack[:, rows], axis=0)
     std[rows] = np.nanstd(stack[:, rows], axis=0)
     recall = np.diagonal(mean)[rows]
+    opt_mean = None
+    if optimistic:  # the same measure as the result: mean per-class recall of the mean matrix
+        opt_stack = np.stack(optimistic)[:, rows]
+        opt_mean = float(np.mean(np.diagonal(np.nanmean(opt_stack, axis=0)[:, rows])))
     if scored[:, rows].all():  # every split scores every class: spread over splits
         per_split = np.diagonal(stack, axis1=1, axis2=2)[:, rows].mean(axis=1)
         spread, over = float(np.std(per_split)), "splits"
@@ -563,10 +606,12 @@ def within_source(
         "splits_tested": {c: int(n) for c, n in zip(classes, np.sum(tested, axis=0), strict=True)},
         "splits_scored": {c: int(scored[:, i].sum()) for i, c in enumerate(classes)},
         "not_evaluated": {c: untested[c] for c in classes if c in untested},
-        "optimistic_accuracy_mean": float(np.mean(optimistic)) if optimistic else None,
+        "optimistic_accuracy_mean": opt_mean,
         "subsets": subsets,
         "n_records": len(y),
         "class_counts": counts,
+        "predictions": predictions,
+        "recordings_held_out": {c: list(v) for c, v in held.items()},
     }
 
 
@@ -620,6 +665,9 @@ def _train_then_test(
         "subset": [names[i] for i in sel.subset],
         "train_counts": {c: int(np.sum(labels[train] == c)) for c in shared},
         "test_counts": {c: int(np.sum(labels[test] == c)) for c in shared},
+        "test_index": np.flatnonzero(test),
+        "true": labels[test],
+        "predicted": pred,
     }
 
 
@@ -671,6 +719,16 @@ def classifier_inputs(
     """The dataset, the classifier input (n_records, n_columns) and the columns' names."""
     if cfg.input == "features":
         data = load_dataset(data_dir, spectrograms=False)
+        bad = np.argwhere(~np.isfinite(data.features))
+        if bad.size:  # an index.csv edited by hand: one line naming it, not an internal error
+            row, col = (int(v) for v in bad[0])
+            raise DataFileError(
+                Path(data_dir) / INDEX,
+                f"record {data.table['id'][row]}: {FEATURE_NAMES[col]} is "
+                f"{data.features[row, col]}, not a finite number ({len(bad)} such values); "
+                "rebuild the dataset or remove the record",
+                row + 2,
+            )
         return data, data.features, list(FEATURE_NAMES)
     data = load_dataset(data_dir, spectrograms=False, histograms=True)
     hists = data.histograms or []
@@ -779,11 +837,14 @@ def _report(
         f"dataset {source} ({len(data.labels)} records); classifier "
         f"{json.dumps(cfg.classifier)}; selection {cfg.selection.method}"
     )
+    skipped: list[str] = []  # warnings, given once something else is evaluated
     for group in sorted(set(data.groups.tolist())):
         mask = data.groups == group
         if len(set(data.labels[mask].tolist())) < 2:
             continue
-        column = cfg.evaluation.by if cfg.evaluation.split == "groups" else "file"
+        column = cfg.evaluation.by if cfg.evaluation.split == "groups" else "recording"
+        if column == "recording" and column not in data.table:  # built before the column
+            column = "file"
         if column not in data.table:
             raise MdfError(
                 f"evaluation.by = {column!r}: the dataset has no such column; rebuild it"
@@ -801,9 +862,7 @@ def _report(
         except ConfigError:  # the config is wrong for every source: the experiment fails
             raise
         except MdfError as exc:  # e.g. more folds than subjects
-            warnings.warn(
-                f"within-source {group}: not evaluated: {exc}", ExperimentWarning, stacklevel=2
-            )
+            skipped.append(f"within-source {group}: not evaluated: {exc}")
             report += [f"## Within-source: {group}", "", f"Not evaluated: {exc}.", ""]
             summary["within"][group] = {"skipped": str(exc)}
             continue
@@ -850,8 +909,21 @@ def _report(
                 caption=f"{caption}; mean ± std over {splits}",
             )
         )
+        ids, truth = data.table["id"][mask], data.labels[mask]
+        (out / f"{stem}_predictions.csv").write_text(
+            _csv(
+                [
+                    {"split": split, "id": ids[i], "true": truth[i], "predicted": p}
+                    for split, test, pred in res["predictions"]
+                    for i, p in zip(test, pred, strict=True)
+                ]
+            ),
+            encoding="utf-8",
+        )
         summary["within"][group] = {
-            k: v for k, v in res.items() if k not in ("confusion_mean", "confusion_std")
+            k: v
+            for k, v in res.items()
+            if k not in ("confusion_mean", "confusion_std", "predictions")
         }
         summary["within"][group]["confusion_mean"] = res["confusion_mean"].tolist()
         opt = res["optimistic_accuracy_mean"]
@@ -862,6 +934,7 @@ def _report(
             f"({_spread_words(res, splits)}); classes and records: {res['class_counts']}.",
             "",
             *_not_evaluated_markdown(res, splits),
+            *_held_out_markdown(res),
             _markdown_matrix(classes, res["confusion_mean"], res["confusion_std"]),
             "",
             *selected_features_markdown(res["subsets"], cfg.selection.method),
@@ -890,7 +963,8 @@ def _report(
                 caption=f"{caption}; features {res['subset']}",
             )
         )
-        summary["cross"] = {**res, "confusion": res["confusion"].tolist()}
+        _write_predictions(out / "cross_predictions.csv", data, res)
+        summary["cross"] = _without_predictions(res)
         report += [
             f"## Cross-source: train {cfg.cross_source.train}, test {cfg.cross_source.test}",
             "",
@@ -919,7 +993,8 @@ def _report(
             None,
             title=f"train {cfg.train_test.train} -> test {cfg.train_test.test}",
         )
-        summary["train_test"] = {**res, "confusion": res["confusion"].tolist()}
+        _write_predictions(out / "train_test_predictions.csv", data, res)
+        summary["train_test"] = _without_predictions(res)
         report += [
             f"## Train on {cfg.train_test.train}, test on {cfg.train_test.test}",
             "",
@@ -931,6 +1006,11 @@ def _report(
             "![train/test](train_test_confusion.png)",
             "",
         ]
+    evaluated = [g for g, res in summary["within"].items() if "skipped" not in res]
+    if not evaluated and cfg.cross_source is None and cfg.train_test is None:
+        raise ConfigError(_nothing_evaluated(cfg.evaluation, summary["within"]))
+    for message in skipped:
+        warnings.warn(message, ExperimentWarning, stacklevel=2)
     note("feature statistics and figures", progress)
     stats = feature_statistics(data)
     (out / "feature_stats.csv").write_text(_csv(stats), encoding="utf-8")
@@ -958,9 +1038,53 @@ def _report(
         draw()
     (out / "report.md").write_text("\n".join(report), encoding="utf-8")
     (out / "summary.json").write_text(
-        json.dumps(summary, indent=2, default=str) + "\n", encoding="utf-8"
+        json.dumps(_strict_json(summary), indent=2, default=str, allow_nan=False) + "\n",
+        encoding="utf-8",
     )
     return summary
+
+
+def _write_predictions(path: Path, data: Dataset, res: dict[str, Any]) -> None:
+    """One row per test record of a train/test result: its id, true (mapped) and predicted
+    label."""
+    ids = data.table["id"][res["test_index"]]
+    rows = [
+        {"id": i, "true": t, "predicted": p}
+        for i, t, p in zip(ids, res["true"], res["predicted"], strict=True)
+    ]
+    path.write_text(_csv(rows), encoding="utf-8")
+
+
+def _without_predictions(res: dict[str, Any]) -> dict[str, Any]:
+    """A train/test result for summary.json: the matrix as lists, the per-record predictions
+    left to their CSV file."""
+    kept = {k: v for k, v in res.items() if k not in ("test_index", "true", "predicted")}
+    return {**kept, "confusion": res["confusion"].tolist()}
+
+
+def _strict_json(value: Any) -> Any:
+    """``value`` with every NaN or infinite number (a matrix row of a class not evaluated) as
+    None, so that summary.json is JSON that every reader takes (null), not Python's NaN."""
+    if isinstance(value, float):
+        return value if np.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: _strict_json(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_strict_json(v) for v in value]
+    return value
+
+
+def _nothing_evaluated(ev: EvaluationConfig, within: dict[str, dict[str, Any]]) -> str:
+    """The error of an experiment with nothing to report: no group could be evaluated within
+    its source (``within``: group -> its result or its reason), and there is no cross-source or
+    train/test part."""
+    if not within:
+        return (
+            "nothing to evaluate: no group of the dataset has two or more classes, and there is "
+            "no [cross_source] or [train_test]"
+        )
+    reasons = "; ".join(f"{g}: {res['skipped']}" for g, res in within.items())
+    return f"evaluation.split = {ev.split!r}: nothing could be evaluated (within-source {reasons})"
 
 
 def _spread_words(res: dict[str, Any], splits: str) -> str:
@@ -972,6 +1096,16 @@ def _spread_words(res: dict[str, Any], splits: str) -> str:
         f"std {std:.3f} over the classes' recalls, as not every split scores every class; the "
         f"mean per-class recall of the matrix below, mean ± std over {splits}"
     )
+
+
+def _held_out_markdown(res: dict[str, Any]) -> list[str]:
+    """The report line saying how many recordings of each class a split held out (the share
+    ``test_fraction`` asks for, rounded, at least one and never all)."""
+    held = res.get("recordings_held_out") or {}
+    if not held:
+        return []
+    words = ", ".join(f"{c} {k} of {n}" for c, (k, n) in held.items())
+    return [f"Recordings held out in every split: {words}.", ""]
 
 
 def _not_evaluated_markdown(res: dict[str, Any], splits: str) -> list[str]:
