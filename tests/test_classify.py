@@ -135,6 +135,31 @@ def test_wrapper_selection_never_sees_the_test_split(rng: np.random.Generator) -
     assert np.any(np.abs(np.concatenate([a.ravel() for a in Spy.seen])) > 500.0)
 
 
+def test_grouped_wrapper_folds_never_split_a_group(rng: np.random.Generator) -> None:
+    """With ``groups`` (e.g. subjects), no inner fold trains and tests on one group's records,
+    and a fold scores only the classes it trains on; without them, folds split records."""
+    n = 60
+    y = np.repeat(["a", "b", "c"], n // 3)
+    groups = np.tile(np.repeat(np.arange(5), 4), 3)  # 5 subjects, 4 records of each class
+    x = rng.normal(size=(n, 7))
+    x[:, 0] = groups  # feature 0 names each record's group: what a fold saw is readable
+    x[:, 2] += np.repeat([0.0, 30.0, 60.0], n // 3)
+
+    def pairs() -> list[tuple[set[float], set[float]]]:
+        seen = Spy.seen
+        return [(set(seen[i][:, 0]), set(seen[i + 1][:, 0])) for i in range(0, len(seen), 2)]
+
+    Spy.seen = []
+    sel = wrapper_select(x, y, Spy, sizes=(1,), folds=4, groups=groups)
+    assert all(not (fit & test) for fit, test in pairs())
+    assert len(Spy.seen) == 2 * 4 * 7 and 2 in sel.subset
+    Spy.seen = []
+    wrapper_select(x, y, Spy, sizes=(1,), folds=4)
+    assert any(fit & test for fit, test in pairs())  # record folds do split groups
+    with pytest.raises(ValueError, match="two groups"):
+        wrapper_select(x, y, Spy, sizes=(1,), groups=np.zeros(n))
+
+
 def test_any_sklearn_estimator_through_the_plugin(rng: np.random.Generator) -> None:
     reg = default_registry()
     assert reg.get("classifier", "sklearn") is SklearnClassifier

@@ -94,6 +94,54 @@ def test_wrapper_in_the_experiment_gets_only_the_training_split(
     assert np.allclose(res["confusion_mean"].sum(axis=1), 1.0)
 
 
+@pytest.mark.parametrize("inner", ["evaluation", "record"])
+def test_wrapper_folds_hold_out_what_the_evaluation_holds_out(
+    rng: np.random.Generator, monkeypatch: pytest.MonkeyPatch, inner: str
+) -> None:
+    """Leave-subjects-out: by default the wrapper's folds hold out whole subjects of the
+    training records too (``selection.inner_split = 'evaluation'``); 'record' folds records."""
+    x, y = _toy(rng)
+    subjects = np.array([f"s{i % 4}" for i in range(60)])
+    got: list[Any] = []
+    real = exp.wrapper_select
+
+    def spy(features: np.ndarray, labels: np.ndarray, *a: Any, **k: Any) -> Any:
+        got.append((features.copy(), k["groups"]))
+        return real(features, labels, *a, **k)
+
+    monkeypatch.setattr(exp, "wrapper_select", spy)
+    cfg = exp.ExperimentConfig.model_validate(
+        {
+            "dataset": {"path": "unused"},
+            "evaluation": {"split": "groups", "by": "subject"},
+            "selection": {"sizes": [1], "folds": 3, "optimistic": False, "inner_split": inner},
+        }
+    )
+    exp.within_source(cfg, exp.classifier_factory({"kind": "knn"}, "t"), x, y, subjects)
+    assert len(got) == 4  # one fold per subject
+    for features, groups in got:
+        if inner == "record":
+            assert groups is None
+        else:
+            train = [int(np.flatnonzero((x == row).all(axis=1))[0]) for row in features]
+            assert np.array_equal(groups, subjects[train])
+            assert len(set(groups.tolist())) == 3
+
+
+def test_grouped_wrapper_needs_two_subjects_to_train_on(rng: np.random.Generator) -> None:
+    x, y = _toy(rng)
+    subjects = np.array([f"s{i % 2}" for i in range(60)])
+    cfg = exp.ExperimentConfig.model_validate(
+        {
+            "dataset": {"path": "unused"},
+            "evaluation": {"split": "groups", "by": "subject"},
+            "selection": {"sizes": [1], "optimistic": False},
+        }
+    )
+    with pytest.raises(ConfigError, match=r"inner_split = 'evaluation'.*one subject only"):
+        exp.within_source(cfg, exp.classifier_factory({"kind": "knn"}, "t"), x, y, subjects)
+
+
 def test_experiment_on_shipped_cmu_data(tmp_path: Path) -> None:
     cfg = exp.load_experiment_config(EXAMPLES / "experiment_cmu.toml")
     cfg = cfg.model_copy(

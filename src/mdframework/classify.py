@@ -132,18 +132,43 @@ def wrapper_select(
     sizes: Sequence[int] = (4,),
     folds: int = 5,
     seed: int = 0,
+    groups: NDArray[Any] | None = None,
 ) -> Selection:
-    """Wrapper feature selection by stratified k-fold cross-validation on the given (training)
-    data only: every subset of the given sizes is scored by its mean balanced accuracy over the
-    folds. The caller passes only training data, so the test split is never seen."""
-    from sklearn.model_selection import StratifiedKFold
+    """Wrapper feature selection by cross-validation on the given (training) data only: every
+    subset of the given sizes is scored by its mean balanced accuracy over the folds. The caller
+    passes only training data, so the test split is never seen.
 
+    Without ``groups``: stratified k-fold over records (``folds``, at most the smallest class's
+    record count). With ``groups`` (n_samples,), e.g. each record's subject or recording: the
+    folds hold out whole groups (scikit-learn's ``StratifiedGroupKFold``, at most one fold per
+    group), so that records of one group are never on both sides; a fold scores only the
+    classes it also trains on (a class whose every group is held out is left out of that fold,
+    not counted as 0)."""
     x, y = _checked(features, labels)
-    n_folds = min(int(folds), int(np.unique(y, return_counts=True)[1].min()))
-    if n_folds < 2:
-        raise ValueError("wrapper selection needs at least two training samples per class")
-    splits = StratifiedKFold(n_folds, shuffle=True, random_state=seed).split(x, y)
-    data = [(x[train], y[train], x[test], y[test]) for train, test in splits]
+    if groups is None:
+        from sklearn.model_selection import StratifiedKFold
+
+        n_folds = min(int(folds), int(np.unique(y, return_counts=True)[1].min()))
+        if n_folds < 2:
+            raise ValueError("wrapper selection needs at least two training samples per class")
+        splits = StratifiedKFold(n_folds, shuffle=True, random_state=seed).split(x, y)
+    else:
+        from sklearn.model_selection import StratifiedGroupKFold
+
+        g = np.asarray(groups)
+        if g.shape != y.shape:
+            raise ValueError("groups must hold one value per training sample")
+        n_folds = min(int(folds), len(np.unique(g)))
+        if n_folds < 2:
+            raise ValueError("grouped wrapper selection needs at least two groups")
+        splits = StratifiedGroupKFold(n_folds, shuffle=True, random_state=seed).split(x, y, g)
+    data = []
+    for train, test in splits:
+        scored = test[np.isin(y[test], y[train])]  # classes this fold also trains on
+        if scored.size:
+            data.append((x[train], y[train], x[scored], y[scored]))
+    if not data:
+        raise ValueError("no fold of the wrapper's cross-validation tests a class it trains on")
     scores = _score_subsets(data, make_classifier, _subsets(x.shape[1], sizes))
     subset, score = _best(scores)
     return Selection(subset, score, scores)

@@ -97,6 +97,13 @@ class SelectionConfig(StrictModel):
         [4], min_length=1, description="Subset sizes to try (the paper: 4 of 7)."
     )
     folds: int = Field(5, ge=2, le=100, description="Cross-validation folds.")
+    inner_split: Literal["evaluation", "record"] = Field(
+        "evaluation",
+        description="What the wrapper's folds hold out: evaluation: what evaluation.split holds "
+        "out (whole recordings with 'recording', whole evaluation.by values with 'groups', "
+        "records with 'record'), so that one recording or subject is never on both sides of a "
+        "fold; record: stratified folds of records whatever the split.",
+    )
     optimistic: bool = Field(
         True, description="Also report the paper's optimistic selection on the test split."
     )
@@ -276,11 +283,24 @@ def _select(
     y: NDArray[Any],
     seed: int,
     counts: dict[str, int] | None = None,
+    units: NDArray[Any] | None = None,
 ) -> Selection:
     """The feature subset for training records ``x``, ``y``; ``counts``: each class's records
-    in the whole source (for the error when a class has too few training records)."""
+    in the whole source (for the error when a class has too few training records); ``units``
+    (n_train,): what the evaluation holds out, per training record (its recording or its
+    ``evaluation.by`` value), or None (records)."""
     if cfg.selection.method == "none":
         return Selection(tuple(range(x.shape[1])), float("nan"))
+    groups = None
+    if cfg.selection.inner_split == "evaluation" and cfg.evaluation.split != "record":
+        groups = units
+    if groups is not None and len(set(groups.tolist())) < 2:
+        what = "recording" if cfg.evaluation.split == "recording" else cfg.evaluation.by
+        raise ConfigError(
+            f"selection.inner_split = 'evaluation': the training records hold one {what} "
+            f"only ({groups[0]!r}), so the wrapper's folds cannot hold one out: build records "
+            "of more, or set selection.inner_split = 'record'"
+        )
     labels, n_train = np.unique(y, return_counts=True)
     if n_train.min() < 2:
         small = str(labels[np.argmin(n_train)])
@@ -292,7 +312,13 @@ def _select(
             "selection.method = 'none'"
         )
     return wrapper_select(
-        x, y, factory, sizes=cfg.selection.sizes, folds=cfg.selection.folds, seed=seed
+        x,
+        y,
+        factory,
+        sizes=cfg.selection.sizes,
+        folds=cfg.selection.folds,
+        seed=seed,
+        groups=groups,
     )
 
 
@@ -367,6 +393,18 @@ def _text(value: Any) -> str:
     return str(value)
 
 
+def held_out_units(ev: EvaluationConfig, data: Dataset) -> NDArray[np.str_]:
+    """What ``ev.split`` holds out, per record (n_records,): its ``ev.by`` value with split =
+    'groups', else its recording (the ``file`` column of a dataset built before the
+    ``recording`` column)."""
+    column = ev.by if ev.split == "groups" else "recording"
+    if column == "recording" and column not in data.table:  # built before the column
+        column = "file"
+    if column not in data.table:
+        raise MdfError(f"evaluation.by = {column!r}: the dataset has no such column; rebuild it")
+    return np.array([_text(v) for v in data.table[column]])
+
+
 def train_test(
     cfg: ExperimentConfig,
     factory: Callable[[], Classifier],
@@ -388,8 +426,9 @@ def train_test(
     if np.any(train & test):
         raise MdfError(f"train_test: {int(np.sum(train & test))} records are in both selections")
     x = data.features if x is None else x
+    units = held_out_units(cfg.evaluation, data)
     return _train_then_test(
-        cfg, factory, x, labels, train, test, names, "train_test: the selections"
+        cfg, factory, x, labels, train, test, names, "train_test: the selections", units
     )
 
 
@@ -551,7 +590,8 @@ def within_source(
     )
     counts = {c: int(np.sum(y == c)) for c in classes}
     for rep, (train, test) in enumerate(bar):
-        sel = _select(cfg, factory, x[train], y[train], cfg.seed + rep, counts)
+        units = None if recordings is None else recordings[train]
+        sel = _select(cfg, factory, x[train], y[train], cfg.seed + rep, counts, units)
         pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
         predictions.append((rep, test, pred))
         trained = set(y[train].tolist())
@@ -635,7 +675,10 @@ def cross_source(
             group = getattr(cs, name)
             raise MdfError(f"cross_source.{name}: no records of group {group!r} (have {groups})")
     x = data.features if x is None else x
-    return _train_then_test(cfg, factory, x, labels, train, test, names, "cross_source: the groups")
+    units = held_out_units(cfg.evaluation, data)
+    return _train_then_test(
+        cfg, factory, x, labels, train, test, names, "cross_source: the groups", units
+    )
 
 
 def _train_then_test(
@@ -647,16 +690,19 @@ def _train_then_test(
     test: NDArray[np.bool_],
     names: Sequence[str],
     who: str,
+    units: NDArray[Any] | None = None,
 ) -> dict[str, Any]:
     """Select features and fit on the ``train`` records (mask), predict the ``test`` records,
     over the classes both hold (``who`` names the two sides in the error when they share
-    fewer than two). ``x`` (n_records, n_columns) named by ``names``; ``labels`` (n_records,)."""
+    fewer than two). ``x`` (n_records, n_columns) named by ``names``; ``labels`` (n_records,);
+    ``units`` (n_records,): what the wrapper's folds hold out (:func:`held_out_units`)."""
     shared = sorted(set(labels[train].tolist()) & set(labels[test].tolist()))
     if len(shared) < 2:
         raise MdfError(f"{who} share fewer than two classes ({shared})")
     train = train & np.isin(labels, shared)
     test = test & np.isin(labels, shared)
-    sel = _select(cfg, factory, x[train], labels[train], cfg.seed)
+    held = None if units is None else units[train]
+    sel = _select(cfg, factory, x[train], labels[train], cfg.seed, units=held)
     pred = _fit_predict(factory, x[train], labels[train], x[test], sel.subset)
     return {
         "classes": shared,
@@ -842,20 +888,13 @@ def _report(
         mask = data.groups == group
         if len(set(data.labels[mask].tolist())) < 2:
             continue
-        column = cfg.evaluation.by if cfg.evaluation.split == "groups" else "recording"
-        if column == "recording" and column not in data.table:  # built before the column
-            column = "file"
-        if column not in data.table:
-            raise MdfError(
-                f"evaluation.by = {column!r}: the dataset has no such column; rebuild it"
-            )
         try:
             res = within_source(
                 cfg,
                 factory,
                 x_all[mask],
                 data.labels[mask],
-                np.array([_text(v) for v in data.table[column][mask]]),
+                held_out_units(cfg.evaluation, data)[mask],
                 names,
                 progress=f"within {group}" if progress else None,
             )
