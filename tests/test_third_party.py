@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 from conftest import EXAMPLES
-from test_plugins import _make_distribution
+from test_plugins import _make_distribution, without_third_party_warnings
 
 from mdframework import cli
 from mdframework.plugins import DISABLE_PLUGINS_ENV
@@ -339,3 +339,62 @@ def test_an_effect_that_returns_the_wrong_thing_is_an_internal_error_naming_it(
         "(mdf_test_xyzzy.XyzzyFx) on the 'scatterers' stage; check it with "
         "mdframework.testing.check_effect; run with --debug for the traceback)"
     ]
+
+
+#: a built-in plugin subclassed by a third party whose method breaks, the run config's edit
+#: that chooses it, and the method the internal error names
+FAILING_METHOD = {
+    "radar receive": (
+        "from mdf_lfm.waveform import LfmPulseDoppler as Base\n",
+        "radar_waveforms",
+        "    def receive(self, block):\n        return 1 / 0\n",
+        ('kind = "lfm"', 'kind = "xyzzy_bug"'),
+        "ZeroDivisionError: division by zero (in receive() of the radar plugin 'xyzzy_bug' "
+        "(mdf_test_xyzzy.XyzzyBug); check it with mdframework.testing.check_radar_waveform",
+    ),
+    "scatterer model": (
+        "from mdf_point_targets.source import IsotropicPoints as Base\n",
+        "scatterer_models",
+        "    def scatterers(self, *args):\n        return [1, 2]\n",
+        ('kind = "points"', 'kind = "xyzzy_bug"'),
+        "AttributeError: 'list' object has no attribute 'rcs' (in scatterers() of the "
+        "scatterers plugin 'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug); check it with "
+        "mdframework.testing.check_scatterer_model",
+    ),
+    "motion source": (
+        "from mdf_point_targets.source import PointTargets as Base\n",
+        "motion_sources",
+        "    def load(self):\n        return None + 1\n",
+        ('kind = "point_targets"', 'kind = "xyzzy_bug"'),
+        "TypeError: unsupported operand type(s) for +: 'NoneType' and 'int' (in load() of the "
+        "motion plugin 'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug); check it with "
+        "mdframework.testing.check_motion_source",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(FAILING_METHOD))
+def test_a_plugin_method_that_fails_is_an_internal_error_naming_the_plugin(
+    case: str, installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A third party's motion source, scatterer model or radar whose method raises is that
+    plugin's bug: the internal error names it and its contract check (it named nobody, as if
+    mdframework had failed; only effects were named)."""
+    base, hook, method, (old, new), why = FAILING_METHOD[case]
+    body = (
+        f"{base}from typing import Literal\nfrom mdframework import hookimpl\n\n"
+        f"class XyzzyConfig(Base.Config):\n    kind: Literal['xyzzy_bug'] = 'xyzzy_bug'\n\n"
+        f"class XyzzyBug(Base):\n    '''Broken.'''\n    name = 'xyzzy_bug'\n"
+        f"    Config = XyzzyConfig\n{method}\n"
+        f"@hookimpl\ndef mdframework_register_{hook}():\n    return [XyzzyBug]\n"
+    )
+    _make_distribution(installed, "xyzzy-bug", "mdf_test_xyzzy", body, "xyzzy_bug")
+    config = tmp_path / "bug.toml"
+    text = (EXAMPLES / "point_target.toml").read_text()
+    assert old in text
+    config.write_text(text.replace(old, new))
+    capsys.readouterr()
+    assert cli.main(["run", str(config), "--out", str(tmp_path / "o")]) == 1
+    lines = without_third_party_warnings(capsys.readouterr().err.strip().splitlines())
+    assert len(lines) == 1 and lines[0].startswith("mdf: internal error: "), lines
+    assert why in lines[0]

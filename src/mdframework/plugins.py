@@ -41,7 +41,8 @@ import importlib.metadata
 import os
 import typing
 import warnings
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import cache
 from typing import Any, Literal, NamedTuple
@@ -49,7 +50,7 @@ from typing import Any, Literal, NamedTuple
 import pluggy
 
 from . import hookspecs
-from .errors import caused_by_interrupt
+from .errors import MdfError, caused_by_interrupt
 from .interfaces import (
     Classifier,
     Effect,
@@ -92,6 +93,39 @@ INTERFACES: dict[str, Interface] = {
     "effects": Interface("mdframework_register_effects", Effect),
     "recording": Interface("mdframework_register_recording_sources", RecordingSource),
 }
+
+#: interface -> the contract check of its plugins (:mod:`mdframework.testing`)
+CONTRACT_CHECKS = {
+    "motion": "check_motion_source",
+    "scatterers": "check_scatterer_model",
+    "radar": "check_radar_waveform",
+    "classifier": "check_classifier",
+    "effects": "check_effect",
+    "recording": "check_recording_source",
+}
+
+
+@contextmanager
+def blame(plugin: Plugin, method: str) -> Iterator[None]:
+    """Run a call of ``plugin``'s ``method``: an exception it raises, other than an
+    :class:`~mdframework.errors.MdfError` (bad input, the user's), is the plugin's bug, and
+    gets a note naming the plugin, its class and its contract check, which the CLI's internal
+    error shows (``in receive() of the radar plugin 'acme' (acme.Radar); check it with
+    mdframework.testing.check_radar_waveform``)."""
+    try:
+        yield
+    except MdfError:
+        raise
+    except Exception as exc:
+        cls = type(plugin)
+        interface = next((i for i, s in INTERFACES.items() if isinstance(plugin, s.base)), "")
+        exc.add_note(
+            f"in {method}() of the {interface} plugin {getattr(plugin, 'name', '?')!r} "
+            f"({cls.__module__}.{cls.__qualname__}); check it with "
+            f"mdframework.testing.{CONTRACT_CHECKS.get(interface, 'check_plugin')}"
+        )
+        raise
+
 
 #: old interface spelling -> current one
 OLD_INTERFACE_NAMES = {"effect": "effects"}
