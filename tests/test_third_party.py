@@ -398,3 +398,45 @@ def test_a_plugin_method_that_fails_is_an_internal_error_naming_the_plugin(
     lines = without_third_party_warnings(capsys.readouterr().err.strip().splitlines())
     assert len(lines) == 1 and lines[0].startswith("mdf: internal error: "), lines
     assert why in lines[0]
+
+
+#: the effect with an array in its config: neither JSON nor a JSON schema
+ARRAY_CONFIG = "from pydantic import ConfigDict, Field\n" + EFFECT.replace(
+    '    kind: Literal["xyzzy_fx"] = "xyzzy_fx"\n',
+    "    model_config = ConfigDict(arbitrary_types_allowed=True)\n"
+    '    kind: Literal["xyzzy_fx"] = "xyzzy_fx"\n'
+    '    data: np.ndarray = Field(default_factory=lambda: np.zeros(3), description="Data.")\n',
+)
+
+
+def test_a_config_model_that_cannot_be_saved_is_named_before_the_run(
+    installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A third party's config model with a field that has no JSON form: `mdf config schema`
+    says it leaves the plugin out (it did so silently), and a run that uses it stops before any
+    pulse with an internal error naming the plugin (after the whole simulation, naming no one)."""
+    body = HEADER + ARRAY_CONFIG + registering("[XyzzyFx]")
+    _make_distribution(installed, "xyzzy-fx", "mdf_test_xyzzy", body, "xyzzy_fx")
+    capsys.readouterr()
+    assert cli.main(["config", "schema"]) == 0
+    out, err = capsys.readouterr()
+    assert "xyzzy_fx" not in out
+    lines = [line for line in err.strip().splitlines() if "xyzzy" in line]
+    assert lines == [
+        "mdf: warning: the effects kind 'xyzzy_fx' (xyzzy-fx 0.0.1) is left out of the schema: "
+        "its Config has no JSON schema (Cannot generate a JsonSchema for "
+        "core_schema.IsInstanceSchema (<class 'numpy.ndarray'>)); check it with "
+        "mdframework.testing.check_plugin_class"
+    ], lines
+    config = tmp_path / "fx.toml"
+    config.write_text(
+        'effects = [{ kind = "xyzzy_fx" }]\n' + (EXAMPLES / "point_target.toml").read_text()
+    )
+    assert cli.main(["run", str(config), "--out", str(tmp_path / "fx")]) == 1
+    lines = without_third_party_warnings(capsys.readouterr().err.strip().splitlines())
+    assert len(lines) == 1 and lines[0].startswith("mdf: internal error: "), lines
+    assert (
+        "(in the config of the effects plugin 'xyzzy_fx' (mdf_test_xyzzy.XyzzyConfig), which "
+        "runs save as JSON; check it with mdframework.testing.check_config_round_trip;"
+    ) in lines[0], lines
+    assert not (tmp_path / "fx").exists()
