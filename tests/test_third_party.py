@@ -440,3 +440,21 @@ def test_a_config_model_that_cannot_be_saved_is_named_before_the_run(
         "runs save as JSON; check it with mdframework.testing.check_config_round_trip;"
     ) in lines[0], lines
     assert not (tmp_path / "fx").exists()
+
+
+def test_mdf_plugins_names_a_plugin_that_is_slow_to_import(
+    installed: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Every command imports every plugin: one that sleeps (or imports a heavy library) at
+    import slowed every command, `mdf --help` included, and nothing said which."""
+    from mdframework import plugins
+
+    monkeypatch.setattr(plugins, "SLOW_IMPORT_SECONDS", 0.05)
+    body = "import time\ntime.sleep(0.2)\n" + HEADER + EFFECT + registering("[XyzzyFx]")
+    _make_distribution(installed, "xyzzy-fx", "mdf_test_xyzzy", body, "xyzzy_fx")
+    out, _ = listed(capsys)
+    slow = out.split("slow to import")[1].splitlines()
+    assert "--disable-plugin" in slow[0]
+    mine = [line.split() for line in slow[1:] if "xyzzy" in line]
+    assert len(mine) == 1 and mine[0][:3] == ["xyzzy_fx", "xyzzy-fx", "0.0.1:"], mine
+    assert 0.2 <= float(mine[0][3]) < 5 and mine[0][4] == "s"

@@ -35,6 +35,7 @@ from .plugins import (
     DISABLE_ENV,
     DISABLE_PLUGINS_ENV,
     INTERFACES,
+    SLOW_IMPORTS,
     PluginError,
     add_cli_commands,
     autoload_enabled,
@@ -213,6 +214,13 @@ def _cmd_plugins(args: argparse.Namespace) -> int:
         print("disabled:")
         for name, why in sorted(registry.disabled.items()):
             print(f"  {name:<16} {why}")
+    if SLOW_IMPORTS:
+        print(
+            "slow to import (every mdf command imports every plugin: import heavy libraries in "
+            "the methods that use them, or mdf --disable-plugin NAME):"
+        )
+        for name, (dist, took) in sorted(SLOW_IMPORTS.items()):
+            print(f"  {name:<16} {dist}: {took:.1f} s")
     return 0
 
 

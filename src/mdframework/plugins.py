@@ -39,6 +39,7 @@ from __future__ import annotations
 import difflib
 import importlib.metadata
 import os
+import time
 import typing
 import warnings
 from collections.abc import Callable, Iterable, Iterator
@@ -248,6 +249,11 @@ def _provider_name(pm: pluggy.PluginManager, plugin: object) -> str:
 
 #: plugin name in the manager -> "distribution version", for entry-point plugins
 _DISTRIBUTIONS: dict[str, str] = {}
+#: a third party's plugin whose import takes longer [s] is listed by ``mdf plugins``
+SLOW_IMPORT_SECONDS = 1.0
+#: entry-point name -> ("distribution version", seconds its import took), for a third party's
+#: plugin that took over :data:`SLOW_IMPORT_SECONDS` (every command imports every plugin)
+SLOW_IMPORTS: dict[str, tuple[str, float]] = {}
 
 
 def _warn_disabled(
@@ -322,6 +328,7 @@ def _load_entry_points(
         if {ep.name, dist_name} & off:
             _disabled(pm)[ep.name] = f"{dist}, disabled by {DISABLE_PLUGINS_ENV}"
             continue
+        clock = time.perf_counter()
         try:
             plugin = ep.load()
         except Exception as exc:
@@ -337,6 +344,9 @@ def _load_entry_points(
             warnings.simplefilter("ignore", DeprecationWarning)
             pm.register(plugin, name=ep.name)
         _DISTRIBUTIONS[ep.name] = dist
+        took = time.perf_counter() - clock
+        if took > SLOW_IMPORT_SECONDS and dist_name not in BUILT_IN_DISTRIBUTIONS:
+            SLOW_IMPORTS[ep.name] = (dist, took)
 
 
 def _reraise_interrupt(exc: Exception) -> None:
@@ -536,3 +546,4 @@ def reset_default_registry() -> None:
     """Forget the cached plugin manager and registry (after changing the environment)."""
     default_registry.cache_clear()
     default_plugin_manager.cache_clear()
+    SLOW_IMPORTS.clear()
