@@ -128,7 +128,8 @@ def build_stages(config: RunConfigBase, registry: Registry | None = None) -> Sta
     waveform = make("radar", cfg.radar)
     effects = tuple(make("effects", e) for e in cfg.effects)
     for effect in effects:  # e.g. clutter needs a bandwidth: refused before any pulse
-        effect.check_radar(waveform)
+        with blame(effect, "check_radar"):
+            effect.check_radar(waveform)
     return Stages(source, model, waveform, effects)
 
 
