@@ -56,6 +56,24 @@ def third_party_entry_points() -> set[str]:
     }
 
 
+def without_third_party_warnings(lines: list[str], *keep: str) -> list[str]:
+    """``lines`` (of stderr, or warning messages) less the warnings that a third party's plugin
+    installed beside ours is disabled (a broken one warns in every command; tests are about
+    ours and the ones they install, ``keep``)."""
+    others = third_party_entry_points() - set(keep)
+    return [line for line in lines if not any(f"plugin {n!r} is disabled" in line for n in others)]
+
+
+@pytest.fixture
+def only_our_plugins(monkeypatch: pytest.MonkeyPatch, fresh_default_registry: object) -> None:
+    """Switch off the third parties' plugins installed beside ours (as ``--disable-plugin``
+    does), for a test whose messages list the installed kinds."""
+    from mdframework.plugins import DISABLE_PLUGINS_ENV
+
+    disabled = [os.environ.get(DISABLE_PLUGINS_ENV, ""), *sorted(third_party_entry_points())]
+    monkeypatch.setenv(DISABLE_PLUGINS_ENV, ",".join(name for name in disabled if name))
+
+
 #: Units of ``--dist loadscope`` (a test class, else a file) that take longest, in the order they
 #: start: the random-scene classes (20-60 s of CPU each), the documented commands (each a class of
 #: its own; the experiments take 5-25 s) and the files that start many `mdf` processes. pytest-xdist

@@ -209,3 +209,24 @@ def test_estimators_outside_sklearns_classifiers_need_allow_import() -> None:
         {"estimator": "sklearn.linear_model.LinearRegression"}, context={"allow_import": True}
     )
     assert cfg.estimator.endswith("LinearRegression")
+
+
+class Failing(Spy):
+    """A classifier plugin whose predict fails (a third party's bug)."""
+
+    name = "failing"
+
+    def predict(self, features: Any) -> Any:
+        raise KeyError("oops")
+
+
+def test_a_classifier_that_fails_is_named_in_the_error(rng: np.random.Generator) -> None:
+    """The exception of a classifier plugin's method carries a note naming the plugin and its
+    contract check, which the CLI's internal error shows (it named nobody)."""
+    x, y = rng.normal(size=(20, 3)), np.repeat(["a", "b"], 10)
+    with pytest.raises(KeyError) as caught:
+        wrapper_select(x, y, Failing, sizes=(1,), folds=2)
+    assert getattr(caught.value, "__notes__", []) == [
+        "in predict() of the classifier plugin 'failing' (test_classify.Failing); check it with "
+        "mdframework.testing.check_classifier"
+    ]

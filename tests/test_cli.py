@@ -466,7 +466,7 @@ FIX_HINTS = {
 
 @pytest.mark.parametrize("case", sorted(FIX_HINTS))
 def test_errors_say_how_to_fix(
-    case: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    case: str, tmp_path: Path, capsys: pytest.CaptureFixture[str], only_our_plugins: None
 ) -> None:
     text, expected = FIX_HINTS[case]
     cfg = tmp_path / "c.toml"

@@ -331,6 +331,47 @@ def test_the_suite_says_a_class_has_no_config() -> None:
         check_plugin(NeedsGain)
 
 
+def test_the_suite_names_a_config_that_breaks_its_own_rules() -> None:
+    """A default that its own field refuses (pydantic does not validate defaults, so the run
+    used it), and a field with no JSON schema (`mdf config schema` left the plugin out, and the
+    run could not save config.resolved.json): each an AssertionError naming the plugin and the
+    check, not a bare pydantic error."""
+    from pydantic import ConfigDict, Field
+
+    class BadDefault(_Returns):
+        """Its default gain is below the gain's own minimum."""
+
+        class Config(PluginConfig):
+            """A gain."""
+
+            kind: Literal["returns"] = "returns"
+            gain: float = Field(-1.0, gt=0, description="Gain.")
+
+    with pytest.raises(AssertionError) as info:
+        check_plugin(BadDefault)
+    assert str(info.value).startswith(
+        "BadDefault ('returns') fails check_config_round_trip: BadDefault ('returns'): its "
+        "config is not valid: gain: Input should be greater than 0"
+    ), info.value
+
+    class ArrayField(_Returns):
+        """Its config holds a numpy array."""
+
+        class Config(PluginConfig):
+            """An array."""
+
+            model_config = ConfigDict(arbitrary_types_allowed=True)
+            kind: Literal["returns"] = "returns"
+            data: np.ndarray = Field(default_factory=lambda: np.zeros(3), description="Data.")
+
+    with pytest.raises(AssertionError) as info:
+        check_plugin(ArrayField)
+    assert str(info.value).startswith(
+        "ArrayField ('returns') fails check_plugin_class: ArrayField.Config has no JSON schema "
+        "(mdf config schema shows it): Cannot generate a JsonSchema"
+    ), info.value
+
+
 def test_the_suite_names_the_plugin_and_the_failing_check() -> None:
     class NoneEffect(_Returns):
         """Forgets to return the data."""

@@ -297,7 +297,9 @@ def test_config_reference_is_current() -> None:
 
 
 def test_config_reference_covers_every_section() -> None:
-    reference = render()
+    from mdframework.docgen import project_registry
+
+    reference = render(project_registry())  # ours, whatever else is installed
     for name, field in RunConfigBase.model_fields.items():
         sub = _submodel(field.annotation)
         if sub is None:
@@ -366,17 +368,25 @@ def test_every_example_in_the_plugin_guide_runs_and_passes_the_contract_suite(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """Each ```python block of docs/plugins.md runs as shown (imports included); every plugin
-    it registers passes the whole contract suite; every interface has an example."""
+    it registers passes the whole contract suite and has a kind of its own (a reader who copies
+    one that claims a built-in kind into a distribution gets it switched off); every interface
+    has an example."""
+    from mdframework.docgen import project_registry
+
+    ours = project_registry()
     monkeypatch.syspath_prepend(str(ROOT / "examples" / "plugin-template" / "src"))
     blocks = _python_blocks(ROOT / "docs" / "plugins.md")
     registered: dict[str, list[str]] = {}
     for i, code in enumerate(blocks):
         module = types.ModuleType(f"mdf_docs_example_{i}")
         monkeypatch.setitem(sys.modules, module.__name__, module)
-        exec(compile(code, f"docs/plugins.md block {i}", "exec"), module.__dict__)
+        # dont_inherit: as in the reader's own module, not under this file's __future__ import
+        where = f"docs/plugins.md block {i}"
+        exec(compile(code, where, "exec", dont_inherit=True), module.__dict__)
         registry = build_registry([module], autoload=False)
         for interface in INTERFACES:
             for name in registry.names(interface):
+                assert name not in ours.names(interface), f"block {i}: {interface} {name!r}"
                 check_plugin(registry.get(interface, name))
                 registered.setdefault(interface, []).append(name)
         for name, value in module.__dict__.items():
@@ -390,7 +400,7 @@ def test_the_plugin_guide_cli_example_adds_a_documented_command(
 ) -> None:
     code = next(b for b in _python_blocks(ROOT / "docs" / "plugins.md") if "add_command" in b)
     namespace: dict[str, object] = {}
-    exec(code, namespace)
+    exec(compile(code, "docs/plugins.md", "exec", dont_inherit=True), namespace)
     parser = argparse.ArgumentParser(prog="mdf")
     sub = parser.add_subparsers()
     namespace["mdframework_add_cli_commands"](subparsers=sub)  # type: ignore[operator]
@@ -488,7 +498,7 @@ def test_every_python_block_of_a_page_runs(
             undefined = _free_names(tree) - set(namespace)
             assert not undefined, f"{block.where}: {sorted(undefined)} defined by no block above"
             continue
-        exec(compile(tree, block.where, "exec"), namespace)
+        exec(compile(tree, block.where, "exec", dont_inherit=True), namespace)
 
 
 def test_every_page_with_python_blocks_is_checked() -> None:

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 import pytest
 import synthetic
-from conftest import third_party_entry_points
+from conftest import third_party_entry_points, without_third_party_warnings
 
 from mdframework import cli, errors
 from mdframework.plugins import (
@@ -33,14 +33,6 @@ def _make_distribution(root: Path, dist: str, module: str, body: str, ep_name: s
     info.mkdir()
     (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {dist}\nVersion: 0.0.1\n")
     (info / "entry_points.txt").write_text(f"[mdframework]\n{ep_name} = {module}\n")
-
-
-def without_third_party_warnings(lines: list[str], *keep: str) -> list[str]:
-    """``lines`` (of stderr, or warning messages) less the warnings that a third party's plugin
-    installed beside ours is disabled (a broken one warns in every command; these tests are
-    about ours and the ones they install, ``keep``)."""
-    others = third_party_entry_points() - set(keep)
-    return [line for line in lines if not any(f"plugin {n!r} is disabled" in line for n in others)]
 
 
 THIRD_PARTY = """

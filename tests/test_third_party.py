@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import EXAMPLES
+from conftest import EXAMPLES, without_third_party_warnings
 from test_plugins import _make_distribution
 
 from mdframework import cli
@@ -333,9 +333,128 @@ def test_an_effect_that_returns_the_wrong_thing_is_an_internal_error_naming_it(
     )
     capsys.readouterr()
     assert cli.main(["run", str(config), "--out", str(tmp_path / "fx")]) == 1
-    lines = capsys.readouterr().err.strip().splitlines()
+    lines = without_third_party_warnings(capsys.readouterr().err.strip().splitlines())
     assert lines == [
         f"mdf: internal error: {why} (in the effects plugin 'xyzzy_fx' "
         "(mdf_test_xyzzy.XyzzyFx) on the 'scatterers' stage; check it with "
         "mdframework.testing.check_effect; run with --debug for the traceback)"
     ]
+
+
+#: a built-in plugin subclassed by a third party whose method breaks, the run config's edit
+#: that chooses it, and the method the internal error names
+FAILING_METHOD = {
+    "radar receive": (
+        "from mdf_lfm.waveform import LfmPulseDoppler as Base\n",
+        "radar_waveforms",
+        "    def receive(self, block):\n        return 1 / 0\n",
+        ('kind = "lfm"', 'kind = "xyzzy_bug"'),
+        "ZeroDivisionError: division by zero (in receive() of the radar plugin 'xyzzy_bug' "
+        "(mdf_test_xyzzy.XyzzyBug); check it with mdframework.testing.check_radar_waveform",
+    ),
+    "scatterer model": (
+        "from mdf_point_targets.source import IsotropicPoints as Base\n",
+        "scatterer_models",
+        "    def scatterers(self, *args):\n        return [1, 2]\n",
+        ('kind = "points"', 'kind = "xyzzy_bug"'),
+        "AttributeError: 'list' object has no attribute 'rcs' (in scatterers() of the "
+        "scatterers plugin 'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug); check it with "
+        "mdframework.testing.check_scatterer_model",
+    ),
+    "motion source": (
+        "from mdf_point_targets.source import PointTargets as Base\n",
+        "motion_sources",
+        "    def load(self):\n        return None + 1\n",
+        ('kind = "point_targets"', 'kind = "xyzzy_bug"'),
+        "TypeError: unsupported operand type(s) for +: 'NoneType' and 'int' (in load() of the "
+        "motion plugin 'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug); check it with "
+        "mdframework.testing.check_motion_source",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(FAILING_METHOD))
+def test_a_plugin_method_that_fails_is_an_internal_error_naming_the_plugin(
+    case: str, installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A third party's motion source, scatterer model or radar whose method raises is that
+    plugin's bug: the internal error names it and its contract check (it named nobody, as if
+    mdframework had failed; only effects were named)."""
+    base, hook, method, (old, new), why = FAILING_METHOD[case]
+    body = (
+        f"{base}from typing import Literal\nfrom mdframework import hookimpl\n\n"
+        f"class XyzzyConfig(Base.Config):\n    kind: Literal['xyzzy_bug'] = 'xyzzy_bug'\n\n"
+        f"class XyzzyBug(Base):\n    '''Broken.'''\n    name = 'xyzzy_bug'\n"
+        f"    Config = XyzzyConfig\n{method}\n"
+        f"@hookimpl\ndef mdframework_register_{hook}():\n    return [XyzzyBug]\n"
+    )
+    _make_distribution(installed, "xyzzy-bug", "mdf_test_xyzzy", body, "xyzzy_bug")
+    config = tmp_path / "bug.toml"
+    text = (EXAMPLES / "point_target.toml").read_text()
+    assert old in text
+    config.write_text(text.replace(old, new))
+    capsys.readouterr()
+    assert cli.main(["run", str(config), "--out", str(tmp_path / "o")]) == 1
+    lines = without_third_party_warnings(capsys.readouterr().err.strip().splitlines())
+    assert len(lines) == 1 and lines[0].startswith("mdf: internal error: "), lines
+    assert why in lines[0]
+
+
+#: the effect with an array in its config: neither JSON nor a JSON schema
+ARRAY_CONFIG = "from pydantic import ConfigDict, Field\n" + EFFECT.replace(
+    '    kind: Literal["xyzzy_fx"] = "xyzzy_fx"\n',
+    "    model_config = ConfigDict(arbitrary_types_allowed=True)\n"
+    '    kind: Literal["xyzzy_fx"] = "xyzzy_fx"\n'
+    '    data: np.ndarray = Field(default_factory=lambda: np.zeros(3), description="Data.")\n',
+)
+
+
+def test_a_config_model_that_cannot_be_saved_is_named_before_the_run(
+    installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A third party's config model with a field that has no JSON form: `mdf config schema`
+    says it leaves the plugin out (it did so silently), and a run that uses it stops before any
+    pulse with an internal error naming the plugin (after the whole simulation, naming no one)."""
+    body = HEADER + ARRAY_CONFIG + registering("[XyzzyFx]")
+    _make_distribution(installed, "xyzzy-fx", "mdf_test_xyzzy", body, "xyzzy_fx")
+    capsys.readouterr()
+    assert cli.main(["config", "schema"]) == 0
+    out, err = capsys.readouterr()
+    assert "xyzzy_fx" not in out
+    lines = [line for line in err.strip().splitlines() if "xyzzy" in line]
+    assert lines == [
+        "mdf: warning: the effects kind 'xyzzy_fx' (xyzzy-fx 0.0.1) is left out of the schema: "
+        "its Config has no JSON schema (Cannot generate a JsonSchema for "
+        "core_schema.IsInstanceSchema (<class 'numpy.ndarray'>)); check it with "
+        "mdframework.testing.check_plugin_class"
+    ], lines
+    config = tmp_path / "fx.toml"
+    config.write_text(
+        'effects = [{ kind = "xyzzy_fx" }]\n' + (EXAMPLES / "point_target.toml").read_text()
+    )
+    assert cli.main(["run", str(config), "--out", str(tmp_path / "fx")]) == 1
+    lines = without_third_party_warnings(capsys.readouterr().err.strip().splitlines())
+    assert len(lines) == 1 and lines[0].startswith("mdf: internal error: "), lines
+    assert (
+        "(in the config of the effects plugin 'xyzzy_fx' (mdf_test_xyzzy.XyzzyConfig), which "
+        "runs save as JSON; check it with mdframework.testing.check_config_round_trip;"
+    ) in lines[0], lines
+    assert not (tmp_path / "fx").exists()
+
+
+def test_mdf_plugins_names_a_plugin_that_is_slow_to_import(
+    installed: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Every command imports every plugin: one that sleeps (or imports a heavy library) at
+    import slowed every command, `mdf --help` included, and nothing said which."""
+    from mdframework import plugins
+
+    monkeypatch.setattr(plugins, "SLOW_IMPORT_SECONDS", 0.05)
+    body = "import time\ntime.sleep(0.2)\n" + HEADER + EFFECT + registering("[XyzzyFx]")
+    _make_distribution(installed, "xyzzy-fx", "mdf_test_xyzzy", body, "xyzzy_fx")
+    out, _ = listed(capsys)
+    slow = out.split("slow to import")[1].splitlines()
+    assert "--disable-plugin" in slow[0]
+    mine = [line.split() for line in slow[1:] if "xyzzy" in line]
+    assert len(mine) == 1 and mine[0][:3] == ["xyzzy_fx", "xyzzy-fx", "0.0.1:"], mine
+    assert 0.2 <= float(mine[0][3]) < 5 and mine[0][4] == "s"

@@ -15,9 +15,22 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .interfaces import Classifier
+from .plugins import blame
 
 FloatArray = NDArray[np.float64]
 ClassifierFactory = Callable[[], Classifier]
+
+
+def fit_predict(
+    classifier: Classifier, x_train: FloatArray, y_train: NDArray[Any], x_test: FloatArray
+) -> NDArray[Any]:
+    """``classifier`` fitted on ``x_train`` (n, n_features) and ``y_train`` (n,), and its
+    labels (m,) of ``x_test`` (m, n_features); an exception from the plugin's ``fit`` or
+    ``predict`` names it (:func:`mdframework.plugins.blame`)."""
+    with blame(classifier, "fit"):
+        fitted = classifier.fit(x_train, y_train)
+    with blame(classifier, "predict"):
+        return fitted.predict(x_test)
 
 
 @dataclass(frozen=True)
@@ -116,7 +129,7 @@ def _score_subsets(
             cols = list(subset)
             accs = [
                 balanced_accuracy(
-                    y_te, make_classifier().fit(x_tr[:, cols], y_tr).predict(x_te[:, cols])
+                    y_te, fit_predict(make_classifier(), x_tr[:, cols], y_tr, x_te[:, cols])
                 )
                 for x_tr, y_tr, x_te, y_te in folds
             ]

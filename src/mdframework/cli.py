@@ -35,6 +35,7 @@ from .plugins import (
     DISABLE_ENV,
     DISABLE_PLUGINS_ENV,
     INTERFACES,
+    SLOW_IMPORTS,
     PluginError,
     add_cli_commands,
     autoload_enabled,
@@ -213,13 +214,35 @@ def _cmd_plugins(args: argparse.Namespace) -> int:
         print("disabled:")
         for name, why in sorted(registry.disabled.items()):
             print(f"  {name:<16} {why}")
+    if SLOW_IMPORTS:
+        print(
+            "slow to import (every mdf command imports every plugin: import heavy libraries in "
+            "the methods that use them, or mdf --disable-plugin NAME):"
+        )
+        for name, (dist, took) in sorted(SLOW_IMPORTS.items()):
+            print(f"  {name:<16} {dist}: {took:.1f} s")
     return 0
 
 
 def _cmd_schema(args: argparse.Namespace) -> int:
+    from pydantic import PydanticUserError
+
     from .config import run_config_model
 
-    print(json.dumps(run_config_model().model_json_schema(), indent=2))
+    registry = default_registry()
+    for interface in ("motion", "scatterers", "radar", "effects"):
+        for name in registry.names(interface):
+            info = registry.plugins[interface][name]
+            try:  # pydantic leaves a member without a schema out of the union, silently
+                info.cls.Config.model_json_schema()
+            except PydanticUserError as exc:
+                why = str(exc).strip().splitlines()[0]
+                say(
+                    f"mdf: warning: the {interface} kind {name!r} ({info.provider}) is left "
+                    f"out of the schema: its Config has no JSON schema ({why}); "
+                    "check it with mdframework.testing.check_plugin_class"
+                )
+    print(json.dumps(run_config_model(registry).model_json_schema(), indent=2))
     return 0
 
 

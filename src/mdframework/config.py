@@ -570,8 +570,31 @@ def validate_run_config(
         config = model.model_validate(data, context={"base_dir": base_dir})
     except ValidationError as exc:
         raise ConfigError(format_validation_error(exc, source, data, model)) from None
+    _check_saveable(config)
     _check_pulse_budget(config, source)
     return config
+
+
+def _check_saveable(config: RunConfigBase) -> None:
+    """Runs save their config as JSON (``config.resolved.json``): a plugin's config that
+    cannot be saved is that plugin's bug, found here, before any work, and named in the
+    exception's note (which the CLI's internal error shows)."""
+    from pydantic_core import PydanticSerializationError
+
+    cfg: Any = config
+    sections = [("motion", cfg.motion), ("scatterers", cfg.scatterers), ("radar", cfg.radar)]
+    sections += [("effects", effect) for effect in cfg.effects]
+    for interface, section in sections:
+        try:
+            section.model_dump_json()
+        except PydanticSerializationError as exc:
+            cls = type(section)
+            exc.add_note(
+                f"in the config of the {interface} plugin {section.kind!r} "
+                f"({cls.__module__}.{cls.__qualname__}), which runs save as JSON; check it "
+                "with mdframework.testing.check_config_round_trip"
+            )
+            raise
 
 
 def _check_pulse_budget(config: RunConfigBase, source: str) -> None:

@@ -45,6 +45,7 @@ from .classify import (
     Selection,
     balanced_accuracy,
     confusion_matrix,
+    fit_predict,
     optimistic_select,
     wrapper_select,
 )
@@ -273,7 +274,7 @@ def _fit_predict(
     x_test: NDArray[np.float64],
     cols: tuple[int, ...],
 ) -> NDArray[Any]:
-    return factory().fit(x_train[:, list(cols)], y_train).predict(x_test[:, list(cols)])
+    return fit_predict(factory(), x_train[:, list(cols)], y_train, x_test[:, list(cols)])
 
 
 def _select(

@@ -43,7 +43,7 @@ from .physics.spectrogram import (
     power_to_db,
     spectrogram,
 )
-from .plugins import Registry, default_registry
+from .plugins import Registry, blame, default_registry
 from .progress import QUIET, Progress
 from .settings import (
     ConditioningConfig,
@@ -128,7 +128,8 @@ def build_stages(config: RunConfigBase, registry: Registry | None = None) -> Sta
     waveform = make("radar", cfg.radar)
     effects = tuple(make("effects", e) for e in cfg.effects)
     for effect in effects:  # e.g. clutter needs a bandwidth: refused before any pulse
-        effect.check_radar(waveform)
+        with blame(effect, "check_radar"):
+            effect.check_radar(waveform)
     return Stages(source, model, waveform, effects)
 
 
@@ -195,6 +196,18 @@ def _check_effect_output(out: Any, data: Scatterers | Received) -> None:
             )
         if not np.all(np.isfinite(out.signal)):
             raise ValueError("apply() returned a signal that is not finite")
+
+
+def _check_received(out: Any, n_pulses: int) -> None:
+    """Refuse what a radar's ``receive`` returned for a block of ``n_pulses`` pulses when it is
+    not ``Received`` with a signal of one sample per pulse."""
+    if not isinstance(out, Received):
+        raise TypeError(f"receive() returned {type(out).__name__} instead of Received")
+    if not isinstance(out.signal, np.ndarray) or out.signal.shape != (n_pulses,):
+        raise ValueError(
+            f"receive() returned a signal of shape {np.shape(out.signal)} for a block of "
+            f"{n_pulses} pulses instead of ({n_pulses},)"
+        )
 
 
 def _describe(stages: Stages, stage: str) -> list[dict[str, Any]]:
@@ -277,7 +290,8 @@ def load_motion(source: MotionSource) -> Motion:
     a one-line user error naming the source, followed by the motion sanity checks
     (:func:`mdframework.sanity.check_motion`, with the source config's ``sanity`` section)."""
     try:
-        motion = source.load()
+        with blame(source, "load"):
+            motion = source.load()
     except ValueError as exc:
         raise SceneError(f"motion {source.name!r}: {exc}") from None
     return sanity.check_motion(motion, getattr(source.config, "sanity", SanityConfig()))
@@ -290,7 +304,8 @@ def spectrogram_geometry(
     (:meth:`RadarWaveform.spectrogram_geometry`); a record too short for it is a
     :class:`SceneError` naming ``processing.window_length``. ``mdf check`` reports it."""
     try:
-        return wf.spectrogram_geometry(n_pulses, proc)
+        with blame(wf, "spectrogram_geometry"):
+            return wf.spectrogram_geometry(n_pulses, proc)
     except RecordTooShortError as exc:
         raise SceneError(f"processing.window_length: {exc}") from None
 
@@ -320,7 +335,8 @@ def record_spectrogram(
     ``processing`` window; ``times`` (n_pulses,) [s]. Its power is
     :func:`spectrogram_geometry`'s shape (the radar contract checks this)."""
     try:
-        spec = wf.spectrogram(signal, times, proc)  # a waveform's own slow time (FMCW)
+        with blame(wf, "spectrogram"):
+            spec = wf.spectrogram(signal, times, proc)  # a waveform's own slow time (FMCW)
         if spec is None:
             spec = processing_stft(signal, wf.prf, proc)
     except RecordTooShortError as exc:
@@ -390,10 +406,13 @@ def _simulate_motion(
         near = placed(near, where)
         resample = interpolation.TrackResampler(near.time, near.positions, near.valid, method)
     record_body = near.select_frames(_inside(near.time, t_start, t_end))
-    model.start_record(record_body)
-    wf.start_record(t, _range_span(record_body, radar_pos))
+    with blame(model, "start_record"):
+        model.start_record(record_body)
+    with blame(wf, "start_record"):
+        wf.start_record(t, _range_span(record_body, radar_pos))
     for effect in stages.effects:
-        effect.start_record(record_body, radar_pos)
+        with blame(effect, "start_record"):
+            effect.start_record(record_body, radar_pos)
     timings["prepare"] = time.perf_counter() - clock
 
     n = t.shape[0]
@@ -411,8 +430,9 @@ def _simulate_motion(
         timings["resample"] = timings.get("resample", 0.0) + time.perf_counter() - clock
 
         clock = time.perf_counter()
-        scat = model.scatterers(motion, at_pulses, radar_pos, lam)
-        rcs_model = scat.rcs
+        with blame(model, "scatterers"):
+            scat = model.scatterers(motion, at_pulses, radar_pos, lam)
+            rcs_model = scat.rcs
         gate = _gate(sc.gate, at_pulses, radar_pos)
         context = SceneContext(
             radar_pos, wf.prf, wf.carrier_frequency, tb, gate, at_pulses, wf, rng, lo
@@ -423,12 +443,16 @@ def _simulate_motion(
         ranges = scat.ranges(radar_pos)
         stream.check(lo, scat, ranges)
         s = slice(None, None, emptiness.SAMPLE_EVERY)
-        gain = wf.gate_gain(ranges[s], gate[s])
+        with blame(wf, "gate_gain"):
+            gain = wf.gate_gain(ranges[s], gate[s])
         losses += emptiness.count_losses(ranges[s], gate[s], rcs_model[s], scat.rcs[s], gain)
         timings["scatterers"] = timings.get("scatterers", 0.0) + time.perf_counter() - clock
 
         clock = time.perf_counter()
-        stream.add(lo, gate, scat, wf.receive(PulseBlock(lo, tb, scat, ranges, gate, radar_pos)))
+        with blame(wf, "receive"):
+            received_block = wf.receive(PulseBlock(lo, tb, scat, ranges, gate, radar_pos))
+            _check_received(received_block, hi - lo)
+        stream.add(lo, gate, scat, received_block)
         timings["receive"] = timings.get("receive", 0.0) + time.perf_counter() - clock
 
     clock = time.perf_counter()
@@ -732,7 +756,8 @@ def record_pulses(wf: RadarWaveform, t_start: float, t_end: float) -> FloatArray
     """The radar's pulse times (n_pulses,) [s] of the record from ``t_start`` to ``t_end`` [s];
     a :class:`SceneError` naming ``motion.duration`` and the shortest record the radar can
     sample when there is none (a record shorter than one FMCW frame's chirps)."""
-    t = np.asarray(wf.pulse_times(t_start, t_end), dtype=np.float64)
+    with blame(wf, "pulse_times"):
+        t = np.asarray(wf.pulse_times(t_start, t_end), dtype=np.float64)
     if t.size == 0:
         kind = getattr(wf, "name", "radar")
         raise SceneError(

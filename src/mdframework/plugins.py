@@ -39,9 +39,11 @@ from __future__ import annotations
 import difflib
 import importlib.metadata
 import os
+import time
 import typing
 import warnings
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import cache
 from typing import Any, Literal, NamedTuple
@@ -49,7 +51,7 @@ from typing import Any, Literal, NamedTuple
 import pluggy
 
 from . import hookspecs
-from .errors import caused_by_interrupt
+from .errors import MdfError, caused_by_interrupt
 from .interfaces import (
     Classifier,
     Effect,
@@ -92,6 +94,39 @@ INTERFACES: dict[str, Interface] = {
     "effects": Interface("mdframework_register_effects", Effect),
     "recording": Interface("mdframework_register_recording_sources", RecordingSource),
 }
+
+#: interface -> the contract check of its plugins (:mod:`mdframework.testing`)
+CONTRACT_CHECKS = {
+    "motion": "check_motion_source",
+    "scatterers": "check_scatterer_model",
+    "radar": "check_radar_waveform",
+    "classifier": "check_classifier",
+    "effects": "check_effect",
+    "recording": "check_recording_source",
+}
+
+
+@contextmanager
+def blame(plugin: Plugin, method: str) -> Iterator[None]:
+    """Run a call of ``plugin``'s ``method``: an exception it raises, other than an
+    :class:`~mdframework.errors.MdfError` (bad input, the user's), is the plugin's bug, and
+    gets a note naming the plugin, its class and its contract check, which the CLI's internal
+    error shows (``in receive() of the radar plugin 'acme' (acme.Radar); check it with
+    mdframework.testing.check_radar_waveform``)."""
+    try:
+        yield
+    except MdfError:
+        raise
+    except Exception as exc:
+        cls = type(plugin)
+        interface = next((i for i, s in INTERFACES.items() if isinstance(plugin, s.base)), "")
+        exc.add_note(
+            f"in {method}() of the {interface} plugin {getattr(plugin, 'name', '?')!r} "
+            f"({cls.__module__}.{cls.__qualname__}); check it with "
+            f"mdframework.testing.{CONTRACT_CHECKS.get(interface, 'check_plugin')}"
+        )
+        raise
+
 
 #: old interface spelling -> current one
 OLD_INTERFACE_NAMES = {"effect": "effects"}
@@ -214,6 +249,11 @@ def _provider_name(pm: pluggy.PluginManager, plugin: object) -> str:
 
 #: plugin name in the manager -> "distribution version", for entry-point plugins
 _DISTRIBUTIONS: dict[str, str] = {}
+#: a third party's plugin whose import takes longer [s] is listed by ``mdf plugins``
+SLOW_IMPORT_SECONDS = 1.0
+#: entry-point name -> ("distribution version", seconds its import took), for a third party's
+#: plugin that took over :data:`SLOW_IMPORT_SECONDS` (every command imports every plugin)
+SLOW_IMPORTS: dict[str, tuple[str, float]] = {}
 
 
 def _warn_disabled(
@@ -288,6 +328,7 @@ def _load_entry_points(
         if {ep.name, dist_name} & off:
             _disabled(pm)[ep.name] = f"{dist}, disabled by {DISABLE_PLUGINS_ENV}"
             continue
+        clock = time.perf_counter()
         try:
             plugin = ep.load()
         except Exception as exc:
@@ -303,6 +344,9 @@ def _load_entry_points(
             warnings.simplefilter("ignore", DeprecationWarning)
             pm.register(plugin, name=ep.name)
         _DISTRIBUTIONS[ep.name] = dist
+        took = time.perf_counter() - clock
+        if took > SLOW_IMPORT_SECONDS and dist_name not in BUILT_IN_DISTRIBUTIONS:
+            SLOW_IMPORTS[ep.name] = (dist, took)
 
 
 def _reraise_interrupt(exc: Exception) -> None:
@@ -502,3 +546,4 @@ def reset_default_registry() -> None:
     """Forget the cached plugin manager and registry (after changing the environment)."""
     default_registry.cache_clear()
     default_plugin_manager.cache_clear()
+    SLOW_IMPORTS.clear()

@@ -111,7 +111,8 @@ class Skeleton:
             bad = int(np.argmax(~(np.diff(time) > 0)))
             raise SkeletonError(
                 f"time stamps must be strictly increasing (frame {bad + 1}: "
-                f"{time[bad + 1]!r} s after {time[bad]!r} s); sort them and drop duplicates first"
+                f"{float(time[bad + 1])!r} s after {float(time[bad])!r} s); sort them and drop "
+                "duplicates first"
             )
         finite = np.isfinite(pos)
         if self.valid is None:

@@ -35,7 +35,8 @@ from functools import partial
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import Field, ValidationError
+from pydantic import Field, PydanticUserError, ValidationError
+from pydantic_core import PydanticSerializationError
 
 from .interfaces import (
     Classifier,
@@ -235,16 +236,37 @@ def check_plugin_class(cls: type[Plugin], interface: str | None = None) -> None:
     assert config.model_config.get("extra") == "forbid", (
         f"{cls.__name__}.Config must forbid unknown fields"
     )
-    config.model_json_schema()  # shown by `mdf config schema`
+    try:
+        config.model_json_schema()  # shown by `mdf config schema`
+    except PydanticUserError as exc:
+        raise AssertionError(
+            f"{cls.__name__}.Config has no JSON schema (mdf config schema shows it): "
+            f"{_first_line(exc)}"
+        ) from None
+
+
+def _first_line(exc: Exception) -> str:
+    return (str(exc).strip().splitlines() or [type(exc).__name__])[0]
 
 
 def check_config_round_trip(plugin: Plugin) -> None:
     """The plugin keeps its validated config, and that config survives a JSON round trip (runs
     save it in ``config.resolved.json`` and must be reproducible from it)."""
-    cfg = plugin.config
-    assert isinstance(cfg, type(plugin).Config), f"{_label(plugin)}: self.config is not its Config"
-    again = type(cfg).model_validate(json.loads(cfg.model_dump_json()))
-    assert again == cfg, f"{_label(plugin)}: its config changes in a JSON round trip"
+    cfg, who = plugin.config, _label(plugin)
+    assert isinstance(cfg, type(plugin).Config), f"{who}: self.config is not its Config"
+    try:
+        saved = json.loads(cfg.model_dump_json())
+    except PydanticSerializationError as exc:
+        raise AssertionError(
+            f"{who}: its config cannot be saved as JSON (config.resolved.json): {exc}"
+        ) from None
+    try:  # pydantic does not check defaults: a default its own field refuses is found here
+        again = type(cfg).model_validate(saved)
+    except ValidationError as exc:
+        error = exc.errors()[0]
+        where = ".".join(map(str, error["loc"]))
+        raise AssertionError(f"{who}: its config is not valid: {where}: {error['msg']}") from None
+    assert again == cfg, f"{who}: its config changes in a JSON round trip"
 
 
 # --------------------------------------------------------------------------- motion sources
