@@ -212,7 +212,7 @@ class SourceEntry(StrictModel):
     run: dict[str, Any] = Field(
         default_factory=dict,
         description="Run-config sections for this source only, merged over `base` (e.g. "
-        "conditioning for Kinect recordings, or its own scene).",
+        "conditioning for Kinect recordings, or its own scene); not motion or seed.",
     )
     randomize: Randomization | None = Field(
         None,
@@ -277,14 +277,16 @@ class DatasetConfig(StrictModel):
 
     seed: Seed = Field(0, description="Seed of the whole dataset.")
     record_lengths: dict[str, PositiveSeconds] = Field(
-        default_factory=dict, description="Record length per label [s]."
+        default_factory=dict,
+        description="Record length per label [s]; a label that no source has is refused.",
     )
     sources: list[SourceEntry] = Field(min_length=1)
     variations: Variations = Field(default_factory=Variations)
     base: dict[str, Any] = Field(
         default_factory=dict,
         description="Run-config sections shared by every record (scatterers, radar, scene, "
-        "processing, effects).",
+        "processing, effects); not motion or seed, which each record takes from its source "
+        "and the dataset's seed.",
     )
     features: FeatureConfig = Field(default_factory=FeatureConfig)
     representation: Literal["spectrogram", "histogram"] = Field(
@@ -852,10 +854,64 @@ def _randomize(config: DatasetConfig, entry: SourceEntry) -> Randomization:
     return config.randomize.model_copy(update=own)
 
 
+#: run-config sections that a build sets for every record itself, and where to give them
+#: instead: in ``base`` or a source's ``run`` they would be replaced without a word
+_PER_RECORD = {
+    "motion": "each record's motion is its source's own `motion` table; give settings such as "
+    "`sanity` there",
+    "seed": "each record's seed derives from the dataset's top-level `seed` and the record's "
+    "number; set that one",
+}
+
+
+def _check_sections(config: DatasetConfig) -> None:
+    """Refuse what a build would silently ignore: a ``base`` or source ``run`` section that it
+    sets itself, and a ``record_lengths`` entry of a label that no source has."""
+    tables = [("base", config.base)]
+    tables += [(f"sources[{n}].run", e.run) for n, e in enumerate(config.sources)]
+    for where, table in tables:
+        for key, instead in _PER_RECORD.items():
+            if key in table:
+                raise ConfigError(f"{where}.{key}: {instead}")
+    labels = sorted({e.label for e in config.sources})
+    for label in config.record_lengths:
+        if label not in labels:
+            raise ConfigError(
+                f"record_lengths.{label}: no source has the label {label!r} (labels: "
+                f"{', '.join(map(repr, labels))})"
+            )
+
+
+def _source_span(motion: dict[str, Any], entry_no: int, loaded: Motion) -> tuple[float, float]:
+    """The span ``(start, end)`` [s] that a source's records are cut from: its motion's own
+    ``start`` and ``duration`` (checked here: the loaded motion is shared by every span of
+    it), within the loaded motion."""
+    where = f"sources[{entry_no}].motion"
+    for name in ("start", "duration"):
+        value = motion.get(name)
+        if value is None:
+            continue
+        if isinstance(value, bool) or not isinstance(value, int | float) or not np.isfinite(value):
+            raise ConfigError(f"{where}.{name}: a number of seconds, not {json.dumps(value)}")
+        if value < 0 or (name == "duration" and value == 0):
+            rule = "at least 0" if name == "start" else "greater than 0"
+            raise ConfigError(f"{where}.{name}: must be {rule} (got {value:g})")
+    start = float(motion.get("start", 0.0))
+    end = loaded.skeleton.duration
+    if start >= end:
+        raise ConfigError(
+            f"{where}.start: {start:g} s is not before the end of the {end:.3f} s motion"
+        )
+    if motion.get("duration") is not None:
+        end = min(end, start + float(motion["duration"]))
+    return start, end
+
+
 def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> list[RecordSpec]:
     """Expand sources x windows x variations x random draws into record specs, in a fixed
     order. With ``workers`` > 1 the sources' motions are first loaded in that many processes
     (:func:`_preload_motions`); the specs are the same."""
+    _check_sections(config)
     v = config.variations
     for rz in [config.randomize] + [_randomize(config, e) for e in config.sources]:
         for name in ("aspect_deg", "radar_range", "radar_height", "height"):
@@ -898,10 +954,7 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
         key = _motion_key(motion)
         if key not in prints:  # once per loaded motion
             prints[key] = motion_fingerprint(loaded)
-        span_start = float(motion.get("start", 0.0))
-        span_end = loaded.skeleton.duration
-        if motion.get("duration") is not None:
-            span_end = min(span_end, span_start + float(motion["duration"]))
+        span_start, span_end = _source_span(motion, entry_no, loaded)
         duration = span_end - span_start
         length = entry.record_length or config.record_lengths.get(entry.label) or duration
         where = motion.get("file", motion["kind"])

@@ -1029,6 +1029,35 @@ def _dataset_cases(c: _Corpus) -> None:
         {"sources": [{**one, "randomize": {"speed": {"uniform": [1.0, inf]}}}]},
         "randomize.speed",
     )
+    # what a build sets for every record itself: never silently dropped
+    repair = {"sanity": {"glitches": "repair"}}
+    ds_case("base-motion", {"sources": [one], "base": {"motion": repair}}, "base.motion")
+    ds_case("run-motion", {"sources": [{**one, "run": {"motion": repair}}]}, "[0].run.motion")
+    ds_case("base-seed", {"sources": [one], "base": {"seed": 5}}, "base.seed", "seed")
+    ds_case(
+        "record-lengths-no-such-label",
+        {"sources": [source], "record_lengths": {"walks": 1.0}},
+        "record_lengths.walks",
+        "'walk'",
+    )
+    # the span a source's records are cut from
+    motion = source["motion"]
+    ds_case(
+        "source-start-text",
+        {"sources": [{**one, "motion": {**motion, "start": "late"}}]},
+        "sources[0].motion.start",
+    )
+    ds_case(
+        "source-duration-zero",
+        {"sources": [{**source, "motion": {**motion, "duration": 0.0}}]},
+        "sources[0].motion.duration",
+    )
+    ds_case(
+        "source-start-past-end",
+        {"sources": [{**source, "motion": {**motion, "start": 1000.0}}]},
+        "sources[0].motion.start",
+        "1000",
+    )
 
     def exp_case(name: str, cfg: dict[str, Any], *expect: str, argv: tuple[str, ...] = ()) -> None:
         d = c.folder(f"experiment-{name}")
