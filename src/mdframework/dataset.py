@@ -570,8 +570,9 @@ def _load_recordings(section_json: str, base_dir: str) -> tuple[Recording, ...]:
 
 def _plan_recordings(
     config: DatasetConfig, entry_no: int, entry: SourceEntry, base_dir: Path, first_index: int
-) -> list[RecordSpec]:
-    """Records of a real radar's recordings: windows of whole frames."""
+) -> tuple[list[RecordSpec], list[str]]:
+    """Records of a real radar's recordings: windows of whole frames; and the recordings
+    shorter than the record length, skipped with a warning (as a short motion source is)."""
     section = dict(entry.recording or {})
     where = f"sources[{entry_no}]"
     if "kind" not in section:
@@ -582,6 +583,7 @@ def _plan_recordings(
         raise ConfigError(f"{where}.{exc}") from None
     hist = config.histogram.model_dump()
     specs: list[RecordSpec] = []
+    short: list[str] = []
     for rec in recordings:
         content = recording_fingerprint(rec)
         period = rec.cloud.frame_period
@@ -595,10 +597,15 @@ def _plan_recordings(
                 f"{rec.name}: give at least {period:.4g} s"
             )
         if length > rec.cloud.n_frames:
-            raise ConfigError(
-                f"{field}: {length} frames of {period * 1e3:.1f} ms ({length_s:g} s) do not fit "
-                f"the {rec.cloud.n_frames} frames of {rec.name}"
+            warnings.warn(
+                f"{where} ({rec.name}): the {rec.cloud.n_frames} frames of {period * 1e3:.1f} ms "
+                f"are fewer than the {length} frames of the {length_s:g} s record length "
+                f"({field}); skipped",
+                DatasetWarning,
+                stacklevel=3,
             )
+            short.append(rec.name)
+            continue
         starts = range(0, rec.cloud.n_frames - length + 1, hop)
         for n, first in enumerate(starts):
             if entry.max_records is not None and n >= entry.max_records:
@@ -620,7 +627,7 @@ def _plan_recordings(
             specs.append(
                 replace(spec, length_field=_length_field(config, entry_no, entry), window=window)
             )
-    return specs
+    return specs, short
 
 
 def _naming(
@@ -938,7 +945,9 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
     prints: dict[str, str] = {}  # motion key -> fingerprint
     for entry_no, entry in enumerate(config.sources):
         if entry.recording is not None:
-            specs += _plan_recordings(config, entry_no, entry, base_dir, len(specs))
+            recorded, too_short = _plan_recordings(config, entry_no, entry, base_dir, len(specs))
+            specs += recorded
+            short += too_short
             continue
         motion = dict(entry.motion or {})
         if "kind" not in motion:
