@@ -1236,7 +1236,8 @@ def _record_or_skip(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
             f"record {spec.record_id} ({spec.label}; source file {file}, window "
             f"{start:.3f}-{start + length:.3f} s)"
         )
-        cause = " ".join(str(exc).split())
+        # named once: the record's own errors start with its name too
+        cause = " ".join(str(exc).split()).removeprefix(f"record {spec.record_id}: ")
         if spec.length_field is not None:  # the record's duration is the dataset's length
             cause = cause.replace("motion.duration", spec.length_field)
         if spec.on_error != "skip":
