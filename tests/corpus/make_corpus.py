@@ -1013,6 +1013,11 @@ def _dataset_cases(c: _Corpus) -> None:
         "record 0",
     )
     rz_case("param-unknown-field", {"params": {"radar.nope": {"uniform": [1, 2]}}}, "nope")
+    # not a field inside a section: the record's seed is the build's, "speed" is no field
+    rz_case("param-seed", {"params": {"seed": {"choice": [1, 2]}}}, 'randomize.params: "seed"')
+    rz_case(
+        "param-no-section", {"params": {"speed": {"uniform": [20, 30]}}}, '"speed"', "radar.prf"
+    )
     rz_case("param-no-list-item", {"params": {"effects.3.snr_db": {"uniform": [1, 2]}}}, "effects")
     rz_case(
         "radar-range-absurd",
