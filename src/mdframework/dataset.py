@@ -815,8 +815,9 @@ def _as_written(
 ) -> ConfigError:
     """A record's config error with the field named where the dataset config wrote it:
     ``base.radar.prf``, ``sources[0].run.radar.prf`` or ``sources[0].motion.file`` rather than
-    the record's ``radar.prf``. Scene fields (which variations and placement rewrite), the
-    window's ``start``/``duration``/``height`` and draws keep the record's name."""
+    the record's ``radar.prf``; a height that ``variations.height`` set is named so. Scene
+    fields (which variations and placement rewrite), the window's ``start``/``duration`` and
+    draws keep the record's name."""
     text = str(exc)
     rest = text.removeprefix(f"{record}: ")
     field, _, problem = rest.partition(": ")
@@ -824,6 +825,8 @@ def _as_written(
     if rest == text or not problem or parts[0] == "scene":
         return exc
     if parts[0] == "motion":
+        if parts[1:] == ["height"] and config.variations.height is not None:
+            return ConfigError(f"{record}: variations.height (for {field}): {problem}")
         if len(parts) < 2 or parts[1] in ("start", "duration", "height"):
             return exc
         where = f"sources[{entry_no}]."

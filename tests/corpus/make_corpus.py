@@ -1030,6 +1030,12 @@ def _dataset_cases(c: _Corpus) -> None:
         "height-on-cmu", {"height": {"uniform": [1.5, 1.9]}}, "randomize.height drew", "record 0"
     )
     ds_case(
+        "variations-height-on-cmu",
+        {"sources": [one], "variations": {"height": [1.7]}},
+        "variations.height",
+        "unknown field 'height'",
+    )
+    ds_case(
         "source-randomize-speed-inf",
         {"sources": [{**one, "randomize": {"speed": {"uniform": [1.0, inf]}}}]},
         "randomize.speed",
