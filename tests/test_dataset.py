@@ -398,11 +398,12 @@ def test_corrupt_and_partial_records_are_redone(tmp_path: Path) -> None:
     with files[2].open("wb") as fh:
         np.savez(fh, **arrays)
     (out / RECORDS / ".tmp-abc.npz").write_bytes(b"half")  # temp file of a killed writer
-    stamp = {p.name: p.stat().st_mtime_ns for p in files[3:]}
+    files[3].write_bytes(files[4].read_bytes())  # whole, but another record's (copied over)
+    stamp = {p.name: p.stat().st_mtime_ns for p in files[4:]}
     build_dataset(cfg, base, out, workers=1, progress=False)
     assert_same(out, reference)
     assert not list((out / RECORDS).glob(".tmp-*"))
-    assert {p.name: p.stat().st_mtime_ns for p in files[3:]} == stamp  # not redone
+    assert {p.name: p.stat().st_mtime_ns for p in files[4:]} == stamp  # not redone
 
 
 def test_a_record_without_permission_stops_the_resume_and_is_kept(

@@ -1426,17 +1426,19 @@ def _planned_meta(spec: RecordSpec) -> dict[str, Any]:
 
 def _complete(path: Path, spec: RecordSpec) -> dict[str, Any] | None:
     """The index row of a finished record, or None if it must be (re)built: a record cut
-    short, corrupt, or whose metadata lacks a field is removed. A record whose label, group,
-    subject, recording or dataset differ from ``spec``'s (the config changed only those) is
-    kept and rewritten with the new ones (atomically; its arrays are not recomputed), and so
-    is its row. A record that cannot be read for want of permission is an error (it is not
-    removed)."""
+    short, corrupt, or whose metadata lacks a field or names another record is removed. A
+    record whose label, group, subject, recording or dataset differ from ``spec``'s (the
+    config changed only those) is kept and rewritten with the new ones (atomically; its arrays
+    are not recomputed), and so is its row. A record that cannot be read for want of
+    permission is an error (it is not removed)."""
     import zipfile
 
     if not path.exists():
         return None
     try:
         arrays, meta = read_record(path)
+        if meta["id"] != spec.record_id:  # another record's file, copied or renamed here
+            raise ValueError(f"{path}: holds record {meta['id']}")
         planned = _planned_meta(spec)
         if any(meta.get(k) != v for k, v in planned.items()):
             meta.update(planned)
