@@ -1929,6 +1929,26 @@ class Dataset:
     histograms: list[NDArray[np.float32] | None] | None = None
 
 
+def _load_record(path: Path) -> dict[str, NDArray[Any]]:
+    """The arrays of one record of a built dataset; a record file that is missing or damaged
+    (deleted or changed since the build) is a :class:`DataFileError` naming it."""
+    import zipfile
+
+    try:
+        return read_record(path)[0]
+    except FileNotFoundError:
+        problem = "missing"
+    except PermissionError as exc:
+        raise DataFileError(path, exc.strerror or str(exc)) from None
+    except (OSError, EOFError, ValueError, KeyError, TypeError, zipfile.BadZipFile):
+        problem = "not a complete record file"
+    raise DataFileError(
+        path,
+        f"{problem}, though index.csv lists it; run the `mdf dataset build` that made the "
+        "dataset again to rebuild it",
+    )
+
+
 def load_dataset(
     path: str | Path, *, spectrograms: bool = True, histograms: bool = False
 ) -> Dataset:
@@ -1963,7 +1983,7 @@ def load_dataset(
         for line, rid in enumerate(table["id"], start=2):
             if safe_name(str(rid)) != rid:  # a record id names a file inside records/ only
                 raise DataFileError(index, f"record id {str(rid)!r} is not a plain name", line)
-            arrays, _ = read_record(root / RECORDS / f"{rid}.npz")
+            arrays = _load_record(root / RECORDS / f"{rid}.npz")
             maps.append(arrays["spectrogram_db"])
             velocity = arrays["velocity_mps"] if velocity is None else velocity
             if hists is not None:
