@@ -892,6 +892,21 @@ def _check_sections(config: DatasetConfig) -> None:
             )
 
 
+def _drawn_fingerprint(
+    section: dict[str, Any], base_dir: Path, prints: dict[str, str]
+) -> str | None:
+    """The fingerprint of the motion a record's draws chose (``prints``: motion key ->
+    fingerprint, filled in); None if it cannot be loaded (the record's validation, or its
+    build, names why)."""
+    key = _motion_key(section)
+    if key not in prints:
+        try:
+            prints[key] = motion_fingerprint(_load_motion(key, str(base_dir)))
+        except MdfError:
+            return None
+    return prints[key]
+
+
 def _source_span(motion: dict[str, Any], entry_no: int, loaded: Motion) -> tuple[float, float]:
     """The span ``(start, end)`` [s] that a source's records are cut from: its motion's own
     ``start`` and ``duration`` (checked here: the loaded motion is shared by every span of
@@ -1026,6 +1041,11 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                     run["scene"] = _place_record(run, placing, loaded)
                     asked = placing.scene.person.aspect_deg
                 run["seed"] = _record_seed(config.seed, index)
+                content = prints[key]
+                if draws and any(
+                    p.startswith("motion.") and isinstance(v, str) for p, v in draws.items()
+                ):  # a drawn file (or a part of one): the record is cut from its contents
+                    content = _drawn_fingerprint(section, base_dir, prints) or content
                 spec = _spec(
                     config,
                     index,
@@ -1039,7 +1059,7 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                     origins if draws else None,
                     _span(motion, span_start, span_end),
                     asked,
-                    prints[key],
+                    content,
                 )
                 specs.append(replace(spec, length_field=_length_field(config, entry_no, entry)))
                 # every record's run config is valid before any file is written (with
