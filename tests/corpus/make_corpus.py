@@ -995,6 +995,7 @@ def _dataset_cases(c: _Corpus) -> None:
     rz_case("loguniform-zero", {"speed": {"loguniform": [0.0, 1.0]}}, "randomize.speed")
     rz_case("low-above-high", {"aspect_deg": {"uniform": [10.0, 0.0]}}, "low must not exceed")
     rz_case("two-distributions", {"aspect_deg": {"uniform": [0, 1], "normal": [0, 1]}}, "one of")
+    rz_case("aspect-list", {"aspect_deg": [0.0, 10.0]}, "randomize.aspect_deg: must be a table (")
     rz_case("choice-empty", {"aspect_deg": {"choice": []}}, "randomize.aspect_deg.choice")
     rz_case("draws-1e9", {"draws": 10**9}, "randomize.draws")
     rz_case("bound-1e300", {"radar_range": {"uniform": [1.0, 1e300]}}, "randomize.radar_range")
