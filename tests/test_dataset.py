@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import socket
 import subprocess
@@ -106,6 +107,26 @@ def test_plan_and_load(tmp_path: Path) -> None:
     assert arrays["features"].dtype == np.float64 and arrays["features"].shape == (7,)
     assert 0.0 < arrays["time_s"][0] < arrays["time_s"][-1] < float(rows[0]["duration_s"])
     assert "histograms" not in meta["units"]  # a spectrogram record has none
+
+
+def test_a_missing_or_corrupt_record_names_its_file_when_loaded(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A dataset folder whose record file was deleted or damaged after the build: loading
+    it (and an experiment on its histograms) is one line naming the file and the cure, not a
+    FileNotFoundError or numpy's "pickled (object) data" ValueError."""
+    cfg, base = load_dataset_config(write_config(tmp_path / "d.toml", boxing_records=1))
+    out = tmp_path / "ds"
+    build_dataset(cfg, base, out, workers=1, progress=False)
+    files = sorted((out / RECORDS).glob("*.npz"))
+    files[1].unlink()
+    with pytest.raises(DataFileError) as err:
+        load_dataset(out)
+    assert str(err.value).startswith(f"{files[1]}: ")
+    assert "mdf dataset build" in str(err.value)
+    files[0].write_text("damaged\n")
+    with pytest.raises(DataFileError, match=rf"^{re.escape(str(files[0]))}: .*mdf dataset build"):
+        load_dataset(out, spectrograms=False, histograms=True)
 
 
 def test_same_result_with_one_and_two_workers_and_dask(
@@ -398,11 +419,12 @@ def test_corrupt_and_partial_records_are_redone(tmp_path: Path) -> None:
     with files[2].open("wb") as fh:
         np.savez(fh, **arrays)
     (out / RECORDS / ".tmp-abc.npz").write_bytes(b"half")  # temp file of a killed writer
-    stamp = {p.name: p.stat().st_mtime_ns for p in files[3:]}
+    files[3].write_bytes(files[4].read_bytes())  # whole, but another record's (copied over)
+    stamp = {p.name: p.stat().st_mtime_ns for p in files[4:]}
     build_dataset(cfg, base, out, workers=1, progress=False)
     assert_same(out, reference)
     assert not list((out / RECORDS).glob(".tmp-*"))
-    assert {p.name: p.stat().st_mtime_ns for p in files[3:]} == stamp  # not redone
+    assert {p.name: p.stat().st_mtime_ns for p in files[4:]} == stamp  # not redone
 
 
 def test_a_record_without_permission_stops_the_resume_and_is_kept(

@@ -142,6 +142,41 @@ def test_a_motion_file_whose_contents_changed_is_simulated_again(tmp_path: Path)
     assert_same_dataset(out, fresh)
 
 
+def test_a_motion_file_drawn_through_params_whose_contents_changed_is_simulated_again(
+    tmp_path: Path,
+) -> None:
+    """A record whose motion file is drawn (randomize.params."motion.file") is cut from that
+    file, so its id covers that file's contents, not only the source's own file's: the drawn
+    walk replaced by a run is simulated afresh when the same config is built again."""
+    mc = tmp_path / "mc"
+    mc.mkdir()
+    shutil.copy(AMC / "02_01.amc", mc / "02_01.amc")
+    shutil.copy(AMC / "02.asf", mc / "02.asf")
+    cfg = tmp_path / "d.toml"
+    cfg.write_text(f"""
+seed = 1
+[[sources]]
+label = "walk"
+motion = {{ kind = "cmu", file = "{AMC / "02_01.amc"}" }}
+max_records = 1
+record_length = 1.0
+[randomize.params]
+"motion.file" = {{ choice = ["{mc / "02_01.amc"}"] }}
+[base.processing]
+nfft = 256
+""")
+    out = tmp_path / "ds"
+    [walk] = build(cfg, out)
+    shutil.copy(AMC / "09_06.amc", mc / "02_01.amc")  # a run, 1.2 s
+    shutil.copy(AMC / "09.asf", mc / "02.asf")
+    [run] = build(cfg, out)  # the same config: resumed
+    assert run["id"] != walk["id"]
+    assert run["torso_mean"] > walk["torso_mean"] + 1.0  # running vs walking [m/s]
+    fresh = tmp_path / "fresh"
+    build(cfg, fresh)
+    assert_same_dataset(out, fresh)
+
+
 def test_a_recording_whose_points_changed_is_recomputed(tmp_path: Path) -> None:
     """A RadHAR NPZ rewritten with the boxing recording's velocities reversed (same file
     name): its records are recomputed on the rerun, as a fresh build makes them, while a

@@ -248,3 +248,18 @@ long_gaps = "error"
     cfg, base = load_dataset_config(config)
     with pytest.raises(MdfError, match=r"conditioning: joint 'l_hand' is untracked for 0\.73"):
         plan_records(cfg, base)
+
+
+def test_a_failing_record_is_named_once(tmp_path: Path) -> None:
+    """The cause of a failing record follows its name, file and window, without the record's
+    name again (histogram records need a radar with point clouds; the LFM radar has none)."""
+    path = walk_config(tmp_path / "d.toml", 'representation = "histogram"')
+    path.write_text(path.read_text().replace("hop = 0.5", "hop = 0.5\nmax_records = 1"))
+    cfg, base = load_dataset_config(path)
+    with pytest.raises(MdfError) as err:
+        build_dataset(cfg, base, tmp_path / "ds", workers=1, progress=False)
+    msg = str(err.value)
+    record = msg.split()[1]
+    assert msg.startswith(f"record {record} (walk; source file ")
+    assert msg.count(record) == 1, msg
+    assert "window 0.000-1.000 s): representation = 'histogram' needs a radar" in msg

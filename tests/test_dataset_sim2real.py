@@ -13,6 +13,7 @@ from mdf_radhar.source import npz_recordings
 
 from mdframework.dataset import (
     RECORDS,
+    DatasetWarning,
     build_dataset,
     load_dataset,
     load_dataset_config,
@@ -360,3 +361,36 @@ radar_position = [4.0, 0.0, 1.0]
     text = str(info.value)
     assert "record_lengths.walk: the 2.000 ms record holds no pulse of the fmcw radar" in text
     assert "at least 3.079 ms" in text and "motion.duration" not in text
+
+
+def test_a_recording_shorter_than_the_record_length_is_skipped_with_a_warning(
+    tmp_path: Path,
+) -> None:
+    """As a motion source shorter than its record length is: 20.1 s is 603 frames, which 3 of
+    the 12 shipped walk recordings hold (the others have 600-602); the 9 are skipped, each
+    named, and the build goes on. Only when no recording is left is it an error."""
+    path = tmp_path / "w.toml"
+    path.write_text(f"""
+[record_lengths]
+walk = 20.1
+[[sources]]
+label = "walk"
+recording = {{ kind = "radhar", file = "{RADHAR / "radhar_walk_subset.npz"}" }}
+""")
+    cfg, base = load_dataset_config(path)
+    with pytest.warns(DatasetWarning) as caught:
+        specs = plan_records(cfg, base)
+    assert [s.run_config["frames"] for s in specs] == [603] * 3
+    assert {s.run_config["name"] for s in specs} == {
+        "___walk_20_2.txt",
+        "___walk_20_4.txt",
+        "__walk_20_4.txt",
+    }
+    texts = [str(w.message) for w in caught if w.category is DatasetWarning]
+    assert len(texts) == 9
+    assert "sources[0] (__20_walk_1.txt): the 600 frames" in texts[0]
+    assert "603 frames" in texts[0] and texts[0].endswith("skipped")
+    path.write_text(path.read_text().replace("20.1", "21.0"))
+    cfg, base = load_dataset_config(path)
+    with pytest.warns(DatasetWarning), pytest.raises(ConfigError, match="no records: every "):
+        plan_records(cfg, base)

@@ -408,6 +408,8 @@ def _plain(error: Any, allowed: list[str] | None) -> str:
         expected = str(ctx.get("expected", "")).replace(" or ", ", ")
         options = [o.strip().strip("'\"") for o in expected.split(",")]
         return f"must be one of {expected}{got}{suggest(str(error.get('input')), options)}"
+    if kind in ("model_type", "dict_type"):  # not pydantic's "instance of <class>"
+        return f"must be a table{got}"
     if kind in ("value_error", "assertion_error"):
         return str(msg.split(", ", 1)[1] if ", " in msg else msg)
     plain = str(msg).replace("Input should be", "must be").replace("Value error, ", "")

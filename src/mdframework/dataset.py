@@ -212,7 +212,7 @@ class SourceEntry(StrictModel):
     run: dict[str, Any] = Field(
         default_factory=dict,
         description="Run-config sections for this source only, merged over `base` (e.g. "
-        "conditioning for Kinect recordings, or its own scene).",
+        "conditioning for Kinect recordings, or its own scene); not motion or seed.",
     )
     randomize: Randomization | None = Field(
         None,
@@ -277,14 +277,16 @@ class DatasetConfig(StrictModel):
 
     seed: Seed = Field(0, description="Seed of the whole dataset.")
     record_lengths: dict[str, PositiveSeconds] = Field(
-        default_factory=dict, description="Record length per label [s]."
+        default_factory=dict,
+        description="Record length per label [s]; a label that no source has is refused.",
     )
     sources: list[SourceEntry] = Field(min_length=1)
     variations: Variations = Field(default_factory=Variations)
     base: dict[str, Any] = Field(
         default_factory=dict,
         description="Run-config sections shared by every record (scatterers, radar, scene, "
-        "processing, effects).",
+        "processing, effects); not motion or seed, which each record takes from its source "
+        "and the dataset's seed.",
     )
     features: FeatureConfig = Field(default_factory=FeatureConfig)
     representation: Literal["spectrogram", "histogram"] = Field(
@@ -568,8 +570,9 @@ def _load_recordings(section_json: str, base_dir: str) -> tuple[Recording, ...]:
 
 def _plan_recordings(
     config: DatasetConfig, entry_no: int, entry: SourceEntry, base_dir: Path, first_index: int
-) -> list[RecordSpec]:
-    """Records of a real radar's recordings: windows of whole frames."""
+) -> tuple[list[RecordSpec], list[str]]:
+    """Records of a real radar's recordings: windows of whole frames; and the recordings
+    shorter than the record length, skipped with a warning (as a short motion source is)."""
     section = dict(entry.recording or {})
     where = f"sources[{entry_no}]"
     if "kind" not in section:
@@ -580,6 +583,7 @@ def _plan_recordings(
         raise ConfigError(f"{where}.{exc}") from None
     hist = config.histogram.model_dump()
     specs: list[RecordSpec] = []
+    short: list[str] = []
     for rec in recordings:
         content = recording_fingerprint(rec)
         period = rec.cloud.frame_period
@@ -593,10 +597,15 @@ def _plan_recordings(
                 f"{rec.name}: give at least {period:.4g} s"
             )
         if length > rec.cloud.n_frames:
-            raise ConfigError(
-                f"{field}: {length} frames of {period * 1e3:.1f} ms ({length_s:g} s) do not fit "
-                f"the {rec.cloud.n_frames} frames of {rec.name}"
+            warnings.warn(
+                f"{where} ({rec.name}): the {rec.cloud.n_frames} frames of {period * 1e3:.1f} ms "
+                f"are fewer than the {length} frames of the {length_s:g} s record length "
+                f"({field}); skipped",
+                DatasetWarning,
+                stacklevel=3,
             )
+            short.append(rec.name)
+            continue
         starts = range(0, rec.cloud.n_frames - length + 1, hop)
         for n, first in enumerate(starts):
             if entry.max_records is not None and n >= entry.max_records:
@@ -618,7 +627,7 @@ def _plan_recordings(
             specs.append(
                 replace(spec, length_field=_length_field(config, entry_no, entry), window=window)
             )
-    return specs
+    return specs, short
 
 
 def _naming(
@@ -806,8 +815,9 @@ def _as_written(
 ) -> ConfigError:
     """A record's config error with the field named where the dataset config wrote it:
     ``base.radar.prf``, ``sources[0].run.radar.prf`` or ``sources[0].motion.file`` rather than
-    the record's ``radar.prf``. Scene fields (which variations and placement rewrite), the
-    window's ``start``/``duration``/``height`` and draws keep the record's name."""
+    the record's ``radar.prf``; a height that ``variations.height`` set is named so. Scene
+    fields (which variations and placement rewrite), the window's ``start``/``duration`` and
+    draws keep the record's name."""
     text = str(exc)
     rest = text.removeprefix(f"{record}: ")
     field, _, problem = rest.partition(": ")
@@ -815,6 +825,8 @@ def _as_written(
     if rest == text or not problem or parts[0] == "scene":
         return exc
     if parts[0] == "motion":
+        if parts[1:] == ["height"] and config.variations.height is not None:
+            return ConfigError(f"{record}: variations.height (for {field}): {problem}")
         if len(parts) < 2 or parts[1] in ("start", "duration", "height"):
             return exc
         where = f"sources[{entry_no}]."
@@ -852,10 +864,79 @@ def _randomize(config: DatasetConfig, entry: SourceEntry) -> Randomization:
     return config.randomize.model_copy(update=own)
 
 
+#: run-config sections that a build sets for every record itself, and where to give them
+#: instead: in ``base`` or a source's ``run`` they would be replaced without a word
+_PER_RECORD = {
+    "motion": "each record's motion is its source's own `motion` table; give settings such as "
+    "`sanity` there",
+    "seed": "each record's seed derives from the dataset's top-level `seed` and the record's "
+    "number; set that one",
+}
+
+
+def _check_sections(config: DatasetConfig) -> None:
+    """Refuse what a build would silently ignore: a ``base`` or source ``run`` section that it
+    sets itself, and a ``record_lengths`` entry of a label that no source has."""
+    tables = [("base", config.base)]
+    tables += [(f"sources[{n}].run", e.run) for n, e in enumerate(config.sources)]
+    for where, table in tables:
+        for key, instead in _PER_RECORD.items():
+            if key in table:
+                raise ConfigError(f"{where}.{key}: {instead}")
+    labels = sorted({e.label for e in config.sources})
+    for label in config.record_lengths:
+        if label not in labels:
+            raise ConfigError(
+                f"record_lengths.{label}: no source has the label {label!r} (labels: "
+                f"{', '.join(map(repr, labels))})"
+            )
+
+
+def _drawn_fingerprint(
+    section: dict[str, Any], base_dir: Path, prints: dict[str, str]
+) -> str | None:
+    """The fingerprint of the motion a record's draws chose (``prints``: motion key ->
+    fingerprint, filled in); None if it cannot be loaded (the record's validation, or its
+    build, names why)."""
+    key = _motion_key(section)
+    if key not in prints:
+        try:
+            prints[key] = motion_fingerprint(_load_motion(key, str(base_dir)))
+        except MdfError:
+            return None
+    return prints[key]
+
+
+def _source_span(motion: dict[str, Any], entry_no: int, loaded: Motion) -> tuple[float, float]:
+    """The span ``(start, end)`` [s] that a source's records are cut from: its motion's own
+    ``start`` and ``duration`` (checked here: the loaded motion is shared by every span of
+    it), within the loaded motion."""
+    where = f"sources[{entry_no}].motion"
+    for name in ("start", "duration"):
+        value = motion.get(name)
+        if value is None:
+            continue
+        if isinstance(value, bool) or not isinstance(value, int | float) or not np.isfinite(value):
+            raise ConfigError(f"{where}.{name}: a number of seconds, not {json.dumps(value)}")
+        if value < 0 or (name == "duration" and value == 0):
+            rule = "at least 0" if name == "start" else "greater than 0"
+            raise ConfigError(f"{where}.{name}: must be {rule} (got {value:g})")
+    start = float(motion.get("start", 0.0))
+    end = loaded.skeleton.duration
+    if start >= end:
+        raise ConfigError(
+            f"{where}.start: {start:g} s is not before the end of the {end:.3f} s motion"
+        )
+    if motion.get("duration") is not None:
+        end = min(end, start + float(motion["duration"]))
+    return start, end
+
+
 def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> list[RecordSpec]:
     """Expand sources x windows x variations x random draws into record specs, in a fixed
     order. With ``workers`` > 1 the sources' motions are first loaded in that many processes
     (:func:`_preload_motions`); the specs are the same."""
+    _check_sections(config)
     v = config.variations
     for rz in [config.randomize] + [_randomize(config, e) for e in config.sources]:
         for name in ("aspect_deg", "radar_range", "radar_height", "height"):
@@ -882,7 +963,9 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
     prints: dict[str, str] = {}  # motion key -> fingerprint
     for entry_no, entry in enumerate(config.sources):
         if entry.recording is not None:
-            specs += _plan_recordings(config, entry_no, entry, base_dir, len(specs))
+            recorded, too_short = _plan_recordings(config, entry_no, entry, base_dir, len(specs))
+            specs += recorded
+            short += too_short
             continue
         motion = dict(entry.motion or {})
         if "kind" not in motion:
@@ -898,10 +981,7 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
         key = _motion_key(motion)
         if key not in prints:  # once per loaded motion
             prints[key] = motion_fingerprint(loaded)
-        span_start = float(motion.get("start", 0.0))
-        span_end = loaded.skeleton.duration
-        if motion.get("duration") is not None:
-            span_end = min(span_end, span_start + float(motion["duration"]))
+        span_start, span_end = _source_span(motion, entry_no, loaded)
         duration = span_end - span_start
         length = entry.record_length or config.record_lengths.get(entry.label) or duration
         where = motion.get("file", motion["kind"])
@@ -961,6 +1041,11 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                     run["scene"] = _place_record(run, placing, loaded)
                     asked = placing.scene.person.aspect_deg
                 run["seed"] = _record_seed(config.seed, index)
+                content = prints[key]
+                if draws and any(
+                    p.startswith("motion.") and isinstance(v, str) for p, v in draws.items()
+                ):  # a drawn file (or a part of one): the record is cut from its contents
+                    content = _drawn_fingerprint(section, base_dir, prints) or content
                 spec = _spec(
                     config,
                     index,
@@ -974,7 +1059,7 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                     origins if draws else None,
                     _span(motion, span_start, span_end),
                     asked,
-                    prints[key],
+                    content,
                 )
                 specs.append(replace(spec, length_field=_length_field(config, entry_no, entry)))
                 # every record's run config is valid before any file is written (with
@@ -1193,7 +1278,8 @@ def _record_or_skip(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
             f"record {spec.record_id} ({spec.label}; source file {file}, window "
             f"{start:.3f}-{start + length:.3f} s)"
         )
-        cause = " ".join(str(exc).split())
+        # named once: the record's own errors start with its name too
+        cause = " ".join(str(exc).split()).removeprefix(f"record {spec.record_id}: ")
         if spec.length_field is not None:  # the record's duration is the dataset's length
             cause = cause.replace("motion.duration", spec.length_field)
         if spec.on_error != "skip":
@@ -1379,17 +1465,19 @@ def _planned_meta(spec: RecordSpec) -> dict[str, Any]:
 
 def _complete(path: Path, spec: RecordSpec) -> dict[str, Any] | None:
     """The index row of a finished record, or None if it must be (re)built: a record cut
-    short, corrupt, or whose metadata lacks a field is removed. A record whose label, group,
-    subject, recording or dataset differ from ``spec``'s (the config changed only those) is
-    kept and rewritten with the new ones (atomically; its arrays are not recomputed), and so
-    is its row. A record that cannot be read for want of permission is an error (it is not
-    removed)."""
+    short, corrupt, or whose metadata lacks a field or names another record is removed. A
+    record whose label, group, subject, recording or dataset differ from ``spec``'s (the
+    config changed only those) is kept and rewritten with the new ones (atomically; its arrays
+    are not recomputed), and so is its row. A record that cannot be read for want of
+    permission is an error (it is not removed)."""
     import zipfile
 
     if not path.exists():
         return None
     try:
         arrays, meta = read_record(path)
+        if meta["id"] != spec.record_id:  # another record's file, copied or renamed here
+            raise ValueError(f"{path}: holds record {meta['id']}")
         planned = _planned_meta(spec)
         if any(meta.get(k) != v for k, v in planned.items()):
             meta.update(planned)
@@ -1880,6 +1968,26 @@ class Dataset:
     histograms: list[NDArray[np.float32] | None] | None = None
 
 
+def _load_record(path: Path) -> dict[str, NDArray[Any]]:
+    """The arrays of one record of a built dataset; a record file that is missing or damaged
+    (deleted or changed since the build) is a :class:`DataFileError` naming it."""
+    import zipfile
+
+    try:
+        return read_record(path)[0]
+    except FileNotFoundError:
+        problem = "missing"
+    except PermissionError as exc:
+        raise DataFileError(path, exc.strerror or str(exc)) from None
+    except (OSError, EOFError, ValueError, KeyError, TypeError, zipfile.BadZipFile):
+        problem = "not a complete record file"
+    raise DataFileError(
+        path,
+        f"{problem}, though index.csv lists it; run the `mdf dataset build` that made the "
+        "dataset again to rebuild it",
+    )
+
+
 def load_dataset(
     path: str | Path, *, spectrograms: bool = True, histograms: bool = False
 ) -> Dataset:
@@ -1914,7 +2022,7 @@ def load_dataset(
         for line, rid in enumerate(table["id"], start=2):
             if safe_name(str(rid)) != rid:  # a record id names a file inside records/ only
                 raise DataFileError(index, f"record id {str(rid)!r} is not a plain name", line)
-            arrays, _ = read_record(root / RECORDS / f"{rid}.npz")
+            arrays = _load_record(root / RECORDS / f"{rid}.npz")
             maps.append(arrays["spectrogram_db"])
             velocity = arrays["velocity_mps"] if velocity is None else velocity
             if hists is not None:

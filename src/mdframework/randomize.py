@@ -32,7 +32,7 @@ from __future__ import annotations
 from typing import Annotated, Any
 
 import numpy as np
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from . import limits
 from .settings import StrictModel
@@ -118,6 +118,22 @@ class Randomization(StrictModel):
     body_scale: Distribution | None = Field(None, description="Body size factor.")
     mirror: float = Field(0.0, ge=0, le=1, description="Probability of the mirror image.")
     time_warp: float = Field(0.0, ge=0, lt=1, description="Time-warp strength s (< 1).")
+
+    @field_validator("params")
+    @classmethod
+    def _field_paths(cls, params: dict[str, Distribution]) -> dict[str, Distribution]:
+        for path in params:
+            if path.split(".")[0] == "seed":
+                raise ValueError(
+                    f"\"{path}\": each record's seed derives from the dataset's top-level seed "
+                    "and the record's number; it is not drawn"
+                )
+            if "." not in path:
+                raise ValueError(
+                    f'"{path}": not a field of a run-config section; give a dotted path such as '
+                    '"radar.prf" (the named draws, e.g. speed, go beside params)'
+                )
+        return params
 
     @model_validator(mode="after")
     def _factors(self) -> Randomization:

@@ -995,6 +995,7 @@ def _dataset_cases(c: _Corpus) -> None:
     rz_case("loguniform-zero", {"speed": {"loguniform": [0.0, 1.0]}}, "randomize.speed")
     rz_case("low-above-high", {"aspect_deg": {"uniform": [10.0, 0.0]}}, "low must not exceed")
     rz_case("two-distributions", {"aspect_deg": {"uniform": [0, 1], "normal": [0, 1]}}, "one of")
+    rz_case("aspect-list", {"aspect_deg": [0.0, 10.0]}, "randomize.aspect_deg: must be a table (")
     rz_case("choice-empty", {"aspect_deg": {"choice": []}}, "randomize.aspect_deg.choice")
     rz_case("draws-1e9", {"draws": 10**9}, "randomize.draws")
     rz_case("bound-1e300", {"radar_range": {"uniform": [1.0, 1e300]}}, "randomize.radar_range")
@@ -1013,6 +1014,11 @@ def _dataset_cases(c: _Corpus) -> None:
         "record 0",
     )
     rz_case("param-unknown-field", {"params": {"radar.nope": {"uniform": [1, 2]}}}, "nope")
+    # not a field inside a section: the record's seed is the build's, "speed" is no field
+    rz_case("param-seed", {"params": {"seed": {"choice": [1, 2]}}}, 'randomize.params: "seed"')
+    rz_case(
+        "param-no-section", {"params": {"speed": {"uniform": [20, 30]}}}, '"speed"', "radar.prf"
+    )
     rz_case("param-no-list-item", {"params": {"effects.3.snr_db": {"uniform": [1, 2]}}}, "effects")
     rz_case(
         "radar-range-absurd",
@@ -1025,9 +1031,44 @@ def _dataset_cases(c: _Corpus) -> None:
         "height-on-cmu", {"height": {"uniform": [1.5, 1.9]}}, "randomize.height drew", "record 0"
     )
     ds_case(
+        "variations-height-on-cmu",
+        {"sources": [one], "variations": {"height": [1.7]}},
+        "variations.height",
+        "unknown field 'height'",
+    )
+    ds_case(
         "source-randomize-speed-inf",
         {"sources": [{**one, "randomize": {"speed": {"uniform": [1.0, inf]}}}]},
         "randomize.speed",
+    )
+    # what a build sets for every record itself: never silently dropped
+    repair = {"sanity": {"glitches": "repair"}}
+    ds_case("base-motion", {"sources": [one], "base": {"motion": repair}}, "base.motion")
+    ds_case("run-motion", {"sources": [{**one, "run": {"motion": repair}}]}, "[0].run.motion")
+    ds_case("base-seed", {"sources": [one], "base": {"seed": 5}}, "base.seed", "seed")
+    ds_case(
+        "record-lengths-no-such-label",
+        {"sources": [source], "record_lengths": {"walks": 1.0}},
+        "record_lengths.walks",
+        "'walk'",
+    )
+    # the span a source's records are cut from
+    motion = source["motion"]
+    ds_case(
+        "source-start-text",
+        {"sources": [{**one, "motion": {**motion, "start": "late"}}]},
+        "sources[0].motion.start",
+    )
+    ds_case(
+        "source-duration-zero",
+        {"sources": [{**source, "motion": {**motion, "duration": 0.0}}]},
+        "sources[0].motion.duration",
+    )
+    ds_case(
+        "source-start-past-end",
+        {"sources": [{**source, "motion": {**motion, "start": 1000.0}}]},
+        "sources[0].motion.start",
+        "1000",
     )
 
     def exp_case(name: str, cfg: dict[str, Any], *expect: str, argv: tuple[str, ...] = ()) -> None:
