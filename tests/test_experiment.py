@@ -98,8 +98,8 @@ def test_wrapper_in_the_experiment_gets_only_the_training_split(
 def test_wrapper_folds_hold_out_what_the_evaluation_holds_out(
     rng: np.random.Generator, monkeypatch: pytest.MonkeyPatch, inner: str
 ) -> None:
-    """Leave-subjects-out: by default the wrapper's folds hold out whole subjects of the
-    training records too (``selection.inner_split = 'evaluation'``); 'record' folds records."""
+    """Leave-subjects-out with ``selection.inner_split = 'evaluation'``: the wrapper's folds
+    hold out whole subjects of the training records too; 'record' (the default) folds records."""
     x, y = _toy(rng)
     subjects = np.array([f"s{i % 4}" for i in range(60)])
     got: list[Any] = []
@@ -128,17 +128,20 @@ def test_wrapper_folds_hold_out_what_the_evaluation_holds_out(
             assert len(set(groups.tolist())) == 3
 
 
-def test_grouped_wrapper_needs_two_subjects_to_train_on(rng: np.random.Generator) -> None:
+def test_grouped_wrapper_needs_two_subjects_of_each_class(rng: np.random.Generator) -> None:
+    """A class of one subject among the training records cannot be both trained and tested
+    by folds holding out whole subjects: one line naming the class and the option."""
     x, y = _toy(rng)
-    subjects = np.array([f"s{i % 2}" for i in range(60)])
+    subjects = np.array([f"s{i % 4}" for i in range(60)])
+    subjects[y == "c"] = "s9"  # class c: one subject only
     cfg = exp.ExperimentConfig.model_validate(
         {
             "dataset": {"path": "unused"},
             "evaluation": {"split": "groups", "by": "subject"},
-            "selection": {"sizes": [1], "optimistic": False},
+            "selection": {"sizes": [1], "optimistic": False, "inner_split": "evaluation"},
         }
     )
-    with pytest.raises(ConfigError, match=r"inner_split = 'evaluation'.*one subject only"):
+    with pytest.raises(ConfigError, match=r"inner_split = 'evaluation': class 'c' has one subj"):
         exp.within_source(cfg, exp.classifier_factory({"kind": "knn"}, "t"), x, y, subjects)
 
 

@@ -98,12 +98,12 @@ class SelectionConfig(StrictModel):
         [4], min_length=1, description="Subset sizes to try (the paper: 4 of 7)."
     )
     folds: int = Field(5, ge=2, le=100, description="Cross-validation folds.")
-    inner_split: Literal["evaluation", "record"] = Field(
-        "evaluation",
-        description="What the wrapper's folds hold out: evaluation: what evaluation.split holds "
-        "out (whole recordings with 'recording', whole evaluation.by values with 'groups', "
-        "records with 'record'), so that one recording or subject is never on both sides of a "
-        "fold; record: stratified folds of records whatever the split.",
+    inner_split: Literal["record", "evaluation"] = Field(
+        "record",
+        description="What the wrapper's folds hold out: record: stratified folds of records; "
+        "evaluation: what evaluation.split holds out (whole recordings with 'recording', whole "
+        "evaluation.by values with 'groups'), so that no recording or subject is on both sides "
+        "of a fold (needs two or more of them per class in every training split).",
     )
     optimistic: bool = Field(
         True, description="Also report the paper's optimistic selection on the test split."
@@ -295,13 +295,17 @@ def _select(
     groups = None
     if cfg.selection.inner_split == "evaluation" and cfg.evaluation.split != "record":
         groups = units
-    if groups is not None and len(set(groups.tolist())) < 2:
+    if groups is not None:
         what = "recording" if cfg.evaluation.split == "recording" else cfg.evaluation.by
-        raise ConfigError(
-            f"selection.inner_split = 'evaluation': the training records hold one {what} "
-            f"only ({groups[0]!r}), so the wrapper's folds cannot hold one out: build records "
-            "of more, or set selection.inner_split = 'record'"
-        )
+        for label in sorted(set(y.tolist())):
+            held = sorted(set(groups[y == label].tolist()))
+            if len(held) < 2:
+                raise ConfigError(
+                    f"selection.inner_split = 'evaluation': class {label!r} has one {what} "
+                    f"({held[0]!r}) among the training records of a split, so no fold of the "
+                    f"wrapper that holds out whole {what}s can both train and test it: build "
+                    f"records of more {what}s, or set selection.inner_split = 'record'"
+                )
     labels, n_train = np.unique(y, return_counts=True)
     if n_train.min() < 2:
         small = str(labels[np.argmin(n_train)])
