@@ -168,3 +168,26 @@ def test_a_threshold_above_the_peak_is_refused() -> None:
     power = np.ones((11, 4))
     with pytest.raises(ValueError, match="threshold_db must be <= 0"):
         envelopes(power, vel, threshold_db=3.0)
+
+
+def test_envelopes_at_the_band_edge_are_named() -> None:
+    """A tone 30 dB above a white noise floor keeps its -20 dB envelope on the tone; 10 dB
+    above it, the envelope reaches the band's edge in most columns, and a run's features say so
+    (their extremes are the band's, not the body's)."""
+    from mdframework.output import band_edge_message
+
+    rng = np.random.default_rng(3)
+    v = np.linspace(-5.0, 5.0, 64)
+    for snr_db, expect in ((30.0, None), (10.0, " of 40 frames")):
+        power = rng.exponential(1.0, size=(64, 40))  # noise, mean 1
+        power[40] += 10.0 ** (snr_db / 10.0)  # a tone at +1.35 m/s
+        env = envelopes(power, v)
+        message = band_edge_message(env, v)
+        if expect is None:
+            assert message is None
+            assert np.all(env.upper < v[-1]) and np.all(env.lower > v[0])
+        else:
+            assert message is not None and expect in message
+            assert "-5.00 to +5.00 m/s" in message
+            edge = np.isclose(env.upper, v[-1]) | np.isclose(env.lower, v[0])
+            assert f"in {int(edge.sum())} of 40 frames" in message and edge.sum() >= 30

@@ -36,13 +36,14 @@ and ``metadata.json``.
 from __future__ import annotations
 
 import json
+import warnings
 from contextlib import AbstractContextManager
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .features import FEATURE_NAMES, envelopes, features_from_envelopes
+from .features import FEATURE_NAMES, Envelopes, envelopes, features_from_envelopes
 from .figures import (
     plot_point_cloud,
     plot_range_doppler,
@@ -84,9 +85,33 @@ FEATURE_SETTINGS: dict[str, Any] = {
 }
 
 
+class FeatureWarning(UserWarning):
+    """A run's features that describe the spectrogram's band, not the body."""
+
+
+def band_edge_message(env: Envelopes, velocity: np.ndarray) -> str | None:
+    """The warning for envelopes (each (n_frames,) [m/s], NaN when silent) that reach the first
+    or last bin of ``velocity`` (n_doppler,) [m/s], or None when no frame does. There the
+    envelope stops at the band, not at the body: the body's Doppler aliases, or the columns'
+    peaks stand less than the envelope threshold above the noise."""
+    live = np.isfinite(env.upper)
+    edge = live & ((env.upper >= velocity[-1]) | (env.lower <= velocity[0]))
+    if not edge.any():
+        return None
+    return (
+        f"features: the {FEATURE_SETTINGS['threshold_db']:g} dB envelope reaches the edge of "
+        f"the Doppler band ({velocity[0]:+.2f} to {velocity[-1]:+.2f} m/s) in "
+        f"{int(edge.sum())} of {int(live.sum())} frames, so upper_max, lower_min and the "
+        "bandwidths there are the band's, not the body's: the body's Doppler aliases, or the "
+        f"spectrogram's columns stand less than {-FEATURE_SETTINGS['threshold_db']:g} dB above "
+        "the noise (raise the pulse rate or the signal-to-noise ratio)"
+    )
+
+
 def feature_arrays(result: RunResult) -> dict[str, np.ndarray]:
     """Envelope tracks (n_frames,) and the seven features (7,) [m/s] of a run's spectrogram
-    (:data:`FEATURE_SETTINGS`); NaN where a frame, or the whole spectrogram, is silent."""
+    (:data:`FEATURE_SETTINGS`); NaN where a frame, or the whole spectrogram, is silent. Warns
+    (:class:`FeatureWarning`) when an envelope reaches the edge of the Doppler band."""
     env = envelopes(
         result.spectrogram.power,
         result.velocity,
@@ -99,6 +124,9 @@ def feature_arrays(result: RunResult) -> dict[str, np.ndarray]:
         feats = features_from_envelopes(env)
     except ValueError:  # silent spectrogram
         feats = np.full(len(FEATURE_NAMES), np.nan)
+    message = band_edge_message(env, np.asarray(result.velocity))
+    if message is not None:
+        warnings.warn(message, FeatureWarning, stacklevel=2)
     return {
         "envelope_upper_mps": env.upper,
         "envelope_lower_mps": env.lower,
