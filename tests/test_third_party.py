@@ -458,3 +458,58 @@ def test_mdf_plugins_names_a_plugin_that_is_slow_to_import(
     mine = [line.split() for line in slow[1:] if "xyzzy" in line]
     assert len(mine) == 1 and mine[0][:3] == ["xyzzy_fx", "xyzzy-fx", "0.0.1:"], mine
     assert 0.2 <= float(mine[0][3]) < 5 and mine[0][4] == "s"
+
+
+#: a radar that drops the last pulse of every block: a ValueError of the plugin's own
+SHORT_RECEIVE = """from dataclasses import replace
+from typing import Literal
+from mdf_lfm.waveform import LfmPulseDoppler as Base
+from mdframework import hookimpl
+
+class XyzzyConfig(Base.Config):
+    kind: Literal['xyzzy_bug'] = 'xyzzy_bug'
+
+class XyzzyBug(Base):
+    '''Broken: one sample short.'''
+    name = 'xyzzy_bug'
+    Config = XyzzyConfig
+    def receive(self, block):
+        out = super().receive(block)
+        return replace(out, signal=out.signal[:-1])
+
+@hookimpl
+def mdframework_register_radar_waveforms():
+    return [XyzzyBug]
+"""
+
+
+@pytest.mark.parametrize("on_error", ["stop", "skip"])
+def test_a_plugin_bug_in_a_dataset_record_is_an_internal_error_not_the_configs(
+    on_error: str, installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A third party's radar whose receive() breaks its contract with a ValueError, in a
+    dataset build: an internal error naming the plugin, as in `mdf run` (it was the user's
+    error, exit 2 naming the config file, and with on_error = 'skip' every record was skipped
+    as if its config were bad)."""
+    _make_distribution(installed, "xyzzy-bug", "mdf_test_xyzzy", SHORT_RECEIVE, "xyzzy_bug")
+    config = tmp_path / "d.toml"
+    config.write_text(f"""
+seed = 1
+on_error = "{on_error}"
+[[sources]]
+label = "recede"
+motion = {{ kind = "point_targets", length = 2.0, targets = [
+    {{ position = [100.0, 0.0, 0.0], velocity = [1.0, 0.0, 0.0], rcs = 1.0 }}] }}
+[base.scatterers]
+kind = "points"
+[base.radar]
+kind = "xyzzy_bug"
+""")
+    capsys.readouterr()
+    assert cli.main(["dataset", "build", str(config), "--out", str(tmp_path / "ds")]) == 1
+    lines = without_third_party_warnings(capsys.readouterr().err.strip().splitlines())
+    assert len(lines) == 1 and lines[0].startswith("mdf: internal error: ValueError: "), lines
+    assert (
+        "(in receive() of the radar plugin 'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug); check it "
+        "with mdframework.testing.check_radar_waveform; while building record 00000-"
+    ) in lines[0], lines

@@ -71,7 +71,7 @@ from .outdir import (
     wait_for_files,
 )
 from .pipeline import build_stages, load_motion, simulate_motion
-from .plugins import default_registry
+from .plugins import default_registry, is_plugin_bug
 from .pointcloud import (
     IWR1443_BIN_WIDTH,
     HistogramSettings,
@@ -1267,6 +1267,9 @@ def _record_or_skip(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     try:
         return _build_record(spec, out_dir)
     except (MdfError, ValueError) as exc:
+        if not isinstance(exc, MdfError) and is_plugin_bug(exc):  # not the config's: a bug
+            exc.add_note(f"while building record {spec.record_id} of {spec.recording}")
+            raise
         if spec.window is not None:
             file, start, length = spec.window
         else:
