@@ -513,3 +513,49 @@ kind = "xyzzy_bug"
         "(in receive() of the radar plugin 'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug); check it "
         "with mdframework.testing.check_radar_waveform; while building record 00000-"
     ) in lines[0], lines
+
+
+#: a recording source whose load() fails: the plugin's bug
+FAILING_RECORDINGS = """from typing import Literal
+from mdf_radhar.source import RadharSource as Base
+from mdframework import hookimpl
+
+class XyzzyConfig(Base.Config):
+    kind: Literal['xyzzy_rec'] = 'xyzzy_rec'
+
+class XyzzyRec(Base):
+    '''Broken.'''
+    name = 'xyzzy_rec'
+    Config = XyzzyConfig
+    def load(self):
+        return 1 / 0
+
+@hookimpl
+def mdframework_register_recording_sources():
+    return [XyzzyRec]
+"""
+
+
+def test_a_recording_source_that_fails_is_an_internal_error_naming_it(
+    installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A third party's recording source whose load() raises is its bug: the internal error
+    names it and its contract check, as docs/plugins.md says of any plugin's method (it named
+    nobody)."""
+    _make_distribution(installed, "xyzzy-rec", "mdf_test_xyzzy", FAILING_RECORDINGS, "xyzzy_rec")
+    data = EXAMPLES / "data" / "radhar" / "radhar_walk_subset.npz"
+    config = tmp_path / "d.toml"
+    config.write_text(f"""
+[[sources]]
+label = "walk"
+recording = {{ kind = "xyzzy_rec", file = "{data}" }}
+""")
+    capsys.readouterr()
+    assert cli.main(["dataset", "build", str(config), "--out", str(tmp_path / "ds")]) == 1
+    lines = without_third_party_warnings(capsys.readouterr().err.strip().splitlines())
+    assert len(lines) == 1, lines
+    assert lines[0].startswith(
+        "mdf: internal error: ZeroDivisionError: division by zero (in load() of the recording "
+        "plugin 'xyzzy_rec' (mdf_test_xyzzy.XyzzyRec); check it with "
+        "mdframework.testing.check_recording_source;"
+    ), lines

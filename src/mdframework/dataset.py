@@ -71,7 +71,7 @@ from .outdir import (
     wait_for_files,
 )
 from .pipeline import build_stages, load_motion, simulate_motion
-from .plugins import default_registry, is_plugin_bug
+from .plugins import blame, default_registry, is_plugin_bug
 from .pointcloud import (
     IWR1443_BIN_WIDTH,
     HistogramSettings,
@@ -565,7 +565,8 @@ def _load_recordings(section_json: str, base_dir: str) -> tuple[Recording, ...]:
         raise ConfigError(format_validation_error(exc, "recording", section)) from None
     source: Any = cls(cfg)
     assert isinstance(source, RecordingSource)
-    return tuple(source.load())
+    with blame(source, "load"):
+        return tuple(source.load())
 
 
 def _plan_recordings(
