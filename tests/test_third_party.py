@@ -373,14 +373,10 @@ FAILING_METHOD = {
 }
 
 
-@pytest.mark.parametrize("case", sorted(FAILING_METHOD))
-def test_a_plugin_method_that_fails_is_an_internal_error_naming_the_plugin(
-    case: str, installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    """A third party's motion source, scatterer model or radar whose method raises is that
-    plugin's bug: the internal error names it and its contract check (it named nobody, as if
-    mdframework had failed; only effects were named)."""
-    base, hook, method, (old, new), why = FAILING_METHOD[case]
+def install_broken(installed: Path, base: str, hook: str, method: str) -> None:
+    """Install a third party's plugin ``mdf_test_xyzzy.XyzzyBug`` (kind ``xyzzy_bug``): the
+    class ``Base`` that the import lines ``base`` give, registered by the hook
+    ``mdframework_register_<hook>``, with ``method`` (source lines) overridden."""
     body = (
         f"{base}from typing import Literal\nfrom mdframework import hookimpl\n\n"
         f"class XyzzyConfig(Base.Config):\n    kind: Literal['xyzzy_bug'] = 'xyzzy_bug'\n\n"
@@ -389,6 +385,17 @@ def test_a_plugin_method_that_fails_is_an_internal_error_naming_the_plugin(
         f"@hookimpl\ndef mdframework_register_{hook}():\n    return [XyzzyBug]\n"
     )
     _make_distribution(installed, "xyzzy-bug", "mdf_test_xyzzy", body, "xyzzy_bug")
+
+
+@pytest.mark.parametrize("case", sorted(FAILING_METHOD))
+def test_a_plugin_method_that_fails_is_an_internal_error_naming_the_plugin(
+    case: str, installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A third party's motion source, scatterer model or radar whose method raises is that
+    plugin's bug: the internal error names it and its contract check (it named nobody, as if
+    mdframework had failed; only effects were named)."""
+    base, hook, method, (old, new), why = FAILING_METHOD[case]
+    install_broken(installed, base, hook, method)
     config = tmp_path / "bug.toml"
     text = (EXAMPLES / "point_target.toml").read_text()
     assert old in text
@@ -461,26 +468,10 @@ def test_mdf_plugins_names_a_plugin_that_is_slow_to_import(
 
 
 #: a radar that drops the last pulse of every block: a ValueError of the plugin's own
-SHORT_RECEIVE = """from dataclasses import replace
-from typing import Literal
-from mdf_lfm.waveform import LfmPulseDoppler as Base
-from mdframework import hookimpl
-
-class XyzzyConfig(Base.Config):
-    kind: Literal['xyzzy_bug'] = 'xyzzy_bug'
-
-class XyzzyBug(Base):
-    '''Broken: one sample short.'''
-    name = 'xyzzy_bug'
-    Config = XyzzyConfig
-    def receive(self, block):
-        out = super().receive(block)
-        return replace(out, signal=out.signal[:-1])
-
-@hookimpl
-def mdframework_register_radar_waveforms():
-    return [XyzzyBug]
-"""
+SHORT_RECEIVE = (
+    "    def receive(self, block):\n        out = super().receive(block)\n"
+    "        return replace(out, signal=out.signal[:-1])\n"
+)
 
 
 @pytest.mark.parametrize("on_error", ["stop", "skip"])
@@ -491,7 +482,8 @@ def test_a_plugin_bug_in_a_dataset_record_is_an_internal_error_not_the_configs(
     dataset build: an internal error naming the plugin, as in `mdf run` (it was the user's
     error, exit 2 naming the config file, and with on_error = 'skip' every record was skipped
     as if its config were bad)."""
-    _make_distribution(installed, "xyzzy-bug", "mdf_test_xyzzy", SHORT_RECEIVE, "xyzzy_bug")
+    base = "from dataclasses import replace\nfrom mdf_lfm.waveform import LfmPulseDoppler as Base\n"
+    install_broken(installed, base, "radar_waveforms", SHORT_RECEIVE)
     config = tmp_path / "d.toml"
     config.write_text(f"""
 seed = 1
@@ -515,40 +507,22 @@ kind = "xyzzy_bug"
     ) in lines[0], lines
 
 
-#: a recording source whose load() fails: the plugin's bug
-FAILING_RECORDINGS = """from typing import Literal
-from mdf_radhar.source import RadharSource as Base
-from mdframework import hookimpl
-
-class XyzzyConfig(Base.Config):
-    kind: Literal['xyzzy_rec'] = 'xyzzy_rec'
-
-class XyzzyRec(Base):
-    '''Broken.'''
-    name = 'xyzzy_rec'
-    Config = XyzzyConfig
-    def load(self):
-        return 1 / 0
-
-@hookimpl
-def mdframework_register_recording_sources():
-    return [XyzzyRec]
-"""
-
-
 def test_a_recording_source_that_fails_is_an_internal_error_naming_it(
     installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A third party's recording source whose load() raises is its bug: the internal error
     names it and its contract check, as docs/plugins.md says of any plugin's method (it named
     nobody)."""
-    _make_distribution(installed, "xyzzy-rec", "mdf_test_xyzzy", FAILING_RECORDINGS, "xyzzy_rec")
+    base = "from mdf_radhar.source import RadharSource as Base\n"
+    install_broken(
+        installed, base, "recording_sources", "    def load(self):\n        return 1 / 0\n"
+    )
     data = EXAMPLES / "data" / "radhar" / "radhar_walk_subset.npz"
     config = tmp_path / "d.toml"
     config.write_text(f"""
 [[sources]]
 label = "walk"
-recording = {{ kind = "xyzzy_rec", file = "{data}" }}
+recording = {{ kind = "xyzzy_bug", file = "{data}" }}
 """)
     capsys.readouterr()
     assert cli.main(["dataset", "build", str(config), "--out", str(tmp_path / "ds")]) == 1
@@ -556,6 +530,6 @@ recording = {{ kind = "xyzzy_rec", file = "{data}" }}
     assert len(lines) == 1, lines
     assert lines[0].startswith(
         "mdf: internal error: ZeroDivisionError: division by zero (in load() of the recording "
-        "plugin 'xyzzy_rec' (mdf_test_xyzzy.XyzzyRec); check it with "
+        "plugin 'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug); check it with "
         "mdframework.testing.check_recording_source;"
     ), lines
