@@ -265,6 +265,30 @@ def test_two_recordings_of_one_name_are_held_out_as_two(tmp_path: Path) -> None:
     assert within["splits_scored"] == {"boxing": 2, "walk": 2}
 
 
+def test_one_file_given_in_two_ways_is_one_recording(tmp_path: Path) -> None:
+    """Beside bob/walk.bvh, alice/walk.bvh cut into two spans by two sources, given once as
+    ./alice/walk.bvh, is still one recording (it was two, so split = 'recording' could train
+    on one span of the file and test on the other)."""
+    import shutil
+    from collections import Counter
+
+    from mdframework.dataset import plan_records
+
+    bvh = EXAMPLES / "data" / "cmu" / "bvh"
+    for person, walk in (("alice", "16_21"), ("bob", "09_03")):
+        (tmp_path / person).mkdir()
+        shutil.copyfile(bvh / f"{walk}.bvh", tmp_path / person / "walk.bvh")
+    spans = (("alice/walk.bvh", "duration = 1.0"), ("./alice/walk.bvh", "start = 1.0"))
+    sources = "".join(
+        f'[[sources]]\nlabel = "walk"\nmax_records = 2\n'
+        f'motion = {{ kind = "cmu", file = "{file}", {span} }}\n'
+        for file, span in (*spans, ("bob/walk.bvh", "start = 0.0"))
+    )
+    (tmp_path / "d.toml").write_text(sources + "[record_lengths]\nwalk = 0.5\n")
+    specs = plan_records(*load_dataset_config(tmp_path / "d.toml"))
+    assert Counter(s.recording for s in specs) == {"alice/walk.bvh": 4, "bob/walk.bvh": 2}
+
+
 # --------------------------------------------------------------------------- evaluation protocols
 
 MSR = EXAMPLES / "data" / "kinect" / "msr-action3d"

@@ -373,14 +373,10 @@ FAILING_METHOD = {
 }
 
 
-@pytest.mark.parametrize("case", sorted(FAILING_METHOD))
-def test_a_plugin_method_that_fails_is_an_internal_error_naming_the_plugin(
-    case: str, installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    """A third party's motion source, scatterer model or radar whose method raises is that
-    plugin's bug: the internal error names it and its contract check (it named nobody, as if
-    mdframework had failed; only effects were named)."""
-    base, hook, method, (old, new), why = FAILING_METHOD[case]
+def install_broken(installed: Path, base: str, hook: str, method: str) -> None:
+    """Install a third party's plugin ``mdf_test_xyzzy.XyzzyBug`` (kind ``xyzzy_bug``): the
+    class ``Base`` that the import lines ``base`` give, registered by the hook
+    ``mdframework_register_<hook>``, with ``method`` (source lines) overridden."""
     body = (
         f"{base}from typing import Literal\nfrom mdframework import hookimpl\n\n"
         f"class XyzzyConfig(Base.Config):\n    kind: Literal['xyzzy_bug'] = 'xyzzy_bug'\n\n"
@@ -389,6 +385,17 @@ def test_a_plugin_method_that_fails_is_an_internal_error_naming_the_plugin(
         f"@hookimpl\ndef mdframework_register_{hook}():\n    return [XyzzyBug]\n"
     )
     _make_distribution(installed, "xyzzy-bug", "mdf_test_xyzzy", body, "xyzzy_bug")
+
+
+@pytest.mark.parametrize("case", sorted(FAILING_METHOD))
+def test_a_plugin_method_that_fails_is_an_internal_error_naming_the_plugin(
+    case: str, installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A third party's motion source, scatterer model or radar whose method raises is that
+    plugin's bug: the internal error names it and its contract check (it named nobody, as if
+    mdframework had failed; only effects were named)."""
+    base, hook, method, (old, new), why = FAILING_METHOD[case]
+    install_broken(installed, base, hook, method)
     config = tmp_path / "bug.toml"
     text = (EXAMPLES / "point_target.toml").read_text()
     assert old in text
@@ -458,3 +465,71 @@ def test_mdf_plugins_names_a_plugin_that_is_slow_to_import(
     mine = [line.split() for line in slow[1:] if "xyzzy" in line]
     assert len(mine) == 1 and mine[0][:3] == ["xyzzy_fx", "xyzzy-fx", "0.0.1:"], mine
     assert 0.2 <= float(mine[0][3]) < 5 and mine[0][4] == "s"
+
+
+#: a radar that drops the last pulse of every block: a ValueError of the plugin's own
+SHORT_RECEIVE = (
+    "    def receive(self, block):\n        out = super().receive(block)\n"
+    "        return replace(out, signal=out.signal[:-1])\n"
+)
+
+
+@pytest.mark.parametrize("on_error", ["stop", "skip"])
+def test_a_plugin_bug_in_a_dataset_record_is_an_internal_error_not_the_configs(
+    on_error: str, installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A third party's radar whose receive() breaks its contract with a ValueError, in a
+    dataset build: an internal error naming the plugin, as in `mdf run` (it was the user's
+    error, exit 2 naming the config file, and with on_error = 'skip' every record was skipped
+    as if its config were bad)."""
+    base = "from dataclasses import replace\nfrom mdf_lfm.waveform import LfmPulseDoppler as Base\n"
+    install_broken(installed, base, "radar_waveforms", SHORT_RECEIVE)
+    config = tmp_path / "d.toml"
+    config.write_text(f"""
+seed = 1
+on_error = "{on_error}"
+[[sources]]
+label = "recede"
+motion = {{ kind = "point_targets", length = 2.0, targets = [
+    {{ position = [100.0, 0.0, 0.0], velocity = [1.0, 0.0, 0.0], rcs = 1.0 }}] }}
+[base.scatterers]
+kind = "points"
+[base.radar]
+kind = "xyzzy_bug"
+""")
+    capsys.readouterr()
+    assert cli.main(["dataset", "build", str(config), "--out", str(tmp_path / "ds")]) == 1
+    lines = without_third_party_warnings(capsys.readouterr().err.strip().splitlines())
+    assert len(lines) == 1 and lines[0].startswith("mdf: internal error: ValueError: "), lines
+    assert (
+        "(in receive() of the radar plugin 'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug); check it "
+        "with mdframework.testing.check_radar_waveform; while building record 00000-"
+    ) in lines[0], lines
+
+
+def test_a_recording_source_that_fails_is_an_internal_error_naming_it(
+    installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A third party's recording source whose load() raises is its bug: the internal error
+    names it and its contract check, as docs/plugins.md says of any plugin's method (it named
+    nobody)."""
+    base = "from mdf_radhar.source import RadharSource as Base\n"
+    install_broken(
+        installed, base, "recording_sources", "    def load(self):\n        return 1 / 0\n"
+    )
+    data = EXAMPLES / "data" / "radhar" / "radhar_walk_subset.npz"
+    config = tmp_path / "d.toml"
+    config.write_text(f"""
+[[sources]]
+label = "walk"
+recording = {{ kind = "xyzzy_bug", file = "{data}" }}
+""")
+    capsys.readouterr()
+    assert cli.main(["dataset", "build", str(config), "--out", str(tmp_path / "ds")]) == 1
+    lines = without_third_party_warnings(capsys.readouterr().err.strip().splitlines())
+    assert len(lines) == 1, lines
+    assert lines[0].startswith(
+        "mdf: internal error: ZeroDivisionError: division by zero (in load() of the recording "
+        "plugin 'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug); check it with "
+        "mdframework.testing.check_recording_source;"
+    ), lines

@@ -71,7 +71,7 @@ from .outdir import (
     wait_for_files,
 )
 from .pipeline import build_stages, load_motion, simulate_motion
-from .plugins import default_registry
+from .plugins import blame, default_registry, is_plugin_bug
 from .pointcloud import (
     IWR1443_BIN_WIDTH,
     HistogramSettings,
@@ -565,7 +565,8 @@ def _load_recordings(section_json: str, base_dir: str) -> tuple[Recording, ...]:
         raise ConfigError(format_validation_error(exc, "recording", section)) from None
     source: Any = cls(cfg)
     assert isinstance(source, RecordingSource)
-    return tuple(source.load())
+    with blame(source, "load"):
+        return tuple(source.load())
 
 
 def _plan_recordings(
@@ -1076,19 +1077,25 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
 def _distinct_recordings(specs: list[RecordSpec]) -> list[RecordSpec]:
     """Simulated records named by distinct recordings: where two different motion files share
     a name (``alice/walk.bvh``, ``bob/walk.bvh``), their records' ``recording`` is the file as
-    the config gives it, so that experiments holding out recordings do not take them for one."""
+    the config gives it, so that experiments holding out recordings do not take them for one;
+    a file the config gives in two ways (``a/walk.bvh``, ``./a/walk.bvh``) is one recording,
+    named as first given."""
     files: dict[str, set[Path]] = {}
+    paths: list[Path | None] = []
+    spelt: dict[Path, str] = {}  # file -> as the config first gives it
     for spec in specs:
         file = spec.run_config["motion"].get("file") if "motion" in spec.run_config else None
-        if file is not None:
-            path = (Path(spec.base_dir) / str(file)).resolve()
+        path = None if file is None else (Path(spec.base_dir) / str(file)).resolve()
+        paths.append(path)
+        if path is not None:
             files.setdefault(spec.recording, set()).add(path)
-    shared = {name for name, paths in files.items() if len(paths) > 1}
+            spelt.setdefault(path, str(file))
+    shared = {name for name, held in files.items() if len(held) > 1}
     return [
-        replace(spec, recording=str(spec.run_config["motion"]["file"]))
-        if spec.recording in shared and "motion" in spec.run_config
+        replace(spec, recording=spelt[path])
+        if spec.recording in shared and path is not None
         else spec
-        for spec in specs
+        for spec, path in zip(specs, paths, strict=True)
     ]
 
 
@@ -1267,6 +1274,9 @@ def _record_or_skip(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     try:
         return _build_record(spec, out_dir)
     except (MdfError, ValueError) as exc:
+        if not isinstance(exc, MdfError) and is_plugin_bug(exc):  # not the config's: a bug
+            exc.add_note(f"while building record {spec.record_id} of {spec.recording}")
+            raise
         if spec.window is not None:
             file, start, length = spec.window
         else:

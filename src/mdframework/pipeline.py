@@ -43,7 +43,7 @@ from .physics.spectrogram import (
     power_to_db,
     spectrogram,
 )
-from .plugins import Registry, blame, default_registry
+from .plugins import Registry, blame, default_registry, name_plugin_bug
 from .progress import QUIET, Progress
 from .settings import (
     ConditioningConfig,
@@ -163,9 +163,10 @@ def _apply_effects(
                 _check_effect_output(out, data)
             except Exception as exc:  # a bug in the plugin: the CLI's internal error names it
                 cls = type(effect)
-                exc.add_note(
+                name_plugin_bug(
+                    exc,
                     f"in the effects plugin {effect.name!r} ({cls.__module__}.{cls.__qualname__})"
-                    f" on the {stage!r} stage; check it with mdframework.testing.check_effect"
+                    f" on the {stage!r} stage; check it with mdframework.testing.check_effect",
                 )
                 raise
             data = out

@@ -43,7 +43,7 @@ import time
 import typing
 import warnings
 from collections.abc import Callable, Iterable, Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field
 from functools import cache
 from typing import Any, Literal, NamedTuple
@@ -120,12 +120,31 @@ def blame(plugin: Plugin, method: str) -> Iterator[None]:
     except Exception as exc:
         cls = type(plugin)
         interface = next((i for i, s in INTERFACES.items() if isinstance(plugin, s.base)), "")
-        exc.add_note(
+        name_plugin_bug(
+            exc,
             f"in {method}() of the {interface} plugin {getattr(plugin, 'name', '?')!r} "
             f"({cls.__module__}.{cls.__qualname__}); check it with "
-            f"mdframework.testing.{CONTRACT_CHECKS.get(interface, 'check_plugin')}"
+            f"mdframework.testing.{CONTRACT_CHECKS.get(interface, 'check_plugin')}",
         )
         raise
+
+
+def name_plugin_bug(exc: Exception, note: str) -> None:
+    """Mark ``exc``, raised by a plugin's method, as that plugin's bug, with ``note`` naming
+    the plugin (the CLI's internal error shows it); :func:`is_plugin_bug` then tells it from
+    the user's bad input, also where a ``ValueError`` would be taken for that (a dataset
+    build's record)."""
+    exc.add_note(note)
+    with suppress(AttributeError, TypeError):  # an exception class without attributes
+        setattr(exc, _PLUGIN_BUG, True)
+
+
+def is_plugin_bug(exc: BaseException) -> bool:
+    """Whether ``exc`` came out of a plugin's method as its bug (:func:`name_plugin_bug`)."""
+    return getattr(exc, _PLUGIN_BUG, False) is True
+
+
+_PLUGIN_BUG = "_mdf_plugin_bug"
 
 
 #: old interface spelling -> current one
