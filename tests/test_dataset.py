@@ -712,3 +712,45 @@ def test_a_motion_files_own_error_keeps_its_file_name(tmp_path: Path) -> None:
     with pytest.raises(MdfError) as err:
         plan_records(*load_dataset_config(path))
     assert str(err.value).startswith(str(lone / "02_01.amc"))
+
+
+def test_records_whose_envelope_reaches_the_band_edge_are_counted(tmp_path: Path) -> None:
+    """The paper's radar (PRF 2400 Hz at 15 GHz: +-12 m/s) keeps a walk's envelope inside the
+    band; the FMCW preset's 0 dBi antennas leave the spectrogram too little above the noise, so
+    the envelope spans the band: index.csv counts such frames per record, and the build warns
+    once naming how many records have any."""
+    walk = CMU / "asf-amc" / "02_01.amc"
+    base = {
+        "lfm": "kind = 'lfm'\ncarrier_frequency = 15e9\nbandwidth = 150e6\nprf = 2400.0",
+        "fmcw": "kind = 'fmcw'\npreset = 'iwr1443_short_range_3d'\npoints = false",
+    }
+    counts = {}
+    for name, radar in base.items():
+        cfg_path = tmp_path / f"{name}.toml"
+        cfg_path.write_text(f"""
+seed = 1
+[[sources]]
+label = "walk"
+motion = {{ kind = "cmu", file = "{walk}" }}
+max_records = 2
+[record_lengths]
+walk = 1.0
+[base.radar]
+{radar}
+[base.scene]
+radar_position = [6.0, 0.0, 1.0]
+""")
+        cfg, base_dir = load_dataset_config(cfg_path)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            build_dataset(cfg, base_dir, tmp_path / name, workers=1, progress=False)
+        edge = [str(w.message) for w in caught if "edge of the Doppler band" in str(w.message)]
+        data = load_dataset(tmp_path / name)
+        counts[name] = data.table["band_edge_frames"]
+        if name == "lfm":
+            assert not edge and np.all(counts[name] == 0)
+        else:
+            assert len(edge) == 1 and edge[0].startswith("2 of 2 records")
+            assert np.all(counts[name] > 10)
+            upper = data.features[:, FEATURE_NAMES.index("upper_max")]
+            assert np.allclose(upper, data.velocity[-1])  # the band's edge, not the body's

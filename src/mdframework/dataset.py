@@ -59,7 +59,7 @@ from . import limits
 from .augment import augment_motion, warp_function
 from .config import format_validation_error, read_config_file, validate_run_config
 from .errors import ConfigError, DataFileError, MdfError, OutputError, SceneError
-from .features import FEATURE_NAMES, spectrogram_features
+from .features import FEATURE_NAMES, band_edge_frames, envelopes, features_from_envelopes
 from .interfaces import Motion, Recording, RecordingSource
 from .outdir import (
     OutputFolder,
@@ -1335,6 +1335,7 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     result = simulate_motion(config, stages, motion)
     fcfg = spec.features
     extra: dict[str, Any] = {}
+    extra_meta: dict[str, Any] = {}
     if spec.histogram is not None:
         cloud = _simulated_cloud(result, config, spec.record_id)
         arrays = _histogram_arrays(cloud, spec.histogram["histogram"], fcfg, spec.record_id)
@@ -1342,9 +1343,9 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         extra = {"histograms": arrays["histograms"]}
         spectrogram = {k: arrays[k] for k in ("spectrogram_db", "velocity_mps", "time_s")}
     else:
-        feats = spectrogram_features(
-            result.spectrogram.power, result.velocity, **_feature_options(fcfg)
-        )
+        env = envelopes(result.spectrogram.power, result.velocity, **_feature_options(fcfg))
+        feats = features_from_envelopes(env)
+        extra_meta["band_edge_frames"] = band_edge_frames(env, result.velocity)
         spectrogram = {
             "spectrogram_db": result.spectrogram_db.astype(np.float32),
             "velocity_mps": result.velocity,
@@ -1373,6 +1374,7 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         "carrier_frequency_hz": result.metadata["carrier_frequency_hz"],
         "units": {k: v for k, v in RECORD_UNITS.items() if k != "histograms" or extra},
         "run_config": json.loads(cfg.model_dump_json()),
+        **extra_meta,
     }
     atomic_savez(
         Path(out_dir) / RECORDS / f"{spec.record_id}.npz",
@@ -1442,6 +1444,7 @@ def _row(meta: dict[str, Any], feats: NDArray[np.float64]) -> dict[str, Any]:
         "radar_z_m": _blank(radar[2]),
         "height_m": _blank(meta["height_m"]),
         "seed": _blank(meta["seed"]),
+        "band_edge_frames": _blank(meta.get("band_edge_frames")),
     }
     row.update({name: float(f) for name, f in zip(FEATURE_NAMES, feats, strict=True)})
     row.update(_draw_columns(meta.get("draws")))
@@ -1797,6 +1800,25 @@ def config_differences(old: Any, new: Any, where: str = "") -> list[str]:
     return [f"{where or 'config'}: {json.dumps(old)} -> {json.dumps(new)}"]
 
 
+def _warn_band_edges(rows: list[dict[str, Any]]) -> None:
+    """One warning for the records whose features' envelope reaches the edge of the Doppler
+    band in some frame (``band_edge_frames`` > 0 in ``index.csv``; blank for histogram and
+    recorded records)."""
+    edged = [
+        r for r in rows if isinstance(r.get("band_edge_frames"), int) and r["band_edge_frames"]
+    ]
+    if edged:
+        warnings.warn(
+            f"{len(edged)} of {len(rows)} records (e.g. {edged[0]['id']}) have frames where the "
+            "features' envelope reaches the edge of the Doppler band (index.csv column "
+            "band_edge_frames): their upper_max, lower_min and bandwidths are the band's, not "
+            "the body's: the body's Doppler aliases, or the spectrograms stand too little above "
+            "the noise (raise the pulse rate or the signal-to-noise ratio)",
+            DatasetWarning,
+            stacklevel=3,
+        )
+
+
 def build_dataset(
     config: DatasetConfig,
     base_dir: Path,
@@ -1883,6 +1905,7 @@ def build_dataset(
             first = next(iter(skipped.values()))["skipped"]
             raise MdfError(f"every record failed; the first: {first}")
         dropped = [skipped[s.record_id] for s in specs if s.record_id in skipped]
+        _warn_band_edges(ordered)
         # three files, each replaced whole: a kill between them leaves them not matching, and
         # the marker says so until the build ends (load_dataset refuses such a folder)
         if wanted not in indexed:  # from now on the index may be the new one

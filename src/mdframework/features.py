@@ -149,6 +149,16 @@ def features_from_envelopes(env: Envelopes) -> FloatArray:
     )
 
 
+def band_edge_frames(env: Envelopes, velocity: FloatArray) -> int:
+    """Frames whose upper envelope reaches the last bin of ``velocity`` (n_doppler,) [m/s] or
+    whose lower envelope reaches the first: there the envelope stops at the Doppler band, not
+    at the body (the body's Doppler aliases, or the frame's column stands less than the
+    envelope threshold above the noise), and the extremes of the features are the band's."""
+    v = np.asarray(velocity, dtype=np.float64)
+    live = np.isfinite(env.upper) & np.isfinite(env.lower)
+    return int(np.sum(live & ((env.upper >= v[-1]) | (env.lower <= v[0]))))
+
+
 def spectrogram_features(
     power: NDArray[np.floating[Any]],
     velocity: FloatArray,

@@ -43,7 +43,13 @@ from typing import Any
 
 import numpy as np
 
-from .features import FEATURE_NAMES, Envelopes, envelopes, features_from_envelopes
+from .features import (
+    FEATURE_NAMES,
+    Envelopes,
+    band_edge_frames,
+    envelopes,
+    features_from_envelopes,
+)
 from .figures import (
     plot_point_cloud,
     plot_range_doppler,
@@ -91,20 +97,18 @@ class FeatureWarning(UserWarning):
 
 def band_edge_message(env: Envelopes, velocity: np.ndarray) -> str | None:
     """The warning for envelopes (each (n_frames,) [m/s], NaN when silent) that reach the first
-    or last bin of ``velocity`` (n_doppler,) [m/s], or None when no frame does. There the
-    envelope stops at the band, not at the body: the body's Doppler aliases, or the columns'
-    peaks stand less than the envelope threshold above the noise."""
-    live = np.isfinite(env.upper)
-    edge = live & ((env.upper >= velocity[-1]) | (env.lower <= velocity[0]))
-    if not edge.any():
+    or last bin of ``velocity`` (n_doppler,) [m/s] (:func:`~mdframework.features.band_edge_frames`),
+    or None when no frame does."""
+    edge = band_edge_frames(env, velocity)
+    if not edge:
         return None
     return (
         f"features: the {FEATURE_SETTINGS['threshold_db']:g} dB envelope reaches the edge of "
         f"the Doppler band ({velocity[0]:+.2f} to {velocity[-1]:+.2f} m/s) in "
-        f"{int(edge.sum())} of {int(live.sum())} frames, so upper_max, lower_min and the "
-        "bandwidths there are the band's, not the body's: the body's Doppler aliases, or the "
-        f"spectrogram's columns stand less than {-FEATURE_SETTINGS['threshold_db']:g} dB above "
-        "the noise (raise the pulse rate or the signal-to-noise ratio)"
+        f"{edge} of {int(np.sum(np.isfinite(env.upper)))} frames, so upper_max, lower_min and "
+        "the bandwidths there are the band's, not the body's: the body's Doppler aliases, or "
+        f"the spectrogram's columns stand less than {-FEATURE_SETTINGS['threshold_db']:g} dB "
+        "above the noise (raise the pulse rate or the signal-to-noise ratio)"
     )
 
 
