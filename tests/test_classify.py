@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from typing import Any, ClassVar
 
 import numpy as np
@@ -158,6 +159,22 @@ def test_grouped_wrapper_folds_never_split_a_group(rng: np.random.Generator) -> 
     assert any(fit & test for fit, test in pairs())  # record folds do split groups
     with pytest.raises(ValueError, match="two groups"):
         wrapper_select(x, y, Spy, sizes=(1,), groups=np.zeros(n))
+
+
+def test_grouped_wrapper_says_nothing_of_a_class_in_fewer_groups_than_folds(
+    rng: np.random.Generator,
+) -> None:
+    """A class of fewer records than folds (two records of two subjects, five folds) is simply
+    in fewer folds: scikit-learn's 'least populated class ... less than n_splits=5' warning,
+    which names none of the user's fields, does not reach them."""
+    y = np.array(["a"] * 20 + ["b"] * 20 + ["c"] * 2)
+    groups = np.concatenate([np.arange(40) % 5, [0, 1]])
+    x = rng.normal(size=(42, 3))
+    x[:, 0] += (y == "b") * 5.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sel = wrapper_select(x, y, lambda: Knn(Knn.Config(k=1)), sizes=(1,), groups=groups)
+    assert sel.subset == (0,)
 
 
 def test_any_sklearn_estimator_through_the_plugin(rng: np.random.Generator) -> None:

@@ -191,6 +191,20 @@ def test_wind_blown_clutter_spread_holds_for_tdm_chirps_and_frame_gaps() -> None
     assert abs(across) < 0.5  # true: exp(-2 pi^2 (30 Hz)^2 (0.64 s)^2) ~ 0
 
 
+def test_wind_blown_clutter_keeps_chirps_apart_when_frames_sit_half_a_chirp_off() -> None:
+    """Frames 100.5 chirp periods apart (times exact in binary) put every other frame's chirps
+    half-way between grid points: each chirp still gets its own sample of the process
+    (rounding half to even gave pairs of chirps one sample, and the next pair one two grid
+    steps on)."""
+    tc = 2.0**-13  # chirp period [s]
+    frame_t = (np.arange(40)[:, None] * 100.5 + np.arange(16)[None, :]) * tc
+    n = frame_t.size
+    eff = GroundClutter(GroundClutter.Config(csr_db=0.0, wind_fraction=1.0, spread_mps=0.3))
+    ctx = dataclasses.replace(clutter_context(15.0, n), pulse_times=frame_t.ravel())
+    out = (eff.apply(Received(np.ones(n, complex)), ctx).signal - 1.0).reshape(40, 16)
+    assert np.all(np.abs(np.diff(out, axis=1)) > 0)  # no two chirps share a sample
+
+
 def test_clutter_rcs_mode_follows_the_range_equation() -> None:
     n = 2400
     ctx = clutter_context(15.0, n)

@@ -129,11 +129,12 @@ def test_wrapper_folds_hold_out_what_the_evaluation_holds_out(
 
 
 def test_grouped_wrapper_needs_two_subjects_of_each_class(rng: np.random.Generator) -> None:
-    """A class of one subject among the training records cannot be both trained and tested
-    by folds holding out whole subjects: one line naming the class and the option."""
+    """A class the evaluation scores but with one subject among a split's training records
+    (two subjects, one held out) cannot be both trained and tested by folds holding out whole
+    subjects: one line naming the class and the option."""
     x, y = _toy(rng)
     subjects = np.array([f"s{i % 4}" for i in range(60)])
-    subjects[y == "c"] = "s9"  # class c: one subject only
+    subjects[y == "c"] = np.where(np.arange(20) < 10, "s8", "s9")  # class c: two subjects
     cfg = exp.ExperimentConfig.model_validate(
         {
             "dataset": {"path": "unused"},
@@ -143,6 +144,35 @@ def test_grouped_wrapper_needs_two_subjects_of_each_class(rng: np.random.Generat
     )
     with pytest.raises(ConfigError, match=r"inner_split = 'evaluation': class 'c' has one subj"):
         exp.within_source(cfg, exp.classifier_factory({"kind": "knn"}, "t"), x, y, subjects)
+
+
+@pytest.mark.parametrize("split", ["groups", "recording"])
+def test_grouped_wrapper_leaves_out_a_class_the_evaluation_leaves_out(
+    rng: np.random.Generator, split: str
+) -> None:
+    """A class of one subject (leave-subjects-out) or of one recording (split = 'recording')
+    is not evaluated, and the wrapper's folds, holding out what the evaluation holds out, leave
+    it out of their scores as well, instead of stopping the experiment: the other classes are
+    evaluated as with inner_split = 'record'."""
+    x, y = _toy(rng)
+    units = np.array([f"s{i % 4}" for i in range(60)])
+    units[y == "c"] = "s9"  # class c: one subject or recording only
+    results = {}
+    for inner in ("evaluation", "record"):
+        cfg = exp.ExperimentConfig.model_validate(
+            {
+                "dataset": {"path": "unused"},
+                "evaluation": {"split": split, "by": "subject", "repeats": 3},
+                "selection": {"sizes": [1], "optimistic": False, "inner_split": inner},
+            }
+        )
+        factory = exp.classifier_factory({"kind": "knn"}, "t")
+        results[inner] = exp.within_source(cfg, factory, x, y, units, exp.FEATURE_NAMES)
+    for res in results.values():
+        assert list(res["not_evaluated"]) == ["c"]
+        assert res["balanced_accuracy_mean"] > 0.9  # a and b: feature 3 tells them apart
+    best = [exp.FEATURE_NAMES[3]]  # the one feature that separates a and b
+    assert all(s == best for s in results["evaluation"]["subsets"])
 
 
 def test_experiment_on_shipped_cmu_data(tmp_path: Path) -> None:

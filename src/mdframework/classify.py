@@ -7,6 +7,7 @@ factory, so the selection and evaluation code never depends on a particular clas
 from __future__ import annotations
 
 import itertools
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -174,7 +175,11 @@ def wrapper_select(
         n_folds = min(int(folds), len(np.unique(g)))
         if n_folds < 2:
             raise ValueError("grouped wrapper selection needs at least two groups")
-        splits = StratifiedGroupKFold(n_folds, shuffle=True, random_state=seed).split(x, y, g)
+        with warnings.catch_warnings():  # a class in fewer groups is in fewer folds, as meant
+            warnings.filterwarnings("ignore", "The least populated class", UserWarning)
+            splits = list(
+                StratifiedGroupKFold(n_folds, shuffle=True, random_state=seed).split(x, y, g)
+            )
     data = []
     for train, test in splits:
         scored = test[np.isin(y[test], y[train])]  # classes this fold also trains on

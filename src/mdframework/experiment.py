@@ -32,7 +32,7 @@ import io
 import json
 import warnings
 from collections import Counter
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from functools import partial
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -103,7 +103,8 @@ class SelectionConfig(StrictModel):
         description="What the wrapper's folds hold out: record: stratified folds of records; "
         "evaluation: what evaluation.split holds out (whole recordings with 'recording', whole "
         "evaluation.by values with 'groups'), so that no recording or subject is on both sides "
-        "of a fold (needs two or more of them per class in every training split).",
+        "of a fold (needs two or more of them in every training split of each class it "
+        "evaluates).",
     )
     optimistic: bool = Field(
         True, description="Also report the paper's optimistic selection on the test split."
@@ -285,11 +286,14 @@ def _select(
     seed: int,
     counts: dict[str, int] | None = None,
     units: NDArray[Any] | None = None,
+    unevaluated: Collection[str] = (),
 ) -> Selection:
     """The feature subset for training records ``x``, ``y``; ``counts``: each class's records
     in the whole source (for the error when a class has too few training records); ``units``
     (n_train,): what the evaluation holds out, per training record (its recording or its
-    ``evaluation.by`` value), or None (records)."""
+    ``evaluation.by`` value), or None (records); ``unevaluated``: classes the evaluation does
+    not evaluate (of one recording or ``by`` value), which the wrapper's folds holding out
+    ``units`` leave out of their scores too instead of refusing them."""
     if cfg.selection.method == "none":
         return Selection(tuple(range(x.shape[1])), float("nan"))
     groups = None
@@ -297,7 +301,7 @@ def _select(
         groups = units
     if groups is not None:
         what = "recording" if cfg.evaluation.split == "recording" else cfg.evaluation.by
-        for label in sorted(set(y.tolist())):
+        for label in sorted(set(y.tolist()) - set(unevaluated)):
             held = sorted(set(groups[y == label].tolist()))
             if len(held) < 2:
                 raise ConfigError(
@@ -596,7 +600,7 @@ def within_source(
     counts = {c: int(np.sum(y == c)) for c in classes}
     for rep, (train, test) in enumerate(bar):
         units = None if recordings is None else recordings[train]
-        sel = _select(cfg, factory, x[train], y[train], cfg.seed + rep, counts, units)
+        sel = _select(cfg, factory, x[train], y[train], cfg.seed + rep, counts, units, untested)
         pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
         predictions.append((rep, test, pred))
         trained = set(y[train].tolist())

@@ -139,7 +139,9 @@ def wind_processes(
     step = float(np.min(np.diff(t))) if t.size > 1 else 0.0
     if not step > 0.0:
         return gaussian_doppler_process(rng, n_series, t.size, prf, spread_hz)
-    idx = np.rint((t - t[0]) / step).astype(np.int64)
+    # half-way rounds up, always: np.rint's half to even would give two chirps of a frame
+    # that sits half a step off the grid one sample, and the next two samples 2 steps apart
+    idx = np.floor((t - t[0]) / step + 0.5).astype(np.int64)
     n_grid = int(idx[-1]) + 1
     per_call = max(1, max(WIND_GRID_VALUES, n_series * t.size) // n_grid)
     out = np.empty((n_series, t.size), dtype=np.complex128)
