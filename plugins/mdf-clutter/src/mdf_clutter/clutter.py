@@ -134,7 +134,9 @@ def wind_processes(
     an FMCW radar's chirps (several transmitters in turn, gaps between frames) get the process
     at their own instants, so the slow time of each virtual antenna (every ``n_tx``-th chirp)
     sees the requested spread and frames apart in time are as decorrelated as that time makes
-    them. ``prf`` [Hz] serves fewer than two pulses. Returns (n_series, n_pulses)."""
+    them (the grid of such pulses is lengthened to the next length whose FFT is fast, 2 to 3
+    times faster than a length of large prime factors). ``prf`` [Hz] serves fewer than two
+    pulses. Returns (n_series, n_pulses)."""
     t = np.asarray(times, dtype=np.float64)
     step = float(np.min(np.diff(t))) if t.size > 1 else 0.0
     if not step > 0.0:
@@ -143,6 +145,10 @@ def wind_processes(
     # that sits half a step off the grid one sample, and the next two samples 2 steps apart
     idx = np.floor((t - t[0]) / step + 0.5).astype(np.int64)
     n_grid = int(idx[-1]) + 1
+    if n_grid != t.size:  # pulses with gaps: a grid of a length whose FFT is fast (2, 3, 5)
+        from scipy.fft import next_fast_len
+
+        n_grid = next_fast_len(n_grid)
     per_call = max(1, max(WIND_GRID_VALUES, n_series * t.size) // n_grid)
     out = np.empty((n_series, t.size), dtype=np.complex128)
     for lo in range(0, n_series, per_call):
