@@ -722,13 +722,20 @@ def test_capture_from_oni_file(fake_nite: Path, tmp_path: Path, monkeypatch, cap
     args = ["capture", "--out", "walk.nite.txt", "--device", "rec.oni", "--duration", "3"]
     assert cli.main([*args, "--nite2", str(fake_nite)]) == 0
     assert Path.cwd() == work and FakeUserTracker.last.cwd == fake_nite
-    assert FakeUserTracker.last.read == list(range(1, 13))
+    # played once, in order, to the last frame; at the recorded speed a slow reader (a busy
+    # machine) misses frames, as NiTE2 does: on an idle one it reads all 12
+    read = FakeUserTracker.last.read
+    assert read == sorted(set(read)) and set(read) <= set(range(1, 13)) and read[-1] == 12
+    tracked = [i for i in read if i >= 4]
     rec = read_nite(work / "walk.nite.txt")
-    assert list(rec.frame_numbers) == list(range(4, 13))
+    assert list(rec.frame_numbers) == tracked and len(tracked) >= 2
     assert rec.metadata["untracked_frames_trimmed"] == 0
     out = capsys.readouterr().out
-    assert "9 frames (9 with user 1 tracked; 3 untracked at the ends left out)" in out
-    assert re.search(r"0\.26\d s measured, 29\.9\d Hz actual", out), out
+    n, left = len(tracked), len(read) - len(tracked)
+    assert f"{n} frames ({n} with user 1 tracked; {left} untracked at the ends left out)" in out
+    measured = re.search(r"([\d.]+) s measured, ([\d.]+) Hz actual", out)
+    assert measured is not None, out
+    assert abs(float(measured.group(1)) - (tracked[-1] - tracked[0]) / 30.0) < 0.005, out
     assert FakeUserTracker.events == ["tracker created", "tracker closed", "device closed"]
     # no NiTE2 data where the tracker is created: the error, the device closed, cwd restored
     (fake_nite / "NiTE2" / "s.dat").unlink()
