@@ -754,3 +754,26 @@ radar_position = [6.0, 0.0, 1.0]
             assert np.all(counts[name] > 10)
             upper = data.features[:, FEATURE_NAMES.index("upper_max")]
             assert np.allclose(upper, data.velocity[-1])  # the band's edge, not the body's
+
+
+def test_a_drawn_motion_file_names_its_own_subject_and_recording(tmp_path: Path) -> None:
+    """A record whose motion file is drawn (randomize.params."motion.file") is that file's
+    subject and recording, not its source's: a CMU subject 9 run drawn in a subject 2 source
+    was labelled subject 2, so leaving subjects out could train and test on subject 9."""
+    amc = CMU / "asf-amc"
+    cfg_path = tmp_path / "d.toml"
+    cfg_path.write_text(f"""
+seed = 1
+[[sources]]
+label = "walk"
+motion = {{ kind = "cmu", file = "{amc / "02_01.amc"}" }}
+record_length = 1.0
+[randomize]
+draws = 3
+[randomize.params]
+"motion.file" = {{ choice = ["{amc / "02_01.amc"}", "{amc / "09_06.amc"}"] }}
+""")
+    cfg, base = load_dataset_config(cfg_path)
+    specs = plan_records(cfg, base)
+    named = {(Path(s.run_config["motion"]["file"]).name, s.subject, s.recording) for s in specs}
+    assert named == {("02_01.amc", "2", "02_01.amc"), ("09_06.amc", "9", "09_06.amc")}

@@ -893,19 +893,20 @@ def _check_sections(config: DatasetConfig) -> None:
             )
 
 
-def _drawn_fingerprint(
+def _drawn_motion(
     section: dict[str, Any], base_dir: Path, prints: dict[str, str]
-) -> str | None:
-    """The fingerprint of the motion a record's draws chose (``prints``: motion key ->
+) -> tuple[str, Motion] | None:
+    """The motion a record's draws chose and its fingerprint (``prints``: motion key ->
     fingerprint, filled in); None if it cannot be loaded (the record's validation, or its
     build, names why)."""
     key = _motion_key(section)
+    try:
+        drawn = _load_motion(key, str(base_dir))  # loaded once per process
+    except MdfError:
+        return None
     if key not in prints:
-        try:
-            prints[key] = motion_fingerprint(_load_motion(key, str(base_dir)))
-        except MdfError:
-            return None
-    return prints[key]
+        prints[key] = motion_fingerprint(drawn)
+    return prints[key], drawn
 
 
 def _source_span(motion: dict[str, Any], entry_no: int, loaded: Motion) -> tuple[float, float]:
@@ -1042,11 +1043,16 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                     run["scene"] = _place_record(run, placing, loaded)
                     asked = placing.scene.person.aspect_deg
                 run["seed"] = _record_seed(config.seed, index)
-                content = prints[key]
+                content, naming = prints[key], meta
                 if draws and any(
                     p.startswith("motion.") and isinstance(v, str) for p, v in draws.items()
-                ):  # a drawn file (or a part of one): the record is cut from its contents
-                    content = _drawn_fingerprint(section, base_dir, prints) or content
+                ):  # a drawn file (or a part of one): the record is cut from its contents,
+                    # and is that file's subject and recording
+                    chosen = _drawn_motion(section, base_dir, prints)
+                    if chosen is not None:
+                        content, drawn_md = chosen[0], chosen[1].metadata
+                        drawn_file = str(drawn_md.get("file") or section.get("file") or where)
+                        naming = _naming(entry, drawn_md, drawn_file, motion["kind"])
                 spec = _spec(
                     config,
                     index,
@@ -1056,7 +1062,7 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                     base_dir,
                     draws,
                     hist,
-                    meta,
+                    naming,
                     origins if draws else None,
                     _span(motion, span_start, span_end),
                     asked,
