@@ -103,6 +103,12 @@ def test_corrected_speed_scale() -> None:
     assert v[:, J["base"], 0].mean() == pytest.approx(0.8838, abs=1e-6)
     for joint in ("r_toe", "l_toe", "r_ankle", "r_knee", "r_hand", "head"):
         assert vc[:, J[joint], 0].max() - v[:, J[joint], 0].max() == pytest.approx(0.1162, abs=2e-4)
+    # docs/validation.md: toe peak 4.5954 m/s; the torso centre approaches (10, 0, 2) m at
+    # 0.878 m/s on average (0.8838 along the ground, less the radar's elevation)
+    assert v[:, J["r_toe"], 0].max() == pytest.approx(4.5954, abs=2e-4)
+    torso = 0.5 * (p[:, J["base"]] + p[:, J["neck"]])
+    approach = -np.gradient(np.linalg.norm(torso - RADAR, axis=1)) * g.nt / g.cycle_duration
+    assert approach.mean() == pytest.approx(0.878, abs=5e-4)
     # exact linear progression (no linspace end-point step, Q6): constant base step
     base_x = (
         p[:, J["base"], 0]

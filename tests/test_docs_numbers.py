@@ -105,3 +105,71 @@ def test_the_reproduction_page_feature_table_is_the_cross_source_experiments(
                 )
                 checked += 1
     assert checked == 84
+
+
+def _span(text: str) -> tuple[str, str]:
+    """``"0.16-2.51"`` -> ``("0.16", "2.51")``."""
+    low, high = text.split("-")
+    return low, high
+
+
+def test_the_datasets_page_quotes_the_torso_tracks_of_the_cmu_walk() -> None:
+    """docs/datasets.md: on CMU 02_01 (examples/cmu_walk.toml) the peak torso track spans
+    0.16-2.51 m/s, the median one 0.30-1.52 m/s, and the hip centre's true radial speed (the
+    tracking gate's, at the pulse times) 0.79-1.58 m/s, each within the page's rounding."""
+    import numpy as np
+
+    from mdframework.config import load_run_config
+    from mdframework.features import envelopes
+    from mdframework.pipeline import build_stages, simulate_motion
+
+    page = " ".join((ROOT / "docs" / "datasets.md").read_text().split())
+    quoted = re.search(
+        r"on CMU 02_01 the peak track spans ([\d.]+-[\d.]+) m/s, the median ([\d.]+-[\d.]+) "
+        r"m/s, the hip centre's true radial speed ([\d.]+-[\d.]+) m/s",
+        page,
+    )
+    assert quoted is not None
+    config = load_run_config(EXAMPLES / "cmu_walk.toml")
+    stages = build_stages(config)
+    res = simulate_motion(config, stages, stages.source.load())
+    power = 10.0 ** (np.asarray(res.spectrogram_db, dtype=np.float64) / 10.0)
+    computed = []
+    for method in ("peak", "median"):
+        torso = envelopes(power, res.velocity, torso_method=method).torso
+        computed.append((np.nanmin(torso), np.nanmax(torso)))
+    radial = -np.gradient(np.asarray(res.gate_range), res.pulse_times)  # + approaching
+    computed.append((radial.min(), radial.max()))
+    for text, values in zip(quoted.groups(), computed, strict=True):
+        for shown, exact in zip(_span(text), values, strict=True):
+            assert abs(float(shown) - exact) <= _half_unit(shown) + 1e-12, (text, values)
+
+
+def test_the_kinect_page_quotes_its_figure_scripts_foot_speeds() -> None:
+    """docs/kinect.md: the peak foot speeds that docs/make_kinect_figure.py measures on the
+    UTKinect walk (left foot 9.4 m/s raw, 3.7 m/s conditioned, the fastest foot), and the raw
+    spectrogram's spikes past +-6 m/s (within the figure's 40 dB) near t = 1.1 s and 2.0 s only,
+    none once conditioned."""
+    import numpy as np
+
+    script = _script("make_kinect_figure")
+    page = " ".join((ROOT / "docs" / "kinect.md").read_text().split())
+    quoted = re.search(
+        r"left foot's tracking \(peak ([\d.]+) m/s between frames\) throw spikes past \+-6 m/s "
+        r"near t = ([\d.]+) s and t = ([\d.]+) s; conditioned, the peak foot speed is ([\d.]+) m/s",
+        page,
+    )
+    assert quoted is not None
+    raw_peak, t1, t2, conditioned_peak = quoted.groups()
+    for enabled, shown in ((False, raw_peak), (True, conditioned_peak)):
+        res, peak = script.run(enabled)
+        fastest = max(peak, key=peak.__getitem__)
+        assert fastest == "l_toe" or enabled, peak
+        assert abs(float(shown) - peak[fastest]) <= _half_unit(shown), (shown, peak)
+        db = np.asarray(res.spectrogram_db)
+        spikes = res.spectrogram.time[(db[np.abs(res.velocity) > 6.0] > -40.0).any(axis=0)]
+        if enabled:
+            assert spikes.size == 0, spikes
+        else:
+            near = [np.abs(spikes - float(t)) <= 0.1 for t in (t1, t2)]
+            assert all(n.any() for n in near) and np.logical_or(*near).all(), spikes
