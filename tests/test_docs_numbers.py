@@ -105,6 +105,53 @@ def test_the_reproduction_page_feature_table_is_the_cross_source_experiments(
                 )
                 checked += 1
     assert checked == 84
+    _check_the_cross_source_accuracies(out)
+
+
+def _close(shown: str, exact: float) -> bool:
+    """``shown`` is ``exact`` to the page's rounding."""
+    return abs(float(shown) - exact) <= _half_unit(shown) + 1e-12
+
+
+def _check_the_cross_source_accuracies(out: Path) -> None:
+    """The page's Table 4 of our data (balanced accuracy and confusion matrix of training on
+    Kinect, testing on CMU) and the within-source accuracies beside it, against the same
+    experiment's summary.json and cross_confusion.csv."""
+    import csv
+    import json
+
+    summary = json.loads((out / "summary.json").read_text())
+    page = (ROOT / "docs" / "reproducing-erol-gurbuz-2015.md").read_text()
+    section = page.split("## Table 4")[1].split("\n## ")[0]
+    prose = " ".join(section.split())
+    cross = re.search(r"balanced accuracy \*\*([\d.]+)\*\*", prose)
+    assert cross is not None
+    assert _close(cross.group(1), summary["cross"]["balanced_accuracy"])
+    within = re.search(
+        r"Kinect group alone the same classifier reaches ([\d.]+) ± ([\d.]+) \(([\d.]+) "
+        r"optimistic\); within the CMU group ([\d.]+) ± ([\d.]+)\.",
+        prose,
+    )
+    assert within is not None
+    kinect, cmu = summary["within"]["kinect"], summary["within"]["cmu"]
+    exact = [
+        kinect["balanced_accuracy_mean"],
+        kinect["balanced_accuracy_std"],
+        kinect["optimistic_accuracy_mean"],
+        cmu["balanced_accuracy_mean"],
+        cmu["balanced_accuracy_std"],
+    ]
+    for shown, value in zip(within.groups(), exact, strict=True):
+        assert _close(shown, value), (shown, value)
+    with (out / "cross_confusion.csv").open() as fh:
+        rows = {r["true"]: r for r in csv.DictReader(fh)}
+    table = re.findall(r"^\| (boxing|run|walk) \|(.*)\|$", section, flags=re.M)
+    header = re.search(r"^\| true \\ predicted \|(.*)\|$", section, flags=re.M)
+    assert header is not None and len(table) == len(rows) == 3
+    predicted = [c.strip() for c in header.group(1).split("|")]
+    for true, cells in table:
+        for column, shown in zip(predicted, cells.split("|"), strict=True):
+            assert _close(shown.strip(), float(rows[true][column])), (true, column, shown)
 
 
 def _span(text: str) -> tuple[str, str]:
@@ -173,3 +220,52 @@ def test_the_kinect_page_quotes_its_figure_scripts_foot_speeds() -> None:
         else:
             near = [np.abs(spikes - float(t)) <= 0.1 for t in (t1, t2)]
             assert all(n.any() for n in near) and np.logical_or(*near).all(), spikes
+
+
+def test_the_reproduction_page_quotes_the_cmu_experiment(tmp_path: Path) -> None:
+    """The page's within-CMU result (Table 3 of our data): the record count, balanced accuracy
+    ± its standard deviation over the splits, the optimistic variant and the confusion matrix
+    (mean ± std), against what `mdf experiment examples/experiment_cmu.toml` writes."""
+    import csv
+    import json
+
+    from mdframework import cli
+
+    out = tmp_path / "c"
+    args = ["experiment", str(EXAMPLES / "experiment_cmu.toml"), "--out", str(out)]
+    assert cli.main([*args, "--no-progress"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    cmu = summary["within"]["cmu"]
+    page = (ROOT / "docs" / "reproducing-erol-gurbuz-2015.md").read_text()
+    section = page.split("Here (`experiment_cmu.toml`")[1].split("\n## ")[0]
+    prose = " ".join(section.split())
+    quoted = re.search(
+        r"(\d+) records; (\d+) stratified .*?balanced accuracy \*\*([\d.]+) ± ([\d.]+)\*\*; the "
+        r"paper's optimistic test-set selection gives ([\d.]+)",
+        prose,
+    )
+    assert quoted is not None
+    n_records, n_splits, mean, std, optimistic = quoted.groups()
+    assert (int(n_records), int(n_splits)) == (summary["n_records"], cmu["n_splits"])
+    exact = [
+        cmu["balanced_accuracy_mean"],
+        cmu["balanced_accuracy_std"],
+        cmu["optimistic_accuracy_mean"],
+    ]
+    for shown, value in zip((mean, std, optimistic), exact, strict=True):
+        assert _close(shown, value), (shown, value)
+    tables = {}
+    for name in ("within_cmu_confusion.csv", "within_cmu_confusion_std.csv"):
+        with (out / name).open() as fh:
+            tables[name] = {r["true"]: r for r in csv.DictReader(fh)}
+    header = re.search(r"^\| true \\ predicted \|(.*)\|$", section, flags=re.M)
+    rows = re.findall(r"^\| (boxing|jump|run|walk) \|(.*)\|$", section, flags=re.M)
+    assert header is not None and len(rows) == 4
+    predicted = [c.strip() for c in header.group(1).split("|")]
+    for true, cells in rows:
+        for column, cell in zip(predicted, cells.split("|"), strict=True):
+            m = re.fullmatch(r"([\d.]+) ± ([\d.]+)", cell.strip())
+            assert m is not None, cell
+            means, stds = tables["within_cmu_confusion.csv"], tables["within_cmu_confusion_std.csv"]
+            assert _close(m.group(1), float(means[true][column])), (true, column, cell)
+            assert _close(m.group(2), float(stds[true][column])), (true, column, cell)
