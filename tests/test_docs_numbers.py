@@ -269,3 +269,25 @@ def test_the_reproduction_page_quotes_the_cmu_experiment(tmp_path: Path) -> None
             means, stds = tables["within_cmu_confusion.csv"], tables["within_cmu_confusion_std.csv"]
             assert _close(m.group(1), float(means[true][column])), (true, column, cell)
             assert _close(m.group(2), float(stds[true][column])), (true, column, cell)
+
+
+def test_the_validation_page_quotes_the_walks_step_times() -> None:
+    """docs/validation.md: a step of the CMU walk (02_01, from the cadence the sanity checks
+    measure) and of the Boulic walker (half its gait cycle at rv = 1, H = 1.8 m)."""
+    import warnings
+
+    from mdf_mujoco.gait import Gait
+
+    from mdframework.config import load_run_config
+    from mdframework.pipeline import build_stages, load_motion
+
+    page = " ".join((ROOT / "docs" / "validation.md").read_text().split())
+    quoted = re.search(r"about ([\d.]+) s per step against Boulic's ([\d.]+) s\)", page)
+    assert quoted is not None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        motion = load_motion(build_stages(load_run_config(EXAMPLES / "cmu_walk.toml")).source)
+    cmu_step = 60.0 / motion.metadata["sanity"]["cadence"]["steps_per_min"]
+    boulic_step = Gait(1.8, 1.0).cycle_duration / 2
+    for shown, exact in zip(quoted.groups(), (cmu_step, boulic_step), strict=True):
+        assert abs(float(shown) - exact) <= _half_unit(shown), (shown, exact)
