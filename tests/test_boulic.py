@@ -70,6 +70,19 @@ def test_timing(rv: float, dc: float, frac: float) -> None:
         assert g.nt / g.cycle_duration == pytest.approx(1521.545, abs=5e-4)
 
 
+@pytest.mark.parametrize("chen", [False, True])
+def test_hip_flexion_jumps_by_the_pages_amount_at_rv_1_3(chen: bool) -> None:
+    """docs/validation.md: the hip flexion curve jumps by up to 0.64 deg at rv = 1.3 in both
+    modes (the model's own discontinuity, left as is), and nowhere just below it."""
+    phase = np.linspace(0.0, 1.0, 20001)
+
+    def hip(rv: float) -> np.ndarray:
+        return np.asarray(Gait(H, rv, chen_compatible=chen).tracks(phase)["hip"])
+
+    assert np.max(np.abs(hip(1.3) - hip(1.3 + 1e-9))) == pytest.approx(0.64, abs=0.005)
+    assert np.max(np.abs(hip(1.3 - 1e-9) - hip(1.3 - 2e-9))) < 1e-6
+
+
 def test_gait_classes() -> None:
     assert [gait_class(r) for r in (0.1, 0.4999, 0.5, 1.2999, 1.3, 3.0)] == list("aabbcc")
 
