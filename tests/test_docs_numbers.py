@@ -106,6 +106,31 @@ def test_the_reproduction_page_feature_table_is_the_cross_source_experiments(
                 checked += 1
     assert checked == 84
     _check_the_cross_source_accuracies(out)
+    _check_the_peak_torso_bandwidth(out / "dataset")
+
+
+def _check_the_peak_torso_bandwidth(dataset: Path) -> None:
+    """The page: with ``torso = "peak"`` the CMU walk's mean torso bandwidth grows to about
+    1.6 m/s (from the records' own spectrograms, whose median-track feature is the build's)."""
+    import numpy as np
+
+    from mdframework.dataset import load_dataset
+    from mdframework.features import FEATURE_NAMES, spectrogram_features
+
+    page = " ".join((ROOT / "docs" / "reproducing-erol-gurbuz-2015.md").read_text().split())
+    quoted = re.search(r"the walk's torso bandwidth grows to about ([\d.]+) m/s", page)
+    assert quoted is not None
+    data = load_dataset(dataset)
+    k = FEATURE_NAMES.index("torso_bandwidth")
+    walks = np.nonzero((np.asarray(data.table["group"]) == "cmu") & (data.labels == "walk"))[0]
+    assert walks.size >= 10
+    tracks: dict[str, list[float]] = {"median": [], "peak": []}
+    for i in walks:
+        power = 10.0 ** (data.spectrograms[i].astype(np.float64) / 10.0)
+        for method, found in tracks.items():
+            found.append(spectrogram_features(power, data.velocity, torso_method=method)[k])
+    assert np.allclose(tracks["median"], data.features[walks, k], atol=1e-9)
+    assert _close(quoted.group(1), float(np.mean(tracks["peak"])))
 
 
 def _close(shown: str, exact: float) -> bool:
