@@ -70,6 +70,19 @@ def test_timing(rv: float, dc: float, frac: float) -> None:
         assert g.nt / g.cycle_duration == pytest.approx(1521.545, abs=5e-4)
 
 
+@pytest.mark.parametrize("chen", [False, True])
+def test_hip_flexion_jumps_by_the_pages_amount_at_rv_1_3(chen: bool) -> None:
+    """docs/validation.md: the hip flexion curve jumps by up to 0.64 deg at rv = 1.3 in both
+    modes (the model's own discontinuity, left as is), and nowhere just below it."""
+    phase = np.linspace(0.0, 1.0, 20001)
+
+    def hip(rv: float) -> np.ndarray:
+        return np.asarray(Gait(H, rv, chen_compatible=chen).tracks(phase)["hip"])
+
+    assert np.max(np.abs(hip(1.3) - hip(1.3 + 1e-9))) == pytest.approx(0.64, abs=0.005)
+    assert np.max(np.abs(hip(1.3 - 1e-9) - hip(1.3 - 2e-9))) < 1e-6
+
+
 def test_gait_classes() -> None:
     assert [gait_class(r) for r in (0.1, 0.4999, 0.5, 1.2999, 1.3, 3.0)] == list("aabbcc")
 
@@ -103,6 +116,12 @@ def test_corrected_speed_scale() -> None:
     assert v[:, J["base"], 0].mean() == pytest.approx(0.8838, abs=1e-6)
     for joint in ("r_toe", "l_toe", "r_ankle", "r_knee", "r_hand", "head"):
         assert vc[:, J[joint], 0].max() - v[:, J[joint], 0].max() == pytest.approx(0.1162, abs=2e-4)
+    # docs/validation.md: toe peak 4.5954 m/s; the torso centre approaches (10, 0, 2) m at
+    # 0.878 m/s on average (0.8838 along the ground, less the radar's elevation)
+    assert v[:, J["r_toe"], 0].max() == pytest.approx(4.5954, abs=2e-4)
+    torso = 0.5 * (p[:, J["base"]] + p[:, J["neck"]])
+    approach = -np.gradient(np.linalg.norm(torso - RADAR, axis=1)) * g.nt / g.cycle_duration
+    assert approach.mean() == pytest.approx(0.878, abs=5e-4)
     # exact linear progression (no linspace end-point step, Q6): constant base step
     base_x = (
         p[:, J["base"], 0]

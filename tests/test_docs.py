@@ -545,3 +545,71 @@ def test_the_effects_page_table_lists_every_effect_plugin() -> None:
     assert len(names) >= 7
     for name in names:
         assert f"\n| `{name}` | `plugins/" in page, name
+
+
+#: ``[.venv/bin/]python benchmarks/x.py ARGS`` or ``python docs/make_x.py ARGS`` in a shell block
+SCRIPT_LINE = re.compile(r"^(?:\.venv/bin/)?python\s+((?:benchmarks|docs)/[\w-]+\.py)(.*)$")
+
+
+def script_commands() -> list[tuple[str, str, list[str]]]:
+    """(where, script, arguments) of every script command of the shell blocks."""
+    found = []
+    for block in blocks():
+        if block.lang not in ("sh", "console", "bash", ""):
+            continue
+        for k, raw in enumerate(block.text.splitlines()):
+            line = raw.removeprefix("$ ").split("  #")[0].split(" # ")[0].strip()
+            m = SCRIPT_LINE.match(line)
+            if m:
+                found.append((f"{block.where}+{k + 1}", m.group(1), shlex.split(m.group(2))))
+    return found
+
+
+class _Parsed(Exception):
+    """Raised in place of running a script once its arguments parsed."""
+
+
+def test_every_documented_script_command_parses(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Each benchmark or docs script command the pages show is one the script accepts: its
+    options parse with the script's own parser (nothing is run); a script without options is
+    shown without any. The measured figures these commands make are checked against their
+    pages by tests of their own (test_accuracy_page.py, test_sim2real_page.py, ...)."""
+    shown = script_commands()
+    assert len({s for _, s, _ in shown}) >= 10  # the extraction finds them at all
+    real_parse = argparse.ArgumentParser.parse_args
+
+    def parse_then_stop(self: argparse.ArgumentParser, args: Any = None, ns: Any = None) -> Any:
+        real_parse(self, args, ns)
+        raise _Parsed
+
+    monkeypatch.setattr(argparse.ArgumentParser, "parse_args", parse_then_stop)
+    for folder in ("benchmarks", "docs"):  # scripts import their neighbours
+        monkeypatch.syspath_prepend(str(ROOT / folder))
+    environ = dict(os.environ)  # some scripts pin BLAS threads when imported
+    try:
+        _parse_each(shown, monkeypatch)
+    finally:
+        os.environ.clear()
+        os.environ.update(environ)
+
+
+def _parse_each(shown: list[tuple[str, str, list[str]]], monkeypatch: pytest.MonkeyPatch) -> None:
+    """Import each script and run its ``main`` up to its parsed arguments."""
+    for where, script, args in shown:
+        path = ROOT / script
+        assert path.exists(), f"{where}: no {script}"
+        if "argparse" not in path.read_text():
+            assert not args, f"{where}: {script} takes no options, the page gives {args}"
+            continue
+        name = f"mdf_docs_script_{path.stem}"
+        spec = importlib.util.spec_from_file_location(name, path)
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        monkeypatch.setitem(sys.modules, name, module)  # dataclasses look their module up
+        spec.loader.exec_module(module)
+        monkeypatch.setattr(sys, "argv", [str(path), *args])
+        with pytest.raises(_Parsed):
+            try:
+                module.main()
+            except SystemExit as exc:
+                pytest.fail(f"{where}: `{script} {shlex.join(args)}` does not parse ({exc})")

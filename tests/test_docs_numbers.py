@@ -105,3 +105,214 @@ def test_the_reproduction_page_feature_table_is_the_cross_source_experiments(
                 )
                 checked += 1
     assert checked == 84
+    _check_the_cross_source_accuracies(out)
+    _check_the_peak_torso_bandwidth(out / "dataset")
+
+
+def _check_the_peak_torso_bandwidth(dataset: Path) -> None:
+    """The page: with ``torso = "peak"`` the CMU walk's mean torso bandwidth grows to about
+    1.6 m/s (from the records' own spectrograms, whose median-track feature is the build's)."""
+    import numpy as np
+
+    from mdframework.dataset import load_dataset
+    from mdframework.features import FEATURE_NAMES, spectrogram_features
+
+    page = " ".join((ROOT / "docs" / "reproducing-erol-gurbuz-2015.md").read_text().split())
+    quoted = re.search(r"the walk's torso bandwidth grows to about ([\d.]+) m/s", page)
+    assert quoted is not None
+    data = load_dataset(dataset)
+    k = FEATURE_NAMES.index("torso_bandwidth")
+    walks = np.nonzero((np.asarray(data.table["group"]) == "cmu") & (data.labels == "walk"))[0]
+    assert walks.size >= 10
+    tracks: dict[str, list[float]] = {"median": [], "peak": []}
+    for i in walks:
+        power = 10.0 ** (data.spectrograms[i].astype(np.float64) / 10.0)
+        for method, found in tracks.items():
+            found.append(spectrogram_features(power, data.velocity, torso_method=method)[k])
+    assert np.allclose(tracks["median"], data.features[walks, k], atol=1e-9)
+    assert _close(quoted.group(1), float(np.mean(tracks["peak"])))
+
+
+def _close(shown: str, exact: float) -> bool:
+    """``shown`` is ``exact`` to the page's rounding."""
+    return abs(float(shown) - exact) <= _half_unit(shown) + 1e-12
+
+
+def _check_the_cross_source_accuracies(out: Path) -> None:
+    """The page's Table 4 of our data (balanced accuracy and confusion matrix of training on
+    Kinect, testing on CMU) and the within-source accuracies beside it, against the same
+    experiment's summary.json and cross_confusion.csv."""
+    import csv
+    import json
+
+    summary = json.loads((out / "summary.json").read_text())
+    page = (ROOT / "docs" / "reproducing-erol-gurbuz-2015.md").read_text()
+    section = page.split("## Table 4")[1].split("\n## ")[0]
+    prose = " ".join(section.split())
+    cross = re.search(r"balanced accuracy \*\*([\d.]+)\*\*", prose)
+    assert cross is not None
+    assert _close(cross.group(1), summary["cross"]["balanced_accuracy"])
+    within = re.search(
+        r"Kinect group alone the same classifier reaches ([\d.]+) ± ([\d.]+) \(([\d.]+) "
+        r"optimistic\); within the CMU group ([\d.]+) ± ([\d.]+)\.",
+        prose,
+    )
+    assert within is not None
+    kinect, cmu = summary["within"]["kinect"], summary["within"]["cmu"]
+    exact = [
+        kinect["balanced_accuracy_mean"],
+        kinect["balanced_accuracy_std"],
+        kinect["optimistic_accuracy_mean"],
+        cmu["balanced_accuracy_mean"],
+        cmu["balanced_accuracy_std"],
+    ]
+    for shown, value in zip(within.groups(), exact, strict=True):
+        assert _close(shown, value), (shown, value)
+    with (out / "cross_confusion.csv").open() as fh:
+        rows = {r["true"]: r for r in csv.DictReader(fh)}
+    table = re.findall(r"^\| (boxing|run|walk) \|(.*)\|$", section, flags=re.M)
+    header = re.search(r"^\| true \\ predicted \|(.*)\|$", section, flags=re.M)
+    assert header is not None and len(table) == len(rows) == 3
+    predicted = [c.strip() for c in header.group(1).split("|")]
+    for true, cells in table:
+        for column, shown in zip(predicted, cells.split("|"), strict=True):
+            assert _close(shown.strip(), float(rows[true][column])), (true, column, shown)
+
+
+def _span(text: str) -> tuple[str, str]:
+    """``"0.16-2.51"`` -> ``("0.16", "2.51")``."""
+    low, high = text.split("-")
+    return low, high
+
+
+def test_the_datasets_page_quotes_the_torso_tracks_of_the_cmu_walk() -> None:
+    """docs/datasets.md: on CMU 02_01 (examples/cmu_walk.toml) the peak torso track spans
+    0.16-2.51 m/s, the median one 0.30-1.52 m/s, and the hip centre's true radial speed (the
+    tracking gate's, at the pulse times) 0.79-1.58 m/s, each within the page's rounding."""
+    import numpy as np
+
+    from mdframework.config import load_run_config
+    from mdframework.features import envelopes
+    from mdframework.pipeline import build_stages, simulate_motion
+
+    page = " ".join((ROOT / "docs" / "datasets.md").read_text().split())
+    quoted = re.search(
+        r"on CMU 02_01 the peak track spans ([\d.]+-[\d.]+) m/s, the median ([\d.]+-[\d.]+) "
+        r"m/s, the hip centre's true radial speed ([\d.]+-[\d.]+) m/s",
+        page,
+    )
+    assert quoted is not None
+    config = load_run_config(EXAMPLES / "cmu_walk.toml")
+    stages = build_stages(config)
+    res = simulate_motion(config, stages, stages.source.load())
+    power = 10.0 ** (np.asarray(res.spectrogram_db, dtype=np.float64) / 10.0)
+    computed = []
+    for method in ("peak", "median"):
+        torso = envelopes(power, res.velocity, torso_method=method).torso
+        computed.append((np.nanmin(torso), np.nanmax(torso)))
+    radial = -np.gradient(np.asarray(res.gate_range), res.pulse_times)  # + approaching
+    computed.append((radial.min(), radial.max()))
+    for text, values in zip(quoted.groups(), computed, strict=True):
+        for shown, exact in zip(_span(text), values, strict=True):
+            assert abs(float(shown) - exact) <= _half_unit(shown) + 1e-12, (text, values)
+
+
+def test_the_kinect_page_quotes_its_figure_scripts_foot_speeds() -> None:
+    """docs/kinect.md: the peak foot speeds that docs/make_kinect_figure.py measures on the
+    UTKinect walk (left foot 9.4 m/s raw, 3.7 m/s conditioned, the fastest foot), and the raw
+    spectrogram's spikes past +-6 m/s (within the figure's 40 dB) near t = 1.1 s and 2.0 s only,
+    none once conditioned."""
+    import numpy as np
+
+    script = _script("make_kinect_figure")
+    page = " ".join((ROOT / "docs" / "kinect.md").read_text().split())
+    quoted = re.search(
+        r"left foot's tracking \(peak ([\d.]+) m/s between frames\) throw spikes past \+-6 m/s "
+        r"near t = ([\d.]+) s and t = ([\d.]+) s; conditioned, the peak foot speed is ([\d.]+) m/s",
+        page,
+    )
+    assert quoted is not None
+    raw_peak, t1, t2, conditioned_peak = quoted.groups()
+    for enabled, shown in ((False, raw_peak), (True, conditioned_peak)):
+        res, peak = script.run(enabled)
+        fastest = max(peak, key=peak.__getitem__)
+        assert fastest == "l_toe" or enabled, peak
+        assert abs(float(shown) - peak[fastest]) <= _half_unit(shown), (shown, peak)
+        db = np.asarray(res.spectrogram_db)
+        spikes = res.spectrogram.time[(db[np.abs(res.velocity) > 6.0] > -40.0).any(axis=0)]
+        if enabled:
+            assert spikes.size == 0, spikes
+        else:
+            near = [np.abs(spikes - float(t)) <= 0.1 for t in (t1, t2)]
+            assert all(n.any() for n in near) and np.logical_or(*near).all(), spikes
+
+
+def test_the_reproduction_page_quotes_the_cmu_experiment(tmp_path: Path) -> None:
+    """The page's within-CMU result (Table 3 of our data): the record count, balanced accuracy
+    ± its standard deviation over the splits, the optimistic variant and the confusion matrix
+    (mean ± std), against what `mdf experiment examples/experiment_cmu.toml` writes."""
+    import csv
+    import json
+
+    from mdframework import cli
+
+    out = tmp_path / "c"
+    args = ["experiment", str(EXAMPLES / "experiment_cmu.toml"), "--out", str(out)]
+    assert cli.main([*args, "--no-progress"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    cmu = summary["within"]["cmu"]
+    page = (ROOT / "docs" / "reproducing-erol-gurbuz-2015.md").read_text()
+    section = page.split("Here (`experiment_cmu.toml`")[1].split("\n## ")[0]
+    prose = " ".join(section.split())
+    quoted = re.search(
+        r"(\d+) records; (\d+) stratified .*?balanced accuracy \*\*([\d.]+) ± ([\d.]+)\*\*; the "
+        r"paper's optimistic test-set selection gives ([\d.]+)",
+        prose,
+    )
+    assert quoted is not None
+    n_records, n_splits, mean, std, optimistic = quoted.groups()
+    assert (int(n_records), int(n_splits)) == (summary["n_records"], cmu["n_splits"])
+    exact = [
+        cmu["balanced_accuracy_mean"],
+        cmu["balanced_accuracy_std"],
+        cmu["optimistic_accuracy_mean"],
+    ]
+    for shown, value in zip((mean, std, optimistic), exact, strict=True):
+        assert _close(shown, value), (shown, value)
+    tables = {}
+    for name in ("within_cmu_confusion.csv", "within_cmu_confusion_std.csv"):
+        with (out / name).open() as fh:
+            tables[name] = {r["true"]: r for r in csv.DictReader(fh)}
+    header = re.search(r"^\| true \\ predicted \|(.*)\|$", section, flags=re.M)
+    rows = re.findall(r"^\| (boxing|jump|run|walk) \|(.*)\|$", section, flags=re.M)
+    assert header is not None and len(rows) == 4
+    predicted = [c.strip() for c in header.group(1).split("|")]
+    for true, cells in rows:
+        for column, cell in zip(predicted, cells.split("|"), strict=True):
+            m = re.fullmatch(r"([\d.]+) ± ([\d.]+)", cell.strip())
+            assert m is not None, cell
+            means, stds = tables["within_cmu_confusion.csv"], tables["within_cmu_confusion_std.csv"]
+            assert _close(m.group(1), float(means[true][column])), (true, column, cell)
+            assert _close(m.group(2), float(stds[true][column])), (true, column, cell)
+
+
+def test_the_validation_page_quotes_the_walks_step_times() -> None:
+    """docs/validation.md: a step of the CMU walk (02_01, from the cadence the sanity checks
+    measure) and of the Boulic walker (half its gait cycle at rv = 1, H = 1.8 m)."""
+    import warnings
+
+    from mdf_mujoco.gait import Gait
+
+    from mdframework.config import load_run_config
+    from mdframework.pipeline import build_stages, load_motion
+
+    page = " ".join((ROOT / "docs" / "validation.md").read_text().split())
+    quoted = re.search(r"about ([\d.]+) s per step against Boulic's ([\d.]+) s\)", page)
+    assert quoted is not None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        motion = load_motion(build_stages(load_run_config(EXAMPLES / "cmu_walk.toml")).source)
+    cmu_step = 60.0 / motion.metadata["sanity"]["cadence"]["steps_per_min"]
+    boulic_step = Gait(1.8, 1.0).cycle_duration / 2
+    for shown, exact in zip(quoted.groups(), (cmu_step, boulic_step), strict=True):
+        assert abs(float(shown) - exact) <= _half_unit(shown), (shown, exact)

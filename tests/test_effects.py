@@ -104,6 +104,27 @@ def test_noise_floor_in_spectrogram_is_sigma2_sum_w2() -> None:
     assert np.mean(spec.power) == pytest.approx(sigma2 * np.sum(w**2), rel=0.05)
 
 
+def test_tone_to_floor_gain_of_the_default_window_is_the_pages() -> None:
+    """docs/effects.md: a tone of power P peaks at P (sum w)^2 in the spectrogram, over a floor
+    of sigma^2 sum w^2 (test above), so the tone-to-floor ratio is the per-pulse SNR plus
+    10 log10((sum w)^2 / sum w^2), which the page quotes for the default 256-sample Hann
+    window."""
+    import re
+
+    from conftest import ROOT
+
+    prf, power = 2400.0, 2.0
+    t = np.arange(4800) / prf
+    tone = np.sqrt(power) * np.exp(2j * np.pi * (10 * prf / 256) * t)  # on a bin of nfft 256
+    spec = spectrogram(tone, prf, nfft=256)
+    w = np.hanning(257)[:-1]  # scipy's periodic hann of length 256, the default window
+    assert spec.power.max() == pytest.approx(power * w.sum() ** 2, rel=1e-6)
+    gain_db = 10 * np.log10(w.sum() ** 2 / np.sum(w**2))
+    page = " ".join((ROOT / "docs" / "effects.md").read_text().split())
+    quoted = re.search(r"\(\+([\d.]+) dB for a 256-sample Hann window\)", page)
+    assert quoted is not None and quoted.group(1) == f"{gain_db:.1f}"
+
+
 def test_noise_is_seeded() -> None:
     a = run(APPROACHING, [{"kind": "noise"}], seed=3)
     b = run(APPROACHING, [{"kind": "noise"}], seed=3)

@@ -27,6 +27,7 @@ from mdframework.sanity import (
     check_motion,
     deviations,
     find_glitches,
+    head_rise,
 )
 from mdframework.settings import SanityConfig
 
@@ -310,3 +311,41 @@ def test_alternation_keeps_exposing_a_wrong_time_base() -> None:
     spm = ok.metadata["sanity"]["cadence"]["steps_per_min"]
     assert fast.metadata["sanity"]["cadence"]["steps_per_min"] == pytest.approx(2 * spm, rel=1e-6)
     assert any("labelled 'jogging' but steps" in m for m in msgs)
+
+
+def test_the_shipped_recordings_are_upright_as_the_page_says() -> None:
+    """docs/motion-formats.md: the head's median height above the pelvis of the shipped
+    recordings, boxing and sitting down included, lies in the range the page gives for them
+    (0.45-0.8 m, well above the 0.2 m check): every recording an example run or dataset config
+    reads, the sitting-down BVH and the other DeepMimic clips."""
+    import re
+    import tomllib
+
+    page = " ".join((EXAMPLES.parent / "docs" / "motion-formats.md").read_text().split())
+    quoted = re.search(r"boxing and sitting down included, give ([\d.]+)-([\d.]+) m\)", page)
+    assert quoted is not None
+    low, high = (float(q) for q in quoted.groups())
+    motions: dict[Path, dict[str, Any]] = {}
+    for path in sorted(EXAMPLES.glob("*.toml")) + sorted((EXAMPLES / "datasets").glob("*.toml")):
+        data = tomllib.loads(path.read_text())
+        sources = data.get("sources", [{"motion": data.get("motion", {})}])
+        for m in (s["motion"] for s in sources if "motion" in s):
+            if "file" in m and m["kind"] not in ("radhar", "c3d"):  # C3D: no head marker
+                file = (path.parent / m["file"]).resolve()
+                motions.setdefault(file, {**m, "file": str(file)})
+    extra = [
+        ("bvh", "data/bvh/test_mocapbank.bvh"),  # sitting down and standing up
+        ("deepmimic", "data/deepmimic/humanoid3d_run.txt"),
+        ("deepmimic", "data/deepmimic/humanoid3d_punch.txt"),
+    ]
+    for kind, name in extra:
+        motions[EXAMPLES / name] = {"kind": kind, "file": str(EXAMPLES / name)}
+    assert len(motions) >= 15
+    rises = {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the recordings' own sanity warnings
+        for file, section in motions.items():
+            cfg = validate_run_config({"motion": section}, source="test", base_dir=EXAMPLES)
+            rises[file.name] = head_rise(load_motion(build_stages(cfg).source).canonical())
+    assert all(low <= r <= high for r in rises.values()), rises
+    assert min(rises.values()) < low + 0.05 and max(rises.values()) > high - 0.05, rises

@@ -86,3 +86,36 @@ def test_the_goal_sentence_follows_the_numbers() -> None:
     }
     assert bench.goal(results) == {"a": True, "b": False, "c": False}
     assert bench.goal_line(results).endswith("met for `a`; not met for `b`, `c`.")
+
+
+def test_the_prose_figures_derived_from_the_results() -> None:
+    """Figures of the prose that the script does not print as such: the walks' per-class rates
+    on the histogram input (two decimals, which the test above does not look at), how many
+    points the histogram inputs fall below real-to-real, and how many times as many points a
+    simulated frame holds as a real one."""
+    results = _results()
+    _, prose = _block(PAGE.read_text())
+    prose = " ".join(prose.split())
+    sim, real = results["sim_to_real"]["full"], results["real_to_real"]
+    weak = re.search(
+        r"weak class \((0\.\d\d) for k-NN, (0\.\d\d) for the forest, against (0\.\d\d) and "
+        r"(0\.\d\d) real-to-real\)",
+        prose,
+    )
+    assert weak is not None
+    inputs = ("knn/histogram", "forest/histogram")
+    walks = [sim[k]["per_class"]["walk"] for k in inputs]
+    walks += [real[k]["per_class"]["walk"] for k in inputs]
+    assert list(weak.groups()) == [f"{w:.2f}" for w in walks]
+    below = re.search(r"at least 0\.80, and (\d+) and (\d+) points below the reference", prose)
+    assert below is not None
+    gaps = [100 * (real[k]["mean"] - sim[k]["mean"]) for k in inputs]
+    assert list(below.groups()) == [f"{g:.0f}" for g in gaps]
+    times = re.search(
+        r"simulated frames also hold ([\d.]+) to ([\d.]+) times as many points", prose
+    )
+    assert times is not None
+    points = results["points"]
+    ratios = [points["full"][a]["points"] / points["real"][a]["points"] for a in points["real"]]
+    low, high = (float(t) for t in times.groups())
+    assert low - 0.05 <= min(ratios) and max(ratios) <= high + 0.05, ratios
