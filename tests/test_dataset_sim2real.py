@@ -394,3 +394,40 @@ recording = {{ kind = "radhar", file = "{RADHAR / "radhar_walk_subset.npz"}" }}
     cfg, base = load_dataset_config(path)
     with pytest.warns(DatasetWarning), pytest.raises(ConfigError, match="no records: every "):
         plan_records(cfg, base)
+
+
+def test_recordings_of_one_name_in_two_files_are_two_recordings(tmp_path: Path) -> None:
+    """Two copies of a RadHAR file (two sessions whose recordings the sensor named alike) give
+    records of two recordings, ``<file>:<name>``, so a split holding out recordings keeps them
+    apart; one file given twice stays one recording under its own name."""
+    import shutil
+
+    for name in ("a", "b"):
+        (tmp_path / name).mkdir()
+        shutil.copy(RADHAR / "radhar_boxing_subset.npz", tmp_path / name / "boxing.npz")
+
+    def recordings(files: list[str]) -> set[str]:
+        cfg_path = tmp_path / "real.toml"
+        cfg_path.write_text(
+            "".join(
+                f"""
+[[sources]]
+label = "boxing"
+record_length = 2.0
+max_records = 1
+[sources.recording]
+kind = "radhar"
+file = "{file}"
+recordings = ["20_boxing_3.txt"]
+"""
+                for file in files
+            )
+        )
+        cfg, base = load_dataset_config(cfg_path)
+        return {s.recording for s in plan_records(cfg, base)}
+
+    assert recordings(["a/boxing.npz", "b/boxing.npz"]) == {
+        "a/boxing.npz:20_boxing_3.txt",
+        "b/boxing.npz:20_boxing_3.txt",
+    }
+    assert recordings(["a/boxing.npz", "./a/boxing.npz"]) == {"20_boxing_3.txt"}

@@ -1081,28 +1081,36 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
 
 
 def _distinct_recordings(specs: list[RecordSpec]) -> list[RecordSpec]:
-    """Simulated records named by distinct recordings: where two different motion files share
-    a name (``alice/walk.bvh``, ``bob/walk.bvh``), their records' ``recording`` is the file as
-    the config gives it, so that experiments holding out recordings do not take them for one;
-    a file the config gives in two ways (``a/walk.bvh``, ``./a/walk.bvh``) is one recording,
-    named as first given."""
+    """Records named by distinct recordings: where two different motion files share a name
+    (``alice/walk.bvh``, ``bob/walk.bvh``), their records' ``recording`` is the file as the
+    config first gives it, and where two different files of a real radar's recordings hold a
+    recording of one name, it is ``<file as the config gives it>:<name>``, so that experiments
+    holding out recordings do not take them for one."""
+    first: dict[Path, str] = {}  # each file as the config first gives it
     files: dict[str, set[Path]] = {}
-    paths: list[Path | None] = []
-    spelt: dict[Path, str] = {}  # file -> as the config first gives it
+
+    def source_file(spec: RecordSpec) -> tuple[Path, str] | None:
+        run = spec.run_config
+        given = run["recording"].get("file") if "recording" in run else run["motion"].get("file")
+        if given is None:
+            return None
+        path = (Path(spec.base_dir) / str(given)).resolve()
+        return path, first.setdefault(path, str(given))
+
     for spec in specs:
-        file = spec.run_config["motion"].get("file") if "motion" in spec.run_config else None
-        path = None if file is None else (Path(spec.base_dir) / str(file)).resolve()
-        paths.append(path)
-        if path is not None:
-            files.setdefault(spec.recording, set()).add(path)
-            spelt.setdefault(path, str(file))
-    shared = {name for name, held in files.items() if len(held) > 1}
-    return [
-        replace(spec, recording=spelt[path])
-        if spec.recording in shared and path is not None
-        else spec
-        for spec, path in zip(specs, paths, strict=True)
-    ]
+        found = source_file(spec)
+        if found is not None:
+            files.setdefault(spec.recording, set()).add(found[0])
+    shared = {name for name, paths in files.items() if len(paths) > 1}
+    out = []
+    for spec in specs:
+        found = source_file(spec) if spec.recording in shared else None
+        if found is not None:
+            given = found[1]
+            name = f"{given}:{spec.recording}" if "recording" in spec.run_config else given
+            spec = replace(spec, recording=name)
+        out.append(spec)
+    return out
 
 
 def _place_record(run: dict[str, Any], config: RunConfigBase, motion: Motion) -> dict[str, Any]:
