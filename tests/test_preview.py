@@ -181,3 +181,27 @@ def test_mdf_show_refuses_an_instant_outside_the_record(
     err = capsys.readouterr().err
     assert code == 2 and "--at: 7 s is outside the record" in err
     assert not out.exists()
+
+
+def test_left_and_right_limbs_are_drawn_in_their_own_colours() -> None:
+    """Every segment ending on an ``l_`` joint has one colour, every ``r_`` one another, the
+    trunk and head a third, in the top view and in the 3-D view, and the 3-D legend names
+    both sides: a mirrored body must look mirrored."""
+    from matplotlib.colors import to_hex
+
+    from mdframework.skeleton import CANONICAL_SEGMENTS
+
+    body = walker()
+    scene = _Scene(body, RADAR)
+    with style() as plt:
+        fig, _ = _figure(plt, scene, spec_for(body))
+        for lines in (scene.top_lines, scene.body_lines):
+            colour: dict[str, set[str]] = {"l_": set(), "r_": set(), "": set()}
+            for line, (_, distal) in zip(lines, CANONICAL_SEGMENTS, strict=True):
+                side = distal[:2] if distal[:2] in ("l_", "r_") else ""
+                colour[side].add(to_hex(line.get_color()))
+            assert all(len(c) == 1 for c in colour.values()), colour
+            assert len(set.union(*colour.values())) == 3, colour
+        names = [t.get_text() for t in scene.body_ax.get_legend().get_texts()]
+        assert "left" in names and "right" in names
+        plt.close(fig)

@@ -43,6 +43,19 @@ FORMATS = ("gif", "mp4")
 ANIMATION_DPI = 80
 #: Side of the 3-D body view [m].
 BODY_BOX_M = 2.2
+#: Colour of a canonical segment by the body side of its distal joint (colour-blind-safe cycle:
+#: blue left, dark orange right, dark grey trunk and head), so left and right limbs differ.
+SIDE_COLOURS = {"left": "C0", "right": "C5", "centre": "C3"}
+
+
+def segment_side(distal: str) -> str:
+    """``"left"``, ``"right"`` or ``"centre"``: the body side of a segment, by the canonical name
+    of its distal joint (``l_...``, ``r_...``, or neither)."""
+    if distal.startswith("l_"):
+        return "left"
+    if distal.startswith("r_"):
+        return "right"
+    return "centre"
 
 
 class PreviewError(MdfError):
@@ -113,9 +126,11 @@ class _Scene:
         self.radar = np.asarray(radar_position, dtype=np.float64)
         if body.joint_names == CANONICAL_JOINTS:
             self.segments = [(body.index(a), body.index(b)) for a, b in CANONICAL_SEGMENTS]
+            self.sides = [segment_side(b) for _, b in CANONICAL_SEGMENTS]
             self.centre: int | None = body.index("base")
         else:
             self.segments = []
+            self.sides = []
             self.centre = None
         self.top_lines: list[Any] = []
         self.body_lines: list[Any] = []
@@ -145,7 +160,7 @@ class _Scene:
         ax.plot(path[:, 0], path[:, 1], ls="--", lw=1.0, color="0.5", label="path")
         ax.plot(*self.radar[:2], marker="^", ms=9, color="C1", ls="", label="radar")
         (self.los_top,) = ax.plot([], [], lw=1.0, color="C1", label="line of sight")
-        self.top_lines = [ax.plot([], [], lw=1.5, color="C0")[0] for _ in self.segments]
+        self.top_lines = [ax.plot([], [], lw=1.5, color=SIDE_COLOURS[s])[0] for s in self.sides]
         (self.top_points,) = ax.plot([], [], ls="", marker=".", ms=3, color="C0")
         xy = np.vstack([path[:, :2], self.radar[None, :2]])
         xy = xy[np.all(np.isfinite(xy), axis=1)]
@@ -161,9 +176,17 @@ class _Scene:
 
     def draw_body(self, ax: Any) -> None:
         """3-D body view that follows the person."""
-        self.body_lines = [ax.plot([], [], [], lw=2.0, color="C0")[0] for _ in self.segments]
-        (self.body_points,) = ax.plot([], [], [], ls="", marker="o", ms=2.5, color="C0")
-        (self.los_body,) = ax.plot([], [], [], lw=1.0, color="C1", label="toward the radar")
+        self.body_lines = []
+        labelled = {"centre"}  # the legend names the sides once each
+        for side in self.sides:
+            label = None if side in labelled else side
+            labelled.add(side)
+            (line,) = ax.plot([], [], [], lw=2.0, color=SIDE_COLOURS[side], label=label)
+            self.body_lines.append(line)
+        (self.body_points,) = ax.plot([], [], [], ls="", marker="o", ms=2.5, color="C3")
+        (self.los_body,) = ax.plot(
+            [], [], [], lw=1.0, ls="--", color="C1", label="toward the radar"
+        )
         ax.set_box_aspect((1.0, 1.0, 1.0))
         # the box follows the person: tick labels would change every frame, so none are drawn
         ax.set_xticklabels([])
