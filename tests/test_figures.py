@@ -172,3 +172,38 @@ def test_a_long_caption_is_wrapped_inside_the_figure(tmp_path: Path) -> None:
     fig.draw(renderer)
     box = text.get_window_extent(renderer)
     assert 0 <= box.x0 and box.x1 <= fig.bbox.x1 and box.y0 >= 0
+
+
+def test_radar_products_carry_the_caption_and_the_figure_options(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """range_doppler.png and point_cloud.png are captioned like the run's other figures, and
+    the range-Doppler map is drawn in the ``[figures]`` colour map and dynamic range."""
+    from mdframework import output
+    from mdframework.progress import QUIET
+
+    calls: dict[str, dict[str, object]] = {}
+
+    def record(name: str) -> object:
+        return lambda path, *args, **kwargs: calls.__setitem__(name, kwargs)
+
+    for name in ("plot_spectrogram", "plot_range_doppler", "plot_point_cloud"):
+        monkeypatch.setattr(output, name, record(name))
+    maps = np.ones((3, 4, 5))
+    maps[1, 2, 3] = 100.0  # the strongest map, and the frame of the points
+    arrays = {
+        "spectrogram_db": np.zeros((4, 3)),
+        "time_s": np.arange(3.0),
+        "velocity_mps": np.linspace(-1.0, 1.0, 4),
+        "doppler_hz": np.linspace(-10.0, 10.0, 4),
+        "range_doppler": maps,
+        "range_doppler_range_m": np.arange(5.0),
+        "range_doppler_velocity_mps": np.linspace(-1.0, 1.0, 4),
+        "points": np.array([[1.0, 0.1, 0.0, 3.0, 0.0, 1.0, 20.0]]),
+    }
+    look = {"dynamic_range_db": 25.0, "velocity_span": "full", "colormap": "magma"}
+    output._plot_run(tmp_path, arrays, "walk — cmu", "fmcw 77 GHz; aspect 0°", look, QUIET)
+    rd, cloud = calls["plot_range_doppler"], calls["plot_point_cloud"]
+    assert rd["caption"] == cloud["caption"] == "fmcw 77 GHz; aspect 0°"
+    assert rd["title"] == cloud["title"] == "walk — cmu frame 1"
+    assert rd["colormap"] == "magma" and rd["dynamic_range_db"] == 25.0

@@ -1040,6 +1040,7 @@ def _report(
             res["confusion"],
             None,
             title=f"train {cfg.train_test.train} -> test {cfg.train_test.test}",
+            caption=f"{caption}; features {res['subset']}",
         )
         _write_predictions(out / "train_test_predictions.csv", data, res)
         summary["train_test"] = _without_predictions(res)
