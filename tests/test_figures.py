@@ -207,3 +207,35 @@ def test_radar_products_carry_the_caption_and_the_figure_options(
     assert rd["caption"] == cloud["caption"] == "fmcw 77 GHz; aspect 0°"
     assert rd["title"] == cloud["title"] == "walk — cmu frame 1"
     assert rd["colormap"] == "magma" and rd["dynamic_range_db"] == 25.0
+
+
+def test_coinciding_records_of_two_activities_both_stay_visible(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Quantised features (coarse Doppler bins) put many records on one point: each activity's
+    records there are one mark of area proportional to their number, the larger drawn behind,
+    so the activity with more records there is not hidden under the other's (RadHAR's jump
+    records all lay under walk records)."""
+    from mdframework import figures
+
+    drawn: list[object] = []
+    monkeypatch.setattr(figures, "save", lambda fig, path, caption="", **kw: drawn.append(fig))
+    x = np.array([0.0] * 5 + [0.0] * 2 + [1.0])
+    y = np.array([0.6] * 5 + [0.6] * 2 + [2.0])
+    labels = np.array(["jump"] * 5 + ["walk"] * 3)
+    groups = np.array(["radhar"] * 8)
+    figures.plot_feature_scatter(tmp_path / "s.png", x, y, labels, groups, "a", "b")
+    (fig,) = drawn
+    marks = []  # (x, y, area, zorder) of every mark
+    for coll in fig.axes[0].collections:
+        for (px, py), area in zip(
+            coll.get_offsets(),
+            np.broadcast_to(coll.get_sizes(), len(coll.get_offsets())),
+            strict=True,
+        ):
+            marks.append((float(px), float(py), float(area), coll.get_zorder()))
+    at = sorted((m for m in marks if (m[0], m[1]) == (0.0, 0.6)), key=lambda m: m[3])
+    assert [m[2] for m in at] == [70.0, 28.0]  # jump's 5 records behind walk's 2
+    assert sorted(m[2] for m in marks if m[0] == 1.0) == [14.0]
+    names = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert names == ["jump (radhar)", "walk (radhar)"]
