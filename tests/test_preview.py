@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -205,3 +206,27 @@ def test_left_and_right_limbs_are_drawn_in_their_own_colours() -> None:
         names = [t.get_text() for t in scene.body_ax.get_legend().get_texts()]
         assert "left" in names and "right" in names
         plt.close(fig)
+
+
+def test_the_spectrogram_axis_spans_the_whole_record(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """STFT frames are centred from half a window after the record's start: the spectrogram's
+    time axis still runs from the record's first to its last instant, so the animation's cursor
+    and the stills' instants near the ends stay on it (the cursor left the axes for the first
+    and last half window; stills at the ends widened the axis by matplotlib's margins)."""
+    from mdframework import preview
+
+    body = walker(frame_rate=10.0)  # 0 .. 1 s
+    time = np.linspace(0.1, 0.9, 17)  # frames 0.05 s apart: cells 0.075 .. 0.925 s
+    velocity = np.linspace(-5.0, 5.0, 101)
+    spec = SpectrogramView(np.zeros((velocity.size, time.size)), time, velocity)
+    with style() as plt:
+        fig, cursor = _figure(plt, _Scene(body, RADAR), spec)
+        assert cursor.axes.get_xlim() == pytest.approx((0.0, 1.0))
+        plt.close(fig)
+    saved: list[Any] = []
+    monkeypatch.setattr(preview, "save", lambda fig, path, caption="", **kw: saved.append(fig))
+    plot_stills(tmp_path / "s.png", body, RADAR, spec, [0.0, 1.0])
+    (ax,) = [a for a in saved[0].axes if a.get_xlabel() == "time [s]"]
+    assert ax.get_xlim() == pytest.approx((0.0, 1.0))

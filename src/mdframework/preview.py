@@ -230,14 +230,17 @@ def _figure(plt: Any, scene: _Scene, spec: SpectrogramView) -> tuple[Any, Any]:
     scene.draw_top(fig.add_subplot(grid[0]))
     scene.draw_body(fig.add_subplot(grid[1], projection="3d"))
     ax = fig.add_subplot(grid[2])
-    im = _spectrogram(ax, spec)
+    im = _spectrogram(ax, spec, scene.body)
     fig.colorbar(im, ax=ax, label="power [dB re peak]")
-    cursor = ax.axvline(float(spec.time[0]), color="white", lw=1.2)
+    cursor = _time_mark(ax, float(spec.time[0]), lw=1.2)
     return fig, cursor
 
 
-def _spectrogram(ax: Any, spec: SpectrogramView) -> Any:
-    return draw_spectrogram(
+def _spectrogram(ax: Any, spec: SpectrogramView, body: Skeleton) -> Any:
+    """The spectrogram, its time axis covering the whole record (the body's first to last
+    frame) as well as the frames: the first frame is centred half a window after the record's
+    start, and a cursor or an instant before it must stay on the axes."""
+    im = draw_spectrogram(
         ax,
         spec.power_db,
         spec.time,
@@ -246,6 +249,18 @@ def _spectrogram(ax: Any, spec: SpectrogramView) -> Any:
         velocity_span=spec.velocity_span,
         colormap=spec.colormap,
     )
+    lo, hi = ax.get_xlim()
+    ax.set_xlim(min(lo, float(body.time[0])), max(hi, float(body.time[-1])))
+    return im
+
+
+def _time_mark(ax: Any, t: float, lw: float) -> Any:
+    """A vertical line at ``t``: white with a dark edge, seen on the colour map and on the
+    blank axes outside the frames."""
+    from matplotlib import patheffects
+
+    edge = [patheffects.Stroke(linewidth=lw + 1.2, foreground="0.2"), patheffects.Normal()]
+    return ax.axvline(t, color="white", lw=lw, path_effects=edge)
 
 
 def animate(
@@ -329,9 +344,9 @@ def plot_stills(
             scene.update(float(body.time[k]))
             ax.set_title(f"t = {body.time[k]:.2f} s")
         ax = fig.add_subplot(grid[1, :])
-        im = _spectrogram(ax, spec)
+        im = _spectrogram(ax, spec, body)
         for i, k in enumerate(frames):
-            ax.axvline(float(body.time[k]), color="white", lw=1.0)
+            _time_mark(ax, float(body.time[k]), lw=1.0)
             ax.annotate(
                 f"{i + 1}",
                 (float(body.time[k]), 1.0),
