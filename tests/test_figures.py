@@ -239,3 +239,24 @@ def test_coinciding_records_of_two_activities_both_stay_visible(
     assert sorted(m[2] for m in marks if m[0] == 1.0) == [14.0]
     names = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
     assert names == ["jump (radhar)", "walk (radhar)"]
+
+
+def test_side_by_side_panels_share_a_velocity_axis_that_holds_both(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A run at 5 m/s beside a walk at 1 m/s: the shared axis covers both panels' power (the
+    last panel's own span used to set it for both, cutting the first panel's)."""
+    from mdframework import figures
+
+    saved: list[object] = []
+    monkeypatch.setattr(figures, "save", lambda fig, path, caption="", **kw: saved.append(fig))
+    fast, velocity = _tone_spectrogram(5.0)
+    slow, _ = _tone_spectrogram(1.0)
+    time = np.arange(fast.shape[1]) * 0.01
+    figures.plot_spectrogram_panels(
+        tmp_path / "p.png", [(fast, time, velocity, "run"), (slow, time, velocity, "walk")]
+    )
+    (fig,) = saved
+    lo, hi = velocity_limits(fast, velocity, "auto", 40.0)
+    for ax in fig.axes[:2]:
+        assert ax.get_ylim() == pytest.approx((lo, hi))  # the run's span holds the walk's

@@ -465,7 +465,8 @@ def plot_spectrogram_panels(
 ) -> None:
     """Save spectrograms side by side, each panel ``(spectrogram_db (n_doppler, n_frames),
     time [s], velocity [m/s] (+ approaching), title)``, each in dB re its own peak on one colour
-    scale (see :func:`draw_spectrogram`)."""
+    scale (see :func:`draw_spectrogram`). The panels share one velocity axis: the union of
+    their own limits, so no panel's power is cut off by another's span."""
     with _rc_context():
         fig, axes = subplots(
             1, len(panels), figsize=(5 * len(panels), 4), sharey=True, layout="constrained"
@@ -485,6 +486,11 @@ def plot_spectrogram_panels(
             ax.set_title(title)
             if k:
                 ax.set_ylabel("")
+        limits = [
+            velocity_limits(db, velocity, velocity_span, dynamic_range_db)
+            for db, _, velocity, _ in panels
+        ]
+        axes[0].set_ylim(min(lo for lo, _ in limits), max(hi for _, hi in limits))
         fig.colorbar(im, ax=list(axes), label="power [dB re peak]")
         save(fig, path, caption)
 
