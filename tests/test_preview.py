@@ -230,3 +230,18 @@ def test_the_spectrogram_axis_spans_the_whole_record(
     plot_stills(tmp_path / "s.png", body, RADAR, spec, [0.0, 1.0])
     (ax,) = [a for a in saved[0].axes if a.get_xlabel() == "time [s]"]
     assert ax.get_xlim() == pytest.approx((0.0, 1.0))
+
+
+def test_the_body_views_axis_names_stay_out_of_the_spectrogram() -> None:
+    """The 3-D view has no tick labels; its axis names sit against its box, so its "z" does not
+    land on the spectrogram's velocity label beside it (as it did in every animation frame)."""
+    body = walker()
+    scene = _Scene(body, RADAR)
+    with style() as plt:
+        fig, cursor = _figure(plt, scene, spec_for(body))
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        z_name = scene.body_ax.zaxis.label.get_window_extent(renderer)
+        velocity_name = cursor.axes.yaxis.label.get_window_extent(renderer)
+        assert z_name.x1 < velocity_name.x0, (z_name, velocity_name)
+        plt.close(fig)

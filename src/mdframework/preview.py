@@ -192,9 +192,10 @@ class _Scene:
         ax.set_xticklabels([])
         ax.set_yticklabels([])
         ax.set_zticklabels([])
-        ax.set_xlabel("x")
-        ax.set_ylabel("y")
-        ax.set_zlabel("z")
+        # no tick labels to clear: the axis names sit against the box, not in the next panel
+        ax.set_xlabel("x", labelpad=-12)
+        ax.set_ylabel("y", labelpad=-12)
+        ax.set_zlabel("z", labelpad=-12)
         ax.set_title(f"body (box {BODY_BOX_M:g} m)")
         ax.legend(loc="upper left", fontsize=7)
         self.body_ax = ax
