@@ -719,15 +719,18 @@ def test_every_confusion_matrix_is_captioned(
     kinect_dataset: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Within-source and train/test confusion matrices both carry the dataset, classifier and
-    selection in their captions (the train/test one had none)."""
+    selection in their captions (the train/test one had none), and the train/test title names
+    the selections in words."""
     from mdframework import figures
 
     captions: dict[str, str] = {}
-    monkeypatch.setattr(
-        figures,
-        "plot_confusion",
-        lambda path, *args, caption="", **kwargs: captions.__setitem__(Path(path).name, caption),
-    )
+    titles: dict[str, str] = {}
+
+    def record(path: Path, *args: object, caption: str = "", title: str = "") -> None:
+        captions[Path(path).name] = caption
+        titles[Path(path).name] = title
+
+    monkeypatch.setattr(figures, "plot_confusion", record)
     body = (
         '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\n'
         '[train_test]\ntrain = { subject = ["s01", "s02"] }\ntest = { subject = "s03" }\n'
@@ -739,3 +742,7 @@ def test_every_confusion_matrix_is_captioned(
     for name, caption in captions.items():
         for part in ("dataset dataset (", 'classifier {"kind": "knn"', "selection none"):
             assert part in caption, (name, caption)
+    # the selections in words, not as Python dictionaries
+    assert titles["train_test_confusion.png"] == (
+        "train subject = s01 or s02 -> test subject = s03"
+    )
