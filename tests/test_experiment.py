@@ -718,9 +718,9 @@ def test_a_random_forest_experiment_repeats_exactly(kinect_dataset: Path, tmp_pa
 def test_every_confusion_matrix_is_captioned(
     kinect_dataset: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """Within-source and train/test confusion matrices both carry the dataset, classifier and
-    selection in their captions (the train/test one had none), and the train/test title names
-    the selections in words."""
+    """Within-source and train/test confusion matrices both carry the dataset, the classifier's
+    input (features or Doppler histograms), the classifier and the selection in their captions
+    (the train/test one had none), and the train/test title names the selections in words."""
     from mdframework import figures
 
     captions: dict[str, str] = {}
@@ -740,7 +740,13 @@ def test_every_confusion_matrix_is_captioned(
         exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
     assert set(captions) == {"within_kinect_confusion.png", "train_test_confusion.png"}
     for name, caption in captions.items():
-        for part in ("dataset dataset (", 'classifier {"kind": "knn"', "selection none"):
+        parts = (
+            "dataset dataset (",
+            "input features",
+            'classifier {"kind": "knn"',
+            "selection none",
+        )
+        for part in parts:
             assert part in caption, (name, caption)
     # the selections in words, not as Python dictionaries
     assert titles["train_test_confusion.png"] == (

@@ -898,7 +898,7 @@ def _report(
     ]
     source = cfg.dataset.config.name if cfg.dataset.config is not None else Path(data_dir).name
     caption = (
-        f"dataset {source} ({len(data.labels)} records); classifier "
+        f"dataset {source} ({len(data.labels)} records); input {cfg.input}; classifier "
         f"{json.dumps(cfg.classifier)}; selection {cfg.selection.method}"
     )
     skipped: list[str] = []  # warnings, given once something else is evaluated
