@@ -245,3 +245,20 @@ def test_the_body_views_axis_names_stay_out_of_the_spectrogram() -> None:
         velocity_name = cursor.axes.yaxis.label.get_window_extent(renderer)
         assert z_name.x1 < velocity_name.x0, (z_name, velocity_name)
         plt.close(fig)
+
+
+@pytest.mark.parametrize("fps", [12, 7])
+def test_gif_frames_start_at_their_own_times(tmp_path: Path, fps: int) -> None:
+    """GIF durations are whole centiseconds: frame k starts within 5 ms of k / fps, so the
+    animation plays in real time (at the default 12 fps every frame lasted 80 ms instead of
+    83.3, and the walk ran 4 % fast)."""
+    body = walker(duration=1.0)
+    n = animate(tmp_path / "m.gif", body, RADAR, spec_for(body), fps=fps)
+    durations = []
+    with Image.open(tmp_path / "m.gif") as gif:
+        for k in range(gif.n_frames):
+            gif.seek(k)
+            durations.append(gif.info["duration"])
+    assert len(durations) == n
+    starts = np.concatenate([[0.0], np.cumsum(durations)])  # [ms]
+    assert np.max(np.abs(starts - 1000.0 * np.arange(n + 1) / fps)) <= 5.0

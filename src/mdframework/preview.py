@@ -286,7 +286,7 @@ def animate(
 
         writer: Any
         if fmt == "gif":
-            writer = PillowWriter(fps=fps)
+            writer = _real_time_gif(PillowWriter)(fps=fps)
         elif fmt == "mp4":
             writer = FFMpegWriter(fps=fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"])
             plt.rcParams["animation.ffmpeg_path"] = _ffmpeg()
@@ -315,6 +315,29 @@ def animate(
                 advance(1)
         plt.close(fig)
     return int(times.size)
+
+
+def _real_time_gif(pillow_writer: Any) -> Any:
+    """A subclass of matplotlib's ``PillowWriter`` whose GIF plays in real time: GIF stores
+    frame durations in whole centiseconds, so one duration for all frames (``int(1000 / fps)``
+    ms, 80 instead of 83.3 at 12 fps) ran the animation up to 6 % fast; each frame here lasts
+    until the next one's time, rounded to a centisecond, so frame ``k`` starts within 5 ms of
+    ``k / fps``."""
+
+    class RealTimeGif(pillow_writer):  # type: ignore[misc]
+        def finish(self) -> None:
+            frames = self._frames
+            edges = np.round(np.arange(len(frames) + 1) * 100.0 / self.fps)  # [cs]
+            durations = [10 * int(d) for d in np.diff(edges)]  # [ms]
+            frames[0].save(
+                self.outfile,
+                save_all=True,
+                append_images=frames[1:],
+                duration=durations,
+                loop=0,
+            )
+
+    return RealTimeGif
 
 
 def plot_stills(
