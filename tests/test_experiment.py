@@ -713,3 +713,42 @@ def test_a_random_forest_experiment_repeats_exactly(kinect_dataset: Path, tmp_pa
             exp.run_experiment(cfg, tmp_path / f"o{i}", progress=False)
         runs.append([(tmp_path / f"o{i}" / n).read_text() for n in ("summary.json", "report.md")])
     assert runs[0] == runs[1]
+
+
+def test_every_confusion_matrix_is_captioned(
+    kinect_dataset: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Within-source and train/test confusion matrices both carry the dataset, the classifier's
+    input (features or Doppler histograms), the classifier and the selection in their captions
+    (the train/test one had none), and the train/test title names the selections in words."""
+    from mdframework import figures
+
+    captions: dict[str, str] = {}
+    titles: dict[str, str] = {}
+
+    def record(path: Path, *args: object, caption: str = "", title: str = "") -> None:
+        captions[Path(path).name] = caption
+        titles[Path(path).name] = title
+
+    monkeypatch.setattr(figures, "plot_confusion", record)
+    body = (
+        '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\n'
+        '[train_test]\ntrain = { subject = ["s01", "s02"] }\ntest = { subject = "s03" }\n'
+    )
+    e = _experiment(kinect_dataset, tmp_path, body)
+    with pytest.warns(exp.ExperimentWarning):  # punch: one subject
+        exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+    assert set(captions) == {"within_kinect_confusion.png", "train_test_confusion.png"}
+    for name, caption in captions.items():
+        parts = (
+            "dataset dataset (",
+            "input features",
+            'classifier {"kind": "knn"',
+            "selection none",
+        )
+        for part in parts:
+            assert part in caption, (name, caption)
+    # the selections in words, not as Python dictionaries
+    assert titles["train_test_confusion.png"] == (
+        "train subject = s01 or s02 -> test subject = s03"
+    )

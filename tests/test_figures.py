@@ -172,3 +172,91 @@ def test_a_long_caption_is_wrapped_inside_the_figure(tmp_path: Path) -> None:
     fig.draw(renderer)
     box = text.get_window_extent(renderer)
     assert 0 <= box.x0 and box.x1 <= fig.bbox.x1 and box.y0 >= 0
+
+
+def test_radar_products_carry_the_caption_and_the_figure_options(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """range_doppler.png and point_cloud.png are captioned like the run's other figures, and
+    the range-Doppler map is drawn in the ``[figures]`` colour map and dynamic range."""
+    from mdframework import output
+    from mdframework.progress import QUIET
+
+    calls: dict[str, dict[str, object]] = {}
+
+    def record(name: str) -> object:
+        return lambda path, *args, **kwargs: calls.__setitem__(name, kwargs)
+
+    for name in ("plot_spectrogram", "plot_range_doppler", "plot_point_cloud"):
+        monkeypatch.setattr(output, name, record(name))
+    maps = np.ones((3, 4, 5))
+    maps[1, 2, 3] = 100.0  # the strongest map, and the frame of the points
+    arrays = {
+        "spectrogram_db": np.zeros((4, 3)),
+        "time_s": np.arange(3.0),
+        "velocity_mps": np.linspace(-1.0, 1.0, 4),
+        "doppler_hz": np.linspace(-10.0, 10.0, 4),
+        "range_doppler": maps,
+        "range_doppler_range_m": np.arange(5.0),
+        "range_doppler_velocity_mps": np.linspace(-1.0, 1.0, 4),
+        "points": np.array([[1.0, 0.1, 0.0, 3.0, 0.0, 1.0, 20.0]]),
+    }
+    look = {"dynamic_range_db": 25.0, "velocity_span": "full", "colormap": "magma"}
+    output._plot_run(tmp_path, arrays, "walk — cmu", "fmcw 77 GHz; aspect 0°", look, QUIET)
+    rd, cloud = calls["plot_range_doppler"], calls["plot_point_cloud"]
+    assert rd["caption"] == cloud["caption"] == "fmcw 77 GHz; aspect 0°"
+    assert rd["title"] == cloud["title"] == "walk — cmu frame 1"
+    assert rd["colormap"] == "magma" and rd["dynamic_range_db"] == 25.0
+
+
+def test_coinciding_records_of_two_activities_both_stay_visible(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Quantised features (coarse Doppler bins) put many records on one point: each activity's
+    records there are one mark of area proportional to their number, the larger drawn behind,
+    so the activity with more records there is not hidden under the other's (RadHAR's jump
+    records all lay under walk records)."""
+    from mdframework import figures
+
+    drawn: list[object] = []
+    monkeypatch.setattr(figures, "save", lambda fig, path, caption="", **kw: drawn.append(fig))
+    x = np.array([0.0] * 5 + [0.0] * 2 + [1.0])
+    y = np.array([0.6] * 5 + [0.6] * 2 + [2.0])
+    labels = np.array(["jump"] * 5 + ["walk"] * 3)
+    groups = np.array(["radhar"] * 8)
+    figures.plot_feature_scatter(tmp_path / "s.png", x, y, labels, groups, "a", "b")
+    (fig,) = drawn
+    marks = []  # (x, y, area, zorder) of every mark
+    for coll in fig.axes[0].collections:
+        for (px, py), area in zip(
+            coll.get_offsets(),
+            np.broadcast_to(coll.get_sizes(), len(coll.get_offsets())),
+            strict=True,
+        ):
+            marks.append((float(px), float(py), float(area), coll.get_zorder()))
+    at = sorted((m for m in marks if (m[0], m[1]) == (0.0, 0.6)), key=lambda m: m[3])
+    assert [m[2] for m in at] == [70.0, 28.0]  # jump's 5 records behind walk's 2
+    assert sorted(m[2] for m in marks if m[0] == 1.0) == [14.0]
+    names = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert names == ["jump (radhar)", "walk (radhar)"]
+
+
+def test_side_by_side_panels_share_a_velocity_axis_that_holds_both(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A run at 5 m/s beside a walk at 1 m/s: the shared axis covers both panels' power (the
+    last panel's own span used to set it for both, cutting the first panel's)."""
+    from mdframework import figures
+
+    saved: list[object] = []
+    monkeypatch.setattr(figures, "save", lambda fig, path, caption="", **kw: saved.append(fig))
+    fast, velocity = _tone_spectrogram(5.0)
+    slow, _ = _tone_spectrogram(1.0)
+    time = np.arange(fast.shape[1]) * 0.01
+    figures.plot_spectrogram_panels(
+        tmp_path / "p.png", [(fast, time, velocity, "run"), (slow, time, velocity, "walk")]
+    )
+    (fig,) = saved
+    lo, hi = velocity_limits(fast, velocity, "auto", 40.0)
+    for ax in fig.axes[:2]:
+        assert ax.get_ylim() == pytest.approx((lo, hi))  # the run's span holds the walk's

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -181,3 +182,83 @@ def test_mdf_show_refuses_an_instant_outside_the_record(
     err = capsys.readouterr().err
     assert code == 2 and "--at: 7 s is outside the record" in err
     assert not out.exists()
+
+
+def test_left_and_right_limbs_are_drawn_in_their_own_colours() -> None:
+    """Every segment ending on an ``l_`` joint has one colour, every ``r_`` one another, the
+    trunk and head a third, in the top view and in the 3-D view, and the 3-D legend names
+    both sides: a mirrored body must look mirrored."""
+    from matplotlib.colors import to_hex
+
+    from mdframework.skeleton import CANONICAL_SEGMENTS
+
+    body = walker()
+    scene = _Scene(body, RADAR)
+    with style() as plt:
+        fig, _ = _figure(plt, scene, spec_for(body))
+        for lines in (scene.top_lines, scene.body_lines):
+            colour: dict[str, set[str]] = {"l_": set(), "r_": set(), "": set()}
+            for line, (_, distal) in zip(lines, CANONICAL_SEGMENTS, strict=True):
+                side = distal[:2] if distal[:2] in ("l_", "r_") else ""
+                colour[side].add(to_hex(line.get_color()))
+            assert all(len(c) == 1 for c in colour.values()), colour
+            assert len(set.union(*colour.values())) == 3, colour
+        names = [t.get_text() for t in scene.body_ax.get_legend().get_texts()]
+        assert "left" in names and "right" in names
+        plt.close(fig)
+
+
+def test_the_spectrogram_axis_spans_the_whole_record(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """STFT frames are centred from half a window after the record's start: the spectrogram's
+    time axis still runs from the record's first to its last instant, so the animation's cursor
+    and the stills' instants near the ends stay on it (the cursor left the axes for the first
+    and last half window; stills at the ends widened the axis by matplotlib's margins)."""
+    from mdframework import preview
+
+    body = walker(frame_rate=10.0)  # 0 .. 1 s
+    time = np.linspace(0.1, 0.9, 17)  # frames 0.05 s apart: cells 0.075 .. 0.925 s
+    velocity = np.linspace(-5.0, 5.0, 101)
+    spec = SpectrogramView(np.zeros((velocity.size, time.size)), time, velocity)
+    with style() as plt:
+        fig, cursor = _figure(plt, _Scene(body, RADAR), spec)
+        assert cursor.axes.get_xlim() == pytest.approx((0.0, 1.0))
+        plt.close(fig)
+    saved: list[Any] = []
+    monkeypatch.setattr(preview, "save", lambda fig, path, caption="", **kw: saved.append(fig))
+    plot_stills(tmp_path / "s.png", body, RADAR, spec, [0.0, 1.0])
+    (ax,) = [a for a in saved[0].axes if a.get_xlabel() == "time [s]"]
+    assert ax.get_xlim() == pytest.approx((0.0, 1.0))
+
+
+def test_the_body_views_axis_names_stay_out_of_the_spectrogram() -> None:
+    """The 3-D view has no tick labels; its axis names sit against its box, so its "z" does not
+    land on the spectrogram's velocity label beside it (as it did in every animation frame)."""
+    body = walker()
+    scene = _Scene(body, RADAR)
+    with style() as plt:
+        fig, cursor = _figure(plt, scene, spec_for(body))
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        z_name = scene.body_ax.zaxis.label.get_window_extent(renderer)
+        velocity_name = cursor.axes.yaxis.label.get_window_extent(renderer)
+        assert z_name.x1 < velocity_name.x0, (z_name, velocity_name)
+        plt.close(fig)
+
+
+@pytest.mark.parametrize("fps", [12, 7])
+def test_gif_frames_start_at_their_own_times(tmp_path: Path, fps: int) -> None:
+    """GIF durations are whole centiseconds: frame k starts within 5 ms of k / fps, so the
+    animation plays in real time (at the default 12 fps every frame lasted 80 ms instead of
+    83.3, and the walk ran 4 % fast)."""
+    body = walker(duration=1.0)
+    n = animate(tmp_path / "m.gif", body, RADAR, spec_for(body), fps=fps)
+    durations = []
+    with Image.open(tmp_path / "m.gif") as gif:
+        for k in range(gif.n_frames):
+            gif.seek(k)
+            durations.append(gif.info["duration"])
+    assert len(durations) == n
+    starts = np.concatenate([[0.0], np.cumsum(durations)])  # [ms]
+    assert np.max(np.abs(starts - 1000.0 * np.arange(n + 1) / fps)) <= 5.0

@@ -154,6 +154,15 @@ class CrossSourceConfig(StrictModel):
 Selector = dict[str, str | list[str]]
 
 
+def selector_words(selector: Selector) -> str:
+    """A record selector in words for titles and the report: ``{source = 'kinect', subject =
+    ['s01', 's02']}`` -> ``source = kinect, subject = s01 or s02``."""
+    return ", ".join(
+        f"{column} = {' or '.join(value) if isinstance(value, list) else value}"
+        for column, value in selector.items()
+    )
+
+
 class TrainTestConfig(StrictModel):
     """Train on one selection of records and test on another, selected by any record column
     (subject, recording, source, dataset, group, file, label)."""
@@ -889,7 +898,7 @@ def _report(
     ]
     source = cfg.dataset.config.name if cfg.dataset.config is not None else Path(data_dir).name
     caption = (
-        f"dataset {source} ({len(data.labels)} records); classifier "
+        f"dataset {source} ({len(data.labels)} records); input {cfg.input}; classifier "
         f"{json.dumps(cfg.classifier)}; selection {cfg.selection.method}"
     )
     skipped: list[str] = []  # warnings, given once something else is evaluated
@@ -1039,12 +1048,15 @@ def _report(
             res["classes"],
             res["confusion"],
             None,
-            title=f"train {cfg.train_test.train} -> test {cfg.train_test.test}",
+            title=f"train {selector_words(cfg.train_test.train)} -> test "
+            f"{selector_words(cfg.train_test.test)}",
+            caption=f"{caption}; features {res['subset']}",
         )
         _write_predictions(out / "train_test_predictions.csv", data, res)
         summary["train_test"] = _without_predictions(res)
         report += [
-            f"## Train on {cfg.train_test.train}, test on {cfg.train_test.test}",
+            f"## Train on {selector_words(cfg.train_test.train)}, test on "
+            f"{selector_words(cfg.train_test.test)}",
             "",
             f"Balanced accuracy {res['balanced_accuracy']:.3f}; features {res['subset']}; "
             f"training {res['train_counts']}, test {res['test_counts']}.",

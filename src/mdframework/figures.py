@@ -321,6 +321,18 @@ def plot_confusion(
         save(fig, path, caption, title=title)
 
 
+def scatter_marks(
+    x: NDArray[np.float64], y: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
+    """The distinct points of ``(x, y)`` (n,) and how many records each stands for: ``(xs, ys,
+    counts)``, each (n_distinct,), in first-seen order. Features of coarse Doppler bins (a
+    frame-based sensor's, RadHAR's) put many records on one point."""
+    xy = np.column_stack([x, y])
+    unique, first, counts = np.unique(xy, axis=0, return_index=True, return_counts=True)
+    order = np.argsort(first, kind="stable")
+    return unique[order, 0], unique[order, 1], counts[order].astype(np.int64)
+
+
 def plot_feature_scatter(
     path: Path,
     x: NDArray[np.float64],
@@ -333,26 +345,54 @@ def plot_feature_scatter(
     title: str = "",
     caption: str = "",
 ) -> None:
-    """Scatter plot of two features [m/s], colour = activity, marker = source group."""
+    """Scatter plot of two features [m/s], colour = activity, marker = source group. Records of
+    one activity and group at the same point are one mark of area proportional to their number,
+    and larger marks are drawn behind smaller ones, so an activity whose records coincide with
+    another's stays visible (:func:`scatter_marks`)."""
+    from matplotlib.lines import Line2D
+
     markers = "o^sDvP*X"
+    base = 14.0  # marker area of one record [pt^2]
+    stacked = False
     with _rc_context():
         fig, ax = subplots(figsize=(6, 4.5), layout="constrained")
+        handles = []
         for gi, group in enumerate(sorted(set(groups.tolist()))):
             for li, label in enumerate(sorted(set(labels.tolist()))):
                 sel = (groups == group) & (labels == label)
-                if np.any(sel):
+                if not np.any(sel):
+                    continue
+                marker = markers[gi % len(markers)]
+                xs, ys, counts = scatter_marks(x[sel], y[sel])
+                stacked = stacked or bool(np.any(counts > 1))
+                for n in np.unique(counts):
                     ax.scatter(
-                        x[sel],
-                        y[sel],
-                        s=14,
-                        marker=markers[gi % len(markers)],
+                        xs[counts == n],
+                        ys[counts == n],
+                        s=base * float(n),
+                        marker=marker,
+                        color=f"C{li}",
+                        alpha=0.7,
+                        zorder=2.0 + 1.0 / float(n),  # more records: further behind
+                    )
+                handles.append(
+                    Line2D(
+                        [],
+                        [],
+                        ls="",
+                        marker=marker,
+                        markersize=float(np.sqrt(base)),
                         color=f"C{li}",
                         alpha=0.7,
                         label=f"{label} ({group})",
                     )
+                )
         ax.set_xlabel(f"{x_name} [m/s]")
         ax.set_ylabel(f"{y_name} [m/s]")
-        ax.legend()
+        ax.legend(handles=handles)
+        if stacked:
+            note = "marker area: number of records at the point"
+            caption = f"{caption}; {note}" if caption else note
         save(fig, path, caption, title=title)
 
 
@@ -425,7 +465,8 @@ def plot_spectrogram_panels(
 ) -> None:
     """Save spectrograms side by side, each panel ``(spectrogram_db (n_doppler, n_frames),
     time [s], velocity [m/s] (+ approaching), title)``, each in dB re its own peak on one colour
-    scale (see :func:`draw_spectrogram`)."""
+    scale (see :func:`draw_spectrogram`). The panels share one velocity axis: the union of
+    their own limits, so no panel's power is cut off by another's span."""
     with _rc_context():
         fig, axes = subplots(
             1, len(panels), figsize=(5 * len(panels), 4), sharey=True, layout="constrained"
@@ -445,6 +486,11 @@ def plot_spectrogram_panels(
             ax.set_title(title)
             if k:
                 ax.set_ylabel("")
+        limits = [
+            velocity_limits(db, velocity, velocity_span, dynamic_range_db)
+            for db, _, velocity, _ in panels
+        ]
+        axes[0].set_ylim(min(lo for lo, _ in limits), max(hi for _, hi in limits))
         fig.colorbar(im, ax=list(axes), label="power [dB re peak]")
         save(fig, path, caption)
 

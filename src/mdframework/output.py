@@ -285,7 +285,14 @@ def _plot_run(
         )
     if "points" in arrays or "range_doppler" in arrays:
         progress.stage("drawing the radar's products")
-        plot_point_products(stage, arrays, title)
+        plot_point_products(
+            stage,
+            arrays,
+            title,
+            caption=caption,
+            dynamic_range_db=look.get("dynamic_range_db", 40.0),
+            colormap=look.get("colormap", "viridis"),
+        )
 
 
 def run_folder(
@@ -309,10 +316,19 @@ def write_points_csv(path: Path, points: np.ndarray) -> None:
             f.write(f"{int(row[0])}," + ",".join(f"{v:.6g}" for v in row[1:]) + "\n")
 
 
-def plot_point_products(stage: Path, arrays: dict[str, np.ndarray], title: str) -> None:
+def plot_point_products(
+    stage: Path,
+    arrays: dict[str, np.ndarray],
+    title: str,
+    *,
+    caption: str = "",
+    dynamic_range_db: float = 40.0,
+    colormap: str = "viridis",
+) -> None:
     """Figures of a waveform's range-Doppler maps and point clouds, when it made them:
     ``range_doppler.png`` / ``point_cloud.png`` of the frame with the most points (the strongest
-    map when there are none)."""
+    map when there are none), with the run's ``caption``; the map in ``colormap``, the top
+    ``dynamic_range_db`` in colour (the ``[figures]`` options)."""
     points = arrays.get("points")
     maps = arrays.get("range_doppler")
     frame = None
@@ -328,12 +344,16 @@ def plot_point_products(stage: Path, arrays: dict[str, np.ndarray], title: str) 
             arrays["range_doppler_range_m"],
             arrays["range_doppler_velocity_mps"],
             title=f"{title} frame {frame}".strip(),
+            caption=caption,
+            dynamic_range_db=dynamic_range_db,
+            colormap=colormap,
         )
     if points is not None and len(points) and frame is not None:
         plot_point_cloud(
             stage / "point_cloud.png",
             points[points[:, 0] == frame],
             title=f"{title} frame {frame}".strip(),
+            caption=caption,
         )
 
 

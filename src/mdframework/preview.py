@@ -43,6 +43,19 @@ FORMATS = ("gif", "mp4")
 ANIMATION_DPI = 80
 #: Side of the 3-D body view [m].
 BODY_BOX_M = 2.2
+#: Colour of a canonical segment by the body side of its distal joint (colour-blind-safe cycle:
+#: blue left, dark orange right, dark grey trunk and head), so left and right limbs differ.
+SIDE_COLOURS = {"left": "C0", "right": "C5", "centre": "C3"}
+
+
+def segment_side(distal: str) -> str:
+    """``"left"``, ``"right"`` or ``"centre"``: the body side of a segment, by the canonical name
+    of its distal joint (``l_...``, ``r_...``, or neither)."""
+    if distal.startswith("l_"):
+        return "left"
+    if distal.startswith("r_"):
+        return "right"
+    return "centre"
 
 
 class PreviewError(MdfError):
@@ -113,9 +126,11 @@ class _Scene:
         self.radar = np.asarray(radar_position, dtype=np.float64)
         if body.joint_names == CANONICAL_JOINTS:
             self.segments = [(body.index(a), body.index(b)) for a, b in CANONICAL_SEGMENTS]
+            self.sides = [segment_side(b) for _, b in CANONICAL_SEGMENTS]
             self.centre: int | None = body.index("base")
         else:
             self.segments = []
+            self.sides = []
             self.centre = None
         self.top_lines: list[Any] = []
         self.body_lines: list[Any] = []
@@ -145,7 +160,7 @@ class _Scene:
         ax.plot(path[:, 0], path[:, 1], ls="--", lw=1.0, color="0.5", label="path")
         ax.plot(*self.radar[:2], marker="^", ms=9, color="C1", ls="", label="radar")
         (self.los_top,) = ax.plot([], [], lw=1.0, color="C1", label="line of sight")
-        self.top_lines = [ax.plot([], [], lw=1.5, color="C0")[0] for _ in self.segments]
+        self.top_lines = [ax.plot([], [], lw=1.5, color=SIDE_COLOURS[s])[0] for s in self.sides]
         (self.top_points,) = ax.plot([], [], ls="", marker=".", ms=3, color="C0")
         xy = np.vstack([path[:, :2], self.radar[None, :2]])
         xy = xy[np.all(np.isfinite(xy), axis=1)]
@@ -161,17 +176,26 @@ class _Scene:
 
     def draw_body(self, ax: Any) -> None:
         """3-D body view that follows the person."""
-        self.body_lines = [ax.plot([], [], [], lw=2.0, color="C0")[0] for _ in self.segments]
-        (self.body_points,) = ax.plot([], [], [], ls="", marker="o", ms=2.5, color="C0")
-        (self.los_body,) = ax.plot([], [], [], lw=1.0, color="C1", label="toward the radar")
+        self.body_lines = []
+        labelled = {"centre"}  # the legend names the sides once each
+        for side in self.sides:
+            label = None if side in labelled else side
+            labelled.add(side)
+            (line,) = ax.plot([], [], [], lw=2.0, color=SIDE_COLOURS[side], label=label)
+            self.body_lines.append(line)
+        (self.body_points,) = ax.plot([], [], [], ls="", marker="o", ms=2.5, color="C3")
+        (self.los_body,) = ax.plot(
+            [], [], [], lw=1.0, ls="--", color="C1", label="toward the radar"
+        )
         ax.set_box_aspect((1.0, 1.0, 1.0))
         # the box follows the person: tick labels would change every frame, so none are drawn
         ax.set_xticklabels([])
         ax.set_yticklabels([])
         ax.set_zticklabels([])
-        ax.set_xlabel("x")
-        ax.set_ylabel("y")
-        ax.set_zlabel("z")
+        # no tick labels to clear: the axis names sit against the box, not in the next panel
+        ax.set_xlabel("x", labelpad=-12)
+        ax.set_ylabel("y", labelpad=-12)
+        ax.set_zlabel("z", labelpad=-12)
         ax.set_title(f"body (box {BODY_BOX_M:g} m)")
         ax.legend(loc="upper left", fontsize=7)
         self.body_ax = ax
@@ -207,14 +231,17 @@ def _figure(plt: Any, scene: _Scene, spec: SpectrogramView) -> tuple[Any, Any]:
     scene.draw_top(fig.add_subplot(grid[0]))
     scene.draw_body(fig.add_subplot(grid[1], projection="3d"))
     ax = fig.add_subplot(grid[2])
-    im = _spectrogram(ax, spec)
+    im = _spectrogram(ax, spec, scene.body)
     fig.colorbar(im, ax=ax, label="power [dB re peak]")
-    cursor = ax.axvline(float(spec.time[0]), color="white", lw=1.2)
+    cursor = _time_mark(ax, float(spec.time[0]), lw=1.2)
     return fig, cursor
 
 
-def _spectrogram(ax: Any, spec: SpectrogramView) -> Any:
-    return draw_spectrogram(
+def _spectrogram(ax: Any, spec: SpectrogramView, body: Skeleton) -> Any:
+    """The spectrogram, its time axis covering the whole record (the body's first to last
+    frame) as well as the frames: the first frame is centred half a window after the record's
+    start, and a cursor or an instant before it must stay on the axes."""
+    im = draw_spectrogram(
         ax,
         spec.power_db,
         spec.time,
@@ -223,6 +250,18 @@ def _spectrogram(ax: Any, spec: SpectrogramView) -> Any:
         velocity_span=spec.velocity_span,
         colormap=spec.colormap,
     )
+    lo, hi = ax.get_xlim()
+    ax.set_xlim(min(lo, float(body.time[0])), max(hi, float(body.time[-1])))
+    return im
+
+
+def _time_mark(ax: Any, t: float, lw: float) -> Any:
+    """A vertical line at ``t``: white with a dark edge, seen on the colour map and on the
+    blank axes outside the frames."""
+    from matplotlib import patheffects
+
+    edge = [patheffects.Stroke(linewidth=lw + 1.2, foreground="0.2"), patheffects.Normal()]
+    return ax.axvline(t, color="white", lw=lw, path_effects=edge)
 
 
 def animate(
@@ -247,7 +286,7 @@ def animate(
 
         writer: Any
         if fmt == "gif":
-            writer = PillowWriter(fps=fps)
+            writer = _real_time_gif(PillowWriter)(fps=fps)
         elif fmt == "mp4":
             writer = FFMpegWriter(fps=fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"])
             plt.rcParams["animation.ffmpeg_path"] = _ffmpeg()
@@ -278,6 +317,29 @@ def animate(
     return int(times.size)
 
 
+def _real_time_gif(pillow_writer: Any) -> Any:
+    """A subclass of matplotlib's ``PillowWriter`` whose GIF plays in real time: GIF stores
+    frame durations in whole centiseconds, so one duration for all frames (``int(1000 / fps)``
+    ms, 80 instead of 83.3 at 12 fps) ran the animation up to 6 % fast; each frame here lasts
+    until the next one's time, rounded to a centisecond, so frame ``k`` starts within 5 ms of
+    ``k / fps``."""
+
+    class RealTimeGif(pillow_writer):  # type: ignore[misc]
+        def finish(self) -> None:
+            frames = self._frames
+            edges = np.round(np.arange(len(frames) + 1) * 100.0 / self.fps)  # [cs]
+            durations = [10 * int(d) for d in np.diff(edges)]  # [ms]
+            frames[0].save(
+                self.outfile,
+                save_all=True,
+                append_images=frames[1:],
+                duration=durations,
+                loop=0,
+            )
+
+    return RealTimeGif
+
+
 def plot_stills(
     path: Path,
     body: Skeleton,
@@ -306,9 +368,9 @@ def plot_stills(
             scene.update(float(body.time[k]))
             ax.set_title(f"t = {body.time[k]:.2f} s")
         ax = fig.add_subplot(grid[1, :])
-        im = _spectrogram(ax, spec)
+        im = _spectrogram(ax, spec, body)
         for i, k in enumerate(frames):
-            ax.axvline(float(body.time[k]), color="white", lw=1.0)
+            _time_mark(ax, float(body.time[k]), lw=1.0)
             ax.annotate(
                 f"{i + 1}",
                 (float(body.time[k]), 1.0),

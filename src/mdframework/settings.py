@@ -443,8 +443,9 @@ COLORMAPS = frozenset(
 
 
 class FiguresConfig(StrictModel):
-    """How a run's figures show the data (``spectrogram.png``, ``range_time.png`` and the
-    motion preview of ``mdf show``). The arrays in ``result.npz`` are not affected."""
+    """How a run's figures show the data (``spectrogram.png``, ``range_time.png``,
+    ``range_doppler.png`` and the motion preview of ``mdf show``). The arrays in ``result.npz``
+    are not affected."""
 
     enabled: bool = Field(
         True,
