@@ -188,6 +188,7 @@ def wind_process_groups(
         if hi - lo <= rows:
             u = gaussian_doppler_process(rng, hi - lo, n_grid, rate, spread_hz)
             yield lo, hi, u if idx is None else u[:, idx]
+            del u  # not held beside the next group
             continue
         # the draw of the series lo:hi takes all their real parts, then all their imaginary
         # parts: a copy of the generator reads the real parts while rng, moved past them,
@@ -203,6 +204,7 @@ def wind_process_groups(
             u = _shaped(white, rate, spread_hz)
             del white
             yield a, b, u if idx is None else u[:, idx]
+            del u
 
 
 class GroundClutter(Effect):
