@@ -9,7 +9,14 @@ time of the simulation, the peak RSS [MiB] and the time exponent between the sho
 longest record (``log(t_long / t_short) / log(len_long / len_short)``), of the wall time and of
 the CPU time (the one to read on a shared machine, where other jobs stretch wall times).
 
+``--effects`` adds ground clutter, multipath, a static scene of 10 reflectors and (on the LFM
+paths; the FMCW preset adds its own receiver noise) noise; ``--motion walk`` replaces the
+treadmill by the Boulic walker walking straight away from the radar (10 m at the start, 0.88 m/s),
+so the range span the tracking gate covers, and with it the clutter's patch count, grows with
+the record.
+
     .venv/bin/python benchmarks/bench_memory.py [--lengths 6 600] [--paths analytic raw fmcw]
+        [--effects] [--motion treadmill|walk]
 """
 
 from __future__ import annotations
@@ -27,42 +34,62 @@ import json, resource, sys, time
 sys.path.insert(0, {bench!r})
 from bench_pipeline import walking_motion
 from mdframework.config import validate_run_config
-from mdframework.pipeline import build_stages, simulate_motion
+from mdframework.pipeline import build_stages, load_motion, simulate_motion
 
-length, path = float(sys.argv[1]), sys.argv[2]
-motion = walking_motion(duration=length + 0.5)
+length, path, effects, walk = float(sys.argv[1]), sys.argv[2], sys.argv[3] == "1", sys.argv[4]
 if path == "fmcw":  # the IWR1443 preset (maximum range 10.5 m): the radar 6 m away
     radar, where = {{"kind": "fmcw", "preset": "iwr1443_short_range_3d"}}, [6.0, 0.0, 1.0]
 else:
     radar, where = {{"kind": "lfm", "path": path}}, [12.0, 0.0, 1.5]
-cfg = validate_run_config({{
+spec = {{
     "motion": {{"kind": "point_targets", "length": 1.0, "targets": [{{"position": [1, 0, 0]}}],
                "duration": length}},
     "scatterers": {{"kind": "ellipsoid", "placement": "joints17", "height": 1.8}},
     "radar": radar,
     "scene": {{"radar_position": where, "person": {{"motion": "treadmill"}}}},
-}})
+}}
+if walk == "walk":  # aspect 180: walking straight away from the radar
+    spec["motion"] = {{"kind": "boulic", "height": 1.8, "rv": 1.0, "duration": length}}
+    spec["scatterers"] = {{"kind": "ellipsoid", "placement": "joints17"}}
+    spec["scene"] = {{"radar_position": [10.0, 0.0, 2.0],
+                     "person": {{"motion": "recorded", "position": [0.0, 0.0],
+                                 "aspect_deg": 180.0}}}}
+if effects:
+    spec["effects"] = [
+        {{"kind": "clutter"}}, {{"kind": "multipath"}}, {{"kind": "static_scene", "count": 10}}
+    ] + ([] if path == "fmcw" else [{{"kind": "noise"}}])
+    if path == "fmcw":  # c/(2B) of the preset's sampled sweep, 3.44 GHz
+        spec["effects"][0]["range_resolution"] = 0.0436
+cfg = validate_run_config(spec)
 stages = build_stages(cfg)
+motion = load_motion(stages.source) if walk == "walk" else walking_motion(duration=length + 0.5)
 t0, c0 = time.perf_counter(), time.process_time()
 res = simulate_motion(cfg, stages, motion)
 wall, cpu = time.perf_counter() - t0, time.process_time() - c0
 rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+clutter = [e for e in res.metadata["effects"] if e.get("kind") == "clutter"]
 print(json.dumps({{"wall_s": wall, "cpu_s": cpu, "peak_rss_mib": rss,
-                  "n_pulses": int(res.pulse_times.size)}}))
+                  "n_pulses": int(res.pulse_times.size),
+                  "n_patches": clutter[0]["n_patches"] if clutter else 0}}))
 """
 
 
-def measure(length: float, path: str) -> dict[str, float]:
+def measure(
+    length: float, path: str, effects: bool = False, motion: str = "treadmill"
+) -> dict[str, float]:
     """Wall time and peak RSS of one record in a fresh process."""
     bench = str(Path(__file__).resolve().parent)
     env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+    argv = [str(length), path, str(int(effects)), motion]
     out = subprocess.run(
-        [sys.executable, "-c", CHILD.format(bench=bench), str(length), path],
-        check=True,
+        [sys.executable, "-c", CHILD.format(bench=bench), *argv],
+        check=False,
         capture_output=True,
         text=True,
         env=env,
     )
+    if out.returncode != 0:
+        sys.exit(f"{path} {length:g} s failed:\n{out.stderr[-2000:]}")
     return dict(json.loads(out.stdout.strip().splitlines()[-1]))
 
 
@@ -71,10 +98,15 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--lengths", type=float, nargs="+", default=[6.0, 600.0])
     parser.add_argument("--paths", nargs="+", default=["analytic", "raw"])
+    parser.add_argument("--effects", action="store_true", help="clutter, multipath, ... too")
+    parser.add_argument("--motion", choices=["treadmill", "walk"], default="treadmill")
     args = parser.parse_args()
     report: dict[str, object] = {}
     for path in args.paths:
-        rows = {f"{length:g}s": measure(length, path) for length in args.lengths}
+        rows = {
+            f"{length:g}s": measure(length, path, args.effects, args.motion)
+            for length in args.lengths
+        }
         first, last = rows[f"{args.lengths[0]:g}s"], rows[f"{args.lengths[-1]:g}s"]
         ratio = args.lengths[-1] / args.lengths[0]
         exponent = math.log(last["wall_s"] / first["wall_s"]) / math.log(ratio)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from mdf_antenna import one_way_gain
 from mdf_antenna.antenna import SINC2_HALF_POWER
-from mdf_clutter import GroundClutter
+from mdf_clutter import GroundClutter, clutter
 from mdf_lfm import LfmPulseDoppler
 from mdf_noise import ReceiverNoise
 
@@ -248,6 +248,82 @@ def test_clutter_csr_in_pipeline_and_zero_velocity_bin() -> None:
     mean_power = spec.power.mean(axis=1)
     assert int(np.argmax(mean_power)) in (k0 - 1, k0, k0 + 1)
     assert mean_power[k_target] > 100 * np.median(mean_power)  # the target is still there
+
+
+@pytest.mark.parametrize("power", ["csr", "rcs"])
+def test_clutter_made_a_group_of_patches_at_a_time_equals_all_patches_at_once(
+    power: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Under a tracking gate crossing 25 m (67 patches), the clutter made a few patches at a time
+    is the clutter computed directly from all patches' responses and wind-blown processes at
+    once (the same draws): stationary ``alpha @ g``, wind-blown ``sum_k g_k u_k``, each scaled to
+    its share of the clutter power."""
+    monkeypatch.setattr(clutter, "WIND_GRID_VALUES", 3 * 4800)  # groups of 3 patches
+    n, spread, fraction = 4800, 0.2, 0.4
+    cfg = GroundClutter.Config(
+        power=power, csr_db=3.0, rcs_m2=0.7, wind_fraction=fraction, spread_mps=spread
+    )
+    gate = np.linspace(15.0, 40.0, n)
+    ctx = dataclasses.replace(clutter_context(15.0, n, seed=5), gate_range=gate)
+    signal = np.exp(2j * np.pi * 40.0 * ctx.pulse_times) * (1.0 + np.arange(n) / n)
+    out = GroundClutter(cfg).apply(Received(signal.copy()), ctx).signal
+
+    ref = dataclasses.replace(ctx, rng=np.random.default_rng(5))
+    eff = GroundClutter(cfg)
+    ranges, g = eff.patch_responses(ref)
+    k = ranges.size
+    assert k == 67
+    alpha = (ref.rng.standard_normal(k) + 1j * ref.rng.standard_normal(k)) / np.sqrt(2)
+    rate = 1.0 / np.min(np.diff(ref.pulse_times))  # the grid: the shortest pulse interval
+    u = clutter.gaussian_doppler_process(ref.rng, k, n, rate, 2 * spread / LAM)
+    stationary, wind = alpha @ g, np.sum(g * u, axis=0)
+    if power == "csr":
+        p_c = np.mean(np.abs(signal) ** 2) * 10 ** (3.0 / 10)
+    else:  # patches every half resolution cell
+        p_c = 0.7 * 0.5 * np.sum(np.mean(np.abs(g) ** 2, axis=1))
+    expected = (
+        signal
+        + stationary * np.sqrt((1 - fraction) * p_c / np.mean(np.abs(stationary) ** 2))
+        + wind * np.sqrt(fraction * p_c / np.mean(np.abs(wind) ** 2))
+    )
+    np.testing.assert_allclose(out, expected, rtol=1e-12, atol=0)
+
+
+def test_wind_processes_in_groups_are_the_processes_made_at_once() -> None:
+    """Chirps in frames with gaps (a grid longer than the pulses): the wind-blown processes made
+    one or two series at a time are bitwise those made a chunk at a time, and the generator
+    ends where it did."""
+    frame_t = (np.arange(12)[:, None] * 300 + np.arange(64)[None, :]) / 2400.0
+    t = frame_t.ravel()
+    at_once, grouped = np.random.default_rng(3), np.random.default_rng(3)
+    whole = clutter.wind_processes(at_once, 7, t, 2400.0, 20.0)
+    parts = list(clutter.wind_process_groups(grouped, 7, t, 2400.0, 20.0, group_values=5000))
+    assert [(lo, hi) for lo, hi, _ in parts] == [(i, i + 1) for i in range(7)]
+    assert np.array_equal(np.concatenate([u for _, _, u in parts]), whole)
+    assert grouped.standard_normal() == at_once.standard_normal()
+
+
+def test_clutter_memory_does_not_grow_with_the_patch_count(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A record of 8000 pulses with 127 clutter patches: the clutter's peak memory stays at a few
+    dozen slow-time signals (it held every patch's response and wind-blown process, 127 of each
+    and their product, over 48 MB)."""
+    import tracemalloc
+
+    monkeypatch.setattr(clutter, "WIND_GRID_VALUES", 2 * 8000)
+    n = 8000
+    ctx = dataclasses.replace(clutter_context(15.0, n), gate_range=np.linspace(15.0, 70.0, n))
+    eff = GroundClutter(GroundClutter.Config(csr_db=0.0))
+    data = Received(np.ones(n, complex))
+    tracemalloc.start()
+    try:
+        eff.apply(data, ctx)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert eff.describe()["n_patches"] == 127
+    assert peak < 40 * n * 16  # 40 complex slow-time signals: 5 MB
 
 
 def test_clutter_with_a_radar_without_bandwidth_is_refused_before_any_pulse() -> None:

@@ -38,7 +38,9 @@ The clutter is added to ``Received.signal``; a range-time map, if any, is passed
 
 from __future__ import annotations
 
+import copy
 import dataclasses
+from collections.abc import Iterator
 from typing import Any, Literal
 
 import numpy as np
@@ -113,7 +115,13 @@ def gaussian_doppler_process(
     white = rng.standard_normal((n_series, n_samples)) + 1j * rng.standard_normal(
         (n_series, n_samples)
     )
-    f = np.fft.fftfreq(n_samples, d=1.0 / prf)
+    return _shaped(white, prf, spread_hz)
+
+
+def _shaped(white: ComplexArray, prf: float, spread_hz: float) -> ComplexArray:
+    """Rows of complex white noise (n, n_samples) shaped to the Gaussian spectrum and scaled to
+    unit mean power (:func:`gaussian_doppler_process`)."""
+    f = np.fft.fftfreq(white.shape[1], d=1.0 / prf)
     psd = np.exp(-0.5 * (f / spread_hz) ** 2)
     shaped = np.fft.ifft(np.fft.fft(white, axis=1) * np.sqrt(psd), axis=1)
     power = np.mean(np.abs(shaped) ** 2, axis=1, keepdims=True)
@@ -138,23 +146,65 @@ def wind_processes(
     times faster than a length of large prime factors). ``prf`` [Hz] serves fewer than two
     pulses. Returns (n_series, n_pulses)."""
     t = np.asarray(times, dtype=np.float64)
-    step = float(np.min(np.diff(t))) if t.size > 1 else 0.0
-    if not step > 0.0:
-        return gaussian_doppler_process(rng, n_series, t.size, prf, spread_hz)
-    # half-way rounds up, always: np.rint's half to even would give two chirps of a frame
-    # that sits half a step off the grid one sample, and the next two samples 2 steps apart
-    idx = np.floor((t - t[0]) / step + 0.5).astype(np.int64)
-    n_grid = int(idx[-1]) + 1
-    if n_grid != t.size:  # pulses with gaps: a grid of a length whose FFT is fast (2, 3, 5)
-        from scipy.fft import next_fast_len
-
-        n_grid = next_fast_len(n_grid)
-    per_call = max(1, max(WIND_GRID_VALUES, n_series * t.size) // n_grid)
     out = np.empty((n_series, t.size), dtype=np.complex128)
+    for lo, hi, u in wind_process_groups(rng, n_series, t, prf, spread_hz):
+        out[lo:hi] = u
+    return out
+
+
+def wind_process_groups(
+    rng: np.random.Generator,
+    n_series: int,
+    times: FloatArray,
+    prf: float,
+    spread_hz: float,
+    group_values: int | None = None,
+) -> Iterator[tuple[int, int, ComplexArray]]:
+    """:func:`wind_processes` a group of series at a time: yields ``(lo, hi, u)`` with ``u``
+    the series ``lo:hi`` (hi - lo, n_pulses), in order, each group at most ``group_values``
+    grid values (default :data:`WIND_GRID_VALUES`; at least one series), so their memory does
+    not grow with ``n_series``. The values, and the draws from ``rng`` (its state after the
+    last group included), are those of :func:`wind_processes` made at once."""
+    t = np.asarray(times, dtype=np.float64)
+    step = float(np.min(np.diff(t))) if t.size > 1 else 0.0
+    idx: NDArray[np.int64] | None = None
+    if step > 0.0:
+        # half-way rounds up, always: np.rint's half to even would give two chirps of a frame
+        # that sits half a step off the grid one sample, and the next two samples 2 steps apart
+        idx = np.floor((t - t[0]) / step + 0.5).astype(np.int64)
+        n_grid, rate = int(idx[-1]) + 1, 1.0 / step
+        if n_grid != t.size:  # pulses with gaps: a grid of a length whose FFT is fast (2, 3, 5)
+            from scipy.fft import next_fast_len
+
+            n_grid = next_fast_len(n_grid)
+        else:  # evenly spaced: the grid is the pulses
+            idx = None
+        per_call = max(1, max(WIND_GRID_VALUES, n_series * t.size) // n_grid)
+    else:
+        n_grid, rate, per_call = t.size, prf, max(n_series, 1)
+    rows = max(1, (WIND_GRID_VALUES if group_values is None else group_values) // max(n_grid, 1))
     for lo in range(0, n_series, per_call):
         hi = min(lo + per_call, n_series)
-        out[lo:hi] = gaussian_doppler_process(rng, hi - lo, n_grid, 1.0 / step, spread_hz)[:, idx]
-    return out
+        if hi - lo <= rows:
+            u = gaussian_doppler_process(rng, hi - lo, n_grid, rate, spread_hz)
+            yield lo, hi, u if idx is None else u[:, idx]
+            del u  # not held beside the next group
+            continue
+        # the draw of the series lo:hi takes all their real parts, then all their imaginary
+        # parts: a copy of the generator reads the real parts while rng, moved past them,
+        # reads the imaginary parts (and ends where the draw at once would leave it)
+        real = copy.deepcopy(rng)
+        for a in range(lo, hi, rows):  # skip the real parts, a group at a time
+            rng.standard_normal((min(a + rows, hi) - a, n_grid))
+        for a in range(lo, hi, rows):
+            b = min(a + rows, hi)
+            white = real.standard_normal((b - a, n_grid)) + 1j * rng.standard_normal(
+                (b - a, n_grid)
+            )
+            u = _shaped(white, rate, spread_hz)
+            del white
+            yield a, b, u if idx is None else u[:, idx]
+            del u
 
 
 class GroundClutter(Effect):
@@ -188,9 +238,9 @@ class GroundClutter(Effect):
             )
         return SPEED_OF_LIGHT / (2.0 * float(bandwidth))
 
-    def patch_responses(self, context: SceneContext) -> tuple[FloatArray, ComplexArray]:
-        """Patch ranges (n_patches,) [m] and each unit-RCS patch's return at the gate
-        (n_patches, n_pulses) [sqrt(W) per sqrt(m^2)]."""
+    def patch_ranges(self, context: SceneContext) -> FloatArray:
+        """Patch ranges (n_patches,) [m], a random position inside each spacing (drawn from
+        ``context.rng``)."""
         c = self.config
         res = self.resolution(context)
         spacing = c.patch_spacing_m if c.patch_spacing_m is not None else res / 2.0
@@ -199,9 +249,14 @@ class GroundClutter(Effect):
         lo = max(float(gate.min()) - margin, spacing)
         hi = float(gate.max()) + margin
         n_patch = max(int(np.ceil((hi - lo) / spacing)), 1)
-        ranges = lo + (np.arange(n_patch) + context.rng.uniform(size=n_patch)) * spacing
+        return np.asarray(lo + (np.arange(n_patch) + context.rng.uniform(size=n_patch)) * spacing)
+
+    def responses(self, context: SceneContext, ranges: FloatArray) -> ComplexArray:
+        """The return at the gate of a unit-RCS patch at each of ``ranges`` (n,) [m]:
+        (n, n_pulses) [sqrt(W) per sqrt(m^2)]."""
+        gate = np.asarray(context.gate_range, dtype=np.float64)
         n_p = gate.shape[0]
-        resp = np.empty((n_patch, n_p), dtype=np.complex128)
+        resp = np.empty((ranges.size, n_p), dtype=np.complex128)
         for k, r_k in enumerate(ranges):
             out = receive_points(
                 context.waveform,
@@ -213,28 +268,46 @@ class GroundClutter(Effect):
                 signal_only=True,  # e.g. no FMCW point cloud of each patch
             )
             resp[k] = out.signal
-        return ranges, resp
+        return resp
+
+    def patch_responses(self, context: SceneContext) -> tuple[FloatArray, ComplexArray]:
+        """Patch ranges (n_patches,) [m] and each unit-RCS patch's return at the gate
+        (n_patches, n_pulses) [sqrt(W) per sqrt(m^2)] (the whole record's: :meth:`apply`
+        makes them a group of patches at a time)."""
+        ranges = self.patch_ranges(context)
+        return ranges, self.responses(context, ranges)
 
     def apply(self, data: Received, context: SceneContext) -> Received:
-        """The received data plus clutter."""
+        """The received data plus clutter. The patches' responses and wind-blown processes are
+        made a group of patches at a time (:func:`wind_process_groups`) and summed, so memory
+        grows with the pulses, not with the pulses times the patches."""
         c = self.config
         res = self.resolution(context)
         spacing = c.patch_spacing_m if c.patch_spacing_m is not None else res / 2.0
-        ranges, resp = self.patch_responses(context)
-        n_patch = resp.shape[0]
+        ranges = self.patch_ranges(context)
+        n_patch = ranges.size
         sigma_k = c.rcs_m2 * spacing / res
+        rng = context.rng
+        alpha = (rng.standard_normal(n_patch) + 1j * rng.standard_normal(n_patch)) / np.sqrt(2)
+        lam = radar.wavelength(context.carrier_frequency)
+        spread_hz = 2.0 * c.spread_mps / lam
+        n_p = np.shape(context.gate_range)[0]
+        stationary = np.zeros(n_p, dtype=np.complex128)
+        wind = np.zeros(n_p, dtype=np.complex128)
+        patch_power = np.empty(n_patch)  # mean_n |g_k(n)|^2 of each unit-RCS patch
+        groups = wind_process_groups(rng, n_patch, context.pulse_times, context.prf, spread_hz)
+        for lo, hi, u in groups:
+            resp = self.responses(context, ranges[lo:hi])
+            patch_power[lo:hi] = np.mean(np.abs(resp) ** 2, axis=1)
+            for k in range(hi - lo):  # patch after patch: the sums of all patches at once
+                stationary += alpha[lo + k] * resp[k]
+                wind += resp[k] * u[k]
+            del resp, u
         if c.power == "csr":
             p_sig = float(np.mean(np.abs(data.signal) ** 2))
             p_c = p_sig * 10.0 ** (c.csr_db / 10.0)
         else:
-            p_c = float(sigma_k * np.sum(np.mean(np.abs(resp) ** 2, axis=1)))
-        rng = context.rng
-        alpha = (rng.standard_normal(n_patch) + 1j * rng.standard_normal(n_patch)) / np.sqrt(2)
-        stationary = alpha @ resp
-        lam = radar.wavelength(context.carrier_frequency)
-        spread_hz = 2.0 * c.spread_mps / lam
-        u = wind_processes(rng, n_patch, context.pulse_times, context.prf, spread_hz)
-        wind = np.sum(resp * u, axis=0)
+            p_c = float(sigma_k * np.sum(patch_power))
         clutter = _scaled(stationary, (1.0 - c.wind_fraction) * p_c) + _scaled(
             wind, c.wind_fraction * p_c
         )
