@@ -142,9 +142,9 @@ def wind_processes(
     an FMCW radar's chirps (several transmitters in turn, gaps between frames) get the process
     at their own instants, so the slow time of each virtual antenna (every ``n_tx``-th chirp)
     sees the requested spread and frames apart in time are as decorrelated as that time makes
-    them (the grid of such pulses is lengthened to the next length whose FFT is fast, 2 to 3
-    times faster than a length of large prime factors). ``prf`` [Hz] serves fewer than two
-    pulses. Returns (n_series, n_pulses)."""
+    them. The grid is lengthened to the next length whose FFT is fast (the process is circular
+    over the grid, not over the record: up to 5x faster than a length of large prime factors).
+    ``prf`` [Hz] serves fewer than two pulses. Returns (n_series, n_pulses)."""
     t = np.asarray(times, dtype=np.float64)
     out = np.empty((n_series, t.size), dtype=np.complex128)
     for lo, hi, u in wind_process_groups(rng, n_series, t, prf, spread_hz):
@@ -167,18 +167,18 @@ def wind_process_groups(
     last group included), are those of :func:`wind_processes` made at once."""
     t = np.asarray(times, dtype=np.float64)
     step = float(np.min(np.diff(t))) if t.size > 1 else 0.0
-    idx: NDArray[np.int64] | None = None
+    idx: NDArray[np.int64] | slice = slice(None)
     if step > 0.0:
+        from scipy.fft import next_fast_len
+
         # half-way rounds up, always: np.rint's half to even would give two chirps of a frame
         # that sits half a step off the grid one sample, and the next two samples 2 steps apart
-        idx = np.floor((t - t[0]) / step + 0.5).astype(np.int64)
-        n_grid, rate = int(idx[-1]) + 1, 1.0 / step
-        if n_grid != t.size:  # pulses with gaps: a grid of a length whose FFT is fast (2, 3, 5)
-            from scipy.fft import next_fast_len
-
-            n_grid = next_fast_len(n_grid)
-        else:  # evenly spaced: the grid is the pulses
-            idx = None
+        grid = np.floor((t - t[0]) / step + 0.5).astype(np.int64)
+        # evenly spaced pulses are the grid's first samples
+        idx = slice(0, t.size) if int(grid[-1]) + 1 == t.size else grid
+        # a grid of a length whose FFT is fast (factors 2, 3, 5): 4.6x faster for a 10 min
+        # record at 2400 Hz (1,440,001 = 337 x 4273 samples)
+        n_grid, rate = next_fast_len(int(grid[-1]) + 1), 1.0 / step
         per_call = max(1, max(WIND_GRID_VALUES, n_series * t.size) // n_grid)
     else:
         n_grid, rate, per_call = t.size, prf, max(n_series, 1)
@@ -187,7 +187,7 @@ def wind_process_groups(
         hi = min(lo + per_call, n_series)
         if hi - lo <= rows:
             u = gaussian_doppler_process(rng, hi - lo, n_grid, rate, spread_hz)
-            yield lo, hi, u if idx is None else u[:, idx]
+            yield lo, hi, u[:, idx]
             del u  # not held beside the next group
             continue
         # the draw of the series lo:hi takes all their real parts, then all their imaginary
@@ -203,7 +203,7 @@ def wind_process_groups(
             )
             u = _shaped(white, rate, spread_hz)
             del white
-            yield a, b, u if idx is None else u[:, idx]
+            yield a, b, u[:, idx]
             del u
 
 
