@@ -84,6 +84,14 @@ def test_caption_names_source_radar_geometry_and_effects(tmp_path: Path) -> None
     assert tmp_path / "run" / "spectrogram.png" in written
 
 
+def test_a_source_named_as_its_activity_is_named_once() -> None:
+    """Point targets name their activity after their source: the title says it once."""
+    meta = {"motion": {"source": "point_targets", "activity": "point_targets"}}
+    assert run_caption(meta, {})[0] == "point_targets"
+    meta = {"motion": {"source": "cmu", "activity": "walk", "file": "02_01.amc"}}
+    assert run_caption(meta, {})[0] == "walk — cmu 02_01.amc"
+
+
 def test_unknown_colormap_is_a_config_error() -> None:
     data = {"motion": {"kind": "point_targets", "length": 1.0, "targets": []}}
     with pytest.raises(ConfigError, match=r"figures\.colormap: .*unknown colour map 'jett'"):

@@ -507,7 +507,9 @@ def run_caption(
     [m] at the first and last pulse), the scatterer model and the effects that ran."""
     motion = dict(metadata.get("motion", {}))
     source = str(motion.get("source", config.get("motion", {}).get("kind", "?")))
-    what = [str(motion["activity"])] if motion.get("activity") else []
+    # an activity that only repeats the source's name (point targets) is said once
+    activity = str(motion.get("activity") or "")
+    what = [activity] if activity and activity != source else []
     origin = [source]
     if motion.get("file"):
         origin.append(str(motion["file"]))
