@@ -93,6 +93,10 @@ def test_instants_outside_the_record_are_refused() -> None:
     assert check_instants(body, [0.0, 0.5, 1.0]).tolist() == [0.0, 0.5, 1.0]
     with pytest.raises(PreviewError, match=r"--at: 1.5 s is outside the record \(0.000 to 1.000"):
         check_instants(body, [0.2, 1.5])
+    # an FMCW record's body starts a few microseconds before its first chirp: 0.000, not -0.000
+    early = Skeleton(body.time - 7e-6, body.positions, body.joint_names)
+    with pytest.raises(PreviewError, match=r"record \(0\.000 to 1\.000 s\)"):
+        check_instants(early, [5.0])
 
 
 def test_gif_has_one_frame_per_step_at_the_frame_rate(tmp_path: Path) -> None:

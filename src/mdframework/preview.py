@@ -107,7 +107,9 @@ def check_instants(body: Skeleton, instants: Sequence[float] | FloatArray) -> Fl
     bad = x[(x < lo - 1e-9) | (x > hi + 1e-9) | ~np.isfinite(x)]
     if x.size == 0 or bad.size:
         which = f"{bad[0]:g} s is" if bad.size else "no instant is"
-        raise PreviewError(f"--at: {which} outside the record ({lo:.3f} to {hi:.3f} s)")
+        # + 0.0: a span starting microseconds before 0 reads 0.000, not -0.000
+        span = f"{round(lo, 3) + 0.0:.3f} to {round(hi, 3) + 0.0:.3f} s"
+        raise PreviewError(f"--at: {which} outside the record ({span})")
     return x
 
 
