@@ -1095,7 +1095,7 @@ def _distinct_recordings(specs: list[RecordSpec]) -> list[RecordSpec]:
         given = run["recording"].get("file") if "recording" in run else run["motion"].get("file")
         if given is None:
             return None
-        path = (Path(spec.base_dir) / str(given)).resolve()
+        path = (Path(spec.base_dir) / Path(str(given)).expanduser()).resolve()  # as DataPath
         return path, first.setdefault(path, str(given))
 
     for spec in specs:
