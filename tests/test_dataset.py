@@ -22,6 +22,7 @@ from conftest import EXAMPLES
 from mdframework import dataset
 from mdframework.dataset import (
     RECORDS,
+    Dataset,
     DatasetWarning,
     build_dataset,
     load_dataset,
@@ -714,24 +715,18 @@ def test_a_motion_files_own_error_keeps_its_file_name(tmp_path: Path) -> None:
     assert str(err.value).startswith(str(lone / "02_01.amc"))
 
 
-def test_records_whose_envelope_reaches_the_band_edge_are_counted(tmp_path: Path) -> None:
-    """The paper's radar (PRF 2400 Hz at 15 GHz: +-12 m/s) keeps a walk's envelope inside the
-    band; the FMCW preset's 0 dBi antennas leave the spectrogram too little above the noise, so
-    the envelope spans the band: index.csv counts such frames per record, and the build warns
-    once naming how many records have any."""
-    walk = CMU / "asf-amc" / "02_01.amc"
-    base = {
-        "lfm": "kind = 'lfm'\ncarrier_frequency = 15e9\nbandwidth = 150e6\nprf = 2400.0",
-        "fmcw": "kind = 'fmcw'\npreset = 'iwr1443_short_range_3d'\npoints = false",
-    }
-    counts = {}
-    for name, radar in base.items():
-        cfg_path = tmp_path / f"{name}.toml"
-        cfg_path.write_text(f"""
+def _build_walk(
+    tmp_path: Path, name: str, radar: str, features: str = ""
+) -> tuple[list[str], Dataset]:
+    """Build a dataset of 1 s records of the CMU walk seen by ``radar`` (TOML lines) from 6 m,
+    max_records per source 2; its band-edge warnings and the loaded dataset."""
+    cfg_path = tmp_path / f"{name}.toml"
+    cfg_path.write_text(f"""
 seed = 1
+{features}
 [[sources]]
 label = "walk"
-motion = {{ kind = "cmu", file = "{walk}" }}
+motion = {{ kind = "cmu", file = "{CMU / "asf-amc" / "02_01.amc"}" }}
 max_records = 2
 [record_lengths]
 walk = 1.0
@@ -740,20 +735,53 @@ walk = 1.0
 [base.scene]
 radar_position = [6.0, 0.0, 1.0]
 """)
-        cfg, base_dir = load_dataset_config(cfg_path)
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            build_dataset(cfg, base_dir, tmp_path / name, workers=1, progress=False)
-        edge = [str(w.message) for w in caught if "edge of the Doppler band" in str(w.message)]
-        data = load_dataset(tmp_path / name)
-        counts[name] = data.table["band_edge_frames"]
+    cfg, base_dir = load_dataset_config(cfg_path)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        build_dataset(cfg, base_dir, tmp_path / name, workers=1, progress=False)
+    edge = [str(w.message) for w in caught if "edge of the Doppler band" in str(w.message)]
+    return edge, load_dataset(tmp_path / name)
+
+
+FMCW_RADAR = "kind = 'fmcw'\npreset = 'iwr1443_short_range_3d'\npoints = false"
+
+
+def test_records_whose_envelope_reaches_the_band_edge_are_counted(tmp_path: Path) -> None:
+    """The paper's radar (PRF 2400 Hz at 15 GHz: +-12 m/s) keeps a walk's envelope inside the
+    band; the FMCW preset's 0 dBi antennas leave the spectrogram too little above the noise, so
+    the envelope spans the band: index.csv counts such frames per record, and the build warns
+    once naming how many records have any."""
+    base = {
+        "lfm": "kind = 'lfm'\ncarrier_frequency = 15e9\nbandwidth = 150e6\nprf = 2400.0",
+        "fmcw": FMCW_RADAR,
+    }
+    for name, radar in base.items():
+        edge, data = _build_walk(tmp_path, name, radar)
+        counts = data.table["band_edge_frames"]
         if name == "lfm":
-            assert not edge and np.all(counts[name] == 0)
+            assert not edge and np.all(counts == 0)
         else:
             assert len(edge) == 1 and edge[0].startswith("2 of 2 records")
-            assert np.all(counts[name] > 10)
+            assert np.all(counts > 10)
             upper = data.features[:, FEATURE_NAMES.index("upper_max")]
             assert np.allclose(upper, data.velocity[-1])  # the band's edge, not the body's
+
+
+def test_band_edge_frames_are_counted_for_percentile_envelopes(tmp_path: Path) -> None:
+    """The percentile envelopes of a spectrogram that stands little above the noise (the FMCW
+    preset's 0 dBi antennas) lie a few bins inside the band (3 % and 97 % of white noise), not
+    on its edge, yet describe the band, not the body: the frames are counted by the threshold
+    envelope of the features' threshold_db, as for the threshold method, and the build warns."""
+    counts = {}
+    for method in ("threshold", "percentile"):
+        edge, data = _build_walk(tmp_path, method, FMCW_RADAR, f"features.method = '{method}'")
+        counts[method] = data.table["band_edge_frames"]
+        assert len(edge) == 1 and edge[0].startswith("2 of 2 records")
+        if method == "percentile":  # the band's percentiles, inside its edge
+            upper = data.features[:, FEATURE_NAMES.index("upper_max")]
+            assert np.all((upper > data.velocity[-1] - 1.0) & (upper < data.velocity[-1]))
+    assert np.array_equal(counts["percentile"], counts["threshold"])
+    assert np.all(counts["threshold"] > 10)
 
 
 def test_a_drawn_motion_file_names_its_own_subject_and_recording(tmp_path: Path) -> None:

@@ -396,10 +396,13 @@ recording = {{ kind = "radhar", file = "{RADHAR / "radhar_walk_subset.npz"}" }}
         plan_records(cfg, base)
 
 
-def test_recordings_of_one_name_in_two_files_are_two_recordings(tmp_path: Path) -> None:
+def test_recordings_of_one_name_in_two_files_are_two_recordings(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """Two copies of a RadHAR file (two sessions whose recordings the sensor named alike) give
     records of two recordings, ``<file>:<name>``, so a split holding out recordings keeps them
-    apart; one file given twice stays one recording under its own name."""
+    apart; one file given twice stays one recording under its own name, ``~/...`` (expanded,
+    as the config's paths are) included."""
     import shutil
 
     for name in ("a", "b"):
@@ -431,3 +434,5 @@ recordings = ["20_boxing_3.txt"]
         "b/boxing.npz:20_boxing_3.txt",
     }
     assert recordings(["a/boxing.npz", "./a/boxing.npz"]) == {"20_boxing_3.txt"}
+    monkeypatch.setenv("HOME", str(tmp_path))
+    assert recordings(["a/boxing.npz", "~/a/boxing.npz"]) == {"20_boxing_3.txt"}

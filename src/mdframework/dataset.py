@@ -17,7 +17,8 @@ representation simulated records get with ``representation = "histogram"``.
                            histogram records also: histograms (n_frames, n_bins) float32
                            (points, or intensity weights, per velocity bin and frame)
     DIR/index.csv          one row per record: id, label, source, file, start_s, duration_s,
-                           aspect_deg, radar_x/y/z_m, height_m, seed, the 7 features, then
+                           aspect_deg, radar_x/y/z_m, height_m, seed, band_edge_frames
+                           (:func:`~mdframework.features.band_edge_frames`), the 7 features, then
                            draw.<name> for every randomised parameter
     DIR/dataset.json       the config, the feature names and units, the record count
 
@@ -1094,7 +1095,7 @@ def _distinct_recordings(specs: list[RecordSpec]) -> list[RecordSpec]:
         given = run["recording"].get("file") if "recording" in run else run["motion"].get("file")
         if given is None:
             return None
-        path = (Path(spec.base_dir) / str(given)).resolve()
+        path = (Path(spec.base_dir) / Path(str(given)).expanduser()).resolve()  # as DataPath
         return path, first.setdefault(path, str(given))
 
     for spec in specs:
@@ -1357,9 +1358,16 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         extra = {"histograms": arrays["histograms"]}
         spectrogram = {k: arrays[k] for k in ("spectrogram_db", "velocity_mps", "time_s")}
     else:
-        env = envelopes(result.spectrogram.power, result.velocity, **_feature_options(fcfg))
+        options = _feature_options(fcfg)
+        env = envelopes(result.spectrogram.power, result.velocity, **options)
         feats = features_from_envelopes(env)
-        extra_meta["band_edge_frames"] = band_edge_frames(env, result.velocity)
+        # counted on the threshold envelope whatever the method: the percentile envelopes of a
+        # spectrogram of noise lie a few bins inside the band's edges, not on them
+        edge = env
+        if options["method"] != "threshold":
+            options["method"] = "threshold"
+            edge = envelopes(result.spectrogram.power, result.velocity, **options)
+        extra_meta["band_edge_frames"] = band_edge_frames(edge, result.velocity)
         spectrogram = {
             "spectrogram_db": result.spectrogram_db.astype(np.float32),
             "velocity_mps": result.velocity,

@@ -18,8 +18,9 @@ Patch ``k`` contributes ``g_k(n) (alpha_k + beta_k u_k(n))``:
   ``S(f) ∝ exp(-f^2 / (2 s_f^2))``, ``s_f = 2 spread_mps / lambda``: ``spread_mps`` is the
   standard deviation of the wind-blown clutter's radial-velocity spectrum [m/s] (about 0.05 m/s
   in light air to 0.3 m/s in gale for trees). It is made by shaping white noise in the frequency
-  domain over the record (a circular process), unit mean power, on a uniform grid at the
-  shortest pulse interval and read at the pulse times: at the pulses themselves for evenly
+  domain, with unit mean power, on a uniform grid at the shortest pulse interval that spans the
+  record and is lengthened to a fast FFT length (a process circular over that grid, not over
+  the record), and read at the pulse times: at the pulses themselves for evenly
   spaced pulses, at each chirp's own instant for an FMCW radar (several transmitters in turn,
   gaps between frames), so each virtual antenna's slow time has the requested spread.
 
@@ -138,12 +139,13 @@ def wind_processes(
 ) -> ComplexArray:
     """:func:`gaussian_doppler_process` read at the pulse ``times`` (n_pulses,) [s]: made on a
     uniform grid at the shortest pulse interval from the first pulse, each pulse taking the grid
-    point nearest to it. Pulses evenly spaced (a pulse-Doppler or CW radar) are the grid itself;
-    an FMCW radar's chirps (several transmitters in turn, gaps between frames) get the process
-    at their own instants, so the slow time of each virtual antenna (every ``n_tx``-th chirp)
-    sees the requested spread and frames apart in time are as decorrelated as that time makes
-    them. The grid is lengthened to the next length whose FFT is fast (the process is circular
-    over the grid, not over the record: up to 5x faster than a length of large prime factors).
+    point nearest to it. Pulses evenly spaced (a pulse-Doppler or CW radar) are the grid's
+    first points; an FMCW radar's chirps (several transmitters in turn, gaps between frames) get
+    the process at their own instants, so the slow time of each virtual antenna (every
+    ``n_tx``-th chirp) sees the requested spread and frames apart in time are as decorrelated as
+    that time makes them. The grid is lengthened to the next length whose FFT is fast (the
+    process is circular over the grid, not over the record: up to 5x faster than a length of
+    large prime factors).
     ``prf`` [Hz] serves fewer than two pulses. Returns (n_series, n_pulses)."""
     t = np.asarray(times, dtype=np.float64)
     out = np.empty((n_series, t.size), dtype=np.complex128)
