@@ -266,3 +266,20 @@ def test_gif_frames_start_at_their_own_times(tmp_path: Path, fps: int) -> None:
     assert len(durations) == n
     starts = np.concatenate([[0.0], np.cumsum(durations)])  # [ms]
     assert np.max(np.abs(starts - 1000.0 * np.arange(n + 1) / fps)) <= 5.0
+
+
+def test_mdf_show_refuses_a_gif_too_fast_to_play_in_real_time(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A GIF's frame times are hundredths of a second: above 50 fps frames of 10 ms appear,
+    which viewers slow down, so the docs' 'played in real time' would not hold."""
+    from conftest import EXAMPLES
+
+    from mdframework import cli
+
+    out = tmp_path / "out"
+    args = ["show", str(EXAMPLES / "point_target.toml"), "--out", str(out), "--fps", "60"]
+    code = cli.main(args)
+    err = capsys.readouterr().err
+    assert code == 2 and "--fps: a GIF plays at most 50 frames per second" in err
+    assert err.count("\n") == 1 and not out.exists()

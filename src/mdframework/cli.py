@@ -102,8 +102,9 @@ def _cmd_show(args: argparse.Namespace) -> int:
         from .config import load_run_config
         from .output import run_folder, stage_run
         from .pipeline import simulate
-        from .preview import check_instants, stage_preview
+        from .preview import check_frame_rate, check_instants, stage_preview
 
+        check_frame_rate(args.format, args.fps)  # before anything is simulated or written
         config = load_run_config(args.config)
     with run_folder(args.out, force=args.force, staging_dir=args.staging_dir) as folder:
         with _naming(args.config):
@@ -412,7 +413,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _run_arguments(show)
     show.add_argument("--format", choices=("gif", "mp4"), default="gif", help="animation format")
-    show.add_argument("--fps", type=_fps, default=12, help="animation frames per second (1 .. 100)")
+    show.add_argument(
+        "--fps", type=_fps, default=12, help="animation frames per second (1 .. 100; a GIF 1 .. 50)"
+    )
     show.add_argument(
         "--at", type=float, nargs="+", default=None, metavar="T",
         help="instants of skeleton.png [s from the record's start]; default: five spread over it",

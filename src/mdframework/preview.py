@@ -99,6 +99,22 @@ def animation_times(body: Skeleton, fps: int) -> FloatArray:
     return np.asarray(body.time[0] + np.arange(n) / fps, dtype=np.float64)
 
 
+#: The highest frame rate a GIF plays at: its frame times are in hundredths of a second, and
+#: viewers commonly slow frames shorter than 20 ms down to 100 ms.
+GIF_MAX_FPS = 50
+
+
+def check_frame_rate(fmt: str, fps: int) -> None:
+    """Refuse (:class:`PreviewError`, naming ``--fps``) a GIF faster than :data:`GIF_MAX_FPS`,
+    which would not play in real time; an MP4 takes any rate ``mdf show`` allows."""
+    if fmt == "gif" and fps > GIF_MAX_FPS:
+        raise PreviewError(
+            f"--fps: a GIF plays at most {GIF_MAX_FPS} frames per second in real time (its "
+            f"frame times are hundredths of a second), got {fps}: lower --fps, or use "
+            "--format mp4"
+        )
+
+
 def check_instants(body: Skeleton, instants: Sequence[float] | FloatArray) -> FloatArray:
     """The instants as an array, each within the body's time span (else :class:`PreviewError`
     naming ``--at`` and the span)."""
