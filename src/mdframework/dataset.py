@@ -1089,25 +1089,21 @@ def _distinct_recordings(specs: list[RecordSpec]) -> list[RecordSpec]:
     holding out recordings do not take them for one."""
     first: dict[Path, str] = {}  # each file as the config first gives it
     files: dict[str, set[Path]] = {}
-
-    def source_file(spec: RecordSpec) -> tuple[Path, str] | None:
+    paths: list[Path | None] = []  # each record's file
+    for spec in specs:
         run = spec.run_config
         given = run["recording"].get("file") if "recording" in run else run["motion"].get("file")
-        if given is None:
-            return None
-        path = (Path(spec.base_dir) / Path(str(given)).expanduser()).resolve()  # as DataPath
-        return path, first.setdefault(path, str(given))
-
-    for spec in specs:
-        found = source_file(spec)
-        if found is not None:
-            files.setdefault(spec.recording, set()).add(found[0])
-    shared = {name for name, paths in files.items() if len(paths) > 1}
+        path = None
+        if given is not None:
+            path = (Path(spec.base_dir) / Path(str(given)).expanduser()).resolve()  # as DataPath
+            first.setdefault(path, str(given))
+            files.setdefault(spec.recording, set()).add(path)
+        paths.append(path)
+    shared = {name for name, held in files.items() if len(held) > 1}
     out = []
-    for spec in specs:
-        found = source_file(spec) if spec.recording in shared else None
-        if found is not None:
-            given = found[1]
+    for spec, path in zip(specs, paths, strict=True):
+        if path is not None and spec.recording in shared:
+            given = first[path]
             name = f"{given}:{spec.recording}" if "recording" in spec.run_config else given
             spec = replace(spec, recording=name)
         out.append(spec)
