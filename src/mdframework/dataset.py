@@ -974,14 +974,14 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
         if "kind" not in motion:
             raise ConfigError(f"sources[{entry_no}].motion: a kind is required")
         # a source's own start/duration limit the span that records are cut from
+        key = _motion_key(motion)
         try:
-            loaded = _load_motion(_motion_key(motion), str(base_dir))
+            loaded = _load_motion(key, str(base_dir))
         except ConfigError as exc:  # named where the dataset config wrote it
             text = str(exc)
             if not text.startswith(f"{_MOTION_WHERE}: "):
                 raise  # names its file already
             raise ConfigError(f"sources[{entry_no}].{text[len(_MOTION_WHERE) + 2 :]}") from None
-        key = _motion_key(motion)
         if key not in prints:  # once per loaded motion
             prints[key] = motion_fingerprint(loaded)
         span_start, span_end = _source_span(motion, entry_no, loaded)
@@ -1013,10 +1013,10 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                 f"{n_draws} draw(s) take the dataset beyond the limit of "
                 f"{limits.MAX_RECORDS:,} records; raise hop or set max_records"
             )
-        starts = float(motion.get("start", 0.0)) + np.arange(n_windows) * hop
+        starts = span_start + np.arange(n_windows) * hop
         for start in starts:
             for (aspect, rng_, rheight, rpos, height), _draw in itertools.product(
-                grid, range(rz.draws if rz.active() else 1)
+                grid, range(n_draws)
             ):
                 section = {**motion, "start": round(float(start), 9), "duration": length}
                 if height is not None:
@@ -1046,7 +1046,7 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                 run["seed"] = _record_seed(config.seed, index)
                 content, naming = prints[key], meta
                 if draws and any(
-                    p.startswith("motion.") and isinstance(v, str) for p, v in draws.items()
+                    p.startswith("motion.") and isinstance(d, str) for p, d in draws.items()
                 ):  # a drawn file (or a part of one): the record is cut from its contents,
                     # and is that file's subject and recording
                     chosen = _drawn_motion(section, base_dir, prints)
