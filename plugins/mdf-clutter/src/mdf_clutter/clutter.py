@@ -129,8 +129,10 @@ def _shaped(white: ComplexArray, prf: float, spread_hz: float) -> ComplexArray:
     return np.asarray(shaped / np.sqrt(np.where(power > 0, power, 1.0)), dtype=np.complex128)
 
 
-#: Grid values the wind-blown processes are made with at a time (unless one series at the
-#: pulses is already larger): bounds their memory when the pulses have gaps between them.
+#: Grid values of the wind-blown processes made at a time: :func:`wind_process_groups` yields
+#: groups of at most this many (at least one series), so their memory does not grow with the
+#: patches; pulses with gaps are drawn in calls of this many (or of all the series at the
+#: pulses, if more), which fixes their draws.
 WIND_GRID_VALUES = 1 << 22
 
 
