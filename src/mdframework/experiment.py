@@ -708,7 +708,7 @@ def _train_then_test(
     test: NDArray[np.bool_],
     names: Sequence[str],
     who: str,
-    units: NDArray[Any] | None = None,
+    units: NDArray[Any],
 ) -> dict[str, Any]:
     """Select features and fit on the ``train`` records (mask), predict the ``test`` records,
     over the classes both hold (``who`` names the two sides in the error when they share
@@ -719,8 +719,7 @@ def _train_then_test(
         raise MdfError(f"{who} share fewer than two classes ({shared})")
     train = train & np.isin(labels, shared)
     test = test & np.isin(labels, shared)
-    held = None if units is None else units[train]
-    sel = _select(cfg, factory, x[train], labels[train], cfg.seed, units=held)
+    sel = _select(cfg, factory, x[train], labels[train], cfg.seed, units=units[train])
     pred = _fit_predict(factory, x[train], labels[train], x[test], sel.subset)
     return {
         "classes": shared,
