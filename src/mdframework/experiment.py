@@ -423,6 +423,13 @@ def held_out_units(ev: EvaluationConfig, data: Dataset) -> NDArray[np.str_]:
     return np.array([_text(v) for v in data.table[column]])
 
 
+def _units(cfg: ExperimentConfig, data: Dataset) -> NDArray[np.str_] | None:
+    """:func:`held_out_units` where the wrapper's folds hold them out (``selection.inner_split
+    = 'evaluation'`` beside a split of recordings or groups), else None (record folds)."""
+    grouped = cfg.selection.method == "wrapper" and cfg.selection.inner_split == "evaluation"
+    return held_out_units(cfg.evaluation, data) if grouped else None
+
+
 def train_test(
     cfg: ExperimentConfig,
     factory: Callable[[], Classifier],
@@ -444,9 +451,8 @@ def train_test(
     if np.any(train & test):
         raise MdfError(f"train_test: {int(np.sum(train & test))} records are in both selections")
     x = data.features if x is None else x
-    units = held_out_units(cfg.evaluation, data)
     return _train_then_test(
-        cfg, factory, x, labels, train, test, names, "train_test: the selections", units
+        cfg, factory, x, labels, train, test, names, "train_test: the selections", _units(cfg, data)
     )
 
 
@@ -693,9 +699,8 @@ def cross_source(
             group = getattr(cs, name)
             raise MdfError(f"cross_source.{name}: no records of group {group!r} (have {groups})")
     x = data.features if x is None else x
-    units = held_out_units(cfg.evaluation, data)
     return _train_then_test(
-        cfg, factory, x, labels, train, test, names, "cross_source: the groups", units
+        cfg, factory, x, labels, train, test, names, "cross_source: the groups", _units(cfg, data)
     )
 
 
@@ -708,18 +713,25 @@ def _train_then_test(
     test: NDArray[np.bool_],
     names: Sequence[str],
     who: str,
-    units: NDArray[Any],
+    units: NDArray[Any] | None,
 ) -> dict[str, Any]:
     """Select features and fit on the ``train`` records (mask), predict the ``test`` records,
     over the classes both hold (``who`` names the two sides in the error when they share
     fewer than two). ``x`` (n_records, n_columns) named by ``names``; ``labels`` (n_records,);
-    ``units`` (n_records,): what the wrapper's folds hold out (:func:`held_out_units`)."""
+    ``units`` (n_records,): what the wrapper's folds hold out (:func:`held_out_units`), or None."""
     shared = sorted(set(labels[train].tolist()) & set(labels[test].tolist()))
     if len(shared) < 2:
         raise MdfError(f"{who} share fewer than two classes ({shared})")
     train = train & np.isin(labels, shared)
     test = test & np.isin(labels, shared)
-    sel = _select(cfg, factory, x[train], labels[train], cfg.seed, units=units[train])
+    sel = _select(
+        cfg,
+        factory,
+        x[train],
+        labels[train],
+        cfg.seed,
+        units=None if units is None else units[train],
+    )
     pred = _fit_predict(factory, x[train], labels[train], x[test], sel.subset)
     return {
         "classes": shared,
