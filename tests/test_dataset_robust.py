@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import csv
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -252,9 +253,8 @@ long_gaps = "error"
 
 def test_a_failing_record_is_named_once(tmp_path: Path) -> None:
     """The cause of a failing record follows its name, file and window, without the record's
-    name again (histogram records need a radar with point clouds; the LFM radar has none)."""
-    path = walk_config(tmp_path / "d.toml", 'representation = "histogram"')
-    path.write_text(path.read_text().replace("hop = 0.5", "hop = 0.5\nmax_records = 1"))
+    name again (the walk comes within scene.min_range of the radar)."""
+    path = walk_config(tmp_path / "d.toml")
     cfg, base = load_dataset_config(path)
     with pytest.raises(MdfError) as err:
         build_dataset(cfg, base, tmp_path / "ds", workers=1, progress=False)
@@ -262,4 +262,4 @@ def test_a_failing_record_is_named_once(tmp_path: Path) -> None:
     record = msg.split()[1]
     assert msg.startswith(f"record {record} (walk; source file ")
     assert msg.count(record) == 1, msg
-    assert "window 0.000-1.000 s): representation = 'histogram' needs a radar" in msg
+    assert re.search(r"window [\d.]+-[\d.]+ s\): ", msg) and "comes within" in msg

@@ -436,3 +436,30 @@ recordings = ["20_boxing_3.txt"]
     assert recordings(["a/boxing.npz", "./a/boxing.npz"]) == {"20_boxing_3.txt"}
     monkeypatch.setenv("HOME", str(tmp_path))
     assert recordings(["a/boxing.npz", "~/a/boxing.npz"]) == {"20_boxing_3.txt"}
+
+
+@pytest.mark.parametrize("on_error", ["stop", "skip"])
+def test_histograms_of_a_radar_without_point_clouds_are_refused_when_planned(
+    tmp_path: Path, on_error: str
+) -> None:
+    """representation = 'histogram' with the paper's LFM radar (no point clouds) is refused
+    before any record is simulated, naming the source, also with on_error = 'skip' (every
+    record was simulated, then skipped, then the build failed)."""
+    walk = EXAMPLES / "data" / "cmu" / "asf-amc" / "02_01.amc"
+    cfg_path = tmp_path / "d.toml"
+    cfg_path.write_text(f"""
+representation = "histogram"
+on_error = "{on_error}"
+[[sources]]
+label = "walk"
+motion = {{ kind = "cmu", file = "{walk}" }}
+record_length = 1.0
+[base.radar]
+kind = "lfm"
+carrier_frequency = 15e9
+bandwidth = 150e6
+prf = 2400.0
+""")
+    cfg, base = load_dataset_config(cfg_path)
+    with pytest.raises(ConfigError, match=r"sources\[0\] \(kind = 'lfm'\) gives no point clouds"):
+        plan_records(cfg, base)

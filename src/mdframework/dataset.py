@@ -858,6 +858,20 @@ def _validate_planned(
         raise _as_written(exc, record, config, entry_no, config.sources[entry_no]) from None
 
 
+def _check_points(config: Any, entry_no: int) -> None:
+    """``representation = 'histogram'``: refuse, before any record is simulated, a source
+    whose radar (``config``: one of its records' run configs, validated) gives no point clouds
+    frame by frame (:func:`_simulated_cloud` needs its ``points`` product and ``frame_period``)."""
+    radar = config.radar
+    if getattr(radar, "frame_period", None) is None or getattr(radar, "points", True) is False:
+        raise ConfigError(
+            f"representation = 'histogram': the radar of sources[{entry_no}] "
+            f"(kind = {radar.kind!r}) gives no point clouds frame by frame; histogram records "
+            "need one that does (e.g. kind = 'fmcw' with points = true), or set "
+            "representation = 'spectrogram'"
+        )
+
+
 def _randomize(config: DatasetConfig, entry: SourceEntry) -> Randomization:
     """The draws of one source: the dataset's, with the fields the source gives replaced."""
     if entry.randomize is None:
@@ -1014,6 +1028,7 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                 f"{limits.MAX_RECORDS:,} records; raise hop or set max_records"
             )
         starts = span_start + np.arange(n_windows) * hop
+        points_checked = hist is None  # histograms need a radar with point clouds: checked once
         for start in starts:
             for (aspect, rng_, rheight, rpos, height), _draw in itertools.product(
                 grid, range(n_draws)
@@ -1074,6 +1089,14 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                 # on_error = "skip" an invalid record is skipped by the build instead)
                 if config.on_error == "stop":
                     _validate_planned(run, record, draws, origins, entry_no, plan)
+                if not points_checked:  # on the first record whose config is valid
+                    try:
+                        planned = _validate_planned(run, record, draws, origins, entry_no, plan)
+                    except ConfigError:  # invalid: its build names why, or skips it
+                        planned = None
+                    if planned is not None:
+                        _check_points(planned, entry_no)
+                        points_checked = True
     if not specs:
         raise ConfigError(
             f"no records: every source is shorter than its record length ({', '.join(short)})"
