@@ -1742,16 +1742,21 @@ def _executor(
 def _quiet_dask_logs() -> Iterator[None]:
     """Silence Dask's own log in this process (the local cluster's nannies and scheduler live
     here) while a local cluster runs: a record's error reaches the user as one line, and
-    Dask's log of it, of the tasks cancelled after it or of Ctrl-C would only surround it."""
+    Dask's log of it, of the tasks cancelled after it or of Ctrl-C would only surround it.
+    Tornado's too, whose event loop runs Dask's: a Ctrl-C that lands while the client waits
+    on the loop can make Dask's cancelling callback fail there, and tornado logged that with
+    its traceback (now and then, on a busy machine)."""
     import logging
 
-    log = logging.getLogger("distributed")
-    level = log.level
-    log.setLevel(logging.CRITICAL)
+    logs = [logging.getLogger(name) for name in ("distributed", "tornado")]
+    levels = [log.level for log in logs]
+    for log in logs:
+        log.setLevel(logging.CRITICAL)
     try:
         yield
     finally:
-        log.setLevel(level)
+        for log, level in zip(logs, levels, strict=True):
+            log.setLevel(level)
 
 
 def _quiet_dask_worker() -> bool:
