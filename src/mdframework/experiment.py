@@ -97,7 +97,14 @@ class SelectionConfig(StrictModel):
     sizes: list[Annotated[int, Field(ge=1, le=len(FEATURE_NAMES))]] = Field(
         [4], min_length=1, description="Subset sizes to try (the paper: 4 of 7)."
     )
-    folds: int = Field(5, ge=2, le=100, description="Cross-validation folds.")
+    folds: int = Field(
+        5,
+        ge=2,
+        le=100,
+        description="The wrapper's cross-validation folds, at most: fewer where the smallest "
+        "class has fewer training records (or, with inner_split = 'evaluation', where there "
+        "are fewer recordings or groups).",
+    )
     inner_split: Literal["record", "evaluation"] = Field(
         "record",
         description="What the wrapper's folds hold out: record: stratified folds of records; "
