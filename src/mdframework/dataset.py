@@ -1087,14 +1087,14 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                 specs.append(replace(spec, length_field=_length_field(config, entry_no, entry)))
                 # every record's run config is valid before any file is written (with
                 # on_error = "skip" an invalid record is skipped by the build instead)
-                if config.on_error == "stop":
-                    _validate_planned(run, record, draws, origins, entry_no, plan)
-                if not points_checked:  # on the first record whose config is valid
+                if config.on_error == "stop" or not points_checked:
                     try:
                         planned = _validate_planned(run, record, draws, origins, entry_no, plan)
-                    except ConfigError:  # invalid: its build names why, or skips it
-                        planned = None
-                    if planned is not None:
+                    except ConfigError:
+                        if config.on_error == "stop":
+                            raise
+                        continue  # skipped by the build, which names why
+                    if not points_checked:  # on the first record whose config is valid
                         _check_points(planned, entry_no)
                         points_checked = True
     if not specs:
