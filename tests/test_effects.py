@@ -345,6 +345,38 @@ def test_clutter_with_a_radar_without_bandwidth_is_refused_before_any_pulse() ->
     assert build_stages(validate_run_config(cfg)).effects[0].name == "clutter"
 
 
+def test_clutter_on_an_fmcw_radar_with_receiver_noise_holds_no_copy_of_that_noise() -> None:
+    """The FMCW presets add receiver noise in the radar itself. Each clutter patch's response is
+    the patch's alone: stationary clutter under a fixed gate stays at zero Doppler, and the
+    clutter is the same with the radar's noise on or off. Each patch's response held the
+    frame's noise, summed over the patches: a quarter of the stationary clutter's power was
+    white, and ``power = "rcs"`` counted the noise as clutter power (10 % here). The clutter
+    takes the FMCW radar's own range resolution (it asked for ``range_resolution``)."""
+    from mdf_fmcw import FmcwRadar
+
+    def clutter_of(receiver_noise: bool, power: str) -> np.ndarray:
+        wf = FmcwRadar(
+            FmcwRadar.Config(preset="iwr1443_short_range_3d", receiver_noise=receiver_noise)
+        )
+        t = wf.pulse_times(0.0, 0.5)
+        n = t.size
+        skel = Skeleton(t, np.zeros((n, 1, 3)), ("target0",))
+        ctx = SceneContext(
+            np.zeros(3), wf.prf, wf.carrier_frequency, t, np.full(n, 3.0), skel, wf,
+            np.random.default_rng(3),
+        )  # fmt: skip
+        cfg = GroundClutter.Config(power=power, csr_db=0.0, rcs_m2=1.0, wind_fraction=0.0)
+        signal = np.full(n, 1e-6, complex)
+        return GroundClutter(cfg).apply(Received(signal), ctx).signal - signal
+
+    for power in ("csr", "rcs"):
+        noisy, clean = clutter_of(True, power), clutter_of(False, power)
+        np.testing.assert_allclose(noisy, clean, rtol=1e-12, atol=0.0)
+    first_slot = noisy[::3]  # one TX's chirps: one virtual antenna's slow time
+    dc_fraction = abs(np.mean(first_slot)) ** 2 / np.mean(np.abs(first_slot) ** 2)
+    assert dc_fraction > 0.999  # all of the stationary clutter at zero Doppler
+
+
 # --------------------------------------------------------------------------- multipath
 
 MP_RADAR = (10.0, 0.0, 5.0)

@@ -367,6 +367,10 @@ class PulseBlock:
     scene clock. ``scatterers``: positions (n, K, 3) float64 [m] in the scene frame and RCS
     (n, K) float64 [m^2]. ``ranges`` (n, K) float64 [m]: scatterer to radar, computed once by the
     pipeline. ``gate_range`` (n,) float64 [m]. ``radar_position`` (3,) float64 [m].
+    ``receiver_noise``: whether a waveform that adds receiver noise itself
+    (:attr:`RadarWaveform.adds_receiver_noise`) adds it to this block; False asks for the
+    scatterers' response alone (:func:`receive_points` for e.g. clutter patches, whose
+    responses are summed and rescaled: noise in each would be summed with them).
     """
 
     start: int
@@ -375,6 +379,7 @@ class PulseBlock:
     ranges: FloatArray
     gate_range: FloatArray
     radar_position: FloatArray
+    receiver_noise: bool = True
 
     @property
     def n_pulses(self) -> int:
@@ -434,6 +439,16 @@ class RadarWaveform(Plugin):
         ``receiver_noise``); the ``noise`` effect is then refused, since it would count that
         noise twice. Default: False."""
         return False
+
+    @property
+    def range_resolution(self) -> float | None:
+        """Range resolution ``c / (2 B)`` [m] of the compressed return (``B`` the swept
+        bandwidth), or ``None`` for a radar without one (CW). Default: from the config's
+        ``bandwidth`` [Hz] when it has one."""
+        from .constants import SPEED_OF_LIGHT
+
+        bandwidth = getattr(self.config, "bandwidth", None)
+        return None if bandwidth is None else SPEED_OF_LIGHT / (2.0 * float(bandwidth))
 
     @property
     def max_unambiguous_velocity(self) -> float:
@@ -527,12 +542,15 @@ def receive_points(
     radar_position: FloatArray | None = None,
     times: FloatArray | None = None,
     signal_only: bool = False,
+    receiver_noise: bool = False,
 ) -> Received:
     """One-off receive of point scatterers given by their ranges, e.g. clutter patches or
     contract checks: ``ranges``, ``rcs`` (n_pulses, K) [m], [m^2]; ``gate_range`` (n_pulses,)
     [m]. The scatterers are put on the +x axis of the radar; ``times`` default to ``n / prf``.
     With ``signal_only`` the result holds only the signal
-    (:meth:`RadarWaveform.receive_signal`: no products)."""
+    (:meth:`RadarWaveform.receive_signal`: no products). The response is the scatterers'
+    alone unless ``receiver_noise`` asks a radar that adds receiver noise itself to add it
+    (:attr:`PulseBlock.receiver_noise`)."""
     r = np.asarray(ranges, dtype=np.float64)
     origin = np.zeros(3) if radar_position is None else np.asarray(radar_position, np.float64)
     positions = np.zeros((*r.shape, 3))
@@ -542,7 +560,8 @@ def receive_points(
     scat = Scatterers(
         positions, np.asarray(rcs, dtype=np.float64), tuple(map(str, range(r.shape[1])))
     )
-    block = PulseBlock(0, t, scat, r, np.asarray(gate_range, dtype=np.float64), origin)
+    gate = np.asarray(gate_range, dtype=np.float64)
+    block = PulseBlock(0, t, scat, r, gate, origin, receiver_noise=receiver_noise)
     if signal_only:
         return Received(waveform.receive_signal(block))
     return waveform.receive(block)

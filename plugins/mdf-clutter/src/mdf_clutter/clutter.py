@@ -57,7 +57,6 @@ from mdframework import (
     SceneError,
     receive_points,
 )
-from mdframework.constants import SPEED_OF_LIGHT
 from mdframework.physics import radar
 from mdframework.settings import Decibels, Rcs
 
@@ -103,7 +102,7 @@ class ClutterConfig(PluginConfig):
         description="Patches beyond the gate's range span [m]; default: 4 cells.",
     )
     range_resolution: float | None = Field(
-        None, gt=0, le=10_000, description="c/(2B) [m]; default: from the waveform's bandwidth."
+        None, gt=0, le=10_000, description="c/(2B) [m]; default: the radar's own (none for CW)."
     )
 
 
@@ -224,8 +223,8 @@ class GroundClutter(Effect):
         self._stats: dict[str, Any] = {}
 
     def check_radar(self, waveform: RadarWaveform) -> None:
-        """A radar without a bandwidth (CW, FMCW) needs ``range_resolution``: refused when the
-        run is built, before any pulse."""
+        """A radar without a range resolution (CW: ``RadarWaveform.range_resolution`` None) needs
+        ``range_resolution``: refused when the run is built, before any pulse."""
         self._resolution(waveform)
 
     def resolution(self, context: SceneContext) -> float:
@@ -235,12 +234,13 @@ class GroundClutter(Effect):
     def _resolution(self, waveform: RadarWaveform) -> float:
         if self.config.range_resolution is not None:
             return float(self.config.range_resolution)
-        bandwidth = getattr(getattr(waveform, "config", None), "bandwidth", None)
-        if bandwidth is None:
+        resolution = waveform.range_resolution
+        if resolution is None:
             raise SceneError(
-                "effects.clutter: the waveform gives no bandwidth; set range_resolution"
+                f"effects.clutter: the {waveform.name!r} radar has no range resolution (no "
+                "bandwidth); set range_resolution"
             )
-        return SPEED_OF_LIGHT / (2.0 * float(bandwidth))
+        return float(resolution)
 
     def patch_ranges(self, context: SceneContext) -> FloatArray:
         """Patch ranges (n_patches,) [m], a random position inside each spacing (drawn from

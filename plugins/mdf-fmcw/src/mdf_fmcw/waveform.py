@@ -330,6 +330,12 @@ class FmcwRadar(RadarWaveform):
         return 1.0 / self.sequence.loop_period
 
     @property
+    def range_resolution(self) -> float:
+        """``c / (2 B)`` [m] over the sampled part of the ramp (``B`` = slope x n_samples /
+        sample_rate)."""
+        return self.sequence.range_resolution
+
+    @property
     def n_range(self) -> int:
         """Range bins."""
         return self.config.range_fft_size or self.config.n_samples
@@ -492,7 +498,7 @@ class FmcwRadar(RadarWaveform):
                 path=c.path,
                 margin=c.analytic_margin,
                 extra_ranges=extra,
-                noise=self._noise(index, antennas.rx.shape[0]),
+                noise=self._noise(index, antennas.rx.shape[0]) if block.receiver_noise else None,
             )
             signal[sl] = fmcw.gate_signal(
                 profiles, raxis, gate, c.gate_width, c.range_window, c.n_samples
