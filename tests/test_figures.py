@@ -84,6 +84,16 @@ def test_caption_names_source_radar_geometry_and_effects(tmp_path: Path) -> None
     assert tmp_path / "run" / "spectrogram.png" in written
 
 
+def test_a_radar_without_a_prf_gives_its_slow_time_rate() -> None:
+    """A CW radar's caption gives its I/Q rate as the slow-time rate, not as a PRF (it has no
+    pulses); an LFM radar's gives its PRF."""
+    meta = {"carrier_frequency_hz": 24e9, "prf_hz": 2000.0}
+    caption = run_caption(meta, {"radar": {"kind": "cw", "sample_rate": 2000.0}})[1]
+    assert caption.startswith("cw 24 GHz, slow time 2000 Hz;") and "PRF" not in caption
+    caption = run_caption(meta, {"radar": {"kind": "lfm", "prf": 2000.0}})[1]
+    assert caption.startswith("lfm 24 GHz, PRF 2000 Hz;")
+
+
 def test_a_source_named_as_its_activity_is_named_once() -> None:
     """Point targets name their activity after their source: the title says it once."""
     meta = {"motion": {"source": "point_targets", "activity": "point_targets"}}

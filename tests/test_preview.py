@@ -93,6 +93,10 @@ def test_instants_outside_the_record_are_refused() -> None:
     assert check_instants(body, [0.0, 0.5, 1.0]).tolist() == [0.0, 0.5, 1.0]
     with pytest.raises(PreviewError, match=r"--at: 1.5 s is outside the record \(0.000 to 1.000"):
         check_instants(body, [0.2, 1.5])
+    # one panel per instant, side by side: more than a dozen would make an unreadable image
+    assert check_instants(body, np.linspace(0, 1, 12)).size == 12
+    with pytest.raises(PreviewError, match=r"^--at: skeleton.png shows at most 12 instants .* 13$"):
+        check_instants(body, np.linspace(0, 1, 13))
     # an FMCW record's body starts a few microseconds before its first chirp: 0.000, not -0.000
     early = Skeleton(body.time - 7e-6, body.positions, body.joint_names)
     with pytest.raises(PreviewError, match=r"record \(0\.000 to 1\.000 s\)"):
@@ -283,3 +287,14 @@ def test_mdf_show_refuses_a_gif_too_fast_to_play_in_real_time(
     err = capsys.readouterr().err
     assert code == 2 and "--fps: a GIF plays at most 50 frames per second" in err
     assert err.count("\n") == 1 and not out.exists()
+
+
+def test_figures_page_quotes_the_limits_of_mdf_show() -> None:
+    """docs/figures.md's limits on ``--fps`` (GIF) and ``--at`` are the code's."""
+    from conftest import ROOT
+
+    from mdframework.preview import GIF_MAX_FPS, MAX_INSTANTS
+
+    page = (ROOT / "docs" / "figures.md").read_text()
+    assert f"a GIF takes `--fps` up to {GIF_MAX_FPS}:" in page
+    assert f"`--at` takes at most {MAX_INSTANTS} instants" in page

@@ -503,8 +503,9 @@ def run_caption(
     """Title and caption of a run's figures, from its ``metadata.json`` and resolved config.
 
     The title names the activity and the source (file, subject); the caption gives the radar
-    (kind, carrier, PRF), the geometry (aspect or heading, and ``gate_range``: the range gate
-    [m] at the first and last pulse), the scatterer model and the effects that ran."""
+    (kind, carrier, PRF or the slow-time rate of a radar without one), the geometry (aspect or
+    heading, and ``gate_range``: the range gate [m] at the first and last pulse), the scatterer
+    model and the effects that ran."""
     motion = dict(metadata.get("motion", {}))
     source = str(motion.get("source", config.get("motion", {}).get("kind", "?")))
     # an activity that only repeats the source's name (point targets) is said once
@@ -520,7 +521,10 @@ def run_caption(
     radar = dict(config.get("radar", {}))
     f_c = float(metadata.get("carrier_frequency_hz", 0.0))
     prf = float(metadata.get("prf_hz", 0.0))
-    radar_part = f"{radar.get('kind', 'radar')} {f_c / 1e9:g} GHz, PRF {prf:g} Hz"
+    # a pulsed radar's slow time is its PRF; a CW radar's is its I/Q rate, an FMCW radar's
+    # its loop rate: neither has a ``prf`` field
+    rate = "PRF" if "prf" in radar else "slow time"
+    radar_part = f"{radar.get('kind', 'radar')} {f_c / 1e9:g} GHz, {rate} {prf:g} Hz"
     placement = dict(metadata.get("placement", {}))
     if placement.get("heading_deg") is not None:
         geometry = f"heading {placement['heading_deg']:g}°"

@@ -115,10 +115,18 @@ def check_frame_rate(fmt: str, fps: int) -> None:
         )
 
 
+#: The most instants ``skeleton.png`` shows: one panel each, side by side, 2.6 inches wide.
+MAX_INSTANTS = 12
+
+
 def check_instants(body: Skeleton, instants: Sequence[float] | FloatArray) -> FloatArray:
-    """The instants as an array, each within the body's time span (else :class:`PreviewError`
-    naming ``--at`` and the span)."""
+    """The instants as an array, at most :data:`MAX_INSTANTS`, each within the body's time span
+    (else :class:`PreviewError` naming ``--at`` and the span)."""
     x: FloatArray = np.asarray(list(instants), dtype=np.float64)
+    if x.size > MAX_INSTANTS:
+        raise PreviewError(
+            f"--at: skeleton.png shows at most {MAX_INSTANTS} instants side by side, got {x.size}"
+        )
     lo, hi = float(body.time[0]), float(body.time[-1])
     bad = x[(x < lo - 1e-9) | (x > hi + 1e-9) | ~np.isfinite(x)]
     if x.size == 0 or bad.size:
