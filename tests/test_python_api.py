@@ -28,3 +28,24 @@ def test_skeleton_leaves_the_callers_arrays_writeable() -> None:
             skeleton.time[0] = 1.0
     with pytest.raises(ValueError, match="read-only"):
         sk.valid[0, 0] = False
+
+
+def test_features_of_a_db_map_say_it_is_db_not_silence() -> None:
+    from mdframework.features import envelopes, spectrogram_features
+    from mdframework.physics.spectrogram import power_to_db
+
+    velocity = np.linspace(-5.0, 5.0, 11)
+    power = np.full((11, 6), 1e-6)
+    power[7] = 1.0  # a line at +2 m/s
+    expected = spectrogram_features(power, velocity)
+    assert expected[0] == pytest.approx(2.0)
+    db = power_to_db(power, -60.0)
+    with pytest.raises(ValueError, match=r"not dB.*10 \*\* \(db / 10\)"):
+        spectrogram_features(db, velocity)
+    # the way back from dB gives the features of the linear map
+    assert np.allclose(spectrogram_features(10 ** (db / 10), velocity), expected)
+    for bad in (np.nan, np.inf):
+        broken = power.copy()
+        broken[0, 0] = bad
+        with pytest.raises(ValueError, match="NaN or infinite"):
+            envelopes(broken, velocity)
