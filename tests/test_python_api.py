@@ -49,3 +49,20 @@ def test_features_of_a_db_map_say_it_is_db_not_silence() -> None:
         broken[0, 0] = bad
         with pytest.raises(ValueError, match="NaN or infinite"):
             envelopes(broken, velocity)
+
+
+def test_knn_refuses_nan_features_instead_of_answering_one_class() -> None:
+    from mdf_knn import Knn
+
+    rng = np.random.default_rng(0)
+    x = np.concatenate([rng.normal(0.0, 1.0, (20, 3)), rng.normal(5.0, 1.0, (20, 3))])
+    y = np.array(["a"] * 20 + ["b"] * 20)
+    assert np.array_equal(Knn(Knn.Config(k=3)).fit(x, y).predict(x), y)
+    broken = x.copy()
+    broken[0, 0] = np.nan
+    with pytest.raises(ValueError, match=r"features.*NaN or infinite.*row 0"):
+        Knn(Knn.Config(k=3)).fit(broken, y)
+    query = x.copy()
+    query[25, 1] = np.inf
+    with pytest.raises(ValueError, match=r"features.*NaN or infinite.*row 25"):
+        Knn(Knn.Config(k=3)).fit(x, y).predict(query)
