@@ -3,6 +3,11 @@ errors that say what is wrong."""
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -66,3 +71,35 @@ def test_knn_refuses_nan_features_instead_of_answering_one_class() -> None:
     query[25, 1] = np.inf
     with pytest.raises(ValueError, match=r"features.*NaN or infinite.*row 25"):
         Knn(Knn.Config(k=3)).fit(x, y).predict(query)
+
+
+def test_figures_keep_the_callers_matplotlib_backend(tmp_path: Path) -> None:
+    """A script or notebook that plots with pyplot keeps its backend (an interactive one there;
+    svg here) when it draws with mdframework.figures or writes a run's figures; a process
+    that has not imported pyplot (the command line) draws with Agg, as before."""
+    script = f"""
+import matplotlib
+matplotlib.use("svg")
+import matplotlib.pyplot as plt
+import numpy as np
+from mdframework.figures import draw_spectrogram, save, style
+with style() as p:
+    fig, ax = p.subplots(layout="constrained")
+    draw_spectrogram(ax, np.zeros((8, 4), np.float32), np.arange(4.0), np.arange(8.0) - 4)
+    save(fig, {str(tmp_path / "a.png")!r})
+print(matplotlib.get_backend())
+"""
+    fresh = """
+import matplotlib
+from mdframework.figures import style
+with style() as plt:
+    pass
+print(matplotlib.get_backend())
+"""
+    env = {k: v for k, v in os.environ.items() if k != "MPLBACKEND"}
+    for code, backend in ((script, "svg"), (fresh, "agg")):
+        out = subprocess.run(
+            [sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True
+        )
+        assert out.stdout.strip().lower() == backend
+    assert (tmp_path / "a.png").stat().st_size > 0
