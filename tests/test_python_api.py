@@ -4,6 +4,7 @@ errors that say what is wrong."""
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -103,3 +104,18 @@ print(matplotlib.get_backend())
         )
         assert out.stdout.strip().lower() == backend
     assert (tmp_path / "a.png").stat().st_size > 0
+
+
+def test_spectrogram_of_a_2d_signal_names_the_shape() -> None:
+    from mdframework.physics.spectrogram import spectrogram
+
+    t = np.arange(4096) / 2400.0
+    signal = np.exp(2j * np.pi * 300.0 * t)
+    spec = spectrogram(signal, 2400.0)
+    assert spec.doppler[np.argmax(spec.power[:, 0])] == pytest.approx(300.0)
+    # a row vector from MATLAB; one column per receive channel
+    for shaped in (signal[None, :], np.stack([signal, signal], axis=1)):
+        with pytest.raises(
+            ValueError, match=r"one channel, \(n_samples,\).*" + re.escape(str(shaped.shape))
+        ):
+            spectrogram(shaped, 2400.0)
