@@ -119,3 +119,17 @@ def test_spectrogram_of_a_2d_signal_names_the_shape() -> None:
             ValueError, match=r"one channel, \(n_samples,\).*" + re.escape(str(shaped.shape))
         ):
             spectrogram(shaped, 2400.0)
+
+
+def test_sklearn_refusal_says_how_python_allows_other_estimators() -> None:
+    from mdf_sklearn import SklearnClassifier
+    from pydantic import ValidationError
+
+    for path in ("numpy.linalg.norm", "sklearn.linear_model.LinearRegression"):
+        with pytest.raises(ValidationError, match=r"in Python: .*context=\{'allow_import': True\}"):
+            SklearnClassifier.Config(estimator=path)  # type: ignore[call-arg]
+    path = "sklearn.linear_model.LinearRegression"
+    allowed = SklearnClassifier.Config.model_validate(
+        {"estimator": path}, context={"allow_import": True}
+    )
+    assert allowed.estimator == path
