@@ -133,3 +133,13 @@ def test_sklearn_refusal_says_how_python_allows_other_estimators() -> None:
         {"estimator": path}, context={"allow_import": True}
     )
     assert allowed.estimator == path
+
+
+def test_mie_sphere_rcs_names_a_nan_or_infinite_size() -> None:
+    from mdframework.physics.rcs import sphere_rcs_mie
+
+    # a sphere many wavelengths across: the optical pi r^2 to a few per cent
+    assert sphere_rcs_mie(0.1, 0.02) == pytest.approx(np.pi * 0.01, rel=0.03)
+    for radius, wavelength in ((np.nan, 0.02), (0.1, np.nan), (np.inf, 0.02), (0.1, 0.0)):
+        with pytest.raises(ValueError, match="must be positive and finite"):
+            sphere_rcs_mie(radius, wavelength)
