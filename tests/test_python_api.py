@@ -143,3 +143,16 @@ def test_mie_sphere_rcs_names_a_nan_or_infinite_size() -> None:
     for radius, wavelength in ((np.nan, 0.02), (0.1, np.nan), (np.inf, 0.02), (0.1, 0.0)):
         with pytest.raises(ValueError, match="must be positive and finite"):
             sphere_rcs_mie(radius, wavelength)
+
+
+def test_a_plugin_made_with_a_dict_says_to_validate_it() -> None:
+    from mdf_knn import Knn
+    from mdf_noise import ReceiverNoise
+
+    x = np.array([[0.0], [1.0], [10.0], [11.0]])
+    y = np.array(["a", "a", "b", "b"])
+    assert list(Knn(Knn.Config(k=1)).fit(x, y).predict(x)) == list(y)
+    for cls, section in ((Knn, {"k": 1}), (ReceiverNoise, {"snr_db": 10.0})):
+        name = cls.__name__
+        with pytest.raises(TypeError, match=rf"{name}\.Config\.model_validate.*got dict"):
+            cls(section)  # type: ignore[arg-type]
