@@ -75,7 +75,8 @@ def envelopes(
     """Upper and lower envelopes and the torso track of a spectrogram.
 
     ``power`` (n_doppler, n_frames), linear (not dB), >= 0; ``velocity`` (n_doppler,) [m/s],
-    ascending. See the module docstring for the methods.
+    ascending. See the module docstring for the methods. ``ValueError`` for a negative value (a
+    map in dB, such as ``spectrogram_db``: pass ``10 ** (db / 10)``) or a NaN or infinite one.
     """
     p = np.asarray(power, dtype=np.float64)
     v = np.asarray(velocity, dtype=np.float64)
@@ -87,6 +88,14 @@ def envelopes(
         raise ValueError(f"threshold_db must be <= 0 dB (below the peak), got {threshold_db}")
     n_frames = p.shape[1]
     p_max = float(p.max()) if p.size else 0.0
+    p_min = float(p.min()) if p.size else 0.0
+    if not (np.isfinite(p_max) and np.isfinite(p_min)):
+        raise ValueError("power has NaN or infinite values")
+    if p_min < 0.0:
+        raise ValueError(
+            f"power must be linear (>= 0), not dB: its lowest value is {p_min:g}; for a map in "
+            "dB (such as spectrogram_db) pass 10 ** (db / 10)"
+        )
     upper = np.full(n_frames, np.nan)
     lower = np.full(n_frames, np.nan)
     torso = np.full(n_frames, np.nan)
@@ -171,7 +180,8 @@ def spectrogram_features(
 ) -> FloatArray:
     """The seven features (7,) [m/s] of a spectrogram, in :data:`FEATURE_NAMES` order.
 
-    ``power`` (n_doppler, n_frames) linear; ``velocity`` (n_doppler,) [m/s] ascending.
+    ``power`` (n_doppler, n_frames) linear (not dB: for ``spectrogram_db`` pass
+    ``10 ** (db / 10)``); ``velocity`` (n_doppler,) [m/s] ascending.
     """
     env = envelopes(
         power,

@@ -49,9 +49,14 @@ _CAPTION_SIZE = 7.5
 
 
 def _pyplot() -> Any:
+    """``matplotlib.pyplot``, on the Agg backend when this process has not imported pyplot
+    yet (the command line); a script or notebook that plots with pyplot keeps its backend."""
+    import sys
+
     import matplotlib
 
-    matplotlib.use("Agg")
+    if "matplotlib.pyplot" not in sys.modules:
+        matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     return plt

@@ -194,6 +194,13 @@ class Plugin(ABC):
     Config: ClassVar[type[PluginConfig]]
 
     def __init__(self, config: PluginConfig) -> None:
+        if isinstance(config, Mapping):  # a config section as read, not validated
+            name = type(self).__name__
+            raise TypeError(
+                f"{name} takes an instance of {name}.Config, e.g. {name}({name}.Config(...)) or, "
+                f"from a dict, {name}({name}.Config.model_validate(d)); got "
+                f"{type(config).__name__}"
+            )
         self.config = config
 
 

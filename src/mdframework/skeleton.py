@@ -10,9 +10,10 @@ Arrays and units:
   that frame (its position must then not be used).
 - ``joint_names``: tuple of ``n_joints`` strings.
 
-The arrays are made read-only on construction: stages share skeletons (and datasets cache them
-across records), so a stage that wants different positions builds a new skeleton
-(:meth:`Skeleton.with_positions`) instead of changing one in place.
+A skeleton's arrays are read-only views of the arrays it was given (not copies; the arrays
+given stay writeable): stages share skeletons (and datasets cache them across records), so a
+stage that wants different positions builds a new skeleton (:meth:`Skeleton.with_positions`)
+instead of changing one in place.
 
 The canonical body is Chen's 17-point set used with the Boulic walking model (V. C. Chen, "The
 Micro-Doppler Effect in Radar", 2011): base (hip centre), neck, head, left/right shoulder, elbow,
@@ -123,8 +124,9 @@ class Skeleton:
                 raise SkeletonError(f"valid must have shape {pos.shape[:2]}, got {valid.shape}")
             if not np.all(finite | ~valid[:, :, None]):
                 raise SkeletonError("positions marked valid must be finite")
-        for array in (time, pos, valid):  # shared between stages (and cached): never mutated
-            array.flags.writeable = False
+        # shared between stages (and cached): never mutated; read-only views, so that the
+        # caller's own arrays stay writeable
+        time, pos, valid = (_read_only(a) for a in (time, pos, valid))
         object.__setattr__(self, "time", time)
         object.__setattr__(self, "positions", pos)
         object.__setattr__(self, "joint_names", names)
@@ -159,7 +161,7 @@ class Skeleton:
             ("valid", valid),
         ):
             if isinstance(value, np.ndarray):
-                value.flags.writeable = False
+                value = _read_only(value)
             object.__setattr__(skeleton, name, value)
         return skeleton
 
@@ -224,6 +226,13 @@ class Skeleton:
     def with_positions(self, positions: FloatArray) -> Skeleton:
         """Same time stamps, names and validity with new positions."""
         return Skeleton(self.time, positions, self.joint_names, self.valid)
+
+
+def _read_only(array: NDArray[Any]) -> NDArray[Any]:
+    """A read-only view of ``array`` (the array itself, the caller's, is left as it was)."""
+    view = array.view()
+    view.flags.writeable = False
+    return view
 
 
 def to_canonical(skeleton: Skeleton, mapping: Mapping[str, str]) -> Skeleton:

@@ -26,9 +26,12 @@ def sphere_rcs_mie(radius: float, wavelength: float) -> float:
     """
     from scipy import special
 
-    ka = 2.0 * np.pi * float(radius) / float(wavelength)
-    if ka <= 0:
-        raise ValueError("radius and wavelength must be positive")
+    r, lam = float(radius), float(wavelength)
+    if not (0.0 < r < np.inf and 0.0 < lam < np.inf):  # NaN too
+        raise ValueError(
+            f"radius and wavelength must be positive and finite, got {radius!r} and {wavelength!r}"
+        )
+    ka = 2.0 * np.pi * r / lam
     n_max = int(ka + 4.05 * ka ** (1.0 / 3.0) + 10)
     n = np.arange(1, n_max + 1)
     jn = special.spherical_jn(n, ka)
@@ -38,7 +41,7 @@ def sphere_rcs_mie(radius: float, wavelength: float) -> float:
     a_n = jn / hn
     b_n = (ka * jn1 - n * jn) / (ka * hn1 - n * hn)
     total = np.sum((-1.0) ** n * (n + 0.5) * (b_n - a_n))
-    return float(wavelength**2 / np.pi * abs(total) ** 2)
+    return float(lam**2 / np.pi * abs(total) ** 2)
 
 
 def ellipsoid_rcs_local(a: ArrayLike, b: ArrayLike, c: ArrayLike, u: ArrayLike) -> FloatArray:

@@ -138,12 +138,15 @@ def spectrogram(
     ``window`` is any scipy window name; ``window_length`` and ``hop`` in samples; ``nfft`` >=
     ``window_length`` (default: the window length). Frame ``m`` covers samples
     ``mH .. mH + L - 1`` and its time is their midpoint ``(mH + (L - 1)/2) / fs``. A record shorter
-    than one window raises :class:`RecordTooShortError`; the resolution never changes silently.
+    than one window raises :class:`RecordTooShortError`; the resolution never changes silently
+    (``ValueError`` for a signal of more than one dimension: one channel at a time).
     ``precision``: ``float32`` (complex64 FFTs, float32 power; the accuracy ladder in
     ``docs/accuracy.md`` measures its cost) or ``float64``. Frames are transformed a few
     thousand at a time, so the only record-sized array is the power itself.
     """
     y = np.asarray(signal)
+    if y.ndim != 1:
+        raise ValueError(f"signal must be one channel, (n_samples,), got shape {y.shape}")
     geometry = stft_geometry(y.shape[0], sample_rate, window_length, hop, nfft)
     nfft, n_frames = geometry.shape
     real, cplx = precision_dtypes(precision)

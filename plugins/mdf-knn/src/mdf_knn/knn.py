@@ -10,6 +10,8 @@
 - **Vote ties**: among the classes with the most votes, the one whose closest member among the
   k neighbours is nearest wins (``tie_rule = "nearest"``, the default); ``"lowest"`` picks the
   alphabetically first class, as ``argmax`` over sorted labels would.
+- **NaN or infinite features** (in ``fit`` or ``predict``): ``ValueError`` naming the first such
+  row (they would make every distance NaN).
 """
 
 from __future__ import annotations
@@ -26,6 +28,17 @@ from mdframework.classify import Standardizer
 #: Queries per block: a block's (queries, training samples, features) difference array stays
 #: near this many float64 elements (32 MiB).
 _BLOCK_ELEMENTS = 1 << 22
+
+
+def _finite(features: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``features`` as float64; ``ValueError`` naming the first row with a NaN or infinite
+    value (one would make every distance NaN, and every answer the first class)."""
+    x = np.asarray(features, dtype=np.float64)
+    bad = ~np.isfinite(x)
+    if np.any(bad):
+        row = int(np.argwhere(bad)[0][0])
+        raise ValueError(f"features have NaN or infinite values (first in row {row})")
+    return x
 
 
 class KnnConfig(PluginConfig):
@@ -49,7 +62,7 @@ class Knn(Classifier):
 
     def fit(self, features: NDArray[np.float64], labels: NDArray[Any]) -> Knn:
         """Store the standardised training data (n_samples, n_features) and labels."""
-        x = np.asarray(features, dtype=np.float64)
+        x = _finite(features)
         if x.ndim != 2 or x.shape[0] != len(labels):
             raise ValueError("features must be (n_samples, n_features) with one label each")
         if self.config.k > x.shape[0]:  # every record would vote: the largest class wins
@@ -83,7 +96,7 @@ class Knn(Classifier):
         ordered by distance, ties by training order."""
         n_train, n_feat = self.train_.shape
         k = self.config.k  # at most n_train (checked by fit)
-        z = self.scaler_.transform(np.asarray(features, dtype=np.float64))
+        z = self.scaler_.transform(_finite(features))
         step = max(1, _BLOCK_ELEMENTS // max(1, n_train * n_feat))
         dist = np.empty((z.shape[0], k))
         idx = np.empty((z.shape[0], k), dtype=np.intp)

@@ -33,6 +33,11 @@ from mdframework.classify import Standardizer
 
 #: Validation-context key that allows any import path (set by ``--allow-import``).
 ALLOW_IMPORT = "allow_import"
+#: How a Python caller allows it (the refusals' messages say so).
+_IN_PYTHON = (
+    f" (in Python: SklearnClassifier.Config.model_validate(..., context={{'{ALLOW_IMPORT}': True}})"
+    ", or classifier_factory(..., allow_import=True))"
+)
 
 
 def _import(path: str) -> Any:
@@ -62,13 +67,13 @@ def check_estimator_path(path: str, allow_import: bool = False) -> Any:
         raise ValueError(
             f"{path!r} is not a scikit-learn classifier path such as 'sklearn.svm.SVC'; other "
             "import paths run code from wherever they point and need the command-line flag "
-            "--allow-import"
+            f"--allow-import{_IN_PYTHON}"
         )
     est = _import(path)
     if not allow_import and est not in sklearn_classifiers():
         raise ValueError(
             f"{path!r} is not one of scikit-learn's classifiers; other estimators need the "
-            "command-line flag --allow-import"
+            f"command-line flag --allow-import{_IN_PYTHON}"
         )
     if not (hasattr(est, "fit") and hasattr(est, "predict")):
         raise ValueError(f"{path!r} has no fit/predict: not a classifier")
