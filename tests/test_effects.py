@@ -29,7 +29,7 @@ ALL_EFFECTS = tuple(
     default_registry().get("effects", name) for name in default_registry().names("effects")
 )
 #: the methods through which an effect does work
-EFFECT_METHODS = ("__init__", "start_record", "check_radar", "apply", "describe")
+EFFECT_METHODS = ("__init__", "start_record", "check_radar", "check_effects", "apply", "describe")
 
 
 def run(
@@ -542,6 +542,47 @@ def test_antenna_pointing_at_target_tracks_it() -> None:
     assert np.all(edge < 0.5)  # ~15 degrees off a 10-degree beam at both ends
 
 
+def test_antenna_after_multipath_weighs_each_path_by_its_own_directions() -> None:
+    """A beam aimed horizontally at a target level with the radar, 3 m away, 1 m above the
+    ground: the ground-bounce paths leave the radar 33.7 deg below boresight. The image gets
+    the two-way gain of that direction, the single bounce one way direct and one way down."""
+    bw, gamma = 20.0, 0.6
+    eff = [
+        {"kind": "multipath", "reflection_magnitude": gamma, "reflection_phase_deg": 0.0},
+        {
+            "kind": "antenna",
+            "beamwidth_az_deg": bw,
+            "pointing": "angles",
+            "azimuth_deg": 0.0,
+            "elevation_deg": 0.0,
+        },
+    ]
+    res = run([{"position": [3.0, 0.0, 1.0], "rcs": 1.0}], eff, radar_position=(0.0, 0.0, 1.0))
+    rcs = dict(zip(res.scatterers.names, res.scatterers.rcs[0], strict=True))
+    r_d, r_b = 3.0, np.hypot(3.0, 2.0)
+    g_b = np.exp(-4 * np.log(2) * (np.degrees(np.arctan2(2.0, 3.0)) / bw) ** 2)  # one way
+    assert 10 * np.log10(g_b) == pytest.approx(-34.17, abs=0.01)
+    assert rcs["target0"] == pytest.approx(1.0, rel=1e-12)
+    assert rcs["target0~image"] == pytest.approx(gamma**4 * g_b**2, rel=1e-9)
+    r_m = (r_d + r_b) / 2  # a 0 deg reflection phase: no range offset
+    bounce = 4 * gamma**2 * g_b * r_m**4 / (r_d**2 * r_b**2)
+    assert rcs["target0~bounce"] == pytest.approx(bounce, rel=1e-9)
+
+
+def test_antenna_before_multipath_is_refused() -> None:
+    """Listed first, the pattern would give the bounced paths the direct path's gain."""
+    from mdframework import SceneError
+
+    eff = [{"kind": "antenna"}, {"kind": "noise"}, {"kind": "multipath"}]
+    with pytest.raises(
+        SceneError,
+        match=r"^effects: antenna \(effects\[0\]\) .* multipath "
+        r"\(effects\[2\]\).*list antenna after multipath$",
+    ):
+        run(APPROACHING, eff, radar_position=(0.0, 0.0, 1.0))
+    assert run(APPROACHING, eff[::-1], radar_position=(0.0, 0.0, 1.0)).metadata["effects"]
+
+
 # --------------------------------------------------------------------------- attenuation
 
 
@@ -606,17 +647,17 @@ def test_only_the_named_effect_runs(monkeypatch: pytest.MonkeyPatch) -> None:
 def test_metadata_records_effects_in_stage_order() -> None:
     effects = [
         {"kind": "noise", "snr_db": 30.0},
-        {"kind": "antenna", "beamwidth_az_deg": 30.0},
+        {"kind": "multipath", "ground_height": -1.0},
         {"kind": "clutter"},
         {"kind": "attenuation", "gas_db_per_km": 0.1},
-        {"kind": "multipath", "ground_height": -1.0},
+        {"kind": "antenna", "beamwidth_az_deg": 30.0},
     ]
     res = run(APPROACHING, effects)
     ran = [(e["kind"], e["stage"]) for e in res.metadata["effects"]]
     assert ran == [
-        ("antenna", "scatterers"),
-        ("attenuation", "scatterers"),
         ("multipath", "scatterers"),
+        ("attenuation", "scatterers"),
+        ("antenna", "scatterers"),
         ("noise", "received"),
         ("clutter", "received"),
     ]
