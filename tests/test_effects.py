@@ -43,10 +43,12 @@ def run(
     seed: int = 0,
     processing: dict[str, Any] | None = None,
 ) -> RunResult:
+    radar_cfg = radar_cfg or {}
+    lfm = {"kind": "lfm", "precision": "float64"} if radar_cfg.get("kind", "lfm") == "lfm" else {}
     cfg = {
         "motion": {"kind": "point_targets", "length": duration, "targets": targets},
         "scatterers": {"kind": "points"},
-        "radar": {"kind": "lfm", "precision": "float64", **(radar_cfg or {})},
+        "radar": {**lfm, **radar_cfg},
         "scene": {"radar_position": list(radar_position), "gate": gate},
         "processing": {"keep_scatterers": True, **(processing or {})},
         "effects": effects,
@@ -92,6 +94,20 @@ def test_thermal_noise_is_kTF_over_tau_after_compression() -> None:
     strong = [{**APPROACHING[0], "rcs": 100.0}]
     noisy_strong = run(strong, [eff], radar_cfg=rcfg)
     assert noisy_strong.metadata["effects"][0]["noise_power_w"] == pytest.approx(expected)
+
+
+def test_thermal_noise_is_refused_without_the_range_equation() -> None:
+    """With sqrt(rcs) amplitudes the signal is not in watts: k T F / tau beside it would be
+    noise some 140 dB below a 1 m^2 target, silently."""
+    from mdframework import SceneError
+
+    thermal = [{"kind": "noise", "mode": "thermal"}]
+    with pytest.raises(SceneError, match=r"^effects\.noise: mode 'thermal' .*'sqrt_rcs'"):
+        run(APPROACHING, thermal, radar_cfg={"amplitude": "sqrt_rcs"}, duration=0.2)
+    with pytest.raises(SceneError, match=r"^effects\.noise: mode 'thermal' .*'sqrt_rcs'"):
+        run(APPROACHING, thermal, radar_cfg={"kind": "cw", "amplitude": "sqrt_rcs"}, duration=0.2)
+    snr = run(APPROACHING, [{"kind": "noise"}], radar_cfg={"amplitude": "sqrt_rcs"}, duration=0.2)
+    assert snr.metadata["effects"][0]["noise_power_w"] > 0
 
 
 def test_noise_floor_in_spectrogram_is_sigma2_sum_w2() -> None:
