@@ -585,8 +585,9 @@ def test_antenna_after_multipath_weighs_each_path_by_its_own_directions() -> Non
     assert rcs["target0~bounce"] == pytest.approx(bounce, rel=1e-9)
 
 
-def test_antenna_before_multipath_is_refused() -> None:
-    """Listed first, the pattern would give the bounced paths the direct path's gain."""
+def test_antenna_before_multipath_or_static_scene_is_refused() -> None:
+    """Listed first, the pattern would give the bounced paths the direct path's gain, and the
+    room's reflectors none."""
     from mdframework import SceneError
 
     eff = [{"kind": "antenna"}, {"kind": "noise"}, {"kind": "multipath"}]
@@ -597,6 +598,13 @@ def test_antenna_before_multipath_is_refused() -> None:
     ):
         run(APPROACHING, eff, radar_position=(0.0, 0.0, 1.0))
     assert run(APPROACHING, eff[::-1], radar_position=(0.0, 0.0, 1.0)).metadata["effects"]
+    room = {"kind": "static_scene", "reflectors": [{"position": [5.0, 5.0, 0.0], "rcs_m2": 1.0}]}
+    with pytest.raises(SceneError, match=r"^effects: antenna .* static_scene \(effects\[1\]\)"):
+        run(APPROACHING, [{"kind": "antenna"}, room])
+    # the room's reflector 45 deg off a 20 deg beam aimed at the target: -61 dB one way
+    weighed = run(APPROACHING, [room, {"kind": "antenna"}], duration=0.2)
+    g = np.exp(-4 * np.log(2) * (45.0 / 20.0) ** 2)
+    assert weighed.scatterers.rcs[0, 1] == pytest.approx(g**2, rel=1e-9)
 
 
 # --------------------------------------------------------------------------- attenuation

@@ -30,7 +30,8 @@ the single-bounce scatterer ``name~bounce``, one leg direct and one bounced, get
 ``g(u_d) g(u_b)``: the gains of the directions of ``name`` and ``name~image`` (its own
 direction, their bisector, would give ``g(bisector)^2``, which for a beam aimed at the body can
 be tens of dB too strong). Listed before ``multipath``, the bounced paths would inherit the
-direct path's gain: that order is refused.
+direct path's gain: that order is refused, as is ``static_scene`` after this effect (the
+room's reflectors would be outside the pattern).
 
 Pointing: ``pointing = "target"`` aims the boresight at the mean position of the gate's
 reference point (the hip centre ``base``, or the first joint of a non-human motion) over the
@@ -148,6 +149,12 @@ def reference_track(context: SceneContext) -> FloatArray:
     return np.asarray(skel.positions[:, ref, :], dtype=np.float64)
 
 
+#: effects that add scatterers the pattern must weigh, and what listing them after it would do
+ADDS_SCATTERERS = {
+    "multipath": "the ground-bounce paths would get the direct path's antenna gain",
+    "static_scene": "the room's reflectors would get no antenna gain",
+}
+
 #: suffixes of the ``multipath`` effect's single-bounce and image scatterers' names
 BOUNCE, IMAGE = "~bounce", "~image"
 
@@ -189,16 +196,16 @@ class AntennaPattern(Effect):
         self._min_gain = 1.0
 
     def check_effects(self, effects: Sequence[Effect]) -> None:
-        """Refuse a ``multipath`` effect listed after this one: its bounced paths would get the
-        direct path's gain instead of the gain toward the ground."""
+        """Refuse an effect listed after this one that adds scatterers the pattern must weigh:
+        ``multipath`` (its bounced paths would keep the direct path's gain, not the gain
+        toward the ground) and ``static_scene`` (the room would be outside the pattern)."""
         mine = next(i for i, e in enumerate(effects) if e is self)
-        later = next((i for i, e in enumerate(effects) if i > mine and e.name == "multipath"), None)
-        if later is not None:
-            raise SceneError(
-                f"effects: antenna (effects[{mine}]) is listed before multipath "
-                f"(effects[{later}]), so the ground-bounce paths would get the direct path's "
-                "antenna gain: list antenna after multipath"
-            )
+        for i, e in enumerate(effects[mine + 1 :], mine + 1):
+            if e.name in ADDS_SCATTERERS:
+                raise SceneError(
+                    f"effects: antenna (effects[{mine}]) is listed before {e.name} "
+                    f"(effects[{i}]), so {ADDS_SCATTERERS[e.name]}: list antenna after {e.name}"
+                )
 
     def boresight(self, context: SceneContext) -> FloatArray:
         """Boresight vector(s): (3,) or (n_pulses, 1, 3) when tracking."""
