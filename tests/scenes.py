@@ -233,7 +233,12 @@ def effect_sections(draw: st.DrawFn) -> list[dict[str, Any]]:
     if draw(st.booleans()):
         out.append({"kind": "attenuation", "gas_db_per_km": draw(st.floats(0.0, 50.0))})
     order = draw(st.permutations(list(range(len(out)))))
-    return [out[i] for i in order]
+    effects = [out[i] for i in order]
+    kinds = [e["kind"] for e in effects]
+    if {"antenna", "multipath"} <= set(kinds):  # antenna after multipath, else refused
+        i, j = sorted((kinds.index("antenna"), kinds.index("multipath")))
+        effects[i], effects[j] = effects[j], effects[i]
+    return effects
 
 
 @st.composite

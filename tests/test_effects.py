@@ -29,7 +29,7 @@ ALL_EFFECTS = tuple(
     default_registry().get("effects", name) for name in default_registry().names("effects")
 )
 #: the methods through which an effect does work
-EFFECT_METHODS = ("__init__", "start_record", "check_radar", "apply", "describe")
+EFFECT_METHODS = ("__init__", "start_record", "check_radar", "check_effects", "apply", "describe")
 
 
 def run(
@@ -43,10 +43,12 @@ def run(
     seed: int = 0,
     processing: dict[str, Any] | None = None,
 ) -> RunResult:
+    radar_cfg = radar_cfg or {}
+    lfm = {"kind": "lfm", "precision": "float64"} if radar_cfg.get("kind", "lfm") == "lfm" else {}
     cfg = {
         "motion": {"kind": "point_targets", "length": duration, "targets": targets},
         "scatterers": {"kind": "points"},
-        "radar": {"kind": "lfm", "precision": "float64", **(radar_cfg or {})},
+        "radar": {**lfm, **radar_cfg},
         "scene": {"radar_position": list(radar_position), "gate": gate},
         "processing": {"keep_scatterers": True, **(processing or {})},
         "effects": effects,
@@ -92,6 +94,20 @@ def test_thermal_noise_is_kTF_over_tau_after_compression() -> None:
     strong = [{**APPROACHING[0], "rcs": 100.0}]
     noisy_strong = run(strong, [eff], radar_cfg=rcfg)
     assert noisy_strong.metadata["effects"][0]["noise_power_w"] == pytest.approx(expected)
+
+
+def test_thermal_noise_is_refused_without_the_range_equation() -> None:
+    """With sqrt(rcs) amplitudes the signal is not in watts: k T F / tau beside it would be
+    noise some 140 dB below a 1 m^2 target, silently."""
+    from mdframework import SceneError
+
+    thermal = [{"kind": "noise", "mode": "thermal"}]
+    with pytest.raises(SceneError, match=r"^effects\.noise: mode 'thermal' .*'sqrt_rcs'"):
+        run(APPROACHING, thermal, radar_cfg={"amplitude": "sqrt_rcs"}, duration=0.2)
+    with pytest.raises(SceneError, match=r"^effects\.noise: mode 'thermal' .*'sqrt_rcs'"):
+        run(APPROACHING, thermal, radar_cfg={"kind": "cw", "amplitude": "sqrt_rcs"}, duration=0.2)
+    snr = run(APPROACHING, [{"kind": "noise"}], radar_cfg={"amplitude": "sqrt_rcs"}, duration=0.2)
+    assert snr.metadata["effects"][0]["noise_power_w"] > 0
 
 
 def test_noise_floor_in_spectrogram_is_sigma2_sum_w2() -> None:
@@ -574,6 +590,55 @@ def test_antenna_pointing_at_target_tracks_it() -> None:
     assert np.all(edge < 0.5)  # ~15 degrees off a 10-degree beam at both ends
 
 
+def test_antenna_after_multipath_weighs_each_path_by_its_own_directions() -> None:
+    """A beam aimed horizontally at a target level with the radar, 3 m away, 1 m above the
+    ground: the ground-bounce paths leave the radar 33.7 deg below boresight. The image gets
+    the two-way gain of that direction, the single bounce one way direct and one way down."""
+    bw, gamma = 20.0, 0.6
+    eff = [
+        {"kind": "multipath", "reflection_magnitude": gamma, "reflection_phase_deg": 0.0},
+        {
+            "kind": "antenna",
+            "beamwidth_az_deg": bw,
+            "pointing": "angles",
+            "azimuth_deg": 0.0,
+            "elevation_deg": 0.0,
+        },
+    ]
+    res = run([{"position": [3.0, 0.0, 1.0], "rcs": 1.0}], eff, radar_position=(0.0, 0.0, 1.0))
+    rcs = dict(zip(res.scatterers.names, res.scatterers.rcs[0], strict=True))
+    r_d, r_b = 3.0, np.hypot(3.0, 2.0)
+    g_b = np.exp(-4 * np.log(2) * (np.degrees(np.arctan2(2.0, 3.0)) / bw) ** 2)  # one way
+    assert 10 * np.log10(g_b) == pytest.approx(-34.17, abs=0.01)
+    assert rcs["target0"] == pytest.approx(1.0, rel=1e-12)
+    assert rcs["target0~image"] == pytest.approx(gamma**4 * g_b**2, rel=1e-9)
+    r_m = (r_d + r_b) / 2  # a 0 deg reflection phase: no range offset
+    bounce = 4 * gamma**2 * g_b * r_m**4 / (r_d**2 * r_b**2)
+    assert rcs["target0~bounce"] == pytest.approx(bounce, rel=1e-9)
+
+
+def test_antenna_before_multipath_or_static_scene_is_refused() -> None:
+    """Listed first, the pattern would give the bounced paths the direct path's gain, and the
+    room's reflectors none."""
+    from mdframework import SceneError
+
+    eff = [{"kind": "antenna"}, {"kind": "noise"}, {"kind": "multipath"}]
+    with pytest.raises(
+        SceneError,
+        match=r"^effects: antenna \(effects\[0\]\) .* multipath "
+        r"\(effects\[2\]\).*list antenna after multipath$",
+    ):
+        run(APPROACHING, eff, radar_position=(0.0, 0.0, 1.0))
+    assert run(APPROACHING, eff[::-1], radar_position=(0.0, 0.0, 1.0)).metadata["effects"]
+    room = {"kind": "static_scene", "reflectors": [{"position": [5.0, 5.0, 0.0], "rcs_m2": 1.0}]}
+    with pytest.raises(SceneError, match=r"^effects: antenna .* static_scene \(effects\[1\]\)"):
+        run(APPROACHING, [{"kind": "antenna"}, room])
+    # the room's reflector 45 deg off a 20 deg beam aimed at the target: -61 dB one way
+    weighed = run(APPROACHING, [room, {"kind": "antenna"}], duration=0.2)
+    g = np.exp(-4 * np.log(2) * (45.0 / 20.0) ** 2)
+    assert weighed.scatterers.rcs[0, 1] == pytest.approx(g**2, rel=1e-9)
+
+
 # --------------------------------------------------------------------------- attenuation
 
 
@@ -638,17 +703,17 @@ def test_only_the_named_effect_runs(monkeypatch: pytest.MonkeyPatch) -> None:
 def test_metadata_records_effects_in_stage_order() -> None:
     effects = [
         {"kind": "noise", "snr_db": 30.0},
-        {"kind": "antenna", "beamwidth_az_deg": 30.0},
+        {"kind": "multipath", "ground_height": -1.0},
         {"kind": "clutter"},
         {"kind": "attenuation", "gas_db_per_km": 0.1},
-        {"kind": "multipath", "ground_height": -1.0},
+        {"kind": "antenna", "beamwidth_az_deg": 30.0},
     ]
     res = run(APPROACHING, effects)
     ran = [(e["kind"], e["stage"]) for e in res.metadata["effects"]]
     assert ran == [
-        ("antenna", "scatterers"),
-        ("attenuation", "scatterers"),
         ("multipath", "scatterers"),
+        ("attenuation", "scatterers"),
+        ("antenna", "scatterers"),
         ("noise", "received"),
         ("clutter", "received"),
     ]

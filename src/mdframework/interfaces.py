@@ -30,7 +30,7 @@ import types
 import typing
 import warnings
 from abc import ABC, abstractmethod
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
@@ -681,6 +681,12 @@ class Effect(Plugin):
         :class:`~mdframework.errors.SceneError` (naming the config field) when this effect
         cannot work with that radar, so that the run is refused before any pulse is simulated.
         Default: nothing."""
+
+    def check_effects(self, effects: Sequence[Effect]) -> None:
+        """Called when a run's plugins are built, after :meth:`check_radar`, with every effect
+        the scene lists, in the listed order (this one among them): raise
+        :class:`~mdframework.errors.SceneError` (naming the ``effects`` list) when this effect
+        cannot work with the others in that order. Default: nothing."""
 
     @abstractmethod
     def apply(self, data: Any, context: SceneContext) -> Any:

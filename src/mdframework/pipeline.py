@@ -106,7 +106,7 @@ class Stages:
 
 def build_stages(config: RunConfigBase, registry: Registry | None = None) -> Stages:
     """Instantiate the plugins a config names; each effect checks the radar
-    (:meth:`Effect.check_radar`)."""
+    (:meth:`Effect.check_radar`) and the other effects (:meth:`Effect.check_effects`)."""
     reg = registry or default_registry()
     cfg: Any = config
 
@@ -130,6 +130,9 @@ def build_stages(config: RunConfigBase, registry: Registry | None = None) -> Sta
     for effect in effects:  # e.g. clutter needs a bandwidth: refused before any pulse
         with blame(effect, "check_radar"):
             effect.check_radar(waveform)
+    for effect in effects:  # e.g. an antenna pattern listed before the multipath it must see
+        with blame(effect, "check_effects"):
+            effect.check_effects(effects)
     return Stages(source, model, waveform, effects)
 
 

@@ -23,6 +23,16 @@ Patterns (``beamwidth_*_deg`` are full one-way half-power widths):
 
 Directions behind the aperture plane (``d.b <= 0``) get ``g = 0`` (no back lobe).
 
+Ground-bounce multipath (the ``multipath`` effect, listed before this one): a bounced path
+leaves and reaches the radar along the direction of the scatterer's mirror image, so the image
+scatterer ``name~image`` (placed along that direction) gets ``g(u_b)^2`` like any scatterer, and
+the single-bounce scatterer ``name~bounce``, one leg direct and one bounced, gets
+``g(u_d) g(u_b)``: the gains of the directions of ``name`` and ``name~image`` (its own
+direction, their bisector, would give ``g(bisector)^2``, which for a beam aimed at the body can
+be tens of dB too strong). Listed before ``multipath``, the bounced paths would inherit the
+direct path's gain: that order is refused, as is ``static_scene`` after this effect (the
+room's reflectors would be outside the pattern).
+
 Pointing: ``pointing = "target"`` aims the boresight at the mean position of the gate's
 reference point (the hip centre ``base``, or the first joint of a non-human motion) over the
 record; ``steering = "track"`` re-aims it at that point on every pulse (a tracking antenna);
@@ -31,13 +41,14 @@ record; ``steering = "track"`` re-aims it at that point on every pulse (a tracki
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field, model_validator
 
-from mdframework import Effect, PluginConfig, Scatterers, SceneContext, Skeleton
+from mdframework import Effect, PluginConfig, Scatterers, SceneContext, SceneError, Skeleton
 from mdframework.settings import AngleDeg
 
 FloatArray = NDArray[np.float64]
@@ -138,8 +149,33 @@ def reference_track(context: SceneContext) -> FloatArray:
     return np.asarray(skel.positions[:, ref, :], dtype=np.float64)
 
 
+#: effects that add scatterers the pattern must weigh, and what listing them after it would do
+ADDS_SCATTERERS = {
+    "multipath": "the ground-bounce paths would get the direct path's antenna gain",
+    "static_scene": "the room's reflectors would get no antenna gain",
+}
+
+#: suffixes of the ``multipath`` effect's single-bounce and image scatterers' names
+BOUNCE, IMAGE = "~bounce", "~image"
+
+
+def bounce_legs(names: Sequence[str]) -> tuple[NDArray[np.intp], ...]:
+    """Indices ``(bounce, direct, image)`` of every single-bounce scatterer ``name~bounce`` whose
+    ``name`` and ``name~image`` are among ``names``, each (n_bounce,)."""
+    index = {n: i for i, n in enumerate(names)}
+    rows = [
+        (i, index[n[: -len(BOUNCE)]], index[n[: -len(BOUNCE)] + IMAGE])
+        for i, n in enumerate(names)
+        if n.endswith(BOUNCE) and n[: -len(BOUNCE)] in index and n[: -len(BOUNCE)] + IMAGE in index
+    ]
+    table = np.asarray(rows, dtype=np.intp).reshape(-1, 3)
+    return table[:, 0], table[:, 1], table[:, 2]
+
+
 class AntennaPattern(Effect):
-    """Multiplies each scatterer's RCS by the two-way pattern gain ``g^2`` of its direction."""
+    """Multiplies each scatterer's RCS by the two-way pattern gain ``g^2`` of its direction.
+
+    A single-bounce multipath scatterer gets ``g(u_d) g(u_b)`` (the module docstring)."""
 
     name = "antenna"
     Config = AntennaConfig
@@ -158,6 +194,18 @@ class AntennaPattern(Effect):
         track = body.positions[:, ref, :][body.valid[:, ref]]
         self._mean = np.asarray(np.mean(track, axis=0), dtype=np.float64) if track.size else None
         self._min_gain = 1.0
+
+    def check_effects(self, effects: Sequence[Effect]) -> None:
+        """Refuse an effect listed after this one that adds scatterers the pattern must weigh:
+        ``multipath`` (its bounced paths would keep the direct path's gain, not the gain
+        toward the ground) and ``static_scene`` (the room would be outside the pattern)."""
+        mine = next(i for i, e in enumerate(effects) if e is self)
+        for i, e in enumerate(effects[mine + 1 :], mine + 1):
+            if e.name in ADDS_SCATTERERS:
+                raise SceneError(
+                    f"effects: antenna (effects[{mine}]) is listed before {e.name} "
+                    f"(effects[{i}]), so {ADDS_SCATTERERS[e.name]}: list antenna after {e.name}"
+                )
 
     def boresight(self, context: SceneContext) -> FloatArray:
         """Boresight vector(s): (3,) or (n_pulses, 1, 3) when tracking."""
@@ -188,7 +236,11 @@ class AntennaPattern(Effect):
             }
         self._min_gain = min(self._min_gain, float(np.min(g)) if g.size else 1.0)
         self._stats["min_two_way_gain_db"] = float(10 * np.log10(max(self._min_gain**2, 1e-300)))
-        return data.replace(rcs=data.rcs * g * g)
+        two_way = g * g
+        bounce, direct, image = bounce_legs(data.names)
+        if bounce.size:  # one leg along the direct path, one toward the ground
+            two_way[:, bounce] = g[:, direct] * g[:, image]
+        return data.replace(rcs=data.rcs * two_way)
 
     def describe(self) -> dict[str, Any]:
         """The config plus the boresight (first pulse when tracking) and the smallest gain."""

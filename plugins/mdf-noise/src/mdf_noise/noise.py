@@ -17,6 +17,7 @@ set in one of two ways:
     ``SNR (sum w)^2 / sum w^2`` (``0.667 L`` for a Hann window, 22.3 dB for L = 256).
 
 ``mode = "thermal"``
+    (refused with a radar whose ``amplitude`` is ``sqrt_rcs``: its signal is not in watts)
     The radar equation's receiver: noise power at the receiver input
     ``N = k_B T F B_n`` (Boltzmann's constant, system temperature ``T`` [K], noise figure ``F``
     (linear), noise bandwidth ``B_n`` [Hz], default the waveform's chirp bandwidth ``B``). The
@@ -144,7 +145,8 @@ class ReceiverNoise(Effect):
 
     def check_radar(self, waveform: RadarWaveform) -> None:
         """Refuse a radar that adds receiver noise itself (``RadarWaveform.adds_receiver_noise``:
-        the FMCW radar's ``receiver_noise``)."""
+        the FMCW radar's ``receiver_noise``), and mode ``thermal`` with a radar whose amplitudes
+        are ``sqrt(rcs)`` (``amplitude = "sqrt_rcs"``), not received powers."""
         if waveform.adds_receiver_noise:
             raise SceneError(
                 f"effects.noise: the {waveform.name!r} radar adds receiver noise itself "
@@ -152,6 +154,13 @@ class ReceiverNoise(Effect):
                 "points and spectrogram: remove the noise effect (or set "
                 "radar.receiver_noise = false to have the effect's noise, which reaches the "
                 "spectrogram only)"
+            )
+        amplitude = getattr(getattr(waveform, "config", None), "amplitude", None)
+        if self.config.mode == "thermal" and amplitude == "sqrt_rcs":
+            raise SceneError(
+                "effects.noise: mode 'thermal' adds the receiver's noise in watts, but with "
+                "radar.amplitude = 'sqrt_rcs' the signal is sqrt(rcs), not a received power: "
+                "use mode 'snr', or radar.amplitude = 'range_equation'"
             )
 
     def _waveform_param(self, context: SceneContext, field: str) -> float:
