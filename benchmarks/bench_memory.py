@@ -58,8 +58,6 @@ if effects:
     spec["effects"] = [
         {{"kind": "clutter"}}, {{"kind": "multipath"}}, {{"kind": "static_scene", "count": 10}}
     ] + ([] if path == "fmcw" else [{{"kind": "noise"}}])
-    if path == "fmcw":  # c/(2B) of the preset's sampled sweep, 3.44 GHz
-        spec["effects"][0]["range_resolution"] = 0.0436
 cfg = validate_run_config(spec)
 stages = build_stages(cfg)
 motion = load_motion(stages.source) if walk == "walk" else walking_motion(duration=length + 0.5)

@@ -381,8 +381,8 @@ def test_the_suite_names_the_plugin_and_the_failing_check() -> None:
 
 
 def test_the_contracts_catch_broken_waveforms() -> None:
-    """A waveform with the wrong Doppler sign, one that is not linear in the scatterers, and a
-    config whose kind is not its name."""
+    """A waveform with the wrong Doppler sign, one that is not linear in the scatterers, one
+    whose separate responses are not separate, and a config whose kind is not its name."""
     from mdf_lfm import LfmPulseDoppler
 
     class Flipped(LfmPulseDoppler):
@@ -403,6 +403,17 @@ def test_the_contracts_catch_broken_waveforms() -> None:
 
     with pytest.raises(AssertionError, match="sum of their returns"):
         check_radar_waveform(Squared(Squared.Config()))
+
+    class Summed(LfmPulseDoppler):
+        """Gives every scatterer the sum of all as its own response (the clutter patches would
+        each carry the others)."""
+
+        def receive_each(self, block: Any) -> Any:
+            total = self.receive_signal(block)
+            return np.tile(total, (block.ranges.shape[1], 1))
+
+    with pytest.raises(AssertionError, match=r"receive_each\(\) must give each scatterer's own"):
+        check_radar_waveform(Summed(Summed.Config()))
 
     class Decimated(LfmPulseDoppler):
         """Takes its spectrogram of every other pulse but keeps the default geometry, so that

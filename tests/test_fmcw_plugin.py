@@ -891,3 +891,47 @@ def test_a_gate_of_four_range_resolutions_is_flat_and_a_narrower_one_warns() -> 
     with pytest.warns(UserWarning, match=r"radar.gate_width: 2 m spans 2\.0 range resolutions"):
         narrow = level(0.0, 2.0)
     assert narrow < 0.8
+
+
+@pytest.mark.parametrize(
+    ("path", "range_fft_size"), [("analytic", None), ("analytic", 512), ("raw", None)]
+)
+def test_each_scatterers_response_is_its_lone_receive(
+    path: str, range_fft_size: int | None
+) -> None:
+    """``point_responses`` (the clutter patches' responses, FMCW's ``receive_each``: all the
+    scatterers in one pass over the frames, at the gate's bins only) gives each scatterer's
+    own slow-time signal: a receive of that scatterer alone, to 1e-12 of the largest, with
+    three TXs in turn, a padded range FFT, a gate that moves and a radar off the origin; the
+    receiver noise of the preset is left out of both."""
+    from mdframework import point_responses
+
+    wf = FmcwRadar(
+        FmcwConfig(preset="iwr1443_short_range_3d", path=path, range_fft_size=range_fft_size)
+    )
+    t = wf.pulse_times(0.0, 0.2)
+    n = t.size
+    gate = np.linspace(3.0, 2.6, n)
+    r = np.random.default_rng(4).uniform(2.2, 3.5, 12)  # inside, at the edge and outside the gate
+    origin = np.array([0.5, -1.0, 1.0])
+    each = point_responses(
+        wf, np.broadcast_to(r, (n, r.size)), np.ones((n, r.size)), gate, origin, t
+    )
+    alone = np.stack([
+        receive_points(wf, np.full((n, 1), ri), np.ones((n, 1)), gate, origin, t).signal for ri in r
+    ])  # fmt: skip
+    assert each.shape == (r.size, n) and np.all(np.abs(alone).max(axis=1) > 0)
+    np.testing.assert_allclose(each, alone, rtol=0, atol=1e-12 * np.abs(alone).max())
+
+
+def test_each_scatterers_response_on_a_radar_without_its_own() -> None:
+    """The interface's default ``receive_each`` (LFM): each scatterer's lone receive, exactly."""
+    from mdframework import point_responses
+
+    wf = LfmPulseDoppler(LfmConfig(precision="float64"))
+    ranges = np.random.default_rng(6).uniform(9.0, 11.0, (300, 5))
+    gate = np.full(300, 10.0)
+    each = point_responses(wf, ranges, np.ones_like(ranges), gate)
+    for i in range(5):
+        alone = receive_points(wf, ranges[:, i : i + 1], np.ones((300, 1)), gate).signal
+        np.testing.assert_array_equal(each[i], alone)

@@ -32,6 +32,7 @@ if TYPE_CHECKING:
         ScattererModel,
         Scatterers,
         SceneContext,
+        point_responses,
         receive_points,
     )
     from .interfaces import RecordingSource as RadarRecordingSource  # noqa: F401 (old name)
@@ -61,6 +62,7 @@ _EXPORTS = {
     "ScattererModel": "interfaces",
     "Scatterers": "interfaces",
     "SceneContext": "interfaces",
+    "point_responses": "interfaces",
     "receive_points": "interfaces",
     "DataPath": "settings",
     "MotionConfig": "settings",
@@ -124,6 +126,7 @@ __all__ = [
     "SceneError",
     "Skeleton",
     "hookimpl",
+    "point_responses",
     "receive_points",
     "to_canonical",
 ]

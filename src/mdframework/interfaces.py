@@ -506,6 +506,24 @@ class RadarWaveform(Plugin):
         and point clouds) overrides it to skip them."""
         return self.receive(block).signal
 
+    def receive_each(self, block: PulseBlock) -> ComplexArray:
+        """Each scatterer's slow-time signal alone, (K, block.n_pulses) complex128 [sqrt(W)]:
+        row ``i`` is :meth:`receive_signal` of the block with scatterer ``i`` only and without
+        receiver noise (``block.receiver_noise`` is not read). For one-off responses of many
+        scatterers, such as the clutter patches. Default: exactly that, one scatterer after
+        another; a radar whose every call has a cost of its own (the FMCW radar's pass over the
+        frames) overrides it to take the scatterers together."""
+        sc = block.scatterers
+        out = np.empty((sc.positions.shape[1], block.n_pulses), dtype=np.complex128)
+        for i in range(out.shape[0]):
+            one = Scatterers(sc.positions[:, i : i + 1], sc.rcs[:, i : i + 1], sc.names[i : i + 1])
+            out[i] = self.receive_signal(
+                dataclasses.replace(
+                    block, scatterers=one, ranges=block.ranges[:, i : i + 1], receiver_noise=False
+                )
+            )
+        return out
+
     def spectrogram(
         self, signal: ComplexArray, times: FloatArray, processing: ProcessingConfig
     ) -> Spectrogram | None:
@@ -541,23 +559,16 @@ class RadarWaveform(Plugin):
         return None
 
 
-def receive_points(
+def _points_block(
     waveform: RadarWaveform,
     ranges: FloatArray,
     rcs: FloatArray,
     gate_range: FloatArray,
-    radar_position: FloatArray | None = None,
-    times: FloatArray | None = None,
-    signal_only: bool = False,
-    receiver_noise: bool = False,
-) -> Received:
-    """One-off receive of point scatterers given by their ranges, e.g. clutter patches or
-    contract checks: ``ranges``, ``rcs`` (n_pulses, K) [m], [m^2]; ``gate_range`` (n_pulses,)
-    [m]. The scatterers are put on the +x axis of the radar; ``times`` default to ``n / prf``.
-    With ``signal_only`` the result holds only the signal
-    (:meth:`RadarWaveform.receive_signal`: no products). The response is the scatterers'
-    alone unless ``receiver_noise`` asks a radar that adds receiver noise itself to add it
-    (:attr:`PulseBlock.receiver_noise`)."""
+    radar_position: FloatArray | None,
+    times: FloatArray | None,
+    receiver_noise: bool,
+) -> PulseBlock:
+    """The block of :func:`receive_points` and :func:`point_responses`."""
     r = np.asarray(ranges, dtype=np.float64)
     origin = np.zeros(3) if radar_position is None else np.asarray(radar_position, np.float64)
     positions = np.zeros((*r.shape, 3))
@@ -568,10 +579,44 @@ def receive_points(
         positions, np.asarray(rcs, dtype=np.float64), tuple(map(str, range(r.shape[1])))
     )
     gate = np.asarray(gate_range, dtype=np.float64)
-    block = PulseBlock(0, t, scat, r, gate, origin, receiver_noise=receiver_noise)
+    return PulseBlock(0, t, scat, r, gate, origin, receiver_noise=receiver_noise)
+
+
+def receive_points(
+    waveform: RadarWaveform,
+    ranges: FloatArray,
+    rcs: FloatArray,
+    gate_range: FloatArray,
+    radar_position: FloatArray | None = None,
+    times: FloatArray | None = None,
+    signal_only: bool = False,
+    receiver_noise: bool = False,
+) -> Received:
+    """One-off receive of point scatterers given by their ranges, e.g. contract checks:
+    ``ranges``, ``rcs`` (n_pulses, K) [m], [m^2]; ``gate_range`` (n_pulses,) [m]. The
+    scatterers are put on the +x axis of the radar; ``times`` default to ``n / prf``. With
+    ``signal_only`` the result holds only the signal (:meth:`RadarWaveform.receive_signal`: no
+    products). The response is the scatterers' alone unless ``receiver_noise`` asks a radar that
+    adds receiver noise itself to add it (:attr:`PulseBlock.receiver_noise`)."""
+    block = _points_block(waveform, ranges, rcs, gate_range, radar_position, times, receiver_noise)
     if signal_only:
         return Received(waveform.receive_signal(block))
     return waveform.receive(block)
+
+
+def point_responses(
+    waveform: RadarWaveform,
+    ranges: FloatArray,
+    rcs: FloatArray,
+    gate_range: FloatArray,
+    radar_position: FloatArray | None = None,
+    times: FloatArray | None = None,
+) -> ComplexArray:
+    """Each point scatterer's slow-time signal alone, without receiver noise, (K, n_pulses)
+    complex128 [sqrt(W)] (:meth:`RadarWaveform.receive_each`), e.g. the clutter patches; the
+    arguments as for :func:`receive_points`."""
+    block = _points_block(waveform, ranges, rcs, gate_range, radar_position, times, False)
+    return waveform.receive_each(block)
 
 
 # --------------------------------------------------------------------------- recorded radar output

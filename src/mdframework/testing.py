@@ -54,6 +54,7 @@ from .interfaces import (
     ScattererModel,
     Scatterers,
     SceneContext,
+    point_responses,
     receive_points,
 )
 from .physics import body as body_physics
@@ -339,9 +340,10 @@ def check_radar_waveform(waveform: RadarWaveform) -> None:
     """Positive carrier and PRF; increasing ``pulse_times``; ``receive`` returns one finite
     complex sample per pulse; an approaching scatterer (5 m away, at a quarter of the radar's
     unambiguous velocity) has positive Doppler (the project's sign convention);
-    ``receive_signal`` gives the same signal; two scatterers
-    give the sum of their separate returns (superposition). The pulses are the radar's own
-    ``pulse_times`` and the Doppler is read from the phase steps between consecutive pulses at
+    ``receive_signal`` gives the same signal; two scatterers give the sum of their separate
+    returns (superposition), and ``receive_each`` gives those separate returns (receiver noise
+    is left out of all these receives). The pulses are the radar's own ``pulse_times`` and the
+    Doppler is read from the phase steps between consecutive pulses at
     most 1.5 / prf apart, so radars whose slow time has gaps (FMCW frames) are checked too.
     The spectrogram of the signal has the geometry ``spectrogram_geometry`` reports."""
     who = _label(waveform)
@@ -378,6 +380,12 @@ def check_radar_waveform(waveform: RadarWaveform) -> None:
     scale = np.max(np.abs(both)) + 1e-300
     assert np.max(np.abs(both - (y + alone))) <= 1e-6 * scale, (
         f"{who}: the return of two scatterers must be the sum of their returns"
+    )
+    each = point_responses(
+        waveform, np.hstack([ranges, second]), np.ones((n, 2)), ranges[:, 0], times=t
+    )
+    assert each.shape == (2, n) and np.max(np.abs(each - np.stack([y, alone]))) <= 1e-6 * scale, (
+        f"{who}: receive_each() must give each scatterer's own return, (n_scatterers, n_pulses)"
     )
     _check_spectrogram_geometry(who, waveform, y, t)
 

@@ -411,13 +411,16 @@ def analytic_range_profile(
     n_fft: int,
     bins: IntArray,
     phasors: ComplexArray | None = None,
+    separate: bool = False,
 ) -> ComplexArray:
     """The range profile of :func:`range_profile` applied to :func:`if_samples`, in closed form
     at the bins ``bins`` (n_sel,) only: ``X_k = sum_i a_i exp(-j 2 pi c0_i) W(k / K - S tau_i /
     fs) / sum w`` (``c0`` the IF phase at the first sample, ``W`` :func:`window_transform`).
     Exact at those bins. ``delays``, ``amplitudes`` (n_chirps, n_scat). Without ``phasors``
     returns (n_chirps, n_sel); with ``phasors`` (n_chirps, n_ch, n_scat), one profile per
-    channel with scatterer ``i`` multiplied by its phasor, (n_chirps, n_ch, n_sel).
+    channel with scatterer ``i`` multiplied by its phasor, (n_chirps, n_ch, n_sel). With
+    ``separate``, each scatterer's profile alone, (n_chirps, n_scat, n_sel), each times its
+    phasor when ``phasors`` (n_chirps, n_scat) are given.
     """
     c0 = _if_cycles0(delays, seq)
     x = seq.slope * delays / seq.sample_rate  # beat frequency in cycles per sample
@@ -426,6 +429,21 @@ def analytic_range_profile(
     coef.real = amplitudes * np.cos(phase)
     coef.imag = amplitudes * np.sin(phase)
     scale = 1.0 / float(np.sum(window(name, seq.n_samples)))
+    if separate:
+        if phasors is not None:
+            coef = coef * phasors
+        if n_fft != seq.n_samples:
+            nu = np.asarray(bins, np.float64)[None, None, :] / n_fft - x[:, :, None]
+            kern = window_transform(name, seq.n_samples, nu)
+            return np.asarray(coef[:, :, None] * kern * scale, np.complex128)
+        sel = np.asarray(bins, np.int64)
+        ext = _window_bins(name, seq.n_samples, sel)
+        kernel = _kernel_on_bins(seq.n_samples, x, ext)
+        each = kernel.inv_sine * kernel.q  # D / factor on the bins, (n_chirps, n_scat, n_ext)
+        chirp, scat, pos = kernel.near
+        each[chirp, scat, pos] = kernel.near_value
+        each *= (coef * kernel.factor)[:, :, None]
+        return _window_combine(name, seq.n_samples, each, ext, sel) * scale
     if n_fft == seq.n_samples:
         # the window is a combination of Dirichlet kernels on neighbouring bins, a linear map
         # that commutes with the sum over scatterers: sum first, combine the bins after
@@ -975,19 +993,7 @@ def chirp_profiles(
         if noise is not None:
             samples += noise
         return range_profile(samples, window_name, n_fft)
-    rel = positions - radar_position[None, None, :]
-    dist = np.sqrt(np.sum(rel * rel, axis=-1))
-    u = rel / dist[..., None]
-    ux, uz = u @ axes[0], u @ axes[2]
-    # envelope: the delay to the chirp's TX and the receive array's centre (far field);
-    # phase: each RX's offset from that centre, at the centre frequency
-    centre = antennas.tx[tx_index] + antennas.rx.mean(axis=0)[None, :]  # (n, 2)
-    delays = (2.0 * dist - (centre[:, 0:1] * ux + centre[:, 1:2] * uz)) / SPEED_OF_LIGHT
-    off = antennas.rx - antennas.rx.mean(axis=0)[None, :]  # (n_rx, 2)
-    arg = (2.0 * np.pi * seq.centre_frequency / SPEED_OF_LIGHT) * (
-        off[None, :, 0:1] * ux[:, None, :] + off[None, :, 1:2] * uz[:, None, :]
-    )
-    phasors = np.exp(1j * arg)
+    dist, delays, phasors = _far_field(positions, radar_position, axes, seq, antennas, tx_index)
     near = (
         np.concatenate([dist.ravel(), np.asarray(extra_ranges, np.float64).ravel()])
         if extra_ranges is not None
@@ -1004,6 +1010,62 @@ def chirp_profiles(
         delays, amplitudes, seq, window_name, n_fft, bins, phasors
     )
     return out
+
+
+def _far_field(
+    positions: FloatArray,
+    radar_position: FloatArray,
+    axes: FloatArray,
+    seq: ChirpSequence,
+    antennas: Antennas,
+    tx_index: IntArray,
+) -> tuple[FloatArray, FloatArray, ComplexArray]:
+    """The analytic path's geometry: ranges (n_chirps, n_scat) [m], delays (n_chirps, n_scat)
+    [s] to the chirp's TX (``tx_index`` (n_chirps,)) and the receive array's centre, and each
+    RX's phasor (n_chirps, n_rx, n_scat) (:func:`chirp_profiles`)."""
+    rel = positions - radar_position[None, None, :]
+    dist = np.sqrt(np.sum(rel * rel, axis=-1))
+    u = rel / dist[..., None]
+    ux, uz = u @ axes[0], u @ axes[2]
+    # envelope: the delay to the chirp's TX and the receive array's centre (far field);
+    # phase: each RX's offset from that centre, at the centre frequency
+    centre = antennas.tx[tx_index] + antennas.rx.mean(axis=0)[None, :]  # (n, 2)
+    delays = (2.0 * dist - (centre[:, 0:1] * ux + centre[:, 1:2] * uz)) / SPEED_OF_LIGHT
+    off = antennas.rx - antennas.rx.mean(axis=0)[None, :]  # (n_rx, 2)
+    arg = (2.0 * np.pi * seq.centre_frequency / SPEED_OF_LIGHT) * (
+        off[None, :, 0:1] * ux[:, None, :] + off[None, :, 1:2] * uz[:, None, :]
+    )
+    return dist, delays, np.exp(1j * arg)
+
+
+def gate_responses(
+    positions: FloatArray,
+    amplitudes: FloatArray,
+    radar_position: FloatArray,
+    axes: FloatArray,
+    seq: ChirpSequence,
+    antennas: Antennas,
+    gate_range: FloatArray,
+    width: float,
+    *,
+    window_name: WindowName,
+    n_fft: int,
+) -> ComplexArray:
+    """Each scatterer's slow-time signal alone on the analytic path, (n_scat, n_chirps)
+    complex128 [sqrt(W)]: :func:`gate_signal` of the :func:`chirp_profiles` of a lone
+    scatterer (no noise), for all scatterers at once. Only the gate's bins are computed, the
+    ones the gate signal sums. Arguments as for :func:`chirp_profiles` and
+    :func:`gate_signal`."""
+    n = positions.shape[0]
+    tx_index = np.asarray(seq.tdm_order, dtype=np.int64)[np.arange(n) % seq.n_tx]
+    _, delays, phasors = _far_field(positions, radar_position, axes, seq, antennas, tx_index)
+    raxis = range_axis(seq, n_fft)
+    weights = gate_weights(raxis, gate_range, width, window_name, seq.n_samples)
+    bins = np.flatnonzero(np.any(weights != 0, axis=0))
+    each = analytic_range_profile(
+        delays, amplitudes, seq, window_name, n_fft, bins, phasors[:, 0, :], separate=True
+    )  # (n_chirps, n_scat, n_bins)
+    return np.asarray(np.einsum("csk,ck->sc", each, weights[:, bins]), np.complex128)
 
 
 def gate_signal(
@@ -1028,7 +1090,20 @@ def gate_signal(
     windowed profile partly cancel.) ``profiles`` (n_chirps, n_rx, K); ``ranges`` (K,) [m];
     ``gate_range`` (n_chirps,) [m]. Returns (n_chirps,) complex128 [sqrt(W)].
     """
-    n_fft = profiles.shape[-1]
+    weights = gate_weights(ranges, gate_range, width, window_name, n_samples)
+    return np.asarray(np.sum(profiles[:, 0, :] * weights, axis=1), dtype=np.complex128)
+
+
+def gate_weights(
+    ranges: FloatArray,
+    gate_range: FloatArray,
+    width: float,
+    window_name: WindowName,
+    n_samples: int,
+) -> ComplexArray:
+    """The weights of :func:`gate_signal` on the range bins, (n_chirps, K) complex128:
+    ``exp(-j 2 pi k m0 / K) sum_m w_m / (K w_m0)`` on the gate's bins, 0 elsewhere."""
+    n_fft = ranges.shape[0]
     m0 = n_samples // 2
     w = window(window_name, n_samples)
     k = np.arange(n_fft)
@@ -1036,7 +1111,7 @@ def gate_signal(
     off = np.abs(ranges[None, :] - gate_range[:, None])
     inside = off <= width / 2.0
     inside[np.arange(off.shape[0]), np.argmin(off, axis=1)] = True  # a gate narrower than a bin
-    return np.asarray(np.sum(profiles[:, 0, :] * (inside * rot), axis=1), dtype=np.complex128)
+    return np.asarray(inside * rot, dtype=np.complex128)
 
 
 #: Frames transformed at a time by :func:`frame_spectrogram`.

@@ -5,10 +5,11 @@ The ground is a row of clutter patches at fixed ranges ``r_k`` covering the rang
 span over the record plus ``margin_m`` on either side, spaced ``patch_spacing_m`` (default half
 the range resolution ``c/(2B)``) with a random position inside each spacing (which also makes
 each patch's carrier phase uniformly random). Each patch's echo goes through the scene's own
-waveform (``waveform.receive`` with the patch as a unit-RCS scatterer), so it carries the
-waveform's gate response ``g_k(n)``: with a fixed gate the patches near the gate dominate; with
-a tracking gate the patches in the gate change as the person moves (the clutter decorrelates on
-the time the gate takes to cross a resolution cell) but each patch stays at zero Doppler.
+waveform (``waveform.receive_each``: each unit-RCS patch's response alone, without receiver
+noise), so it carries the waveform's gate response ``g_k(n)``: with a fixed gate the patches
+near the gate dominate; with a tracking gate the patches in the gate change as the person moves
+(the clutter decorrelates on the time the gate takes to cross a resolution cell) but each patch
+stays at zero Doppler.
 
 Patch ``k`` contributes ``g_k(n) (alpha_k + beta_k u_k(n))``:
 
@@ -55,7 +56,7 @@ from mdframework import (
     Received,
     SceneContext,
     SceneError,
-    receive_points,
+    point_responses,
 )
 from mdframework.physics import radar
 from mdframework.settings import Decibels, Rcs
@@ -133,6 +134,11 @@ def _shaped(white: ComplexArray, prf: float, spread_hz: float) -> ComplexArray:
 #: patches; pulses with gaps are drawn in calls of this many (or of all the series at the
 #: pulses, if more), which fixes their draws.
 WIND_GRID_VALUES = 1 << 22
+
+#: Patches whose responses one call of the waveform makes (their positions, (n_pulses, n, 3),
+#: are made for the call): a radar with a cost per call (the FMCW radar's pass over the frames)
+#: pays it once for so many.
+PATCHES_PER_CALL = 16
 
 
 def wind_processes(
@@ -256,22 +262,22 @@ class GroundClutter(Effect):
         return np.asarray(lo + (np.arange(n_patch) + context.rng.uniform(size=n_patch)) * spacing)
 
     def responses(self, context: SceneContext, ranges: FloatArray) -> ComplexArray:
-        """The return at the gate of a unit-RCS patch at each of ``ranges`` (n,) [m]:
+        """The return at the gate of a unit-RCS patch at each of ``ranges`` (n,) [m], each alone
+        (:func:`~mdframework.point_responses`; no receiver noise):
         (n, n_pulses) [sqrt(W) per sqrt(m^2)]."""
         gate = np.asarray(context.gate_range, dtype=np.float64)
         n_p = gate.shape[0]
         resp = np.empty((ranges.size, n_p), dtype=np.complex128)
-        for k, r_k in enumerate(ranges):
-            out = receive_points(
+        for lo in range(0, ranges.size, PATCHES_PER_CALL):  # positions of a few patches at once
+            r = np.asarray(ranges[lo : lo + PATCHES_PER_CALL], np.float64)
+            resp[lo : lo + r.size] = point_responses(
                 context.waveform,
-                np.full((n_p, 1), r_k),
-                np.ones((n_p, 1)),
+                np.broadcast_to(r, (n_p, r.size)),
+                np.ones((n_p, r.size)),
                 gate,
                 context.radar_position,
                 context.pulse_times,
-                signal_only=True,  # e.g. no FMCW point cloud of each patch
             )
-            resp[k] = out.signal
         return resp
 
     def patch_responses(self, context: SceneContext) -> tuple[FloatArray, ComplexArray]:

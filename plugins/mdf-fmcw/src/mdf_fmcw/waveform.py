@@ -454,6 +454,37 @@ class FmcwRadar(RadarWaveform):
         angle scans of a point cloud cost several times the signal itself)."""
         return self._receive(block, products=False).signal
 
+    def receive_each(self, block: PulseBlock) -> NDArray[np.complex128]:
+        """Each scatterer's slow-time signal alone, without receiver noise, (K, n_pulses): on
+        the analytic path all scatterers in one pass over the frames
+        (:func:`~mdframework.physics.fmcw.gate_responses`), on the raw path one scatterer
+        after another."""
+        seq, c = self.sequence, self.config
+        if c.path != "analytic":
+            return super().receive_each(block)
+        ranges = np.asarray(block.ranges, np.float64)
+        self._check_ranges(ranges)
+        n_frames = fmcw.split_frames(ranges.shape[0], seq)
+        amp = c.amplitudes(block.scatterers.rcs, ranges, seq.wavelength)
+        radar_position = np.asarray(block.radar_position, np.float64)
+        sensor = self.sensor_axes(radar_position)
+        out = np.empty((ranges.shape[1], ranges.shape[0]), dtype=np.complex128)
+        for f in range(n_frames):
+            sl = slice(f * seq.chirps_per_frame, (f + 1) * seq.chirps_per_frame)
+            out[:, sl] = fmcw.gate_responses(
+                block.scatterers.positions[sl],
+                amp[sl],
+                radar_position,
+                sensor,
+                seq,
+                self.antennas,
+                block.gate_range[sl],
+                c.gate_width,
+                window_name=c.range_window,
+                n_fft=self.n_range,
+            )
+        return out
+
     def _receive(self, block: PulseBlock, products: bool) -> Received:
         """:meth:`receive`, with the configured products or (``products`` False) none."""
         seq, c = self.sequence, self.config
