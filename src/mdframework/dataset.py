@@ -1721,7 +1721,7 @@ def _executor(
         client = _connect(Client, cluster, address)
         try:
             if cluster is not None:
-                client.run(_quiet_dask_worker)
+                client.run(_quiet_dask_worker, warnings.showwarning, _warning_filters())
             client.run(_receive_motions, dict(_MOTIONS))  # each worker gets what planning loaded
 
             def run_dask(specs: list[RecordSpec], out: str) -> Iterator[dict[str, Any]]:
@@ -1759,16 +1759,35 @@ def _quiet_dask_logs() -> Iterator[None]:
             log.setLevel(level)
 
 
-def _quiet_dask_worker() -> bool:
+def _warning_filters() -> list[tuple[Any, ...]]:
+    """This process's warning filters, newest first, as arguments of
+    :func:`warnings.filterwarnings` (a filter holds its patterns compiled or as text)."""
+
+    def text(pattern: Any) -> str:
+        return str(getattr(pattern, "pattern", pattern) or "")
+
+    return [(f[0], text(f[1]), f[2], text(f[3]), f[4]) for f in warnings.filters]
+
+
+def _quiet_dask_worker(show: Callable[..., None], filters: list[tuple[Any, ...]]) -> bool:
     """:func:`_quiet_dask_logs` in a local cluster's worker process, for its lifetime, and
     Ctrl-C ignored there, as in the process pool's workers: the build's process handles it
-    and closes the cluster (the worker's own KeyboardInterrupt printed a traceback). Whether
-    Ctrl-C could be ignored (only from the worker's main thread)."""
+    and closes the cluster (the worker's own KeyboardInterrupt printed a traceback). The
+    worker also takes the build process's warning handling, which the pool's workers inherit
+    as copies of it: ``show`` prints a warning (``mdf: warning: ...`` under ``mdf``; Python's
+    own format, with the file and line, was printed) and ``filters`` (:func:`_warning_filters`)
+    decide which warnings are errors (``mdf`` stops at a numerical warning rather than write a
+    record it cannot trust; a Dask build wrote it). Whether Ctrl-C could be ignored (only from
+    the worker's main thread)."""
     import logging
     import signal
     import threading
 
     logging.getLogger("distributed").setLevel(logging.CRITICAL)
+    warnings.resetwarnings()
+    for action, message, category, module, lineno in reversed(filters):
+        warnings.filterwarnings(action, message, category, module, lineno)
+    warnings.showwarning = show
     if threading.current_thread() is not threading.main_thread():
         return False
     signal.signal(signal.SIGINT, signal.SIG_IGN)
