@@ -805,3 +805,31 @@ draws = 3
     specs = plan_records(cfg, base)
     named = {(Path(s.run_config["motion"]["file"]).name, s.subject, s.recording) for s in specs}
     assert named == {("02_01.amc", "2", "02_01.amc"), ("09_06.amc", "9", "09_06.amc")}
+
+
+def test_dataset_json_and_run_metadata_name_the_software_versions(tmp_path: Path) -> None:
+    """dataset.json and a run's metadata.json name the versions of mdframework, its numerical
+    libraries and every plugin distribution (none was written anywhere: a dataset could not
+    say what made it)."""
+    import importlib.metadata
+
+    from mdframework import cli
+
+    config = tmp_path / "d.toml"
+    config.write_text("""
+seed = 1
+[[sources]]
+label = "recede"
+motion = { kind = "point_targets", length = 0.5, targets = [
+    { position = [100.0, 0.0, 0.0], velocity = [1.0, 0.0, 0.0], rcs = 1.0 }] }
+[base.scatterers]
+kind = "points"
+""")
+    build_dataset(*load_dataset_config(config), tmp_path / "ds", workers=1, progress=False)
+    assert cli.main(["run", str(EXAMPLES / "point_target.toml"), "--out", str(tmp_path / "r")]) == 0
+    for written in (tmp_path / "ds" / "dataset.json", tmp_path / "r" / "metadata.json"):
+        versions = json.loads(written.read_text())["versions"]
+        assert versions["mdframework"] == importlib.metadata.version("mdframework"), written
+        assert versions["numpy"] == np.__version__, written
+        for dist in ("mdf-point-targets", "mdf-lfm"):
+            assert f"{dist} {importlib.metadata.version(dist)}" in versions["plugins"], written

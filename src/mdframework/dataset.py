@@ -72,7 +72,7 @@ from .outdir import (
     wait_for_files,
 )
 from .pipeline import build_stages, load_motion, simulate_motion
-from .plugins import blame, default_registry, is_plugin_bug
+from .plugins import blame, default_registry, is_plugin_bug, versions
 from .pointcloud import (
     IWR1443_BIN_WIDTH,
     HistogramSettings,
@@ -2041,6 +2041,7 @@ def _write_index(
         "feature_units": "m/s",
         "labels": sorted({r["label"] for r in rows}),
         "config": json.loads(config.model_dump_json()),
+        "versions": versions(),  # of the build that wrote the index (records may be older)
     }
     atomic_write_text(out / MANIFEST, json.dumps(manifest, indent=2) + "\n")
 

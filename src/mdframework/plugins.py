@@ -261,6 +261,32 @@ class Registry:
         return Registry(plugins, dict(self.disabled))
 
 
+def versions(registry: Registry | None = None) -> dict[str, Any]:
+    """The software a result was made with, for its provenance (``metadata.json``,
+    ``dataset.json``, ``summary.json``): the versions of mdframework, Python, NumPy, SciPy and
+    scikit-learn (``None`` when not installed), and ``plugins``, every plugin distribution of
+    ``registry`` (default: the installed plugins) as ``"name version"``, sorted."""
+    import platform
+
+    from . import __version__
+
+    def of(distribution: str) -> str | None:
+        try:
+            return importlib.metadata.version(distribution)
+        except importlib.metadata.PackageNotFoundError:
+            return None
+
+    reg = default_registry() if registry is None else registry
+    return {
+        "mdframework": of("mdframework") or __version__,
+        "python": platform.python_version(),
+        "numpy": of("numpy"),
+        "scipy": of("scipy"),
+        "scikit-learn": of("scikit-learn"),
+        "plugins": sorted({i.provider for infos in reg.plugins.values() for i in infos.values()}),
+    }
+
+
 def _provider_name(pm: pluggy.PluginManager, plugin: object) -> str:
     name = pm.get_name(plugin) or repr(plugin)
     return _DISTRIBUTIONS.get(name, name)
