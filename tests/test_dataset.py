@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 import pytest
 from conftest import EXAMPLES
+from helpers import point_dataset
 
 from mdframework import dataset
 from mdframework.dataset import (
@@ -815,16 +816,7 @@ def test_dataset_json_and_run_metadata_name_the_software_versions(tmp_path: Path
 
     from mdframework import cli
 
-    config = tmp_path / "d.toml"
-    config.write_text("""
-seed = 1
-[[sources]]
-label = "recede"
-motion = { kind = "point_targets", length = 0.5, targets = [
-    { position = [100.0, 0.0, 0.0], velocity = [1.0, 0.0, 0.0], rcs = 1.0 }] }
-[base.scatterers]
-kind = "points"
-""")
+    config = point_dataset(tmp_path / "d.toml")
     build_dataset(*load_dataset_config(config), tmp_path / "ds", workers=1, progress=False)
     assert cli.main(["run", str(EXAMPLES / "point_target.toml"), "--out", str(tmp_path / "r")]) == 0
     for written in (tmp_path / "ds" / "dataset.json", tmp_path / "r" / "metadata.json"):

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 from conftest import EXAMPLES, without_third_party_warnings
+from helpers import point_dataset
 from test_plugins import _make_distribution
 
 from mdframework import cli
@@ -556,18 +557,7 @@ def test_a_numerical_warning_in_a_record_stops_the_build_however_it_runs(
         pytest.importorskip("distributed")
     base = "import numpy as np\nfrom mdf_lfm.waveform import LfmPulseDoppler as Base\n"
     install_broken(installed, base, "radar_waveforms", OVERFLOWING_RECEIVE)
-    config = tmp_path / "d.toml"
-    config.write_text("""
-seed = 1
-[[sources]]
-label = "recede"
-motion = { kind = "point_targets", length = 0.5, targets = [
-    { position = [100.0, 0.0, 0.0], velocity = [1.0, 0.0, 0.0], rcs = 1.0 }] }
-[base.scatterers]
-kind = "points"
-[base.radar]
-kind = "xyzzy_bug"
-""")
+    config = point_dataset(tmp_path / "d.toml", radar="xyzzy_bug")
     out = tmp_path / "ds"
     capsys.readouterr()
     assert cli.main(["dataset", "build", str(config), "--out", str(out), *how]) == 1
