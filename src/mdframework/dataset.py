@@ -1904,6 +1904,7 @@ def build_dataset(
 
     check_scheduler_address(scheduler_address(scheduler))
     with dataset_folder(out_dir, force=force) as folder:
+        _refuse_names_in_the_way(folder.path)
         note("planning the records (reading each recording once)", progress)
         _forget_loaded()  # every file is read afresh: one changed since is seen
         # errors in the config stop before any file
@@ -1990,6 +1991,22 @@ def build_dataset(
 #: (:func:`atomic_savez`'s temporary file): the only files of ``records/`` a build removes
 _RECORD_NAME = re.compile(r"\d{5,}-[0-9a-f]{10}\.npz")
 _PARTIAL_NAME = re.compile(r"\.tmp-\w+\.(part|npz)")  # .npz: earlier versions
+
+
+def _refuse_names_in_the_way(out: Path) -> None:
+    """:class:`OutputError` for a name the build writes that holds the other kind of entry: a
+    file (anything but a folder) named ``records``, a folder named as one of the index files.
+    Checked before anything is written, with ``--force`` too (which replaces files of the
+    dataset's names, never a folder, and needs ``records`` to be one)."""
+    for name in DATASET_FILES:
+        path = out / name
+        if not os.path.lexists(path) or path.is_dir() == (name == RECORDS):
+            continue
+        kind, writes = ("file", "folder") if name == RECORDS else ("folder", "file")
+        raise OutputError(
+            f"--out {out}: holds the {kind} {name!r}, where `mdf dataset` writes a {writes}; "
+            "move it away or choose another folder"
+        )
 
 
 def _remove_partials(out: Path) -> None:
