@@ -30,6 +30,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import os
 import warnings
 from collections import Counter
 from collections.abc import Callable, Collection, Sequence
@@ -896,7 +897,8 @@ def _report(
     """Run the experiments on ``data`` (classifier inputs ``x_all`` named ``names``) and write
     every report file into ``out``. The figures are drawn together at the end, once every number
     is computed (matplotlib loads only then). ``summary.json`` ends with the experiment's config
-    (``config``, every default filled in: it repeats the experiment) and the software's
+    (``config``, every default filled in, the dataset's path absolute: it repeats the
+    experiment) and the software's
     ``versions`` (:func:`mdframework.plugins.versions` of ``registry``)."""
     from .figures import plot_confusion, plot_feature_scatter
 
@@ -1118,7 +1120,9 @@ def _report(
     for draw in figures:
         draw()
     (out / "report.md").write_text("\n".join(report), encoding="utf-8")
-    summary["config"] = cfg.model_dump(mode="json")
+    config = cfg.model_dump(mode="json")  # its dataset read from any folder, not only this one
+    config["dataset"] = {k: v and os.path.abspath(v) for k, v in config["dataset"].items()}
+    summary["config"] = config
     summary["versions"] = versions(registry)
     (out / "summary.json").write_text(
         json.dumps(_strict_json(summary), indent=2, default=str, allow_nan=False) + "\n",
