@@ -1234,6 +1234,7 @@ def _build_recorded(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         "recording": dict(rec.metadata),
         "units": RECORD_UNITS,
     }
+    meta["versions"] = versions(used=_used_plugins(meta))
     atomic_savez(
         Path(out_dir) / RECORDS / f"{spec.record_id}.npz",
         in_background=True,
@@ -1417,6 +1418,7 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         "run_config": json.loads(cfg.model_dump_json()),
         **extra_meta,
     }
+    meta["versions"] = versions(used=_used_plugins(meta))
     atomic_savez(
         Path(out_dir) / RECORDS / f"{spec.record_id}.npz",
         in_background=True,
@@ -1517,13 +1519,17 @@ def _planned_meta(spec: RecordSpec) -> dict[str, Any]:
     return planned
 
 
-def _complete(path: Path, spec: RecordSpec) -> dict[str, Any] | None:
+def _complete(
+    path: Path, spec: RecordSpec, other_versions: dict[str, Any] | None = None
+) -> dict[str, Any] | None:
     """The index row of a finished record, or None if it must be (re)built: a record cut
     short, corrupt, or whose metadata lacks a field or names another record is removed. A
     record whose label, group, subject, recording or dataset differ from ``spec``'s (the
     config changed only those) is kept and rewritten with the new ones (atomically; its arrays
     are not recomputed), and so is its row. A record that cannot be read for want of
-    permission is an error (it is not removed)."""
+    permission is an error (it is not removed). A record computed by other software versions
+    than this process's is kept, its id, its versions and this process's added to
+    ``other_versions``."""
     import zipfile
 
     if not path.exists():
@@ -1532,6 +1538,10 @@ def _complete(path: Path, spec: RecordSpec) -> dict[str, Any] | None:
         arrays, meta = read_record(path)
         if meta["id"] != spec.record_id:  # another record's file, copied or renamed here
             raise ValueError(f"{path}: holds record {meta['id']}")
+        made_by = meta.get("versions")  # None: by a version before records named theirs
+        now = versions(used=_used_plugins(meta))
+        if other_versions is not None and made_by is not None and made_by != now:
+            other_versions[spec.record_id] = (made_by, now)
         planned = _planned_meta(spec)
         if any(meta.get(k) != v for k, v in planned.items()):
             meta.update(planned)
@@ -1865,6 +1875,35 @@ def config_differences(old: Any, new: Any, where: str = "") -> list[str]:
     return [f"{where or 'config'}: {json.dumps(old)} -> {json.dumps(new)}"]
 
 
+def _used_plugins(meta: dict[str, Any]) -> list[tuple[str, str]]:
+    """The (interface, kind) of every plugin a record ran, from its metadata: a real radar's
+    recording source, or the motion source, scatterers, radar and effects of its run config."""
+    run = meta.get("run_config")
+    if run is None:
+        return [("recording", str(meta["source"]))]
+    return [(s, run[s]["kind"]) for s in ("motion", "scatterers", "radar")] + [
+        ("effects", e["kind"]) for e in run.get("effects", [])
+    ]
+
+
+def _warn_other_versions(made_by: dict[str, Any], n_records: int) -> None:
+    """Warn once when records kept from the folder were computed by other software versions
+    (``made_by``: record id -> its ``versions`` and this process's for the same plugins): a
+    record's id covers its config, not the software, so a build after an upgrade keeps them."""
+    if not made_by:
+        return
+    first, (old, now) = next(iter(made_by.items()))
+    diff = config_differences(old, now)
+    shown = "; ".join(diff[:3]) + (f" and {len(diff) - 3} more" if len(diff) > 3 else "")
+    warnings.warn(
+        f"{len(made_by)} of {n_records} records (e.g. {first}) were computed by other "
+        f"software versions ({shown}) and are kept, as their config is the same: the dataset "
+        "mixes versions; build into a new folder to compute every record with these",
+        DatasetWarning,
+        stacklevel=3,
+    )
+
+
 def _warn_band_edges(rows: list[dict[str, Any]]) -> None:
     """One warning for the records whose features' envelope reaches the edge of the Doppler
     band in some frame (``band_edge_frames`` > 0 in ``index.csv``; blank for histogram and
@@ -1931,12 +1970,14 @@ def build_dataset(
             _remove_partials(out)
         rows: dict[str, dict[str, Any]] = {}
         todo = []
+        other_versions: dict[str, Any] = {}
         for spec in specs:
-            row = _complete(out / RECORDS / f"{spec.record_id}.npz", spec)
+            row = _complete(out / RECORDS / f"{spec.record_id}.npz", spec, other_versions)
             if row is None:
                 todo.append(spec)
             else:
                 rows[spec.record_id] = row
+        _warn_other_versions(other_versions, len(specs))
         printed()
         bar = tqdm(
             total=len(specs),
