@@ -103,3 +103,20 @@ def walking_c3d(path: Path, seconds: float = 2.0, rate: float = 100.0) -> Path:
     body = {j: pos[:, k] for k, j in enumerate(CANONICAL_JOINTS)}
     write_c3d(path, pig_markers(body), rate, "mm", 0.001)
     return path
+
+
+def point_dataset(path: Path, radar: str = "lfm") -> Path:
+    """Write a dataset config at ``path``: one 0.5 s record of a point 100 m away receding at
+    1 m/s, seen by the radar plugin ``radar``; ``path``."""
+    path.write_text(f"""
+seed = 1
+[[sources]]
+label = "recede"
+motion = {{ kind = "point_targets", length = 0.5, targets = [
+    {{ position = [100.0, 0.0, 0.0], velocity = [1.0, 0.0, 0.0], rcs = 1.0 }}] }}
+[base.scatterers]
+kind = "points"
+[base.radar]
+kind = "{radar}"
+""")
+    return path

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib.metadata
 import json
 import os
 import re
@@ -18,6 +19,7 @@ from typing import Any
 import numpy as np
 import pytest
 from conftest import EXAMPLES
+from helpers import point_dataset
 
 from mdframework import dataset
 from mdframework.dataset import (
@@ -805,3 +807,52 @@ draws = 3
     specs = plan_records(cfg, base)
     named = {(Path(s.run_config["motion"]["file"]).name, s.subject, s.recording) for s in specs}
     assert named == {("02_01.amc", "2", "02_01.amc"), ("09_06.amc", "9", "09_06.amc")}
+
+
+def test_dataset_json_and_run_metadata_name_the_software_versions(tmp_path: Path) -> None:
+    """dataset.json and a run's metadata.json name the versions of mdframework, its numerical
+    libraries and every plugin distribution (none was written anywhere: a dataset could not
+    say what made it)."""
+    from mdframework import cli
+
+    config = point_dataset(tmp_path / "d.toml")
+    build_dataset(*load_dataset_config(config), tmp_path / "ds", workers=1, progress=False)
+    assert cli.main(["run", str(EXAMPLES / "point_target.toml"), "--out", str(tmp_path / "r")]) == 0
+    for written in (tmp_path / "ds" / "dataset.json", tmp_path / "r" / "metadata.json"):
+        versions = json.loads(written.read_text())["versions"]
+        assert versions["mdframework"] == importlib.metadata.version("mdframework"), written
+        assert versions["numpy"] == np.__version__, written
+        for dist in ("mdf-point-targets", "mdf-lfm"):
+            assert f"{dist} {importlib.metadata.version(dist)}" in versions["plugins"], written
+
+
+def test_a_record_kept_from_other_software_versions_is_said(tmp_path: Path) -> None:
+    """Each record names the versions that computed it; a build that keeps records computed
+    by other versions (their id covers the config, not the software) warns, naming how many
+    and what differs, so that a dataset mixing versions is never silent."""
+    from mdframework.plugins import versions
+
+    config = point_dataset(tmp_path / "d.toml")  # five records of 0.5 s from a 2.5 s motion
+    text = config.read_text().replace("length = 0.5", "length = 2.5")
+    config.write_text(text + "[record_lengths]\nrecede = 0.5\n")
+    cfg, base = load_dataset_config(config)
+    out = tmp_path / "ds"
+    build_dataset(cfg, base, out, workers=1, progress=False)
+    files = sorted((out / RECORDS).glob("*.npz"))
+    assert len(files) == 5
+    arrays, meta = read_record(files[1])
+    ran = ("mdf-lfm", "mdf-point-targets")  # only the plugins the record ran
+    assert meta["versions"] == {
+        **versions(),
+        "plugins": [f"{d} {importlib.metadata.version(d)}" for d in ran],
+    }
+    meta["versions"] = {**meta["versions"], "mdframework": "0.0.1"}
+    np.savez(files[1], **arrays, meta=np.array(json.dumps(meta)))
+    kept = files[1].read_bytes()
+    with pytest.warns(dataset.DatasetWarning) as caught:
+        build_dataset(cfg, base, out, workers=1, progress=False)
+    said = [str(w.message) for w in caught if "versions" in str(w.message)]
+    assert len(said) == 1, said
+    assert said[0].startswith(f"1 of 5 records (e.g. {files[1].stem}) were computed by ")
+    assert f'mdframework: "0.0.1" -> "{versions()["mdframework"]}"' in said[0]
+    assert files[1].read_bytes() == kept  # kept, not computed again

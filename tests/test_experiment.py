@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 from pathlib import Path
 from typing import Any
 
@@ -752,3 +753,44 @@ def test_every_confusion_matrix_is_captioned(
     assert titles["train_test_confusion.png"] == (
         "train subject = s01 or s02 -> test subject = s03"
     )
+
+
+def test_summary_json_holds_what_repeats_the_experiment(
+    kinect_dataset: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """summary.json names the experiment's config (seed, classifier, selection, evaluation)
+    and the versions of the software: the config read back from it repeats the experiment
+    exactly (the seed was nowhere in the report folder, and no version anywhere)."""
+    import importlib.metadata
+
+    e = _experiment(
+        kinect_dataset,
+        tmp_path,
+        '[classifier]\nkind = "sklearn"\nestimator = "sklearn.ensemble.RandomForestClassifier"\n'
+        'params = { n_estimators = 3, max_features = 1 }\n[selection]\nmethod = "none"\n'
+        "[evaluation]\nrepeats = 3\n",
+    )
+    relative = os.path.relpath(kinect_dataset, tmp_path)  # to the config's folder
+    e.write_text(
+        e.read_text().replace("seed = 0", "seed = 11").replace(str(kinect_dataset), relative)
+    )
+    monkeypatch.chdir(tmp_path.parent)  # the dataset's path is read from the config's folder
+    cfg = exp.load_experiment_config(Path(tmp_path.name) / e.name)  # as given: relative
+    exp.run_experiment(cfg, tmp_path / "a", progress=False)
+    written = json.loads((tmp_path / "a" / "summary.json").read_text())
+    assert written["config"]["seed"] == 11
+    assert written["config"]["dataset"]["path"] == str(kinect_dataset)  # read from anywhere
+    assert written["config"]["classifier"]["params"] == {"n_estimators": 3, "max_features": 1}
+    versions = written["versions"]
+    assert versions["mdframework"] == importlib.metadata.version("mdframework")
+    assert versions["scikit-learn"] == importlib.metadata.version("scikit-learn")
+    assert f"mdf-sklearn {importlib.metadata.version('mdf-sklearn')}" in versions["plugins"]
+    monkeypatch.chdir(kinect_dataset)
+    again = exp.ExperimentConfig.model_validate(written["config"])
+    exp.run_experiment(again, tmp_path / "b", progress=False)
+    repeated = json.loads((tmp_path / "b" / "summary.json").read_text())
+    assert repeated.pop("dataset") == str(kinect_dataset)  # the path the config gave, as given
+    assert written.pop("dataset") == os.path.join(tmp_path.name, relative)
+    assert repeated == written
+    predictions = "within_kinect_predictions.csv"
+    assert (tmp_path / "a" / predictions).read_text() == (tmp_path / "b" / predictions).read_text()

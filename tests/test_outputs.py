@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 import pytest
 from conftest import EXAMPLES
+from helpers import point_dataset
 
 from mdframework import cli, outdir
 from mdframework.dataset import load_dataset, read_record
@@ -180,6 +181,25 @@ def test_killed_rerun_keeps_the_old_output_and_stages_inside_out(tmp_path: Path)
     again = mdf_process(["run", str(POINT), "--out", str(out)])
     assert again.wait(120) == 0, again.communicate()[1]
     assert not [p for p in out.iterdir() if p.name.startswith(".mdf-staging")]
+
+
+def test_a_rerun_into_a_copied_output_folder_says_why_its_files_count_as_yours(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An output folder copied elsewhere (another disk or machine) holds new files, which the
+    rerun refuses as not its own: the line says that a copy counts so (it said the command
+    "did not write" files that it had written, before the copy)."""
+    import shutil
+
+    assert mdf(["run", str(POINT), "--out", str(tmp_path / "a")], capsys)[0] == 0
+    shutil.copytree(tmp_path / "a", tmp_path / "b")  # times kept, new files
+    before = snapshot(tmp_path / "b")
+    code, err = mdf(["run", str(POINT), "--out", str(tmp_path / "b")], capsys)
+    assert code == 2
+    line = one_error_line(err)
+    assert "metadata.json" in line and "copied from elsewhere" in line and "--force" in line
+    assert "did not write" not in line
+    assert snapshot(tmp_path / "b") == before
 
 
 # --------------------------------------------------------------------------- unusable --out
@@ -415,6 +435,39 @@ def test_group_names_with_control_characters_are_refused(tmp_path: Path) -> None
     p.write_text(p.read_text().replace('group = "../../escape"', 'group = "a\\tb"', 1))
     with pytest.raises(ConfigError, match=r"sources\.0\.group: .*control characters"):
         load_dataset_config(p)
+
+
+@pytest.mark.parametrize(
+    ("name", "kind", "writes"),
+    [
+        ("records", "file", "folder"),
+        ("index.csv", "folder", "file"),
+        ("dataset.json", "folder", "file"),
+        ("skipped.csv", "folder", "file"),
+    ],
+)
+def test_a_dataset_name_taken_by_the_other_kind_is_refused_before_any_record(
+    name: str, kind: str, writes: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A file named ``records``, or a folder named as one of the index files, in a folder
+    given with --force: one line, exit 2, the folder as it was. It was an internal error (exit
+    1), after every record had been computed for the index files, leaving a marker, records
+    and a half-written index that the same command, run again, failed on in the same way."""
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    if kind == "file":
+        (out / name).write_text("my own file")
+    else:
+        (out / name).mkdir()
+    before = snapshot(out)
+    config = point_dataset(tmp_path / "d.toml")
+    code, err = mdf(["dataset", "build", str(config), "--out", str(out), "--force"], capsys)
+    assert code == 2
+    line = one_error_line(err)
+    assert f"holds the {kind} '{name}', where `mdf dataset` writes a {writes}" in line, line
+    assert snapshot(out) == before
+    assert sorted(p.name for p in out.iterdir()) == sorted([name, "notes.txt"])
 
 
 # --------------------------------------------------------------------------- permissions

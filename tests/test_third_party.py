@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 from conftest import EXAMPLES, without_third_party_warnings
+from helpers import point_dataset
 from test_plugins import _make_distribution
 
 from mdframework import cli
@@ -533,3 +534,34 @@ recording = {{ kind = "xyzzy_bug", file = "{data}" }}
         "plugin 'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug); check it with "
         "mdframework.testing.check_recording_source;"
     ), lines
+
+
+#: a radar whose receive() overflows (a numerical warning in a plugin's own code) and that
+#: otherwise works
+OVERFLOWING_RECEIVE = (
+    "    def receive(self, block):\n"
+    "        np.float64(1e308) * 10.0\n"
+    "        return super().receive(block)\n"
+)
+
+
+@pytest.mark.parametrize("how", [["--workers", "1"], ["--workers", "2"], ["--scheduler", "local"]])
+def test_a_numerical_warning_in_a_record_stops_the_build_however_it_runs(
+    how: list[str], installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """mdf stops at a numerical warning in its own or a plugin's code rather than write a
+    result it cannot trust: in the build's process and its forked workers, and also on a local
+    Dask cluster, whose workers start afresh (they wrote every record and the build succeeded,
+    so the same config gave a dataset or an error depending on --scheduler)."""
+    if how[0] == "--scheduler":
+        pytest.importorskip("distributed")
+    base = "import numpy as np\nfrom mdf_lfm.waveform import LfmPulseDoppler as Base\n"
+    install_broken(installed, base, "radar_waveforms", OVERFLOWING_RECEIVE)
+    config = point_dataset(tmp_path / "d.toml", radar="xyzzy_bug")
+    out = tmp_path / "ds"
+    capsys.readouterr()
+    assert cli.main(["dataset", "build", str(config), "--out", str(out), *how]) == 1
+    lines = without_third_party_warnings(capsys.readouterr().err.strip().splitlines())
+    assert len(lines) == 1 and lines[0].startswith("mdf: internal error: RuntimeWarning: "), lines
+    assert "overflow" in lines[0] and "xyzzy_bug" in lines[0], lines
+    assert not (out / "index.csv").exists()

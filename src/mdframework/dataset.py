@@ -72,7 +72,7 @@ from .outdir import (
     wait_for_files,
 )
 from .pipeline import build_stages, load_motion, simulate_motion
-from .plugins import blame, default_registry, is_plugin_bug
+from .plugins import blame, default_registry, is_plugin_bug, versions
 from .pointcloud import (
     IWR1443_BIN_WIDTH,
     HistogramSettings,
@@ -1234,6 +1234,7 @@ def _build_recorded(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         "recording": dict(rec.metadata),
         "units": RECORD_UNITS,
     }
+    meta["versions"] = versions(used=_used_plugins(meta))
     atomic_savez(
         Path(out_dir) / RECORDS / f"{spec.record_id}.npz",
         in_background=True,
@@ -1417,6 +1418,7 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         "run_config": json.loads(cfg.model_dump_json()),
         **extra_meta,
     }
+    meta["versions"] = versions(used=_used_plugins(meta))
     atomic_savez(
         Path(out_dir) / RECORDS / f"{spec.record_id}.npz",
         in_background=True,
@@ -1517,13 +1519,17 @@ def _planned_meta(spec: RecordSpec) -> dict[str, Any]:
     return planned
 
 
-def _complete(path: Path, spec: RecordSpec) -> dict[str, Any] | None:
+def _complete(
+    path: Path, spec: RecordSpec, other_versions: dict[str, Any] | None = None
+) -> dict[str, Any] | None:
     """The index row of a finished record, or None if it must be (re)built: a record cut
     short, corrupt, or whose metadata lacks a field or names another record is removed. A
     record whose label, group, subject, recording or dataset differ from ``spec``'s (the
     config changed only those) is kept and rewritten with the new ones (atomically; its arrays
     are not recomputed), and so is its row. A record that cannot be read for want of
-    permission is an error (it is not removed)."""
+    permission is an error (it is not removed). A record computed by other software versions
+    than this process's is kept, its id, its versions and this process's added to
+    ``other_versions``."""
     import zipfile
 
     if not path.exists():
@@ -1532,6 +1538,10 @@ def _complete(path: Path, spec: RecordSpec) -> dict[str, Any] | None:
         arrays, meta = read_record(path)
         if meta["id"] != spec.record_id:  # another record's file, copied or renamed here
             raise ValueError(f"{path}: holds record {meta['id']}")
+        made_by = meta.get("versions")  # None: by a version before records named theirs
+        now = versions(used=_used_plugins(meta))
+        if other_versions is not None and made_by is not None and made_by != now:
+            other_versions[spec.record_id] = (made_by, now)
         planned = _planned_meta(spec)
         if any(meta.get(k) != v for k, v in planned.items()):
             meta.update(planned)
@@ -1721,7 +1731,7 @@ def _executor(
         client = _connect(Client, cluster, address)
         try:
             if cluster is not None:
-                client.run(_quiet_dask_worker)
+                client.run(_quiet_dask_worker, warnings.showwarning, _warning_filters())
             client.run(_receive_motions, dict(_MOTIONS))  # each worker gets what planning loaded
 
             def run_dask(specs: list[RecordSpec], out: str) -> Iterator[dict[str, Any]]:
@@ -1759,16 +1769,35 @@ def _quiet_dask_logs() -> Iterator[None]:
             log.setLevel(level)
 
 
-def _quiet_dask_worker() -> bool:
+def _warning_filters() -> list[tuple[Any, ...]]:
+    """This process's warning filters, newest first, as arguments of
+    :func:`warnings.filterwarnings` (a filter holds its patterns compiled or as text)."""
+
+    def text(pattern: Any) -> str:
+        return str(getattr(pattern, "pattern", pattern) or "")
+
+    return [(f[0], text(f[1]), f[2], text(f[3]), f[4]) for f in warnings.filters]
+
+
+def _quiet_dask_worker(show: Callable[..., None], filters: list[tuple[Any, ...]]) -> bool:
     """:func:`_quiet_dask_logs` in a local cluster's worker process, for its lifetime, and
     Ctrl-C ignored there, as in the process pool's workers: the build's process handles it
-    and closes the cluster (the worker's own KeyboardInterrupt printed a traceback). Whether
-    Ctrl-C could be ignored (only from the worker's main thread)."""
+    and closes the cluster (the worker's own KeyboardInterrupt printed a traceback). The
+    worker also takes the build process's warning handling, which the pool's workers inherit
+    as copies of it: ``show`` prints a warning (``mdf: warning: ...`` under ``mdf``; Python's
+    own format, with the file and line, was printed) and ``filters`` (:func:`_warning_filters`)
+    decide which warnings are errors (``mdf`` stops at a numerical warning rather than write a
+    record it cannot trust; a Dask build wrote it). Whether Ctrl-C could be ignored (only from
+    the worker's main thread)."""
     import logging
     import signal
     import threading
 
     logging.getLogger("distributed").setLevel(logging.CRITICAL)
+    warnings.resetwarnings()
+    for action, message, category, module, lineno in reversed(filters):
+        warnings.filterwarnings(action, message, category, module, lineno)
+    warnings.showwarning = show
     if threading.current_thread() is not threading.main_thread():
         return False
     signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -1846,6 +1875,35 @@ def config_differences(old: Any, new: Any, where: str = "") -> list[str]:
     return [f"{where or 'config'}: {json.dumps(old)} -> {json.dumps(new)}"]
 
 
+def _used_plugins(meta: dict[str, Any]) -> list[tuple[str, str]]:
+    """The (interface, kind) of every plugin a record ran, from its metadata: a real radar's
+    recording source, or the motion source, scatterers, radar and effects of its run config."""
+    run = meta.get("run_config")
+    if run is None:
+        return [("recording", str(meta["source"]))]
+    return [(s, run[s]["kind"]) for s in ("motion", "scatterers", "radar")] + [
+        ("effects", e["kind"]) for e in run.get("effects", [])
+    ]
+
+
+def _warn_other_versions(made_by: dict[str, Any], n_records: int) -> None:
+    """Warn once when records kept from the folder were computed by other software versions
+    (``made_by``: record id -> its ``versions`` and this process's for the same plugins): a
+    record's id covers its config, not the software, so a build after an upgrade keeps them."""
+    if not made_by:
+        return
+    first, (old, now) = next(iter(made_by.items()))
+    diff = config_differences(old, now)
+    shown = "; ".join(diff[:3]) + (f" and {len(diff) - 3} more" if len(diff) > 3 else "")
+    warnings.warn(
+        f"{len(made_by)} of {n_records} records (e.g. {first}) were computed by other "
+        f"software versions ({shown}) and are kept, as their config is the same: the dataset "
+        "mixes versions; build into a new folder to compute every record with these",
+        DatasetWarning,
+        stacklevel=3,
+    )
+
+
 def _warn_band_edges(rows: list[dict[str, Any]]) -> None:
     """One warning for the records whose features' envelope reaches the edge of the Doppler
     band in some frame (``band_edge_frames`` > 0 in ``index.csv``; blank for histogram and
@@ -1885,6 +1943,7 @@ def build_dataset(
 
     check_scheduler_address(scheduler_address(scheduler))
     with dataset_folder(out_dir, force=force) as folder:
+        _refuse_names_in_the_way(folder.path)
         note("planning the records (reading each recording once)", progress)
         _forget_loaded()  # every file is read afresh: one changed since is seen
         # errors in the config stop before any file
@@ -1911,12 +1970,14 @@ def build_dataset(
             _remove_partials(out)
         rows: dict[str, dict[str, Any]] = {}
         todo = []
+        other_versions: dict[str, Any] = {}
         for spec in specs:
-            row = _complete(out / RECORDS / f"{spec.record_id}.npz", spec)
+            row = _complete(out / RECORDS / f"{spec.record_id}.npz", spec, other_versions)
             if row is None:
                 todo.append(spec)
             else:
                 rows[spec.record_id] = row
+        _warn_other_versions(other_versions, len(specs))
         printed()
         bar = tqdm(
             total=len(specs),
@@ -1973,6 +2034,22 @@ _RECORD_NAME = re.compile(r"\d{5,}-[0-9a-f]{10}\.npz")
 _PARTIAL_NAME = re.compile(r"\.tmp-\w+\.(part|npz)")  # .npz: earlier versions
 
 
+def _refuse_names_in_the_way(out: Path) -> None:
+    """:class:`OutputError` for a name the build writes that holds the other kind of entry: a
+    file (anything but a folder) named ``records``, a folder named as one of the index files.
+    Checked before anything is written, with ``--force`` too (which replaces files of the
+    dataset's names, never a folder, and needs ``records`` to be one)."""
+    for name in DATASET_FILES:
+        path = out / name
+        if not os.path.lexists(path) or path.is_dir() == (name == RECORDS):
+            continue
+        kind, writes = ("file", "folder") if name == RECORDS else ("folder", "file")
+        raise OutputError(
+            f"--out {out}: holds the {kind} {name!r}, where `mdf dataset` writes a {writes}; "
+            "move it away or choose another folder"
+        )
+
+
 def _remove_partials(out: Path) -> None:
     """Remove the records that were being written when a build stopped."""
     for partial in (out / RECORDS).glob(".tmp-*"):
@@ -2022,6 +2099,7 @@ def _write_index(
         "feature_units": "m/s",
         "labels": sorted({r["label"] for r in rows}),
         "config": json.loads(config.model_dump_json()),
+        "versions": versions(),  # of the build that wrote the index (records may be older)
     }
     atomic_write_text(out / MANIFEST, json.dumps(manifest, indent=2) + "\n")
 

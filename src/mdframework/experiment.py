@@ -30,6 +30,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import os
 import warnings
 from collections import Counter
 from collections.abc import Callable, Collection, Sequence
@@ -55,7 +56,7 @@ from .errors import ConfigError, DataFileError, MdfError
 from .features import FEATURE_NAMES
 from .interfaces import Classifier
 from .outdir import output_folder, safe_name
-from .plugins import Registry, default_registry
+from .plugins import Registry, default_registry, versions
 from .pointcloud import histogram_vector, histogram_vector_names, velocity_bins
 from .progress import note, progress_enabled
 from .settings import Seed, StrictModel, Workers
@@ -877,7 +878,7 @@ def run_experiment(
         note(f"loading the dataset {data_dir}", progress)
         data, x_all, names = classifier_inputs(cfg, data_dir)
         stage = folder.stage()
-        summary = _report(cfg, factory, data, x_all, names, data_dir, stage, progress)
+        summary = _report(cfg, factory, data, x_all, names, data_dir, stage, progress, registry)
         folder.commit(stage, keep=("dataset",))  # a built dataset is never deleted
     return summary
 
@@ -891,10 +892,14 @@ def _report(
     data_dir: Path,
     out: Path,
     progress: bool = True,
+    registry: Registry | None = None,
 ) -> dict[str, Any]:
     """Run the experiments on ``data`` (classifier inputs ``x_all`` named ``names``) and write
     every report file into ``out``. The figures are drawn together at the end, once every number
-    is computed (matplotlib loads only then)."""
+    is computed (matplotlib loads only then). ``summary.json`` ends with the experiment's config
+    (``config``, every default filled in, the dataset's path absolute: it repeats the
+    experiment) and the software's
+    ``versions`` (:func:`mdframework.plugins.versions` of ``registry``)."""
     from .figures import plot_confusion, plot_feature_scatter
 
     figures: list[Callable[[], None]] = []  # drawn at the end
@@ -1115,6 +1120,10 @@ def _report(
     for draw in figures:
         draw()
     (out / "report.md").write_text("\n".join(report), encoding="utf-8")
+    config = cfg.model_dump(mode="json")  # its dataset read from any folder, not only this one
+    config["dataset"] = {k: v and os.path.abspath(v) for k, v in config["dataset"].items()}
+    summary["config"] = config
+    summary["versions"] = versions(registry)
     (out / "summary.json").write_text(
         json.dumps(_strict_json(summary), indent=2, default=str, allow_nan=False) + "\n",
         encoding="utf-8",

@@ -441,7 +441,9 @@ class OutputFolder:
             if foreign:
                 raise OutputError(
                     f"--out {self.path}: holds {_describe(foreign)}, which `mdf {self.command}` "
-                    "writes but did not write there; move it away, or add --force to replace it"
+                    "writes, but not the very files it wrote there (edited, replaced, or copied "
+                    "from elsewhere, as a copied output folder's are); move it away, or add "
+                    "--force to replace it"
                 )
         stale = [n for n in sorted(ours) if n not in names and n not in keep]
         aside = stage / _ASIDE

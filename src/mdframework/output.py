@@ -60,6 +60,7 @@ from .figures import (
 from .outdir import OutputFolder, output_folder
 from .physics.spectrogram import power_to_db
 from .pipeline import RunResult
+from .plugins import versions
 from .progress import QUIET, Progress
 
 #: Range-time rows saved to result.npz (``range_time_db``) and drawn in range_time.png: the
@@ -246,7 +247,7 @@ def _stage_run(
         json.dumps(resolved_config, indent=2) + "\n", encoding="utf-8"
     )
     (stage / "metadata.json").write_text(
-        json.dumps(result.metadata, indent=2, default=_jsonable) + "\n",
+        json.dumps({**result.metadata, "versions": versions()}, indent=2, default=_jsonable) + "\n",
         encoding="utf-8",
     )
 

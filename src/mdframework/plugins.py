@@ -261,6 +261,46 @@ class Registry:
         return Registry(plugins, dict(self.disabled))
 
 
+def versions(
+    registry: Registry | None = None, used: Iterable[tuple[str, str]] | None = None
+) -> dict[str, Any]:
+    """The software a result was made with, for its provenance (``metadata.json``,
+    ``dataset.json``, ``summary.json``, each dataset record): the versions of mdframework,
+    Python, NumPy, SciPy and scikit-learn (``None`` when not installed), and ``plugins``, every
+    plugin distribution of ``registry`` (default: the installed plugins) as ``"name version"``,
+    sorted; with ``used`` (interface, kind) pairs, only the distributions providing those."""
+    import platform
+
+    from . import __version__
+
+    reg = default_registry() if registry is None else registry
+    wanted = None if used is None else set(used)
+    return {
+        "mdframework": _distribution_version("mdframework") or __version__,
+        "python": platform.python_version(),
+        "numpy": _distribution_version("numpy"),
+        "scipy": _distribution_version("scipy"),
+        "scikit-learn": _distribution_version("scikit-learn"),
+        "plugins": sorted(
+            {
+                info.provider
+                for interface, infos in reg.plugins.items()
+                for kind, info in infos.items()
+                if wanted is None or (interface, kind) in wanted
+            }
+        ),
+    }
+
+
+@cache
+def _distribution_version(distribution: str) -> str | None:
+    """An installed distribution's version (once per process: each record names them)."""
+    try:
+        return importlib.metadata.version(distribution)
+    except importlib.metadata.PackageNotFoundError:
+        return None
+
+
 def _provider_name(pm: pluggy.PluginManager, plugin: object) -> str:
     name = pm.get_name(plugin) or repr(plugin)
     return _DISTRIBUTIONS.get(name, name)
