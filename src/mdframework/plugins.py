@@ -39,6 +39,7 @@ from __future__ import annotations
 import difflib
 import importlib.metadata
 import os
+import sys
 import time
 import typing
 import warnings
@@ -269,15 +270,13 @@ def versions(
     Python, NumPy, SciPy and scikit-learn (``None`` when not installed), and ``plugins``, every
     plugin distribution of ``registry`` (default: the installed plugins) as ``"name version"``,
     sorted; with ``used`` (interface, kind) pairs, only the distributions providing those."""
-    import platform
-
     from . import __version__
 
     reg = default_registry() if registry is None else registry
     wanted = None if used is None else set(used)
     return {
         "mdframework": _distribution_version("mdframework") or __version__,
-        "python": platform.python_version(),
+        "python": "{}.{}.{}".format(*sys.version_info[:3]),
         "numpy": _distribution_version("numpy"),
         "scipy": _distribution_version("scipy"),
         "scikit-learn": _distribution_version("scikit-learn"),
