@@ -172,6 +172,12 @@ class SanityConfig(StrictModel):
         description="Smallest median height [m] of the head above the pelvis of an upright "
         "body (the shipped recordings give 0.45-0.8 m).",
     )
+    mirrored: Literal["warn", "ignore", "error"] = Field(
+        "warn",
+        description="An upright body whose feet point backwards from the way its left and "
+        "right joints face (a mirror image: a left-handed file, or left and right joints "
+        "named the other way round): warn, flag silently, or stop.",
+    )
 
 
 class MotionConfig(PluginConfig):
