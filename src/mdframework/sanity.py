@@ -37,7 +37,10 @@ Checks, on the canonical 17-joint body:
    frames; below ``upright_min_m`` (0.2 m; the shipped recordings, boxing and sitting down
    included, give 0.45-0.8 m) the body lies flat or stands on its head, which a file read with
    the wrong up axis gives: the message names the sources' ``axes`` option.
-6. **Mirrored** (:func:`foot_facing_cosine`), on an upright body: the median cosine between
+6. **Size** (:func:`leg_length`): the median length of a leg, hip to knee to ankle; outside
+   ``leg_length_m`` (0.4-1.5 m; the shipped recordings give 0.76-1.04 m) the file was read in
+   the wrong length unit. A body of the wrong size is not judged upright or not.
+7. **Mirrored** (:func:`foot_facing_cosine`), on an upright body: the median cosine between
    where the feet point (toes ahead of ankles) and the facing direction the left and right
    joints give; below 0 the body is a mirror image (a left-handed file, or left and right
    joints named the other way round), whose left lies on its right.
@@ -407,6 +410,22 @@ def head_rise(body: Skeleton) -> float | None:
     return float(np.median(rise[ok])) if ok.any() else None
 
 
+def leg_length(body: Skeleton) -> float | None:
+    """Median over the frames and both sides of a leg's length [m], hip to knee plus knee to
+    ankle (frames where the three joints are valid); None without such a frame. The shipped
+    recordings give 0.76-1.04 m; a file read in the wrong length unit scales it by the units'
+    ratio (2.54 for inches and centimetres, 10, 100, 1000)."""
+    lengths = []
+    for side in ("l", "r"):
+        hip, knee, ankle = (body.joint(f"{side}_{j}") for j in ("hip", "knee", "ankle"))
+        ok = np.all(body.valid[:, [body.index(f"{side}_{j}") for j in ("hip", "knee", "ankle")]], 1)
+        thigh = np.linalg.norm(hip - knee, axis=1)
+        shin = np.linalg.norm(knee - ankle, axis=1)
+        lengths.append((thigh + shin)[ok])
+    both = np.concatenate(lengths)
+    return float(np.median(both)) if both.size else None
+
+
 def foot_facing_cosine(body: Skeleton) -> float | None:
     """Median over the frames of the cosine between where the feet point and where the left
     and right joints say the body faces, both horizontal: the feet ``(l_toe - l_ankle) +
@@ -542,8 +561,24 @@ def check_motion(motion: Motion, config: SanityConfig) -> Motion:
                 )
             )
 
+    leg = leg_length(body)
+    lo_leg, hi_leg = config.leg_length_m
+    sized = leg is None or lo_leg <= leg <= hi_leg
+    report["size"] = {"median_leg_m": leg, "plausible": [lo_leg, hi_leg], "ok": sized}
+    if not sized:
+        assert leg is not None
+        notes.append(
+            (
+                config.size,
+                f"the legs are {leg:.3g} m long (hip to knee to ankle, median over the frames; "
+                f"people's {lo_leg:g}-{hi_leg:g} m): the file's length unit is likely not the "
+                "one it was read in: check its unit (motion.unit_m, or motion.units for a table)",
+            )
+        )
+
     rise = head_rise(body)
-    upright = rise is None or rise >= config.upright_min_m
+    # judged at human size only: a body scaled by a wrong unit is the size check's finding
+    upright = rise is None or rise >= config.upright_min_m or not sized
     report["upright"] = {"median_head_rise_m": rise, "min_m": config.upright_min_m, "ok": upright}
     if not upright:
         assert rise is not None
