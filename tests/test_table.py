@@ -351,3 +351,18 @@ def test_a_time_unit_that_makes_no_recording_rate_is_refused(tmp_path: Path) -> 
         read_table(UT, frames)
     with pytest.raises(DataFileError, match=r"frames/s, above the 10000 frames/s"):
         read_table(ms, TableLayout(time_unit_s=1e-6))
+
+
+def test_time_unit_and_frame_rate_together_are_refused(tmp_path: Path) -> None:
+    """The real walk stamped in milliseconds, configured with time_unit_s = 0.001 and the
+    capture's frame_rate = 60 beside it: frame_rate won silently, reading the milliseconds as
+    frame numbers, a 35 s walk stretched to 583 s. Both say how to read the time column:
+    refused naming both; either alone reads the walk (35 s)."""
+    ref = read_utkinect(UT)
+    ms = _ut_table(tmp_path / "ms.csv", (ref.time - ref.time[0]) * 1e3, long=False)
+    with pytest.raises(ValueError, match=r"time_unit_s \(0\.001 s per unit\) and frame_rate"):
+        TableConfig(file=ms, time_unit_s=1e-3, frame_rate=60.0)
+    walk = TableSource(TableConfig(file=ms, joint_set="kinect-v1", time_unit_s=1e-3)).load()
+    assert walk.skeleton.duration == pytest.approx(35.0)
+    # no time column: frame_rate is the rows' rate and time_unit_s reads nothing
+    TableConfig(file=ms, time_column="", time_unit_s=1e-3, frame_rate=60.0)
