@@ -414,3 +414,32 @@ def test_lying_body_from_a_wrong_up_axis_is_warned_naming_axes(tmp_path: Path) -
     ]
     with pytest.raises(DataFileError, match=r"16_21\.bvh: motion sanity: the body is not upright"):
         check_motion(flat, SanityConfig(cadence=False, upright="error"))
+
+
+def test_a_resampled_cmu_trial_keeps_its_header_rate(tmp_path: Path) -> None:
+    """CMU's index corrects only cgspeed's known-wrong header (120 Hz for a 60 Hz subject). The
+    real 16_21 walk resampled to 30 Hz (every 4th frame, T-pose frame 0 kept, Frame Time
+    .0333333, as a re-export writes it) under its own name is read at 30 Hz, silently: the hips
+    keep the original's 1.70 m/s and 2.59 s (read at the index's 120 Hz they ran at 6.8 m/s)."""
+    lines = (CMU_BVH / "16_21.bvh").read_text().splitlines()
+    motion = next(i for i, line in enumerate(lines) if line.strip() == "MOTION")
+    frames = lines[motion + 3 :][::4]
+    head = [*lines[: motion + 1], f"Frames: {len(frames)}", "Frame Time: .0333333"]
+    path = tmp_path / "16_21.bvh"
+    path.write_text("\n".join([*head, *frames]) + "\n")
+    full = bvh(CMU_BVH / "16_21.bvh")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FrameRateWarning)
+        resampled = bvh(path)
+    assert (resampled.metadata["frame_rate_hz"], resampled.metadata["frame_rate_from"]) == (
+        30.0,
+        "header",
+    )
+
+    def hip_speed(m) -> float:
+        base = m.canonical().joint("base")
+        return float(np.linalg.norm(np.diff(base, axis=0), axis=1).sum() / m.skeleton.duration)
+
+    assert resampled.skeleton.duration == pytest.approx(full.skeleton.duration, abs=1 / 30)
+    assert hip_speed(full) == pytest.approx(1.70, abs=0.01)
+    assert hip_speed(resampled) == pytest.approx(hip_speed(full), rel=0.02)

@@ -27,7 +27,9 @@ from mdframework.sanity import (
     check_motion,
     deviations,
     find_glitches,
+    foot_facing_cosine,
     head_rise,
+    leg_length,
 )
 from mdframework.settings import SanityConfig
 
@@ -317,7 +319,9 @@ def test_the_shipped_recordings_are_upright_as_the_page_says() -> None:
     """docs/motion-formats.md: the head's median height above the pelvis of the shipped
     recordings, boxing and sitting down included, lies in the range the page gives for them
     (0.45-0.8 m, well above the 0.2 m check): every recording an example run or dataset config
-    reads, the sitting-down BVH and the other DeepMimic clips."""
+    reads, the sitting-down BVH and the other DeepMimic clips. Their feet point the way their
+    left and right joints face them (the mirrored check's cosine, as the page gives it), and
+    their legs are of the length the page gives for them."""
     import re
     import tomllib
 
@@ -341,11 +345,107 @@ def test_the_shipped_recordings_are_upright_as_the_page_says() -> None:
     for kind, name in extra:
         motions[EXAMPLES / name] = {"kind": kind, "file": str(EXAMPLES / name)}
     assert len(motions) >= 15
-    rises = {}
+    rises, facing, legs = {}, {}, {}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the recordings' own sanity warnings
         for file, section in motions.items():
             cfg = validate_run_config({"motion": section}, source="test", base_dir=EXAMPLES)
-            rises[file.name] = head_rise(load_motion(build_stages(cfg).source).canonical())
+            body = load_motion(build_stages(cfg).source).canonical()
+            rises[file.name], facing[file.name] = head_rise(body), foot_facing_cosine(body)
+            legs[file.name] = leg_length(body)
     assert all(low <= r <= high for r in rises.values()), rises
     assert min(rises.values()) < low + 0.05 and max(rises.values()) > high - 0.05, rises
+    # and none is mirrored: the feet point the way the left and right joints face them
+    quoted = re.search(r"the shipped recordings give ([\d.]+)-1\.00, a mirrored", page)
+    assert quoted is not None
+    assert min(facing.values()) == pytest.approx(float(quoted.group(1)), abs=0.005), facing
+    # and of human size: their legs' lengths, hip to knee to ankle
+    quoted = re.search(r"the shipped recordings give ([\d.]+)-([\d.]+) m\) \|", page)
+    assert quoted is not None
+    lo, hi = (float(q) for q in quoted.groups())
+    assert min(legs.values()) == pytest.approx(lo, abs=0.005), legs
+    assert max(legs.values()) == pytest.approx(hi, abs=0.005), legs
+
+
+def _mirrored_bvh(src: Path, dst: Path) -> Path:
+    """The BVH file's mirror image in its X axis, as a left-handed export writes it: every
+    OFFSET's and Xposition's X negated, and the Y and Z rotations (a rotation mirrored in X
+    keeps its X angle and turns the others the other way)."""
+    bvh = read_bvh(src)
+    sign = np.ones(bvh.values.shape[1])
+    for j in bvh.joints:
+        for k, ch in enumerate(j.channels):
+            if ch in ("Xposition", "Yrotation", "Zrotation"):
+                sign[j.first_channel + k] = -1.0
+    lines = src.read_text().splitlines()
+    motion = next(i for i, line in enumerate(lines) if line.strip() == "MOTION")
+    out = []
+    for line in lines[: motion + 3]:
+        head, _, rest = line.partition("OFFSET")
+        if rest:
+            x, y, z = (float(v) for v in rest.split())
+            line = f"{head}OFFSET {-x:g} {y:g} {z:g}"
+        out.append(line)
+    for line in lines[motion + 3 :]:
+        values = np.array(line.split(), dtype=float) * sign
+        out.append(" ".join(f"{v:.6g}" for v in values))
+    dst.write_text("\n".join(out) + "\n")
+    return dst
+
+
+def test_a_mirrored_body_is_flagged_and_the_real_ones_are_not(tmp_path: Path) -> None:
+    """The real 16_21 walk mirrored in the file's X axis (a left-handed export) read as it is:
+    the same walk at the same speed, but its left joints on its right, which nothing said. Its
+    feet point backwards from where its left and right joints face it (cosine -1.00, the real
+    file's +1.00): warned, or stopped with mirrored = "error"."""
+    mirror = _mirrored_bvh(EXAMPLES / CMU["16_21"]["file"], tmp_path / "16_21.bvh")
+    real, real_msgs = load(CMU["16_21"])
+    flipped, msgs = load({"kind": "cmu", "file": str(mirror)})
+    # the same walk: the pelvis path, mirrored across the walking direction
+    base, fbase = real.canonical().joint("base"), flipped.canonical().joint("base")
+    np.testing.assert_allclose(fbase[:, [0, 2]], base[:, [0, 2]], atol=1e-6)
+    np.testing.assert_allclose(fbase[:, 1], -base[:, 1], atol=1e-6)
+    assert foot_facing_cosine(real.canonical()) > 0.99
+    assert foot_facing_cosine(flipped.canonical()) < -0.99
+    assert real.metadata["sanity"]["mirrored"]["ok"] and not real_msgs
+    assert not flipped.metadata["sanity"]["mirrored"]["ok"]
+    assert msgs == [
+        f"{mirror}: the body looks mirrored: its feet point backwards from the way its left and "
+        "right joints face (median cosine -1.00; real bodies near +1), so its left is on its "
+        "right: the file's frame is left-handed (a mirror image) or its left and right joints "
+        "are named the other way round"
+    ]
+    with pytest.raises(DataFileError, match="motion sanity: the body looks mirrored"):
+        load({"kind": "cmu", "file": str(mirror)}, mirrored="error")
+
+
+def test_a_body_read_in_the_wrong_length_unit_is_flagged() -> None:
+    """The real 16_21 walk (cgspeed's unit, 1/0.45 inch) read as inches, as CMU's files are
+    often said to be: a body 0.45 times its size, legs of 0.38 m, walking at 0.77 m/s, which
+    no check flagged (the speeds stay human). The legs, hip to knee to ankle, are outside
+    people's 0.4-1.5 m: warned naming the unit option, and not judged upright or not. Read
+    in its own unit, the legs are 0.84 m and nothing is said."""
+    section = {"kind": "bvh", "file": CMU["16_21"]["file"]}
+    real, real_msgs = load(section)
+    assert real.metadata["sanity"]["size"]["median_leg_m"] == pytest.approx(0.836, abs=0.001)
+    assert real.metadata["sanity"]["size"]["ok"] and not real_msgs
+    small, msgs = load({**section, "unit_m": 0.0254})
+    assert small.metadata["sanity"]["size"] == {
+        "median_leg_m": pytest.approx(0.376, abs=0.001),
+        "plausible": [0.4, 1.5],
+        "ok": False,
+    }
+    path = (EXAMPLES / CMU["16_21"]["file"]).absolute()
+    assert msgs == [
+        f"{path}: the legs are 0.376 m long (hip to knee to ankle, median over the frames; "
+        "people's 0.4-1.5 m): the file's length unit is likely not the one it was read in: "
+        "check its unit (motion.unit_m, or motion.units for a table)"
+    ]
+    # read as centimetres, the head is 0.09 m above the pelvis: not a body lying down (whose
+    # message would send the user to motion.axes) but the size's finding alone
+    tiny, tiny_msgs = load({**section, "unit_m": 0.01})
+    assert tiny.metadata["sanity"]["upright"]["median_head_rise_m"] < 0.1
+    assert tiny.metadata["sanity"]["upright"]["ok"]
+    assert [m.split(": ", 1)[1][:30] for m in tiny_msgs] == ["the legs are 0.148 m long (hip"]
+    with pytest.raises(DataFileError, match=r"motion sanity: the legs are 0\.376 m long"):
+        load({**section, "unit_m": 0.0254}, size="error")

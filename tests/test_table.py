@@ -325,3 +325,44 @@ def test_time_limits_are_in_seconds_and_say_so(tmp_path: Path) -> None:
     far = _ut_table(tmp_path / "far.csv", 2e10 + ref.time, long=False)
     with pytest.raises(DataFileError, match=r"far\.csv:2: time \[s\] \(motion\.time_unit_s = 1 s"):
         read_table(far)
+
+
+def test_a_time_unit_that_makes_no_recording_rate_is_refused(tmp_path: Path) -> None:
+    """The real 35 s UTKinect walk stamped in milliseconds but read as seconds (the default
+    time_unit_s) was a 35,000 s motion at 0.015 frames a second, moving 1000 times too slowly,
+    without a word. Like every recording's, a table's frame rate (from the median step) must
+    lie within 1 .. 10,000 frames/s: refused naming the unit it was read in and what to set;
+    with time_unit_s = 0.001 it is the walk, 35 s long. Its frame numbers read as seconds
+    (frame_rate forgotten) and milliseconds read as microseconds are refused alike."""
+    ref = read_utkinect(UT)
+    ms = _ut_table(tmp_path / "ms.csv", (ref.time - ref.time[0]) * 1e3, long=False)
+    with pytest.raises(DataFileError) as err:
+        read_table(ms)
+    assert str(err.value) == (
+        f"{ms}: the frames are 66.67 s apart (the median step, motion.time_unit_s = 1 s per "
+        "unit): 0.015 frames/s, below the 1 frames/s of a motion recording: check the time "
+        "column's unit (motion.time_unit_s, 0.001 for milliseconds, or motion.frame_rate for "
+        "frame numbers)"
+    )
+    walk = read_table(ms, TableLayout(time_unit_s=1e-3))
+    assert walk.time[-1] - walk.time[0] == pytest.approx(35.0)
+    frames = TableLayout(header=False, joints=tuple(KINECT_V1_JOINTS), time_column="frame")
+    with pytest.raises(DataFileError, match=r"apart \(the median step, motion\.time_unit_s"):
+        read_table(UT, frames)
+    with pytest.raises(DataFileError, match=r"frames/s, above the 10000 frames/s"):
+        read_table(ms, TableLayout(time_unit_s=1e-6))
+
+
+def test_time_unit_and_frame_rate_together_are_refused(tmp_path: Path) -> None:
+    """The real walk stamped in milliseconds, configured with time_unit_s = 0.001 and the
+    capture's frame_rate = 60 beside it: frame_rate won silently, reading the milliseconds as
+    frame numbers, a 35 s walk stretched to 583 s. Both say how to read the time column:
+    refused naming both; either alone reads the walk (35 s)."""
+    ref = read_utkinect(UT)
+    ms = _ut_table(tmp_path / "ms.csv", (ref.time - ref.time[0]) * 1e3, long=False)
+    with pytest.raises(ValueError, match=r"time_unit_s \(0\.001 s per unit\) and frame_rate"):
+        TableConfig(file=ms, time_unit_s=1e-3, frame_rate=60.0)
+    walk = TableSource(TableConfig(file=ms, joint_set="kinect-v1", time_unit_s=1e-3)).load()
+    assert walk.skeleton.duration == pytest.approx(35.0)
+    # no time column: frame_rate is the rows' rate and time_unit_s reads nothing
+    TableConfig(file=ms, time_column="", time_unit_s=1e-3, frame_rate=60.0)

@@ -37,6 +37,13 @@ Checks, on the canonical 17-joint body:
    frames; below ``upright_min_m`` (0.2 m; the shipped recordings, boxing and sitting down
    included, give 0.45-0.8 m) the body lies flat or stands on its head, which a file read with
    the wrong up axis gives: the message names the sources' ``axes`` option.
+6. **Size** (:func:`leg_length`): the median length of a leg, hip to knee to ankle; outside
+   ``leg_length_m`` (0.4-1.5 m; the shipped recordings give 0.76-1.04 m) the file was read in
+   the wrong length unit. A body of the wrong size is not judged upright or not.
+7. **Mirrored** (:func:`foot_facing_cosine`), on an upright body: the median cosine between
+   where the feet point (toes ahead of ankles) and the facing direction the left and right
+   joints give; below 0 the body is a mirror image (a left-handed file, or left and right
+   joints named the other way round), whose left lies on its right.
 """
 
 from __future__ import annotations
@@ -403,6 +410,43 @@ def head_rise(body: Skeleton) -> float | None:
     return float(np.median(rise[ok])) if ok.any() else None
 
 
+def leg_length(body: Skeleton) -> float | None:
+    """Median over the frames and both sides of a leg's length [m], hip to knee plus knee to
+    ankle (frames where the three joints are valid); None without such a frame. The shipped
+    recordings give 0.76-1.04 m; a file read in the wrong length unit scales it by the units'
+    ratio (2.54 for inches and centimetres, 10, 100, 1000)."""
+    lengths = []
+    for side in ("l", "r"):
+        hip, knee, ankle = (body.joint(f"{side}_{j}") for j in ("hip", "knee", "ankle"))
+        ok = np.all(body.valid[:, [body.index(f"{side}_{j}") for j in ("hip", "knee", "ankle")]], 1)
+        thigh = np.linalg.norm(hip - knee, axis=1)
+        shin = np.linalg.norm(knee - ankle, axis=1)
+        lengths.append((thigh + shin)[ok])
+    both = np.concatenate(lengths)
+    return float(np.median(both)) if both.size else None
+
+
+def foot_facing_cosine(body: Skeleton) -> float | None:
+    """Median over the frames of the cosine between where the feet point and where the left
+    and right joints say the body faces, both horizontal: the feet ``(l_toe - l_ankle) +
+    (r_toe - r_ankle)``, the facing ``L x z`` with ``L = (l_hip - r_hip) + (l_shoulder -
+    r_shoulder)`` (a body's left at +y faces +x). Near +1 for a real body (the shipped
+    recordings give 0.73-1.00); near -1 for a mirror image, whose left joints lie on its right.
+    None without a frame where all of these joints are valid and both directions are
+    nonzero."""
+    names = ("l_toe", "l_ankle", "r_toe", "r_ankle", "l_hip", "r_hip", "l_shoulder", "r_shoulder")
+    p = {n: body.joint(n) for n in names}
+    ok = np.all(body.valid[:, [body.index(n) for n in names]], axis=1)
+    feet = (p["l_toe"] - p["l_ankle"] + p["r_toe"] - p["r_ankle"])[ok, :2]
+    left = (p["l_hip"] - p["r_hip"] + p["l_shoulder"] - p["r_shoulder"])[ok, :2]
+    facing = np.stack([left[:, 1], -left[:, 0]], axis=1)  # (L x z) in the horizontal plane
+    norms = np.linalg.norm(feet, axis=1) * np.linalg.norm(facing, axis=1)
+    keep = norms > 0
+    if not keep.any():
+        return None
+    return float(np.median(np.sum(feet * facing, axis=1)[keep] / norms[keep]))
+
+
 def _activity_kind(activity: str) -> str | None:
     a = activity.lower()
     if "walk" in a:
@@ -517,8 +561,24 @@ def check_motion(motion: Motion, config: SanityConfig) -> Motion:
                 )
             )
 
+    leg = leg_length(body)
+    lo_leg, hi_leg = config.leg_length_m
+    sized = leg is None or lo_leg <= leg <= hi_leg
+    report["size"] = {"median_leg_m": leg, "plausible": [lo_leg, hi_leg], "ok": sized}
+    if not sized:
+        assert leg is not None
+        notes.append(
+            (
+                config.size,
+                f"the legs are {leg:.3g} m long (hip to knee to ankle, median over the frames; "
+                f"people's {lo_leg:g}-{hi_leg:g} m): the file's length unit is likely not the "
+                "one it was read in: check its unit (motion.unit_m, or motion.units for a table)",
+            )
+        )
+
     rise = head_rise(body)
-    upright = rise is None or rise >= config.upright_min_m
+    # judged at human size only: a body scaled by a wrong unit is the size check's finding
+    upright = rise is None or rise >= config.upright_min_m or not sized
     report["upright"] = {"median_head_rise_m": rise, "min_m": config.upright_min_m, "ok": upright}
     if not upright:
         assert rise is not None
@@ -528,6 +588,20 @@ def check_motion(motion: Motion, config: SanityConfig) -> Motion:
                 f"the body is not upright: the head is {rise:.2f} m above the pelvis (median "
                 f"over the frames; upright bodies {config.upright_min_m:g} m or more): if the "
                 "file's up axis is not the one its source assumes, set motion.axes",
+            )
+        )
+
+    # judged on an upright body only: lying down, the horizontal plane holds its length
+    cos = foot_facing_cosine(body) if upright else None
+    report["mirrored"] = {"median_foot_facing_cos": cos, "ok": cos is None or cos >= 0.0}
+    if cos is not None and cos < 0.0:
+        notes.append(
+            (
+                config.mirrored,
+                f"the body looks mirrored: its feet point backwards from the way its left and "
+                f"right joints face (median cosine {cos:.2f}; real bodies near +1), so its left "
+                "is on its right: the file's frame is left-handed (a mirror image) or its left "
+                "and right joints are named the other way round",
             )
         )
 

@@ -66,6 +66,8 @@ Rcs = Annotated[float, Field(ge=0, le=limits.MAX_RCS_M2)]
 Seed = Annotated[int, Field(ge=0, lt=2**64)]
 #: A step rate [steps/min].
 Cadence = Annotated[float, Field(ge=0, le=1000)]
+#: A leg's length [m], hip to knee to ankle (a bound of the motion size check).
+LegLength = Annotated[float, Field(ge=0, le=100)]
 #: A worker (process) count.
 Workers = Annotated[int, Field(ge=1, le=1024)]
 
@@ -171,6 +173,23 @@ class SanityConfig(StrictModel):
         le=10,
         description="Smallest median height [m] of the head above the pelvis of an upright "
         "body (the shipped recordings give 0.45-0.8 m).",
+    )
+    size: Literal["warn", "ignore", "error"] = Field(
+        "warn",
+        description="A body whose legs (hip to knee to ankle, median over the frames) are "
+        "outside leg_length_m: a file read in the wrong length unit (see the sources' unit_m "
+        "or units): warn, flag silently, or stop.",
+    )
+    leg_length_m: tuple[LegLength, LegLength] = Field(
+        (0.4, 1.5),
+        description="Plausible length [m] of a leg, hip to knee to ankle (the shipped "
+        "recordings give 0.76-1.04 m).",
+    )
+    mirrored: Literal["warn", "ignore", "error"] = Field(
+        "warn",
+        description="An upright body whose feet point backwards from the way its left and "
+        "right joints face (a mirror image: a left-handed file, or left and right joints "
+        "named the other way round): warn, flag silently, or stop.",
     )
 
 

@@ -14,10 +14,11 @@ Frame rate, in order:
 
 1. the config's ``frame_rate``;
 2. for a file recognised as a CMU conversion (rig ``cmu-cgspeed`` or ``cmu-3dsmax``) whose
-   file name gives a subject of CMU's index (``80_10.bvh``) whose header rate
-   differs from CMU's index (cgspeed wrote ``Frame Time: .0083333``, 120 Hz, into every file,
-   also for the subjects captured at 60 Hz): the index's rate, with a
-   :class:`FrameRateWarning` naming both (``cmu_rate_correction = false`` turns this off);
+   file name gives a subject of CMU's index (``80_10.bvh``) whose header says cgspeed's
+   120 Hz while CMU's index gives another rate (cgspeed wrote ``Frame Time: .0083333`` into
+   every file, also for the subjects captured at 60 Hz): the index's rate, with a
+   :class:`FrameRateWarning` naming both (``cmu_rate_correction = false`` turns this off); a
+   header of any other rate (a trial resampled to 30 Hz) stands;
 3. the header's ``Frame Time``: its inverse, rounded to a whole number of hertz when within
    0.05 % of one (headers write ``1 / rate`` to about six digits).
 """
@@ -57,6 +58,10 @@ class FrameRateWarning(UserWarning):
 #: every shipped rig faces +Z with its left at +X.
 BVH_AXES: tuple[Axis, Axis, Axis] = ("z", "x", "y")
 
+#: The rate cgspeed's conversions write into every header (``Frame Time: .0083333``), also for
+#: the subjects CMU's index lists at 60 Hz: the only header :func:`choose_rate` corrects.
+CGSPEED_HEADER_HZ = 120.0
+
 RigName = Literal["auto", "cmu-cgspeed", "cmu-3dsmax", "mixamo", "biovision"]
 
 
@@ -84,7 +89,16 @@ def choose_rate(
     if config_rate is not None:
         return float(config_rate), "config"
     rate = header_rate(frame_time)
-    if rig is not None and rig.cmu and cmu_correction and subject in CMU_SUBJECTS:
+    # only cgspeed's own header (120 Hz in every file) is known to be wrong; any other rate was
+    # written by whatever resampled the trial (a 30 Hz re-export), and stands
+    cgspeed_header = rate == CGSPEED_HEADER_HZ
+    if (
+        rig is not None
+        and rig.cmu
+        and cmu_correction
+        and cgspeed_header
+        and subject in CMU_SUBJECTS
+    ):
         index = subject_frame_rate(subject, trial)
         if abs(index - rate) > 1e-3 * index:
             warnings.warn(

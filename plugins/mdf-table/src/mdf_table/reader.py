@@ -35,7 +35,9 @@ NPZ member's declared shape is read from its header and must stay within
 missing) and within ``limits.MAX_FILE_COORDINATE``; every time, in seconds (after
 ``time_unit_s`` or ``frame_rate``), within ``limits.MAX_CLOCK_TIME_S`` (clock times such as Unix
 epoch seconds pass: the motion counts from its first frame), and the times spanning at most
-``limits.MAX_DURATION_S``.
+``limits.MAX_DURATION_S``; and the frame rate (the inverse of the median step between frames)
+within ``limits.MIN_FRAME_RATE_HZ .. MAX_FRAME_RATE_HZ``, as for every recording (milliseconds
+read as seconds are not a 0.12 Hz recording).
 
 Arrays: :class:`Table` ``positions`` (n_frames, n_joints, 3) float64 in the file's unit, NaN
 where missing; ``time`` (n_frames,) float64 [s], strictly increasing.
@@ -157,6 +159,7 @@ def read_table(path: Path, spec: TableLayout | None = None) -> Table:
     t, p, _ok, report = sort_timestamps(time, pos)
     if t.shape[0] < 2:
         raise DataFileError(path, "fewer than two distinct time stamps: a motion needs two")
+    _check_frame_rate(path, t, spec)
     return Table(names, t, p, layout, rows, report["out_of_order"], report["duplicates_dropped"])
 
 
@@ -289,12 +292,8 @@ def _time_of(
             )
         return np.arange(n_rows, dtype=np.float64) / spec.frame_rate
     limits.check_values(path, values, float("inf"), "time", line_of)  # finite, in any unit
-    if spec.frame_rate is not None:
-        seconds = values / spec.frame_rate
-        unit = f"frame numbers at motion.frame_rate = {spec.frame_rate:g} Hz"
-    else:
-        seconds = values * spec.time_unit_s
-        unit = f"motion.time_unit_s = {spec.time_unit_s:g} s per unit"
+    seconds = values / spec.frame_rate if spec.frame_rate is not None else values * spec.time_unit_s
+    unit = _time_unit(spec)
     limits.check_values(path, seconds, limits.MAX_CLOCK_TIME_S, f"time [s] ({unit})", line_of, " s")
     span = float(seconds.max() - seconds.min()) if seconds.size else 0.0
     if span > limits.MAX_DURATION_S:
@@ -304,6 +303,35 @@ def _time_of(
             "the time column's unit (motion.time_unit_s or motion.frame_rate)",
         )
     return seconds
+
+
+def _time_unit(spec: TableLayout) -> str:
+    """How the time column was read, for messages."""
+    if not spec.time_column:
+        return f"rows at motion.frame_rate = {spec.frame_rate:g} Hz"
+    if spec.frame_rate is not None:
+        return f"frame numbers at motion.frame_rate = {spec.frame_rate:g} Hz"
+    return f"motion.time_unit_s = {spec.time_unit_s:g} s per unit"
+
+
+def _check_frame_rate(path: Path, time: FloatArray, spec: TableLayout) -> None:
+    """The frame rate the times give (the inverse of the median step between frames, which
+    gaps do not move) within ``limits.MIN_FRAME_RATE_HZ .. MAX_FRAME_RATE_HZ``, as every
+    recording's: milliseconds read as seconds (0.12 frames a second at 120 Hz) or frame
+    numbers read as seconds are refused with the unit they were read in."""
+    step = float(np.median(np.diff(time)))
+    rate = 1.0 / step
+    if limits.MIN_FRAME_RATE_HZ <= rate <= limits.MAX_FRAME_RATE_HZ:
+        return
+    side = "below" if rate < limits.MIN_FRAME_RATE_HZ else "above"
+    bound = limits.MIN_FRAME_RATE_HZ if side == "below" else limits.MAX_FRAME_RATE_HZ
+    raise DataFileError(
+        path,
+        f"the frames are {step:.4g} s apart (the median step, {_time_unit(spec)}): "
+        f"{rate:.4g} frames/s, {side} the {bound:g} frames/s of a motion recording: check the "
+        "time column's unit (motion.time_unit_s, 0.001 for milliseconds, or motion.frame_rate "
+        "for frame numbers)",
+    )
 
 
 def _need(path: Path, col: dict[str, int], name: str, what: str, named_at: int | None) -> int:

@@ -117,6 +117,15 @@ class TableConfig(MotionConfig):
                 f"file must be a .csv, .tsv, .txt, .dat or .npz table, got {Path(self.file).name!r}"
             )
         check_canonical_keys(self.joint_map, "joint_map")
+        if self.time_column and self.frame_rate is not None and self.time_unit_s != 1.0:
+            # frame_rate would win silently: milliseconds at 120 Hz read as frame numbers run
+            # 8.3 times too slowly (the default 1 s per unit says nothing, and a dumped config
+            # repeats it)
+            raise ValueError(
+                f"time_unit_s ({self.time_unit_s:g} s per unit) and frame_rate "
+                f"({self.frame_rate:g} Hz: the time column holds frame numbers) both say how to "
+                f"read the time column {self.time_column!r}: give one"
+            )
         if self.time_range is not None:
             if self.time_range[0] > self.time_range[1]:
                 raise ValueError(f"time_range: first {self.time_range[0]:g} is after last")
