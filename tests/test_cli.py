@@ -781,3 +781,43 @@ def test_a_bug_in_a_plugins_constructor_is_an_internal_error_naming_the_plugin(
     assert not (tmp_path / "o").exists()
     with pytest.raises(KeyError, match="presets"):
         cli.main([*args, "--debug"])
+
+
+def test_check_counts_the_scatterers_effects_add(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A room of 40 static reflectors with its ground bounce: the run's pulses carry
+    3 x (17 + 40) = 171 scatterers (direct, single bounce, image), and `mdf check` counts them
+    all in its memory estimate (it used to count the 17 joints alone, 10 times too few)."""
+    from mdframework.check import MIB, SCATTERER_PULSE_BYTES
+
+    amc = EXAMPLES / "data" / "cmu" / "asf-amc" / "02_01.amc"
+    cfg = tmp_path / "room.toml"
+    cfg.write_text(
+        'effects = [{ kind = "static_scene", count = 40, seed = 0 }, { kind = "multipath" }]\n'
+        f'[motion]\nkind = "cmu"\nfile = "{amc}"\nduration = 0.5\n'
+        '[scatterers]\nkind = "ellipsoid"\n[radar]\nkind = "lfm"\n'
+        "[scene]\nradar_position = [10.0, 0.0, 2.0]\n"
+    )
+    plan, meta, _ = check_then_run(cfg, tmp_path, capsys)
+    assert len(meta["scatterers"]) == 171
+    assert plan["n_scatterers"] == 171
+    rows = min(plan["n_pulses"], 4096)
+    expected = rows * 171 * SCATTERER_PULSE_BYTES / MIB
+    assert plan["memory_terms_mib"]["scatterers"] == pytest.approx(expected, rel=1e-12)
+
+
+def test_check_refuses_an_fmcw_scatterer_beyond_the_maximum_range(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The FMCW radar refuses a body beyond its maximum range before its first chirp; `mdf
+    check` refuses it with the same line instead of calling the config valid."""
+    text = (EXAMPLES / "fmcw_walk.toml").read_text().replace('"data/', f'"{EXAMPLES}/data/')
+    cfg = tmp_path / "far.toml"
+    cfg.write_text(
+        text.replace("radar_position = [6.0, 0.0, 1.0]", "radar_position = [14.0, 0.0, 1.0]")
+    )
+    line = "radar.sample_rate: the farthest scatterer at 14.26 m beats at 6.658 MHz"
+    for command in (["check"], ["run", "--out", str(tmp_path / "o")]):
+        code, _, err = run_cli([*command, str(cfg)], capsys)
+        assert code == 2 and line in err, err

@@ -7,6 +7,11 @@ estimate of the memory the run needs. No pulses are simulated. It refuses what t
 refuse before its first pulse, and a joint nearer the radar than ``scene.min_range``; what the
 run finds only in the pulses (an empty range gate, an effect's own checks) it cannot see.
 
+The memory estimate counts the scatterers a run's pulses get: the scatterer model's and those
+the scatterer-stage effects add (``static_scene``'s reflectors, ``multipath``'s bounced paths),
+found by passing the record's first two pulse times through the model and those effects (no
+radar, no received signal).
+
 The aliasing risk is judged from the radial speed of the body's joints at the motion's own frame
 times (finite differences of each joint's range to the radar): body-part scatterers sit on the
 segments between joints, so they move no faster than the fastest joint (up to the accuracy of
@@ -21,9 +26,15 @@ from typing import Any
 import numpy as np
 
 from . import limits
-from .physics import radar
+from .interfaces import SceneContext
+from .physics import interpolation, radar
 from .pipeline import (
+    Stages,
+    _apply_effects,
+    _gate,
+    _inside,
     build_stages,
+    effect_generators,
     load_motion,
     placed,
     prepare_body,
@@ -31,11 +42,18 @@ from .pipeline import (
     record_window,
     refuse_near,
     spectrogram_geometry,
+    start_record,
 )
-from .plugins import Registry, default_registry
+from .plugins import Registry, blame, default_registry
 from .settings import RunConfigBase
+from .skeleton import Skeleton
 
 MIB = 1024.0**2
+
+#: Bytes a block of the streaming pipeline holds per scatterer and pulse at its peak: the
+#: positions, ranges and RCS and the model's, the effects' and the radar's temporaries (traced
+#: peaks of 100 bytes for ellipsoids and 150 with multipath's bounced paths, analytic path).
+SCATTERER_PULSE_BYTES = 160
 
 
 @dataclass(frozen=True)
@@ -51,6 +69,7 @@ class RunPlan:
     carrier_frequency_hz: float
     wavelength_m: float
     n_joints: int
+    n_scatterers: int  # per pulse, with those the scatterer-stage effects add
     window_pulses: int  # slow-time samples per spectrum
     hop_pulses: float  # slow-time samples from one spectrum to the next
     nfft: int
@@ -104,15 +123,45 @@ def memory_estimate(
     stft_bytes: int = 4,
 ) -> dict[str, float]:
     """The arrays a run holds at once [MiB]: per pulse the time, gate and complex signal
-    (8 + 8 + 16 bytes); the scatterer positions, ranges and RCS (5 float64 per scatterer) of one
-    block of ``block_pulses`` (of every pulse with ``keep_scatterers``); the spectrogram's power
-    (``stft_bytes`` per value) and its float64 dB map."""
+    (8 + 8 + 16 bytes); the scatterers' arrays (:data:`SCATTERER_PULSE_BYTES` per scatterer)
+    of one block of ``block_pulses`` (of every pulse with ``keep_scatterers``); the
+    spectrogram's power (``stft_bytes`` per value) and its float64 dB map."""
     rows = n_pulses if keep_scatterers else min(n_pulses, block_pulses)
     return {
         "signal": n_pulses * 32 / MIB,
-        "scatterers": rows * n_scatterers * 40 / MIB,
+        "scatterers": rows * n_scatterers * SCATTERER_PULSE_BYTES / MIB,
         "spectrogram": n_doppler * n_frames * (stft_bytes + 8) / MIB,
     }
+
+
+def count_scatterers(
+    config: RunConfigBase,
+    stages: Stages,
+    motion: Any,
+    body: Skeleton,
+    record_body: Skeleton,
+    t: np.ndarray,
+) -> int:
+    """The scatterers of a run's pulses: those of the model and of the scatterer-stage effects
+    at the record's first two pulse times ``t[:2]`` [s] (``body``: the placed body; the model
+    and effects are started with ``record_body`` first, see
+    :func:`~mdframework.pipeline.start_record`)."""
+    radar_pos = np.asarray(config.scene.radar_position, dtype=np.float64)
+    tb = t[:2]
+    near = body.select_frames(interpolation.window_frames(body.time, float(tb[0]), float(tb[-1])))
+    resample = interpolation.TrackResampler(near.time, near.positions, near.valid, "linear")
+    at_pulses = Skeleton.resampled(tb, resample(tb), body.joint_names)
+    wf = stages.radar
+    with blame(stages.model, "scatterers"):
+        scat = stages.model.scatterers(
+            motion, at_pulses, radar_pos, radar.wavelength(wf.carrier_frequency)
+        )
+    generators = effect_generators(config.seed, stages.effects)
+    rng = generators[0] if generators else np.random.default_rng(config.seed)
+    gate = _gate(config.scene.gate, at_pulses, radar_pos)
+    context = SceneContext(radar_pos, wf.prf, wf.carrier_frequency, tb, gate, at_pulses, wf, rng, 0)
+    scat = _apply_effects(stages, "scatterers", scat, context, generators)
+    return int(scat.positions.shape[1])
 
 
 def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan:
@@ -133,8 +182,11 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
     limits.check_pulses(
         t_end - t_start, wf.pulse_rate, body.n_joints, "motion.duration", proc.keep_scatterers
     )
-    n_pulses = int(record_pulses(wf, t_start, t_end).shape[0])
+    t = record_pulses(wf, t_start, t_end)
+    n_pulses = int(t.shape[0])
     geometry = spectrogram_geometry(wf, n_pulses, proc)
+    record_body = body.select_frames(_inside(body.time, t_start, t_end))
+    start_record(stages, record_body, t, radar_pos)  # what the radar refuses before a pulse
 
     inside = (body.time >= t_start - 1e-9) & (body.time <= t_end + 1e-9)
     # a joint nearer than scene.min_range: refused as the run refuses the scatterer there
@@ -146,7 +198,7 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
         body.time[inside], body.positions[inside], body.valid[inside], radar_pos
     )
     v_max = float(wf.max_unambiguous_velocity)
-    n_scatterers = body.n_joints  # the body models have about one scatterer per joint/segment
+    n_scatterers = count_scatterers(config, stages, motion, body, record_body, t)
     terms = memory_estimate(
         n_pulses,
         n_scatterers,
@@ -170,6 +222,7 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
         carrier_frequency_hz=fc,
         wavelength_m=lam,
         n_joints=body.n_joints,
+        n_scatterers=n_scatterers,
         window_pulses=geometry.window,
         hop_pulses=geometry.hop,
         nfft=geometry.nfft,
@@ -196,6 +249,10 @@ def _hz(value: float) -> str:
     return f"{value:.4g} Hz"
 
 
+def _mib(value: float) -> str:
+    return f"{value:.3g}" if value < 1000 else f"{value:,.0f}"
+
+
 def format_plan(plan: RunPlan, source: str) -> str:
     """The plan as the lines ``mdf check`` prints."""
     p = plan
@@ -207,7 +264,7 @@ def format_plan(plan: RunPlan, source: str) -> str:
         f"  {'carrier':<12}{_hz(p.carrier_frequency_hz)} (wavelength "
         f"{p.wavelength_m * 100:.3g} cm), PRF {_hz(p.prf_hz)}",
         f"  {'record':<12}{p.record_length_s:.3f} s from {p.record_start_s:.3f} s: "
-        f"{p.n_pulses} pulses; joints: {p.n_joints}",
+        f"{p.n_pulses} pulses; joints: {p.n_joints}, scatterers: {p.n_scatterers}",
         f"  {'spectrogram':<12}window {p.window_pulses} pulses "
         f"({1e3 * p.window_pulses / p.spectrum_rate_hz:.1f} ms), hop {p.hop_pulses:.4g} "
         f"({1e3 * p.hop_pulses / p.spectrum_rate_hz:.2f} ms), nfft {p.nfft}: {p.n_frames} frames",
@@ -222,6 +279,6 @@ def format_plan(plan: RunPlan, source: str) -> str:
         lines.append(f"  {'aliasing':<12}LIKELY: {speed}; {p.faster_sampling}")
     else:
         lines.append(f"  {'aliasing':<12}none expected: {speed}")
-    terms = ", ".join(f"{k} {v:.3g}" for k, v in p.memory_terms_mib.items())
-    lines.append(f"  {'memory':<12}about {p.memory_mib:.3g} MiB of arrays ({terms} MiB)")
+    terms = ", ".join(f"{k} {_mib(v)}" for k, v in p.memory_terms_mib.items())
+    lines.append(f"  {'memory':<12}about {_mib(p.memory_mib)} MiB of arrays ({terms} MiB)")
     return "\n".join(lines)
