@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import csv
 import json
 import os
 import re
@@ -821,3 +822,48 @@ def test_check_refuses_an_fmcw_scatterer_beyond_the_maximum_range(
     for command in (["check"], ["run", "--out", str(tmp_path / "o")]):
         code, _, err = run_cli([*command, str(cfg)], capsys)
         assert code == 2 and line in err, err
+
+
+def test_dataset_check_predicts_the_build(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`mdf dataset check` plans a dataset as the build does and reports, per label, the
+    records and what `mdf check` says of the first: here 2 walk records of 1 s and 2 run
+    records of 0.5 s at PRF 1500 Hz, each with 3 x (17 + 10) = 81 scatterers (a room of 10
+    reflectors and its ground bounce); the build then makes exactly those records with those
+    spectrograms (the run's own count of the scatterers is tested above). The run at 10 m/s
+    aliases at 7.5 m/s and the plan says so. It writes
+    nothing, and a run config is refused naming the command that reads it."""
+    cmu = EXAMPLES / "data" / "cmu" / "asf-amc"
+    cfg = tmp_path / "ds.toml"
+    cfg.write_text(
+        "seed = 1\n"
+        f'[[sources]]\nlabel = "walk"\nmotion = {{ kind = "cmu", file = "{cmu}/02_01.amc" }}\n'
+        "hop = 1.0\n"
+        f'[[sources]]\nlabel = "run"\nmotion = {{ kind = "cmu", file = "{cmu}/09_06.amc" }}\n'
+        "hop = 0.5\n"
+        "[record_lengths]\nwalk = 1.0\nrun = 0.5\n"
+        '[base.radar]\nkind = "lfm"\nprf = 1500.0\n[base.scatterers]\nkind = "ellipsoid"\n'
+        '[base]\neffects = [{ kind = "static_scene", count = 10, seed = 0 }, '
+        '{ kind = "multipath" }]\n'
+        "[base.processing]\nnfft = 256\nwindow_length = 128\nhop = 16\n"
+    )
+    code, out, err = run_cli(["dataset", "check", str(cfg), "--json"], capsys)
+    assert code == 0, err
+    plan = json.loads(out)
+    assert list(tmp_path.iterdir()) == [cfg]
+    assert plan["records"] == {"walk": 2, "run": 2} and plan["n_records"] == 4
+    assert plan["first"]["run"]["aliasing"] and not plan["first"]["walk"]["aliasing"]
+    code, _, err = run_cli(
+        ["dataset", "build", str(cfg), "--out", str(tmp_path / "ds"), "--workers", "1"], capsys
+    )
+    assert code == 0, err
+    rows = list(csv.DictReader((tmp_path / "ds" / "index.csv").open()))
+    assert [r["label"] for r in rows].count("walk") == 2 and len(rows) == 4
+    for row in rows:
+        first = plan["first"][row["label"]]
+        with np.load(tmp_path / "ds" / "records" / f"{row['id']}.npz") as d:
+            assert d["spectrogram_db"].shape == (first["nfft"], first["n_frames"])
+        assert first["n_scatterers"] == 81
+    code, out, err = run_cli(["dataset", "check", str(EXAMPLES / "cmu_walk.toml")], capsys)
+    assert code == 2 and "a run config (it has `motion`), not a dataset config" in err

@@ -282,3 +282,62 @@ def format_plan(plan: RunPlan, source: str) -> str:
     terms = ", ".join(f"{k} {_mib(v)}" for k, v in p.memory_terms_mib.items())
     lines.append(f"  {'memory':<12}about {_mib(p.memory_mib)} MiB of arrays ({terms} MiB)")
     return "\n".join(lines)
+
+
+@dataclass(frozen=True)
+class DatasetPlan:
+    """What ``mdf dataset build`` would build: the records per label and, for each label's first
+    simulated record, its :class:`RunPlan` (before its motion augmentations)."""
+
+    n_records: int
+    records: dict[str, int]  # label -> records
+    first: dict[str, RunPlan]  # label -> plan of its first simulated record
+    #: the records' float32 spectrograms, from each label's first (None: histogram records)
+    spectrogram_mib: float | None
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-serialisable view."""
+        return asdict(self)
+
+
+def plan_dataset(config: Any, base_dir: Any, registry: Registry | None = None) -> DatasetPlan:
+    """Plan a dataset config (:class:`~mdframework.dataset.DatasetConfig`, its folder
+    ``base_dir``) as a build does before its first record: every record's config is validated,
+    with its draws, and each label's first simulated record is planned (:func:`plan_run`)."""
+    from .dataset import plan_records, validate_record
+
+    specs = plan_records(config, base_dir)
+    records: dict[str, int] = {}
+    first: dict[str, RunPlan] = {}
+    for spec in specs:
+        records[spec.label] = records.get(spec.label, 0) + 1
+        if spec.label in first or "recording" in spec.run_config:
+            continue
+        where = f"record {spec.record_id}"
+        run = validate_record(spec.run_config, where, spec.base_dir, spec.draws, spec.draw_origins)
+        first[spec.label] = plan_run(run, registry)
+    cells = sum(records[k] * p.nfft * p.n_frames for k, p in first.items())
+    stored = None if config.representation == "histogram" else cells * 4 / MIB
+    return DatasetPlan(len(specs), records, first, stored)
+
+
+def format_dataset_plan(plan: DatasetPlan, source: str) -> str:
+    """The dataset plan as the lines ``mdf dataset check`` prints."""
+    lines = [f"{source}: valid, {plan.n_records} records"]
+    for label, n in plan.records.items():
+        p = plan.first.get(label)
+        if p is None:
+            lines.append(f"  {label}: {n} records of a real radar's recordings")
+            continue
+        alias = "LIKELY" if p.aliasing else "none expected"
+        lines.append(
+            f"  {label}: {n} records; the first: {p.record_length_s:.3f} s, {p.n_pulses} pulses, "
+            f"{p.n_scatterers} scatterers, spectrogram {p.nfft} x {p.n_frames}, aliasing "
+            f"{alias} (fastest joint {p.max_joint_radial_speed_mps:.3g} m/s, unambiguous "
+            f"+-{p.max_unambiguous_velocity_mps:.3g} m/s), memory about {_mib(p.memory_mib)} MiB"
+        )
+    if plan.spectrogram_mib:
+        lines.append(
+            f"  spectrograms about {_mib(plan.spectrogram_mib)} MiB (float32, before compression)"
+        )
+    return "\n".join(lines)

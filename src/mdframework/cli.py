@@ -199,6 +199,21 @@ def _cmd_check(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_dataset_check(args: argparse.Namespace) -> int:
+    with _progress(args).step("reading the config, the installed plugins and the motions"):
+        from .check import format_dataset_plan, plan_dataset
+        from .dataset import load_dataset_config
+
+        config, base = load_dataset_config(args.config)
+        with _naming(args.config):
+            plan = plan_dataset(config, base)
+    if args.json:
+        print(json.dumps(plan.as_dict(), indent=2))
+    else:
+        print(format_dataset_plan(plan, args.config))
+    return 0
+
+
 def _cmd_plugins(args: argparse.Namespace) -> int:
     registry = default_registry()
     for interface in INTERFACES:
@@ -346,6 +361,13 @@ def _run_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-progress", action="store_true", help=PROGRESS_HELP)
 
 
+def _check_arguments(parser: argparse.ArgumentParser, config_help: str) -> None:
+    """The arguments of ``mdf check`` and ``mdf dataset check``."""
+    parser.add_argument("config", help=config_help)
+    parser.add_argument("--json", action="store_true", help="print the report as JSON")
+    parser.add_argument("--no-progress", action="store_true", help=PROGRESS_HELP)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``mdf`` (with the commands installed plugins add)."""
     parser = _Parser(
@@ -435,17 +457,19 @@ def build_parser() -> argparse.ArgumentParser:
             "mdf check examples/point_target.toml --json",
         ],
     )
-    check.add_argument("config", help="run config file (.toml, .yaml or .json)")
-    check.add_argument("--json", action="store_true", help="print the report as JSON")
-    check.add_argument("--no-progress", action="store_true", help=PROGRESS_HELP)
+    _check_arguments(check, "run config file (.toml, .yaml or .json)")
     check.set_defaults(func=_cmd_check)
 
     dataset = add_command(
         sub,
         "dataset",
         "labelled datasets of simulated records",
-        "Build labelled datasets of simulated records (see docs/datasets.md).",
-        ["mdf dataset build examples/datasets/cmu.toml --out out/ds"],
+        "Build labelled datasets of simulated records, or check a dataset config before "
+        "building it (see docs/datasets.md).",
+        [
+            "mdf dataset check examples/datasets/cmu.toml",
+            "mdf dataset build examples/datasets/cmu.toml --out out/ds",
+        ],
     )
     dataset_sub = dataset.add_subparsers(
         dest="dataset_command", required=True, metavar="SUBCOMMAND"
@@ -474,6 +498,23 @@ def build_parser() -> argparse.ArgumentParser:
     build.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     build.add_argument("--force", action="store_true", help=FORCE_DATASET_HELP)
     build.set_defaults(func=_cmd_dataset_build)
+
+    dcheck = add_command(
+        dataset_sub,
+        "check",
+        "validate a dataset config and report what a build would do, without building",
+        "Plan a dataset config as a build does before its first record (every record's config "
+        "validated, with its random draws) and report the records per label and, for each "
+        "label's first simulated record, what `mdf check` reports of a run: its pulses, "
+        "scatterers, spectrogram, aliasing risk and memory. Simulates nothing and writes "
+        "nothing.",
+        [
+            "mdf dataset check examples/datasets/cmu.toml",
+            "mdf dataset check examples/datasets/cmu.toml --json",
+        ],
+    )
+    _check_arguments(dcheck, "dataset config file")
+    dcheck.set_defaults(func=_cmd_dataset_check)
 
     experiment = add_command(
         sub,
