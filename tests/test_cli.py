@@ -867,3 +867,21 @@ def test_dataset_check_predicts_the_build(
         assert first["n_scatterers"] == 81
     code, out, err = run_cli(["dataset", "check", str(EXAMPLES / "cmu_walk.toml")], capsys)
     assert code == 2 and "a run config (it has `motion`), not a dataset config" in err
+
+
+def test_check_judges_aliasing_on_the_tracks_the_run_interpolates(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """CMU 09_06 (a run) at PRF 2040 Hz: the frames' differences give 10.16 m/s, under the
+    unambiguous 10.19 m/s, but the cubic spline the run resamples at its pulses reaches
+    10.61 m/s, so the run warns of aliasing and asks for 2124 Hz. `mdf check`
+    judged the frames alone ("none expected", and at least 2033 Hz to a run that aliased);
+    it now names the run's speed and PRF."""
+    text = (EXAMPLES / "cmu_run.toml").read_text().replace('"data/', f'"{EXAMPLES}/data/')
+    cfg = tmp_path / "run.toml"
+    cfg.write_text(text.replace('kind = "lfm"', 'kind = "lfm"\nprf = 2040.0'))
+    code, out, err = run_cli(["check", str(cfg)], capsys)
+    assert code == 0, err
+    assert "LIKELY: fastest joint 10.6 m/s radially; raise radar.prf to at least 2124 Hz" in out
+    code, _, err = run_cli(["run", str(cfg), "--out", str(tmp_path / "o"), "--no-figures"], capsys)
+    assert code == 0 and "raise radar.prf to at least 2124 Hz" in err, err

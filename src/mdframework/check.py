@@ -12,10 +12,11 @@ the scatterer-stage effects add (``static_scene``'s reflectors, ``multipath``'s 
 found by passing the record's first two pulse times through the model and those effects (no
 radar, no received signal).
 
-The aliasing risk is judged from the radial speed of the body's joints at the motion's own frame
-times (finite differences of each joint's range to the radar): body-part scatterers sit on the
-segments between joints, so they move no faster than the fastest joint (up to the accuracy of
-the frame-rate differences).
+The aliasing risk is judged from the radial speed of the body's joints on the tracks the run
+resamples (``processing.interpolation``, whose cubic spline overshoots the frames' differences:
+10.61 against 10.16 m/s on CMU 09_06), at every pulse or 16 samples per motion frame, and at the
+motion's own frame times: body-part scatterers sit on the segments between joints, so they move
+no faster than the fastest joint.
 """
 
 from __future__ import annotations
@@ -113,6 +114,33 @@ def max_joint_radial_speed(
     return float(np.max(rate[both], initial=0.0))
 
 
+#: Interpolated samples per motion frame at which ``mdf check`` judges the radial speeds.
+SPEED_SAMPLES_PER_FRAME = 16
+
+
+def interpolated_radial_speed(
+    body: Skeleton, t: np.ndarray, method: Any, radar_position: np.ndarray
+) -> float:
+    """Largest |d range / dt| [m/s] of any joint on the tracks a run resamples at its pulse
+    times ``t`` (n_pulses,) [s] (``method``: ``processing.interpolation``), taken at every
+    pulse or, when the pulses are denser, at :data:`SPEED_SAMPLES_PER_FRAME` per motion frame,
+    a block at a time. ``body``: the placed body [m]; ``radar_position`` (3,) [m]."""
+    frames = interpolation.window_frames(body.time, float(t[0]), float(t[-1]))
+    near = body.select_frames(frames)
+    resample = interpolation.TrackResampler(near.time, near.positions, near.valid, method)
+    n_frames = max(int(np.count_nonzero((near.time >= t[0]) & (near.time <= t[-1]))), 1)
+    step = max(1, t.shape[0] // (SPEED_SAMPLES_PER_FRAME * n_frames))
+    ts = np.append(t[::step], t[-1]) if (t.shape[0] - 1) % step else t[::step]
+    speed, block = 0.0, 1 << 16
+    for lo in range(0, ts.shape[0] - 1, block):
+        tb = ts[lo : lo + block + 1]  # one sample of overlap: every difference is seen
+        if tb.shape[0] < 2:
+            break
+        ranges = radar.distances(resample(tb), radar_position)
+        speed = max(speed, float(np.max(np.abs(np.diff(ranges, axis=0)) / np.diff(tb)[:, None])))
+    return speed
+
+
 def memory_estimate(
     n_pulses: int,
     n_scatterers: int,
@@ -192,11 +220,14 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
     # a joint nearer than scene.min_range: refused as the run refuses the scatterer there
     seen = body.valid[inside]
     ranges = np.where(seen, radar.distances(body.positions[inside], radar_pos), np.inf)
-    t = body.time[inside] - body.time[inside][:1]
-    refuse_near(ranges, body.joint_names, t, config.scene.min_range, "joint")
+    since = body.time[inside] - body.time[inside][:1]
+    refuse_near(ranges, body.joint_names, since, config.scene.min_range, "joint")
     speed = max_joint_radial_speed(
         body.time[inside], body.positions[inside], body.valid[inside], radar_pos
     )
+    # the run interpolates the tracks (a cubic spline overshoots the frames' differences)
+    method = "linear" if motion.linear_tracks else proc.interpolation
+    speed = max(speed, interpolated_radial_speed(body, t, method, radar_pos))
     v_max = float(wf.max_unambiguous_velocity)
     n_scatterers = count_scatterers(config, stages, motion, body, record_body, t)
     terms = memory_estimate(
