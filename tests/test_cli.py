@@ -885,3 +885,24 @@ def test_check_judges_aliasing_on_the_tracks_the_run_interpolates(
     assert "LIKELY: fastest joint 10.6 m/s radially; raise radar.prf to at least 2124 Hz" in out
     code, _, err = run_cli(["run", str(cfg), "--out", str(tmp_path / "o"), "--no-figures"], capsys)
     assert code == 0 and "raise radar.prf to at least 2124 Hz" in err, err
+
+
+def test_mdf_help_lists_the_exit_codes_a_script_sees(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A script needs the exit codes: `mdf --help` lists them, and they are the ones the
+    commands return (2 for a missing config)."""
+    with pytest.raises(SystemExit) as ended:
+        cli.main(["--help"])
+    assert ended.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    for number, meaning in (
+        (0, "done"),
+        (1, "internal error"),
+        (2, "bad input"),
+        (cli.EXIT_INTERRUPTED, "interrupted (Ctrl-C)"),
+        (cli.EXIT_TERMINATED, "terminated (SIGTERM)"),
+    ):
+        assert f"{number} {meaning}" in text
+    code, _, _ = run_cli(["check", str(tmp_path / "nope.toml")], capsys)
+    assert code == 2

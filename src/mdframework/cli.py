@@ -319,6 +319,14 @@ STAGING_HELP = (
 )
 
 
+#: the exit codes, as ``mdf --help`` lists them
+EXIT_CODES_HELP = (
+    "exit codes: 0 done; 1 internal error (a bug, in mdf or a plugin: --debug shows the "
+    "traceback); 2 bad input (a config, a data file, a scene that cannot be simulated, the "
+    "command line, --out); 130 interrupted (Ctrl-C); 143 terminated (SIGTERM)."
+)
+
+
 def _examples(*lines: str) -> str:
     return "examples:\n" + "\n".join(f"  {line}" for line in lines)
 
@@ -380,12 +388,14 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=_examples(
             "mdf check examples/cmu_walk.toml            # what a run would do",
             "mdf run examples/cmu_walk.toml --out out/walk",
+            "mdf dataset check examples/datasets/cmu.toml # what a build would do",
             "mdf dataset build examples/datasets/cmu.toml --out out/ds",
             "mdf experiment examples/experiment_cmu.toml --out out/exp",
             "mdf plugins                                  # installed and disabled plugins",
             "mdf COMMAND --help                           # options and examples of a command",
         )
-        + "\n\n--debug and --disable-plugin may be given anywhere on the command line.",
+        + "\n\n--debug and --disable-plugin may be given anywhere on the command line.\n\n"
+        + textwrap.fill(EXIT_CODES_HELP, 79),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--version", action="version", version=_version())
