@@ -906,3 +906,29 @@ def test_mdf_help_lists_the_exit_codes_a_script_sees(
         assert f"{number} {meaning}" in text
     code, _, _ = run_cli(["check", str(tmp_path / "nope.toml")], capsys)
     assert code == 2
+
+
+def test_experiment_takes_the_build_options_of_dataset_build(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`mdf experiment` builds its dataset as `mdf dataset build` does, so it takes the same
+    --workers (over the config's `workers`) and --scheduler (it refused both as unknown, so a
+    cluster job could not choose its processes or its scheduler)."""
+    from mdframework import experiment
+    from mdframework.errors import ConfigError
+
+    seen: dict[str, Any] = {}
+
+    def build(*args: Any, **kw: Any) -> None:
+        seen.update(workers=kw["workers"], scheduler=kw["scheduler"])
+        raise ConfigError("stopped here")
+
+    monkeypatch.setattr(experiment, "build_dataset", build)
+    cfg = EXAMPLES / "experiment_cmu.toml"
+    argv = ["experiment", str(cfg), "--out", str(tmp_path / "e")]
+    code, _, err = run_cli([*argv, "--workers", "3", "--scheduler", "local"], capsys)
+    assert code == 2 and "stopped here" in err, err
+    assert seen == {"workers": 3, "scheduler": "local"}
+    monkeypatch.undo()
+    code, _, err = run_cli([*argv, "--scheduler", "nonsense"], capsys)
+    assert code == 2 and "Dask scheduler 'nonsense': not an address" in err, err

@@ -289,6 +289,8 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
 
     note("reading the experiment config and the installed plugins", not args.no_progress)
     config = load_experiment_config(args.config)
+    if args.workers is not None:
+        config = config.model_copy(update={"workers": args.workers})
     with _naming(args.config):
         run_experiment(
             config,
@@ -298,6 +300,7 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
             allow_import=args.allow_import,
             force=args.force,
             staging_dir=args.staging_dir,
+            scheduler=args.scheduler,
         )
     print(Path(args.out) / "report.md")
     return 0
@@ -367,6 +370,18 @@ def _run_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--force", action="store_true", help=FORCE_HELP)
     parser.add_argument("--staging-dir", default=None, help=STAGING_HELP)
     parser.add_argument("--no-progress", action="store_true", help=PROGRESS_HELP)
+
+
+def _build_arguments(parser: argparse.ArgumentParser, workers_help: str) -> None:
+    """The options of the commands that build a dataset: ``--workers``, ``--scheduler``."""
+    parser.add_argument("--workers", type=_positive_int, default=None, help=workers_help)
+    parser.add_argument(
+        "--scheduler",
+        default=None,
+        help="Dask scheduler address, or 'local' for a local Dask cluster (default: the "
+        "MDF_DASK_SCHEDULER environment variable, else local processes; connection timeout "
+        "MDF_DASK_TIMEOUT seconds, default 10)",
+    )
 
 
 def _check_arguments(parser: argparse.ArgumentParser, config_help: str) -> None:
@@ -497,14 +512,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     build.add_argument("config", help="dataset config file")
     build.add_argument("--out", required=True, type=_output_path, help="dataset folder")
-    build.add_argument("--workers", type=_positive_int, default=None, help="local processes")
-    build.add_argument(
-        "--scheduler",
-        default=None,
-        help="Dask scheduler address, or 'local' for a local Dask cluster (default: the "
-        "MDF_DASK_SCHEDULER environment variable, else local processes; connection timeout "
-        "MDF_DASK_TIMEOUT seconds, default 10)",
-    )
+    _build_arguments(build, "local processes")
     build.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     build.add_argument("--force", action="store_true", help=FORCE_DATASET_HELP)
     build.set_defaults(func=_cmd_dataset_build)
@@ -546,6 +554,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     experiment.add_argument("--force", action="store_true", help=FORCE_DATASET_HELP)
     experiment.add_argument("--staging-dir", default=None, help=STAGING_HELP)
+    _build_arguments(
+        experiment, "local processes building the dataset (default: the config's workers)"
+    )
     experiment.set_defaults(func=_cmd_experiment)
 
     plugins = add_command(
