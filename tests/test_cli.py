@@ -932,3 +932,20 @@ def test_experiment_takes_the_build_options_of_dataset_build(
     monkeypatch.undo()
     code, _, err = run_cli([*argv, "--scheduler", "nonsense"], capsys)
     assert code == 2 and "Dask scheduler 'nonsense': not an address" in err, err
+
+
+def test_an_fft_shorter_than_its_window_names_the_field(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """nfft below window_length is blamed on processing.nfft (it named the section alone)."""
+    cfg = tmp_path / "fft.toml"
+    cfg.write_text(
+        (EXAMPLES / "point_target.toml").read_text()
+        + "[processing]\nnfft = 100\nwindow_length = 256\n"
+    )
+    code, _, err = run_cli(["check", str(cfg)], capsys)
+    assert code == 2
+    assert err.strip() == (
+        f"mdf: error: {cfg}: processing.nfft: 100 is shorter than window_length 256: give an "
+        "nfft of at least the window's length"
+    )
