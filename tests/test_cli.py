@@ -949,3 +949,33 @@ def test_an_fft_shorter_than_its_window_names_the_field(
         f"mdf: error: {cfg}: processing.nfft: 100 is shorter than window_length 256: give an "
         "nfft of at least the window's length"
     )
+
+
+def test_dataset_check_all_finds_the_record_the_build_stops_at(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A walk toward a radar 3.2 m ahead in 0.5 s records: the fifth record brings the hip
+    within 0.24 m, under scene.min_range. `mdf dataset check --all` plans every record and
+    stops naming that record, window and cause as the build does; with on_error = "skip" it
+    counts it as the build skips it."""
+    amc = EXAMPLES / "data" / "cmu" / "asf-amc" / "02_01.amc"
+    text = (
+        f'seed = 1\n[[sources]]\nlabel = "walk"\nmotion = {{ kind = "cmu", file = "{amc}" }}\n'
+        "hop = 0.5\n[record_lengths]\nwalk = 0.5\n"
+        '[base.radar]\nkind = "lfm"\n[base.scatterers]\nkind = "ellipsoid"\n'
+        "[base.scene]\nradar_position = [3.2, 0.0, 1.0]\n"
+    )
+    stop, skip = tmp_path / "stop.toml", tmp_path / "skip.toml"
+    stop.write_text(text)
+    skip.write_text('on_error = "skip"\n' + text)
+    where = re.escape(f"(walk; source file {amc}, window 2.000-2.500 s): ")
+    where = r"record 00004-[0-9a-f]{10} " + where
+    code, _, err = run_cli(["dataset", "check", str(stop), "--all"], capsys)
+    assert code == 2 and re.search(where + "joint 'l_hip' comes within 0.242 m", err), err
+    code, _, err = run_cli(["dataset", "build", str(stop), "--out", str(tmp_path / "d")], capsys)
+    assert code == 2 and re.search(where + "scatterer 'l_hip' comes within 0.242 m", err), err
+    code, out, err = run_cli(["dataset", "check", str(skip), "--all", "--json"], capsys)
+    assert code == 0, err
+    plan = json.loads(out)
+    assert plan["n_planned"] == {"walk": 4} and plan["n_skipped"] == {"walk": 1}
+    assert re.match(where, plan["skipped"]["walk"])

@@ -21,12 +21,13 @@ no faster than the fastest joint.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
 from . import limits
+from .errors import MdfError
 from .interfaces import SceneContext
 from .physics import interpolation, radar
 from .pipeline import (
@@ -322,34 +323,63 @@ class DatasetPlan:
 
     n_records: int
     records: dict[str, int]  # label -> records
-    first: dict[str, RunPlan]  # label -> plan of its first simulated record
+    first: dict[str, RunPlan]  # label -> plan of its first simulated record that runs
     #: the records' float32 spectrograms, from each label's first (None: histogram records)
     spectrogram_mib: float | None
+    #: label -> the first of its records a run refuses (``on_error = "skip"``: the build skips
+    #: them), named with its cause, and how many of those planned it refuses
+    skipped: dict[str, str] = field(default_factory=dict)
+    n_skipped: dict[str, int] = field(default_factory=dict)
+    #: with every record planned (``every``): label -> records planned, records whose Doppler
+    #: aliases, and the largest memory estimate [MiB]
+    n_planned: dict[str, int] = field(default_factory=dict)
+    n_aliasing: dict[str, int] = field(default_factory=dict)
+    max_memory_mib: dict[str, float] = field(default_factory=dict)
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-serialisable view."""
         return asdict(self)
 
 
-def plan_dataset(config: Any, base_dir: Any, registry: Registry | None = None) -> DatasetPlan:
+def plan_dataset(
+    config: Any, base_dir: Any, registry: Registry | None = None, *, every: bool = False
+) -> DatasetPlan:
     """Plan a dataset config (:class:`~mdframework.dataset.DatasetConfig`, its folder
     ``base_dir``) as a build does before its first record: every record's config is validated,
-    with its draws, and each label's first simulated record is planned (:func:`plan_run`)."""
-    from .dataset import plan_records, validate_record
+    with its draws, and each label's first simulated record is planned (:func:`plan_run`), or
+    with ``every`` each simulated record (what a run refuses stops the plan, naming the record,
+    unless the config's ``on_error = "skip"``: then it is counted as the build would skip it)."""
+    from .dataset import plan_records, record_failure, validate_record
 
     specs = plan_records(config, base_dir)
-    records: dict[str, int] = {}
-    first: dict[str, RunPlan] = {}
+    plan = DatasetPlan(len(specs), {}, {}, None)
     for spec in specs:
-        records[spec.label] = records.get(spec.label, 0) + 1
-        if spec.label in first or "recording" in spec.run_config:
+        label = spec.label
+        plan.records[label] = plan.records.get(label, 0) + 1
+        if (label in plan.first and not every) or "recording" in spec.run_config:
             continue
         where = f"record {spec.record_id}"
-        run = validate_record(spec.run_config, where, spec.base_dir, spec.draws, spec.draw_origins)
-        first[spec.label] = plan_run(run, registry)
-    cells = sum(records[k] * p.nfft * p.n_frames for k, p in first.items())
-    stored = None if config.representation == "histogram" else cells * 4 / MIB
-    return DatasetPlan(len(specs), records, first, stored)
+        try:
+            run = validate_record(
+                spec.run_config, where, spec.base_dir, spec.draws, spec.draw_origins
+            )
+            p = plan_run(run, registry)
+        except MdfError as exc:  # named as the build names it
+            named, cause, _ = record_failure(spec, exc)
+            if spec.on_error != "skip":
+                raise MdfError(f"{named}: {cause}") from None
+            plan.skipped.setdefault(label, f"{named}: {cause}")
+            plan.n_skipped[label] = plan.n_skipped.get(label, 0) + 1
+            continue
+        plan.first.setdefault(label, p)
+        if every:
+            plan.n_planned[label] = plan.n_planned.get(label, 0) + 1
+            plan.n_aliasing[label] = plan.n_aliasing.get(label, 0) + int(p.aliasing)
+            plan.max_memory_mib[label] = max(plan.max_memory_mib.get(label, 0.0), p.memory_mib)
+    if config.representation != "histogram":
+        cells = sum(plan.records[k] * p.nfft * p.n_frames for k, p in plan.first.items())
+        return replace(plan, spectrogram_mib=cells * 4 / MIB)
+    return plan
 
 
 def format_dataset_plan(plan: DatasetPlan, source: str) -> str:
@@ -357,16 +387,28 @@ def format_dataset_plan(plan: DatasetPlan, source: str) -> str:
     lines = [f"{source}: valid, {plan.n_records} records"]
     for label, n in plan.records.items():
         p = plan.first.get(label)
-        if p is None:
+        if p is not None:
+            alias = "LIKELY" if p.aliasing else "none expected"
+            lines.append(
+                f"  {label}: {n} records; the first that runs: {p.record_length_s:.3f} s, "
+                f"{p.n_pulses} pulses, {p.n_scatterers} scatterers, spectrogram {p.nfft} x "
+                f"{p.n_frames}, aliasing {alias} (fastest joint "
+                f"{p.max_joint_radial_speed_mps:.3g} m/s, unambiguous "
+                f"+-{p.max_unambiguous_velocity_mps:.3g} m/s), memory about "
+                f"{_mib(p.memory_mib)} MiB"
+            )
+        elif label not in plan.skipped:
             lines.append(f"  {label}: {n} records of a real radar's recordings")
-            continue
-        alias = "LIKELY" if p.aliasing else "none expected"
-        lines.append(
-            f"  {label}: {n} records; the first: {p.record_length_s:.3f} s, {p.n_pulses} pulses, "
-            f"{p.n_scatterers} scatterers, spectrogram {p.nfft} x {p.n_frames}, aliasing "
-            f"{alias} (fastest joint {p.max_joint_radial_speed_mps:.3g} m/s, unambiguous "
-            f"+-{p.max_unambiguous_velocity_mps:.3g} m/s), memory about {_mib(p.memory_mib)} MiB"
-        )
+        if label in plan.n_planned:
+            lines.append(
+                f"  {label}: {plan.n_planned[label]} records run: {plan.n_aliasing[label]} with "
+                f"aliasing, memory at most {_mib(plan.max_memory_mib[label])} MiB"
+            )
+        if label in plan.skipped:
+            lines.append(
+                f"  {label}: {plan.n_skipped[label]} record(s) refused, which the build skips "
+                f"(on_error = 'skip'), the first: {plan.skipped[label]}"
+            )
     if plan.spectrogram_mib:
         lines.append(
             f"  spectrograms about {_mib(plan.spectrogram_mib)} MiB (float32, before compression)"

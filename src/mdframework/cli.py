@@ -206,7 +206,7 @@ def _cmd_dataset_check(args: argparse.Namespace) -> int:
 
         config, base = load_dataset_config(args.config)
         with _naming(args.config):
-            plan = plan_dataset(config, base)
+            plan = plan_dataset(config, base, every=args.all)
     if args.json:
         print(json.dumps(plan.as_dict(), indent=2))
     else:
@@ -529,9 +529,16 @@ def build_parser() -> argparse.ArgumentParser:
         [
             "mdf dataset check examples/datasets/cmu.toml",
             "mdf dataset check examples/datasets/cmu.toml --json",
+            "mdf dataset check examples/datasets/cmu.toml --all   # every record",
         ],
     )
     _check_arguments(dcheck, "dataset config file")
+    dcheck.add_argument(
+        "--all",
+        action="store_true",
+        help="plan every record, not only each label's first: what a run refuses, aliasing "
+        "and the largest memory over all of them (each record's motion is loaded)",
+    )
     dcheck.set_defaults(func=_cmd_dataset_check)
 
     experiment = add_command(
