@@ -168,13 +168,11 @@ def count_scatterers(
     stages: Stages,
     motion: Any,
     body: Skeleton,
-    record_body: Skeleton,
     t: np.ndarray,
 ) -> int:
     """The scatterers of a run's pulses: those of the model and of the scatterer-stage effects
     at the record's first two pulse times ``t[:2]`` [s] (``body``: the placed body; the model
-    and effects are started with ``record_body`` first, see
-    :func:`~mdframework.pipeline.start_record`)."""
+    and effects must have been started, :func:`~mdframework.pipeline.start_record`)."""
     radar_pos = np.asarray(config.scene.radar_position, dtype=np.float64)
     tb = t[:2]
     near = body.select_frames(interpolation.window_frames(body.time, float(tb[0]), float(tb[-1])))
@@ -230,7 +228,7 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
     method = "linear" if motion.linear_tracks else proc.interpolation
     speed = max(speed, interpolated_radial_speed(body, t, method, radar_pos))
     v_max = float(wf.max_unambiguous_velocity)
-    n_scatterers = count_scatterers(config, stages, motion, body, record_body, t)
+    n_scatterers = count_scatterers(config, stages, motion, body, t)
     terms = memory_estimate(
         n_pulses,
         n_scatterers,
