@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import csv
 import json
 import os
 import re
@@ -781,3 +782,200 @@ def test_a_bug_in_a_plugins_constructor_is_an_internal_error_naming_the_plugin(
     assert not (tmp_path / "o").exists()
     with pytest.raises(KeyError, match="presets"):
         cli.main([*args, "--debug"])
+
+
+def test_check_counts_the_scatterers_effects_add(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A room of 40 static reflectors with its ground bounce: the run's pulses carry
+    3 x (17 + 40) = 171 scatterers (direct, single bounce, image), and `mdf check` counts them
+    all in its memory estimate (it used to count the 17 joints alone, 10 times too few)."""
+    from mdframework.check import MIB, SCATTERER_PULSE_BYTES
+
+    amc = EXAMPLES / "data" / "cmu" / "asf-amc" / "02_01.amc"
+    cfg = tmp_path / "room.toml"
+    cfg.write_text(
+        'effects = [{ kind = "static_scene", count = 40, seed = 0 }, { kind = "multipath" }]\n'
+        f'[motion]\nkind = "cmu"\nfile = "{amc}"\nduration = 0.5\n'
+        '[scatterers]\nkind = "ellipsoid"\n[radar]\nkind = "lfm"\n'
+        "[scene]\nradar_position = [10.0, 0.0, 2.0]\n"
+    )
+    plan, meta, _ = check_then_run(cfg, tmp_path, capsys)
+    assert len(meta["scatterers"]) == 171
+    assert plan["n_scatterers"] == 171
+    rows = min(plan["n_pulses"], 4096)
+    expected = rows * 171 * SCATTERER_PULSE_BYTES / MIB
+    assert plan["memory_terms_mib"]["scatterers"] == pytest.approx(expected, rel=1e-12)
+
+
+def test_check_refuses_an_fmcw_scatterer_beyond_the_maximum_range(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The FMCW radar refuses a body beyond its maximum range before its first chirp; `mdf
+    check` refuses it with the same line instead of calling the config valid."""
+    text = (EXAMPLES / "fmcw_walk.toml").read_text().replace('"data/', f'"{EXAMPLES}/data/')
+    cfg = tmp_path / "far.toml"
+    cfg.write_text(
+        text.replace("radar_position = [6.0, 0.0, 1.0]", "radar_position = [14.0, 0.0, 1.0]")
+    )
+    line = "radar.sample_rate: the farthest scatterer at 14.26 m beats at 6.658 MHz"
+    for command in (["check"], ["run", "--out", str(tmp_path / "o")]):
+        code, _, err = run_cli([*command, str(cfg)], capsys)
+        assert code == 2 and line in err, err
+
+
+def test_dataset_check_predicts_the_build(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`mdf dataset check` plans a dataset as the build does and reports, per label, the
+    records and what `mdf check` says of the first: here 2 walk records of 1 s and 2 run
+    records of 0.5 s at PRF 1500 Hz, each with 3 x (17 + 10) = 81 scatterers (a room of 10
+    reflectors and its ground bounce); the build then makes exactly those records with those
+    spectrograms (the run's own count of the scatterers is tested above). The run at 10 m/s
+    aliases at 7.5 m/s and the plan says so. It writes
+    nothing, and a run config is refused naming the command that reads it."""
+    cmu = EXAMPLES / "data" / "cmu" / "asf-amc"
+    cfg = tmp_path / "ds.toml"
+    cfg.write_text(
+        "seed = 1\n"
+        f'[[sources]]\nlabel = "walk"\nmotion = {{ kind = "cmu", file = "{cmu}/02_01.amc" }}\n'
+        "hop = 1.0\n"
+        f'[[sources]]\nlabel = "run"\nmotion = {{ kind = "cmu", file = "{cmu}/09_06.amc" }}\n'
+        "hop = 0.5\n"
+        "[record_lengths]\nwalk = 1.0\nrun = 0.5\n"
+        '[base.radar]\nkind = "lfm"\nprf = 1500.0\n[base.scatterers]\nkind = "ellipsoid"\n'
+        '[base]\neffects = [{ kind = "static_scene", count = 10, seed = 0 }, '
+        '{ kind = "multipath" }]\n'
+        "[base.processing]\nnfft = 256\nwindow_length = 128\nhop = 16\n"
+    )
+    code, out, err = run_cli(["dataset", "check", str(cfg), "--json"], capsys)
+    assert code == 0, err
+    plan = json.loads(out)
+    assert list(tmp_path.iterdir()) == [cfg]
+    assert plan["records"] == {"walk": 2, "run": 2} and plan["n_records"] == 4
+    assert plan["first"]["run"]["aliasing"] and not plan["first"]["walk"]["aliasing"]
+    code, _, err = run_cli(
+        ["dataset", "build", str(cfg), "--out", str(tmp_path / "ds"), "--workers", "1"], capsys
+    )
+    assert code == 0, err
+    rows = list(csv.DictReader((tmp_path / "ds" / "index.csv").open()))
+    assert [r["label"] for r in rows].count("walk") == 2 and len(rows) == 4
+    for row in rows:
+        first = plan["first"][row["label"]]
+        with np.load(tmp_path / "ds" / "records" / f"{row['id']}.npz") as d:
+            assert d["spectrogram_db"].shape == (first["nfft"], first["n_frames"])
+        assert first["n_scatterers"] == 81
+    code, out, err = run_cli(["dataset", "check", str(EXAMPLES / "cmu_walk.toml")], capsys)
+    assert code == 2 and "a run config (it has `motion`), not a dataset config" in err
+
+
+def test_check_judges_aliasing_on_the_tracks_the_run_interpolates(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """CMU 09_06 (a run) at PRF 2040 Hz: the frames' differences give 10.16 m/s, under the
+    unambiguous 10.19 m/s, but the cubic spline the run resamples at its pulses reaches
+    10.61 m/s, so the run warns of aliasing and asks for 2124 Hz. `mdf check`
+    judged the frames alone ("none expected", and at least 2033 Hz to a run that aliased);
+    it now names the run's speed and PRF."""
+    text = (EXAMPLES / "cmu_run.toml").read_text().replace('"data/', f'"{EXAMPLES}/data/')
+    cfg = tmp_path / "run.toml"
+    cfg.write_text(text.replace('kind = "lfm"', 'kind = "lfm"\nprf = 2040.0'))
+    code, out, err = run_cli(["check", str(cfg)], capsys)
+    assert code == 0, err
+    assert "LIKELY: fastest joint 10.6 m/s radially; raise radar.prf to at least 2124 Hz" in out
+    code, _, err = run_cli(["run", str(cfg), "--out", str(tmp_path / "o"), "--no-figures"], capsys)
+    assert code == 0 and "raise radar.prf to at least 2124 Hz" in err, err
+
+
+def test_mdf_help_lists_the_exit_codes_a_script_sees(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A script needs the exit codes: `mdf --help` lists them, and they are the ones the
+    commands return (2 for a missing config)."""
+    with pytest.raises(SystemExit) as ended:
+        cli.main(["--help"])
+    assert ended.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    for number, meaning in (
+        (0, "done"),
+        (1, "internal error"),
+        (2, "bad input"),
+        (cli.EXIT_INTERRUPTED, "interrupted (Ctrl-C)"),
+        (cli.EXIT_TERMINATED, "terminated (SIGTERM)"),
+    ):
+        assert f"{number} {meaning}" in text
+    code, _, _ = run_cli(["check", str(tmp_path / "nope.toml")], capsys)
+    assert code == 2
+
+
+def test_experiment_takes_the_build_options_of_dataset_build(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`mdf experiment` builds its dataset as `mdf dataset build` does, so it takes the same
+    --workers (over the config's `workers`) and --scheduler (it refused both as unknown, so a
+    cluster job could not choose its processes or its scheduler)."""
+    from mdframework import experiment
+    from mdframework.errors import ConfigError
+
+    seen: dict[str, Any] = {}
+
+    def build(*args: Any, **kw: Any) -> None:
+        seen.update(workers=kw["workers"], scheduler=kw["scheduler"])
+        raise ConfigError("stopped here")
+
+    monkeypatch.setattr(experiment, "build_dataset", build)
+    cfg = EXAMPLES / "experiment_cmu.toml"
+    argv = ["experiment", str(cfg), "--out", str(tmp_path / "e")]
+    code, _, err = run_cli([*argv, "--workers", "3", "--scheduler", "local"], capsys)
+    assert code == 2 and "stopped here" in err, err
+    assert seen == {"workers": 3, "scheduler": "local"}
+    monkeypatch.undo()
+    code, _, err = run_cli([*argv, "--scheduler", "nonsense"], capsys)
+    assert code == 2 and "Dask scheduler 'nonsense': not an address" in err, err
+
+
+def test_an_fft_shorter_than_its_window_names_the_field(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """nfft below window_length is blamed on processing.nfft (it named the section alone)."""
+    cfg = tmp_path / "fft.toml"
+    cfg.write_text(
+        (EXAMPLES / "point_target.toml").read_text()
+        + "[processing]\nnfft = 100\nwindow_length = 256\n"
+    )
+    code, _, err = run_cli(["check", str(cfg)], capsys)
+    assert code == 2
+    assert err.strip() == (
+        f"mdf: error: {cfg}: processing.nfft: 100 is shorter than window_length 256: give an "
+        "nfft of at least the window's length"
+    )
+
+
+def test_dataset_check_all_finds_the_record_the_build_stops_at(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A walk toward a radar 3.2 m ahead in 0.5 s records: the fifth record brings the hip
+    within 0.24 m, under scene.min_range. `mdf dataset check --all` plans every record and
+    stops naming that record, window and cause as the build does; with on_error = "skip" it
+    counts it as the build skips it."""
+    amc = EXAMPLES / "data" / "cmu" / "asf-amc" / "02_01.amc"
+    text = (
+        f'seed = 1\n[[sources]]\nlabel = "walk"\nmotion = {{ kind = "cmu", file = "{amc}" }}\n'
+        "hop = 0.5\n[record_lengths]\nwalk = 0.5\n"
+        '[base.radar]\nkind = "lfm"\n[base.scatterers]\nkind = "ellipsoid"\n'
+        "[base.scene]\nradar_position = [3.2, 0.0, 1.0]\n"
+    )
+    stop, skip = tmp_path / "stop.toml", tmp_path / "skip.toml"
+    stop.write_text(text)
+    skip.write_text('on_error = "skip"\n' + text)
+    where = re.escape(f"(walk; source file {amc}, window 2.000-2.500 s): ")
+    where = r"record 00004-[0-9a-f]{10} " + where
+    code, _, err = run_cli(["dataset", "check", str(stop), "--all"], capsys)
+    assert code == 2 and re.search(where + "joint 'l_hip' comes within 0.242 m", err), err
+    code, _, err = run_cli(["dataset", "build", str(stop), "--out", str(tmp_path / "d")], capsys)
+    assert code == 2 and re.search(where + "scatterer 'l_hip' comes within 0.242 m", err), err
+    code, out, err = run_cli(["dataset", "check", str(skip), "--all", "--json"], capsys)
+    assert code == 0, err
+    plan = json.loads(out)
+    assert plan["n_planned"] == {"walk": 4} and plan["n_skipped"] == {"walk": 1}
+    assert re.match(where, plan["skipped"]["walk"])

@@ -199,6 +199,21 @@ def _cmd_check(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_dataset_check(args: argparse.Namespace) -> int:
+    with _progress(args).step("reading the config, the installed plugins and the motions"):
+        from .check import format_dataset_plan, plan_dataset
+        from .dataset import load_dataset_config
+
+        config, base = load_dataset_config(args.config)
+        with _naming(args.config):
+            plan = plan_dataset(config, base, every=args.all)
+    if args.json:
+        print(json.dumps(plan.as_dict(), indent=2))
+    else:
+        print(format_dataset_plan(plan, args.config))
+    return 0
+
+
 def _cmd_plugins(args: argparse.Namespace) -> int:
     registry = default_registry()
     for interface in INTERFACES:
@@ -274,6 +289,8 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
 
     note("reading the experiment config and the installed plugins", not args.no_progress)
     config = load_experiment_config(args.config)
+    if args.workers is not None:
+        config = config.model_copy(update={"workers": args.workers})
     with _naming(args.config):
         run_experiment(
             config,
@@ -283,6 +300,7 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
             allow_import=args.allow_import,
             force=args.force,
             staging_dir=args.staging_dir,
+            scheduler=args.scheduler,
         )
     print(Path(args.out) / "report.md")
     return 0
@@ -301,6 +319,14 @@ PROGRESS_HELP = (
 STAGING_HELP = (
     "folder for the files being written (default: inside --out); must be on the same file "
     "system as --out"
+)
+
+
+#: the exit codes, as ``mdf --help`` lists them
+EXIT_CODES_HELP = (
+    "exit codes: 0 done; 1 internal error (a bug, in mdf or a plugin: --debug shows the "
+    "traceback); 2 bad input (a config, a data file, a scene that cannot be simulated, the "
+    "command line, --out); 130 interrupted (Ctrl-C); 143 terminated (SIGTERM)."
 )
 
 
@@ -346,6 +372,25 @@ def _run_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-progress", action="store_true", help=PROGRESS_HELP)
 
 
+def _build_arguments(parser: argparse.ArgumentParser, workers_help: str) -> None:
+    """The options of the commands that build a dataset: ``--workers``, ``--scheduler``."""
+    parser.add_argument("--workers", type=_positive_int, default=None, help=workers_help)
+    parser.add_argument(
+        "--scheduler",
+        default=None,
+        help="Dask scheduler address, or 'local' for a local Dask cluster (default: the "
+        "MDF_DASK_SCHEDULER environment variable, else local processes; connection timeout "
+        "MDF_DASK_TIMEOUT seconds, default 10)",
+    )
+
+
+def _check_arguments(parser: argparse.ArgumentParser, config_help: str) -> None:
+    """The arguments of ``mdf check`` and ``mdf dataset check``."""
+    parser.add_argument("config", help=config_help)
+    parser.add_argument("--json", action="store_true", help="print the report as JSON")
+    parser.add_argument("--no-progress", action="store_true", help=PROGRESS_HELP)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``mdf`` (with the commands installed plugins add)."""
     parser = _Parser(
@@ -358,12 +403,14 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=_examples(
             "mdf check examples/cmu_walk.toml            # what a run would do",
             "mdf run examples/cmu_walk.toml --out out/walk",
+            "mdf dataset check examples/datasets/cmu.toml # what a build would do",
             "mdf dataset build examples/datasets/cmu.toml --out out/ds",
             "mdf experiment examples/experiment_cmu.toml --out out/exp",
             "mdf plugins                                  # installed and disabled plugins",
             "mdf COMMAND --help                           # options and examples of a command",
         )
-        + "\n\n--debug and --disable-plugin may be given anywhere on the command line.",
+        + "\n\n--debug and --disable-plugin may be given anywhere on the command line.\n\n"
+        + textwrap.fill(EXIT_CODES_HELP, 79),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--version", action="version", version=_version())
@@ -435,17 +482,19 @@ def build_parser() -> argparse.ArgumentParser:
             "mdf check examples/point_target.toml --json",
         ],
     )
-    check.add_argument("config", help="run config file (.toml, .yaml or .json)")
-    check.add_argument("--json", action="store_true", help="print the report as JSON")
-    check.add_argument("--no-progress", action="store_true", help=PROGRESS_HELP)
+    _check_arguments(check, "run config file (.toml, .yaml or .json)")
     check.set_defaults(func=_cmd_check)
 
     dataset = add_command(
         sub,
         "dataset",
         "labelled datasets of simulated records",
-        "Build labelled datasets of simulated records (see docs/datasets.md).",
-        ["mdf dataset build examples/datasets/cmu.toml --out out/ds"],
+        "Build labelled datasets of simulated records, or check a dataset config before "
+        "building it (see docs/datasets.md).",
+        [
+            "mdf dataset check examples/datasets/cmu.toml",
+            "mdf dataset build examples/datasets/cmu.toml --out out/ds",
+        ],
     )
     dataset_sub = dataset.add_subparsers(
         dest="dataset_command", required=True, metavar="SUBCOMMAND"
@@ -463,17 +512,34 @@ def build_parser() -> argparse.ArgumentParser:
     )
     build.add_argument("config", help="dataset config file")
     build.add_argument("--out", required=True, type=_output_path, help="dataset folder")
-    build.add_argument("--workers", type=_positive_int, default=None, help="local processes")
-    build.add_argument(
-        "--scheduler",
-        default=None,
-        help="Dask scheduler address, or 'local' for a local Dask cluster (default: the "
-        "MDF_DASK_SCHEDULER environment variable, else local processes; connection timeout "
-        "MDF_DASK_TIMEOUT seconds, default 10)",
-    )
+    _build_arguments(build, "local processes")
     build.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     build.add_argument("--force", action="store_true", help=FORCE_DATASET_HELP)
     build.set_defaults(func=_cmd_dataset_build)
+
+    dcheck = add_command(
+        dataset_sub,
+        "check",
+        "validate a dataset config and report what a build would do, without building",
+        "Plan a dataset config as a build does before its first record (every record's config "
+        "validated, with its random draws) and report the records per label and, for each "
+        "label's first simulated record, what `mdf check` reports of a run: its pulses, "
+        "scatterers, spectrogram, aliasing risk and memory. Simulates nothing and writes "
+        "nothing.",
+        [
+            "mdf dataset check examples/datasets/cmu.toml",
+            "mdf dataset check examples/datasets/cmu.toml --json",
+            "mdf dataset check examples/datasets/cmu.toml --all   # every record",
+        ],
+    )
+    _check_arguments(dcheck, "dataset config file")
+    dcheck.add_argument(
+        "--all",
+        action="store_true",
+        help="plan every record, not only each label's first: what a run refuses, aliasing "
+        "and the largest memory over all of them (each record's motion is loaded)",
+    )
+    dcheck.set_defaults(func=_cmd_dataset_check)
 
     experiment = add_command(
         sub,
@@ -495,6 +561,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     experiment.add_argument("--force", action="store_true", help=FORCE_DATASET_HELP)
     experiment.add_argument("--staging-dir", default=None, help=STAGING_HELP)
+    _build_arguments(
+        experiment, "local processes building the dataset (default: the config's workers)"
+    )
     experiment.set_defaults(func=_cmd_experiment)
 
     plugins = add_command(

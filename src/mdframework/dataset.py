@@ -1304,6 +1304,29 @@ def build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     return build_records([spec], out_dir)[0]
 
 
+def record_failure(spec: RecordSpec, exc: Exception) -> tuple[str, str, tuple[str, float, float]]:
+    """How a record's failure is named: the record with its label, source file and window
+    (``record 00003-<digest> (walk; source file ..., window 1.500-2.500 s)``), the cause (with
+    the dataset's length field for ``motion.duration``) and the window (file, start [s],
+    length [s])."""
+    if spec.window is not None:
+        file, start, length = spec.window
+    else:
+        motion = spec.run_config.get("motion", {})
+        file = str(motion.get("file", motion.get("kind", "?")))
+        start = float(motion.get("start", 0.0))
+        length = float(motion.get("duration") or 0.0)
+    where = (
+        f"record {spec.record_id} ({spec.label}; source file {file}, window "
+        f"{start:.3f}-{start + length:.3f} s)"
+    )
+    # named once: the record's own errors start with its name too
+    cause = " ".join(str(exc).split()).removeprefix(f"record {spec.record_id}: ")
+    if spec.length_field is not None:  # the record's duration is the dataset's length
+        cause = cause.replace("motion.duration", spec.length_field)
+    return where, cause, (file, start, length)
+
+
 def _record_or_skip(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     """:func:`build_record` but for its wait: the file may still be on its way to the disk."""
     try:
@@ -1312,21 +1335,7 @@ def _record_or_skip(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         if not isinstance(exc, MdfError) and is_plugin_bug(exc):  # not the config's: a bug
             exc.add_note(f"while building record {spec.record_id} of {spec.recording}")
             raise
-        if spec.window is not None:
-            file, start, length = spec.window
-        else:
-            motion = spec.run_config.get("motion", {})
-            file = str(motion.get("file", motion.get("kind", "?")))
-            start = float(motion.get("start", 0.0))
-            length = float(motion.get("duration") or 0.0)
-        where = (
-            f"record {spec.record_id} ({spec.label}; source file {file}, window "
-            f"{start:.3f}-{start + length:.3f} s)"
-        )
-        # named once: the record's own errors start with its name too
-        cause = " ".join(str(exc).split()).removeprefix(f"record {spec.record_id}: ")
-        if spec.length_field is not None:  # the record's duration is the dataset's length
-            cause = cause.replace("motion.duration", spec.length_field)
+        where, cause, (file, start, length) = record_failure(spec, exc)
         if spec.on_error != "skip":
             raise MdfError(f"{where}: {cause}") from None
         return {

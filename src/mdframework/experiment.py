@@ -857,11 +857,13 @@ def run_experiment(
     force: bool = False,
     staging_dir: Path | str | None = None,
     allow_import: bool = False,
+    scheduler: str | None = None,
 ) -> dict[str, Any]:
     """Build or load the dataset, run the experiments, write the report. ``out_dir`` follows
     the rules of :mod:`mdframework.outdir` (``force``, ``staging_dir``); a dataset the
-    experiment builds goes to ``out_dir/dataset`` (resumable, see :func:`build_dataset`).
-    ``allow_import``: see :func:`classifier_factory`."""
+    experiment builds goes to ``out_dir/dataset`` (resumable, see :func:`build_dataset`, with
+    the config's ``workers`` and the Dask ``scheduler``). ``allow_import``: see
+    :func:`classifier_factory`."""
     with output_folder(
         out_dir, "experiment", EXPERIMENT_FILES, force=force, staging_dir=staging_dir
     ) as folder:
@@ -871,7 +873,15 @@ def run_experiment(
         if cfg.dataset.config is not None:
             dcfg, base = load_dataset_config(cfg.dataset.config)
             data_dir = folder.path / "dataset"
-            build_dataset(dcfg, base, data_dir, workers=cfg.workers, progress=progress, force=force)
+            build_dataset(
+                dcfg,
+                base,
+                data_dir,
+                workers=cfg.workers,
+                scheduler=scheduler,
+                progress=progress,
+                force=force,
+            )
         else:
             assert cfg.dataset.path is not None
             data_dir = cfg.dataset.path

@@ -49,6 +49,9 @@ FEATURE_NAMES: tuple[str, ...] = (
     "lower_mean",
 )
 
+#: Spectrogram cells :func:`envelopes` works on at once (whole columns, at least one).
+ENVELOPE_CELLS = 1 << 18
+
 EnvelopeMethod = Literal["threshold", "percentile"]
 TorsoMethod = Literal["median", "peak"]
 
@@ -78,17 +81,23 @@ def envelopes(
     ascending. See the module docstring for the methods. ``ValueError`` for a negative value (a
     map in dB, such as ``spectrogram_db``: pass ``10 ** (db / 10)``) or a NaN or infinite one.
     """
-    p = np.asarray(power, dtype=np.float64)
+    p_all = np.asarray(power)
+    if p_all.dtype not in (np.float32, np.float64):
+        p_all = p_all.astype(np.float64)
     v = np.asarray(velocity, dtype=np.float64)
-    if p.ndim != 2 or p.shape[0] != v.shape[0]:
-        raise ValueError(f"power must be (n_doppler={v.shape[0]}, n_frames), got {p.shape}")
+    if p_all.ndim != 2 or p_all.shape[0] != v.shape[0]:
+        raise ValueError(f"power must be (n_doppler={v.shape[0]}, n_frames), got {p_all.shape}")
     if np.any(np.diff(v) <= 0):
         raise ValueError("velocity must be strictly ascending")
     if not threshold_db <= 0.0:  # a column's peak must pass its own threshold
         raise ValueError(f"threshold_db must be <= 0 dB (below the peak), got {threshold_db}")
-    n_frames = p.shape[1]
-    p_max = float(p.max()) if p.size else 0.0
-    p_min = float(p.min()) if p.size else 0.0
+    if method not in ("threshold", "percentile"):
+        raise ValueError(f"unknown envelope method {method!r}")
+    if torso_method not in ("median", "peak"):
+        raise ValueError(f"unknown torso method {torso_method!r}")
+    n_frames = p_all.shape[1]
+    p_max = float(p_all.max()) if p_all.size else 0.0
+    p_min = float(p_all.min()) if p_all.size else 0.0
     if not (np.isfinite(p_max) and np.isfinite(p_min)):
         raise ValueError("power has NaN or infinite values")
     if p_min < 0.0:
@@ -101,28 +110,32 @@ def envelopes(
     torso = np.full(n_frames, np.nan)
     if p_max <= 0.0:
         return Envelopes(upper, lower, torso)
-    above_floor = p >= p_max * 10.0 ** (floor_db / 10.0)
-    live = np.any(above_floor, axis=0)
-    if method == "threshold":
-        col_peak = p.max(axis=0)
-        mask = above_floor & (p >= col_peak * 10.0 ** (threshold_db / 10.0))
-        # the first and the last bin of each column in the mask (a live column has its peak
-        # in it); argmax of a boolean array is the first True
-        lo = np.argmax(mask, axis=0)
-        hi = v.size - 1 - np.argmax(mask[::-1], axis=0)
-        upper[live] = v[hi[live]]
-        lower[live] = v[lo[live]]
-    elif method == "percentile":
-        lower[live] = _quantile_velocity(p, above_floor, v, percentiles[0] / 100.0)[live]
-        upper[live] = _quantile_velocity(p, above_floor, v, percentiles[1] / 100.0)[live]
-    else:
-        raise ValueError(f"unknown envelope method {method!r}")
-    if torso_method == "peak":
-        torso[live] = v[np.argmax(p, axis=0)[live]]
-    elif torso_method == "median":
-        torso[live] = _quantile_velocity(p, above_floor, v, 0.5)[live]
-    else:
-        raise ValueError(f"unknown torso method {torso_method!r}")
+    floor = p_max * 10.0 ** (floor_db / 10.0)
+    # the columns a few at a time: a long record's float64 copies and masks would otherwise
+    # take about 30 bytes per spectrogram cell at once
+    step = max(1, ENVELOPE_CELLS // max(v.size, 1))
+    for lo in range(0, n_frames, step):
+        cols = slice(lo, lo + step)
+        p = np.asarray(p_all[:, cols], dtype=np.float64)
+        up, low, mid = upper[cols], lower[cols], torso[cols]  # views: filled in place
+        above_floor = p >= floor
+        live = np.any(above_floor, axis=0)
+        if method == "threshold":
+            col_peak = p.max(axis=0)
+            mask = above_floor & (p >= col_peak * 10.0 ** (threshold_db / 10.0))
+            # the first and the last bin of each column in the mask (a live column has its
+            # peak in it); argmax of a boolean array is the first True
+            first = np.argmax(mask, axis=0)
+            last = v.size - 1 - np.argmax(mask[::-1], axis=0)
+            up[live] = v[last[live]]
+            low[live] = v[first[live]]
+        else:
+            low[live] = _quantile_velocity(p, above_floor, v, percentiles[0] / 100.0)[live]
+            up[live] = _quantile_velocity(p, above_floor, v, percentiles[1] / 100.0)[live]
+        if torso_method == "peak":
+            mid[live] = v[np.argmax(p, axis=0)[live]]
+        else:
+            mid[live] = _quantile_velocity(p, above_floor, v, 0.5)[live]
     return Envelopes(upper, lower, torso)
 
 

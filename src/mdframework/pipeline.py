@@ -410,13 +410,7 @@ def _simulate_motion(
         near = placed(near, where)
         resample = interpolation.TrackResampler(near.time, near.positions, near.valid, method)
     record_body = near.select_frames(_inside(near.time, t_start, t_end))
-    with blame(model, "start_record"):
-        model.start_record(record_body)
-    with blame(wf, "start_record"):
-        wf.start_record(t, _range_span(record_body, radar_pos))
-    for effect in stages.effects:
-        with blame(effect, "start_record"):
-            effect.start_record(record_body, radar_pos)
+    start_record(stages, record_body, t, radar_pos)
     timings["prepare"] = time.perf_counter() - clock
 
     n = t.shape[0]
@@ -512,6 +506,22 @@ def _simulate_motion(
         stream.scatterers(),
         metadata,
     )
+
+
+def start_record(
+    stages: Stages, record_body: Skeleton, t: FloatArray, radar_pos: FloatArray
+) -> None:
+    """Tell the scatterer model, the radar and the effects the record about to be simulated:
+    the placed body at its frame times within the record, the pulse times ``t`` (n_pulses,) [s]
+    and the radar position (3,) [m]. The radar refuses here what it cannot simulate (an FMCW
+    scatterer beyond its maximum range, range-Doppler maps over the product limit)."""
+    with blame(stages.model, "start_record"):
+        stages.model.start_record(record_body)
+    with blame(stages.radar, "start_record"):
+        stages.radar.start_record(t, _range_span(record_body, radar_pos))
+    for effect in stages.effects:
+        with blame(effect, "start_record"):
+            effect.start_record(record_body, radar_pos)
 
 
 def _check_empty(

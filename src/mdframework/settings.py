@@ -367,7 +367,10 @@ class ProcessingConfig(StrictModel):
     @model_validator(mode="after")
     def _check(self) -> ProcessingConfig:
         if self.nfft < self.window_length:
-            raise ValueError(f"nfft ({self.nfft}) must be >= window_length ({self.window_length})")
+            raise ValueError(
+                f"nfft: {self.nfft} is shorter than window_length {self.window_length}: give an "
+                "nfft of at least the window's length"
+            )
         return self
 
 

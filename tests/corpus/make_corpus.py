@@ -1262,6 +1262,7 @@ def _command_cases(c: _Corpus) -> None:
         "show": ("show", "--out"),
         "check": ("check",),
         "dataset": ("dataset", "build", "--out"),
+        "dataset-check": ("dataset", "check"),
         "experiment": ("experiment", "--out"),
     }
 
@@ -1286,7 +1287,11 @@ def _command_cases(c: _Corpus) -> None:
         case(f"{name}-empty-yaml", words, "empty.yaml", "empty.yaml", "top level")
     for name, words in commands.items():
         kind = (
-            "dataset" if name in ("dataset",) else "experiment" if name == "experiment" else "run"
+            "dataset"
+            if name in ("dataset", "dataset-check")
+            else "experiment"
+            if name == "experiment"
+            else "run"
         )
         for other in ("run", "dataset", "experiment"):
             if other != kind:
