@@ -137,6 +137,15 @@ class SanityConfig(StrictModel):
         description="... and at least this many times the median deviation of the 13 frames "
         "around it (fast but smooth motion has no such outlier).",
     )
+    glitch_return_ratio: float = Field(
+        0.3,
+        ge=0,
+        le=1000,
+        description="... and the joint comes back: its velocity after the frame differs from "
+        "the one before by at most this fraction of the deviation (as a distance, |v_after - "
+        "v_before| dt1 dt2 / (dt1 + dt2)): a one-frame spike gives 0, a real change of "
+        "velocity made within one frame (a foot leaving the floor at 30 Hz) 1 or more.",
+    )
     limits: Literal["warn", "ignore", "error"] = Field(
         "warn",
         description="A joint faster or more accelerated than the human limits "
