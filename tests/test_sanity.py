@@ -550,25 +550,29 @@ def test_the_shipped_recordings_are_upright_as_the_page_says() -> None:
 def _mirrored_bvh(src: Path, dst: Path) -> Path:
     """The BVH file's mirror image in its X axis, as a left-handed export writes it: every
     OFFSET's and Xposition's X negated, and the Y and Z rotations (a rotation mirrored in X
-    keeps its X angle and turns the others the other way)."""
+    keeps its X angle and turns the others the other way). The numbers' text is negated, so
+    the mirror is exact."""
     bvh = read_bvh(src)
-    sign = np.ones(bvh.values.shape[1])
+    flip = np.zeros(bvh.values.shape[1], dtype=bool)
     for j in bvh.joints:
         for k, ch in enumerate(j.channels):
-            if ch in ("Xposition", "Yrotation", "Zrotation"):
-                sign[j.first_channel + k] = -1.0
+            flip[j.first_channel + k] = ch in ("Xposition", "Yrotation", "Zrotation")
+
+    def negated(text: str) -> str:
+        return text[1:] if text.startswith("-") else f"-{text}"
+
     lines = src.read_text().splitlines()
     motion = next(i for i, line in enumerate(lines) if line.strip() == "MOTION")
     out = []
     for line in lines[: motion + 3]:
         head, _, rest = line.partition("OFFSET")
         if rest:
-            x, y, z = (float(v) for v in rest.split())
-            line = f"{head}OFFSET {-x:g} {y:g} {z:g}"
+            x, y, z = rest.split()
+            line = f"{head}OFFSET {negated(x)} {y} {z}"
         out.append(line)
     for line in lines[motion + 3 :]:
-        values = np.array(line.split(), dtype=float) * sign
-        out.append(" ".join(f"{v:.6g}" for v in values))
+        values = line.split()
+        out.append(" ".join(negated(v) if f else v for v, f in zip(values, flip, strict=True)))
     dst.write_text("\n".join(out) + "\n")
     return dst
 
@@ -592,11 +596,33 @@ def test_a_mirrored_body_is_flagged_and_the_real_ones_are_not(tmp_path: Path) ->
     assert msgs == [
         f"{mirror}: the body looks mirrored: its feet point backwards from the way its left and "
         "right joints face (median cosine -1.00; real bodies near +1), so its left is on its "
-        "right: the file's frame is left-handed (a mirror image) or its left and right joints "
-        "are named the other way round"
+        "right: the file's frame is left-handed (a mirror image, which the sources that have "
+        "motion.axes read with motion.handedness = 'left') or its left and right joints are "
+        "named the other way round"
     ]
     with pytest.raises(DataFileError, match="motion sanity: the body looks mirrored"):
         load({"kind": "cmu", "file": str(mirror)}, mirrored="error")
+
+
+def test_a_left_handed_file_is_read_as_the_body_it_holds(tmp_path: Path) -> None:
+    """The real 16_21 walk written as a left-handed exporter writes it (its X axis mirrored,
+    the left joints' positions at -X): read as right-handed, the body is the walk's mirror
+    image, flagged by the mirrored check; declared left-handed (handedness = "left", with the
+    default axes' left axis mirrored), it is the original walk to 1e-9 m, and nothing is said."""
+    mirror = _mirrored_bvh(EXAMPLES / CMU["16_21"]["file"], tmp_path / "16_21.bvh")
+    real, real_msgs = load({"kind": "bvh", "file": CMU["16_21"]["file"]})
+    as_right, right_msgs = load({"kind": "bvh", "file": str(mirror)})
+    assert not as_right.metadata["sanity"]["mirrored"]["ok"]
+    assert [m.split(": ", 1)[1][:25] for m in right_msgs] == ["the body looks mirrored: "]
+    assert "motion.handedness = 'left'" in right_msgs[0]
+    as_left, left_msgs = load(
+        {"kind": "bvh", "file": str(mirror), "handedness": "left", "axes": ["z", "-x", "y"]}
+    )
+    assert as_left.metadata["sanity"]["mirrored"]["ok"] and left_msgs == real_msgs == []
+    body, read = real.canonical(), as_left.canonical()
+    assert np.array_equal(read.time, body.time)
+    np.testing.assert_allclose(read.positions, body.positions, rtol=0, atol=1e-9)
+    assert foot_facing_cosine(read) == pytest.approx(foot_facing_cosine(body), abs=1e-9)
 
 
 def test_a_body_read_in_the_wrong_length_unit_is_flagged() -> None:

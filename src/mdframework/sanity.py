@@ -50,8 +50,9 @@ Checks, on the canonical 17-joint body:
    the wrong length unit. A body of the wrong size is not judged upright or not.
 7. **Mirrored** (:func:`foot_facing_cosine`), on an upright body: the median cosine between
    where the feet point (toes ahead of ankles) and the facing direction the left and right
-   joints give; below 0 the body is a mirror image (a left-handed file, or left and right
-   joints named the other way round), whose left lies on its right.
+   joints give; below 0 the body is a mirror image (a left-handed file, which a source's
+   ``handedness = "left"`` reads, or left and right joints named the other way round), whose
+   left lies on its right.
 """
 
 from __future__ import annotations
@@ -634,7 +635,8 @@ def check_motion(motion: Motion, config: SanityConfig) -> Motion:
                 config.mirrored,
                 f"the body looks mirrored: its feet point backwards from the way its left and "
                 f"right joints face (median cosine {cos:.2f}; real bodies near +1), so its left "
-                "is on its right: the file's frame is left-handed (a mirror image) or its left "
+                "is on its right: the file's frame is left-handed (a mirror image, which the "
+                "sources that have motion.axes read with motion.handedness = 'left') or its left "
                 "and right joints are named the other way round",
             )
         )
