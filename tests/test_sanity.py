@@ -245,10 +245,14 @@ def test_the_shipped_recordings_hold_no_glitch_but_their_real_ones(rate: int | N
     """Every shipped recording, at its own frame rate and decimated to 60 and 30 Hz (every
     n-th frame, where its rate allows): the glitches found are the real ones above, no more;
     before the detector asked whether the joint comes back, 30 Hz gave 4 toe-offs of 16_21,
-    13 of 13_18's footfalls and more. The C3D file's markers (no whole body) likewise."""
+    13 of 13_18's footfalls and more. The C3D file's markers (no whole body) likewise.
+    Of the frames the other thresholds pass, the real glitches' change of velocity is at most
+    0.29 x their deviation, the others' 0.34 x or more (the page's numbers)."""
     from mdf_c3d import read_c3d
 
     found: dict[str, set[tuple[str, float]]] = {}
+    ratios: list[float] = []  # glitches' change of velocity / deviation
+    others: list[float] = []  # the same, frames flagged but for glitch_return_ratio
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         for name, section in _recordings().items():
@@ -264,10 +268,20 @@ def test_the_shipped_recordings_hold_no_glitch_but_their_real_ones(rate: int | N
                 Motion(sk, motion.metadata, motion.canonical_map), SanityConfig()
             )
             items = checked.metadata["sanity"]["glitches"]["items"]
+            body = checked.canonical()
+            e, _ = deviations(body.time, body.positions, body.valid)
+            ratio = turns(body.time, body.positions) / np.where(e > 0, e, np.inf)
+            candidates = find_glitches(body.time, body.positions, body.valid, return_ratio=np.inf)
+            flagged = np.zeros_like(candidates)
+            for it in items:
+                flagged[it["frame"], CANONICAL_JOINTS.index(it["joint"])] = True
+            ratios += ratio[flagged].tolist()
+            others += ratio[candidates & ~flagged].tolist()
             if items:
                 found[name] = {(it["joint"], round(it["time_s"], 2)) for it in items}
     expected = {name: g for (name, r), g in REAL_GLITCHES.items() if r == rate}
     assert found == expected
+    assert max(ratios, default=0.0) < 0.295 and min(others, default=1.0) >= 0.34
     markers = read_c3d(EXAMPLES / "data/c3d/treadmill_events.c3d")
     tracks = [j for j, label in enumerate(markers.labels) if label.isupper()]  # not forces
     assert len(tracks) == 78
