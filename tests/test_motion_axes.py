@@ -6,7 +6,8 @@ would turn the person's left into their right, so every source refuses it with t
 line naming ``motion.axes`` (only DeepMimic did). Each kind is checked on its shipped real
 file (C3D: the TRC's markers written as C3D): the default's left axis with its sign changed is
 refused; the default turned 180 degrees about the up axis is accepted and gives the default body
-turned, joint for joint.
+turned, joint for joint. A file declared left-handed (``handedness = "left"``) is the other way
+round: a mirror reads it, a rotation is refused.
 """
 
 from __future__ import annotations
@@ -79,7 +80,8 @@ def test_mirrored_axes_are_refused_and_rotations_turn_the_body(kind: str, c3d_wa
         _validate({**section, "axes": mirror})
     assert str(err.value) == (
         f"t.toml: motion.axes: {mirror} mirror the body (its left would become its right): "
-        f"change the sign of one axis, e.g. of the one that becomes y (left): {default}"
+        f"change the sign of one axis, e.g. of the one that becomes y (left): {default}; or, if "
+        "the file's frame is left-handed (as Unity's is), declare it with handedness = 'left'"
     )
     # x and y both flipped: a half turn about z, a rotation
     turned = [_flip(default[0]), _flip(default[1]), default[2]]
@@ -88,3 +90,30 @@ def test_mirrored_axes_are_refused_and_rotations_turn_the_body(kind: str, c3d_wa
     assert np.array_equal(half.valid, body.valid)
     ok = body.valid
     np.testing.assert_allclose(half.positions[ok], body.positions[ok] * [-1.0, -1.0, 1.0])
+
+
+@pytest.mark.parametrize("kind", sorted(SECTIONS))
+def test_a_left_handed_frame_is_read_through_a_mirror_and_only_one(
+    kind: str, c3d_walk: Path
+) -> None:
+    """handedness = "left" declares the file's frame left-handed (a Unity export, say): its
+    axes must then be a mirror, which reads the body as the file's mirror image of it; the
+    default axes, a rotation, are refused with it, naming the mirror to give."""
+    section = SECTIONS[kind] if kind != "c3d" else {**SECTIONS[kind], "file": str(c3d_walk)}
+    config = _validate(section)
+    default = list(config.motion.axes)
+    mirror = [default[0], _flip(default[1]), default[2]]
+    left = _validate({**section, "handedness": "left", "axes": mirror})
+    assert left.motion.handedness == "left" and config.motion.handedness == "right"
+    body = build_stages(config).source.load().canonical()
+    flipped = build_stages(left).source.load().canonical()
+    ok = body.valid
+    assert np.array_equal(flipped.valid, ok)
+    np.testing.assert_allclose(flipped.positions[ok], body.positions[ok] * [1.0, -1.0, 1.0])
+    with pytest.raises(ConfigError) as err:
+        _validate({**section, "handedness": "left"})
+    assert str(err.value) == (
+        "t.toml: motion: handedness = 'left' declares the file's frame left-handed, which only "
+        f"a mirror turns into the project's right-handed frame, but axes {default} are a "
+        f"rotation: change the sign of one axis, e.g. of the one that becomes y (left): {mirror}"
+    )

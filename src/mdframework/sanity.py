@@ -10,17 +10,25 @@ Checks, on the canonical 17-joint body:
 
 1. **Single-frame glitches** (:func:`find_glitches`): a frame whose position lies far off the
    line between its two neighbours (the deviation ``e``, :func:`deviations`) while the
-   neighbours do not, and while the frames around it move smoothly. A one-frame spike of size
-   ``d`` gives ``e = d`` at the frame and ``d / 2`` at each neighbour; fast but real motion
-   (a punch, a running foot) spreads its acceleration over several frames. Thresholds:
-   ``glitch_min_m`` (2 cm), ``glitch_ratio`` (1.6 x the neighbours) and ``glitch_local_ratio``
-   (5 x the median of the 13 frames around). Flagged in the metadata and warned about by
-   default; ``glitches = "repair"`` replaces the frame by linear interpolation from the
-   unflagged frames (:func:`repair_glitches`). Only frames with two valid frames on either
-   side, one frame period apart (no step longer than :data:`GAP_STEP_RATIO` times the median
-   step), are judged, and the local median is taken over such measured deviations: beside a
-   gap (missing samples or missing frames) a neighbour's deviation is unknown or spans the
-   gap, and a real frame there would look like a spike.
+   neighbours do not, and while the frames around it move smoothly, and after which the joint
+   comes back to its path: its velocity after the frame (frame f+1 to f+2) is the one before it
+   (f-2 to f-1). A one-frame spike of size ``d`` gives ``e = d`` at the frame, ``d / 2`` at
+   each neighbour and no change of velocity; a real change of velocity made within one frame
+   period (a foot leaving or striking the floor, 30-50 ms, is one frame at 30 Hz) gives a lone
+   deviation too, but the velocity stays changed: the change times ``dt1 dt2 / (dt1 + dt2)``
+   (:func:`turns`) equals ``e`` there, and exceeds it when the change is spread over several
+   frames. Thresholds: ``glitch_min_m`` (2 cm), ``glitch_ratio`` (1.6 x the neighbours),
+   ``glitch_local_ratio`` (5 x the median of the 13 frames around) and
+   ``glitch_return_ratio`` (the velocity change at most 0.3 x ``e``). The first three alone
+   held at 120 Hz only, where a foot's change of velocity spreads over several frames; the
+   last, a ratio of two distances of one frame, holds at any frame rate. Flagged in the
+   metadata and warned about by default; ``glitches = "repair"`` replaces the frame by linear
+   interpolation from the unflagged frames (:func:`repair_glitches`). Only frames with two
+   valid frames on either side, one frame period apart (no step longer than
+   :data:`GAP_STEP_RATIO` times the median step), are judged, and the local median is taken
+   over such measured deviations: beside a gap (missing samples or missing frames) a
+   neighbour's deviation is unknown or spans the gap, and a real frame there would look like
+   a spike.
 2. **Human limits**: the frame-to-frame speed and the acceleration
    implied by ``e`` (``2 e / (dt1 dt2)``) against :data:`SPEED_LIMITS_MPS` and
    :data:`ACCEL_LIMITS_MPS2` (times ``speed_scale``).
@@ -42,8 +50,9 @@ Checks, on the canonical 17-joint body:
    the wrong length unit. A body of the wrong size is not judged upright or not.
 7. **Mirrored** (:func:`foot_facing_cosine`), on an upright body: the median cosine between
    where the feet point (toes ahead of ankles) and the facing direction the left and right
-   joints give; below 0 the body is a mirror image (a left-handed file, or left and right
-   joints named the other way round), whose left lies on its right.
+   joints give; below 0 the body is a mirror image (a left-handed file, which a source's
+   ``handedness = "left"`` reads, or left and right joints named the other way round), whose
+   left lies on its right.
 """
 
 from __future__ import annotations
@@ -159,10 +168,36 @@ def find_glitches(
     min_m: float = 0.02,
     ratio: float = 1.6,
     local_ratio: float = 5.0,
+    return_ratio: float = 0.3,
 ) -> BoolArray:
     """Single-frame glitches, (n_frames, n_joints) bool (see the module docstring)."""
     e, _ = deviations(time, positions, valid)
-    return _glitch_mask(e, _measured(time, valid, e.shape), min_m, ratio, local_ratio)
+    measured = _measured(time, valid, e.shape)
+    back = e * return_ratio >= turns(time, positions)
+    return _glitch_mask(e, measured, min_m, ratio, local_ratio) & back
+
+
+def turns(time: FloatArray, positions: FloatArray) -> FloatArray:
+    """How far each frame's velocity changes across it, as a distance comparable with
+    :func:`deviations`: ``|v_after - v_before| dt1 dt2 / (dt1 + dt2)``, (n_frames, n_joints)
+    [m], with ``v_before`` from frame f-2 to f-1, ``v_after`` from f+1 to f+2 and ``dt1``,
+    ``dt2`` the steps either side of frame f.
+
+    A real change of velocity made at frame f gives its deviation ``e`` exactly, one spread
+    over several frames more; a one-frame spike on a steady path 0 (the joint comes back).
+    Infinite at the first and last two frames and where a position is not finite.
+    """
+    t = np.asarray(time, dtype=np.float64)
+    p = np.asarray(positions, dtype=np.float64)
+    out = np.full(p.shape[:2], np.inf)
+    if t.shape[0] < 5:
+        return out
+    before = (p[1:-3] - p[:-4]) / (t[1:-3] - t[:-4])[:, None, None]
+    after = (p[4:] - p[3:-1]) / (t[4:] - t[3:-1])[:, None, None]
+    dt1, dt2 = t[2:-2] - t[1:-3], t[3:-1] - t[2:-2]
+    change = np.linalg.norm(after - before, axis=2) * (dt1 * dt2 / (dt1 + dt2))[:, None]
+    out[2:-2] = np.nan_to_num(change, nan=np.inf)
+    return out
 
 
 def _measured(time: FloatArray, valid: BoolArray | None, shape: tuple[int, ...]) -> BoolArray:
@@ -478,7 +513,7 @@ def check_motion(motion: Motion, config: SanityConfig) -> Motion:
     measured = _measured(body.time, body.valid, e.shape)
     mask = _glitch_mask(
         e, measured, config.glitch_min_m, config.glitch_ratio, config.glitch_local_ratio
-    )
+    ) & (e * config.glitch_return_ratio >= turns(body.time, body.positions))
     frames, joints = np.nonzero(mask)
     items = [
         {
@@ -600,7 +635,8 @@ def check_motion(motion: Motion, config: SanityConfig) -> Motion:
                 config.mirrored,
                 f"the body looks mirrored: its feet point backwards from the way its left and "
                 f"right joints face (median cosine {cos:.2f}; real bodies near +1), so its left "
-                "is on its right: the file's frame is left-handed (a mirror image) or its left "
+                "is on its right: the file's frame is left-handed (a mirror image, which the "
+                "sources that have motion.axes read with motion.handedness = 'left') or its left "
                 "and right joints are named the other way round",
             )
         )

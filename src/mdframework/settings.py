@@ -32,7 +32,7 @@ from . import limits
 from .interfaces import ConfigSection, FloatArray, PluginConfig, RadarConfig
 from .physics import radar
 from .physics.interpolation import Method
-from .skeleton import Axis, check_motion_axes
+from .skeleton import Axis, check_axes, check_motion_axes
 
 # ----------------------------------------------------------------- bounded numeric types
 
@@ -88,14 +88,18 @@ def _resolve_path(value: Path, info: ValidationInfo) -> Path:
 DataPath = Annotated[Path, AfterValidator(_resolve_path)]
 
 
-def _motion_axes(value: tuple[str, str, str]) -> tuple[str, str, str]:
-    check_motion_axes(value)
+def _motion_axes(value: tuple[str, str, str], info: ValidationInfo) -> tuple[str, str, str]:
+    if info.data.get("handedness") == "left":
+        check_axes(value)  # a mirror, as a left-handed file needs: OrientedMotionConfig's check
+    else:
+        check_motion_axes(value)
     return value
 
 
 #: A motion source's ``axes``: the file axis (with sign) that becomes x (forward), y (left) and
 #: z (up); x, y and z once each, and a rotation, not a mirror
-#: (:func:`mdframework.skeleton.check_motion_axes`).
+#: (:func:`mdframework.skeleton.check_motion_axes`), unless the config declares the file's
+#: frame left-handed (:class:`OrientedMotionConfig`).
 MotionAxes = Annotated[tuple[Axis, Axis, Axis], AfterValidator(_motion_axes)]
 
 
@@ -136,6 +140,15 @@ class SanityConfig(StrictModel):
         le=1000,
         description="... and at least this many times the median deviation of the 13 frames "
         "around it (fast but smooth motion has no such outlier).",
+    )
+    glitch_return_ratio: float = Field(
+        0.3,
+        ge=0,
+        le=1000,
+        description="... and the joint comes back: its velocity after the frame differs from "
+        "the one before by at most this fraction of the deviation (as a distance, |v_after - "
+        "v_before| dt1 dt2 / (dt1 + dt2)): a one-frame spike gives 0, a real change of "
+        "velocity made within one frame (a foot leaving the floor at 30 Hz) 1 or more.",
     )
     limits: Literal["warn", "ignore", "error"] = Field(
         "warn",
@@ -188,8 +201,9 @@ class SanityConfig(StrictModel):
     mirrored: Literal["warn", "ignore", "error"] = Field(
         "warn",
         description="An upright body whose feet point backwards from the way its left and "
-        "right joints face (a mirror image: a left-handed file, or left and right joints "
-        "named the other way round): warn, flag silently, or stop.",
+        "right joints face (a mirror image: a left-handed file, which the sources' handedness "
+        "option reads, or left and right joints named the other way round): warn, flag "
+        "silently, or stop.",
     )
 
 
@@ -211,6 +225,28 @@ class MotionConfig(PluginConfig):
         """Length of the record [s] when the config alone fixes it (``duration``), else
         ``None`` (known once the motion is loaded). Generators override it."""
         return self.duration
+
+
+class OrientedMotionConfig(MotionConfig):
+    """Base of the configs of motion sources that read a file's frame with ``axes``
+    (:data:`MotionAxes`, which a subclass declares): declares whether that frame is
+    right-handed, as motion files are and ``axes`` then must be a rotation, or left-handed (a
+    Unity export, say), whose ``axes`` must then be a mirror, so that the body is read as it is,
+    not as its mirror image."""
+
+    handedness: Literal["right", "left"] = Field(
+        "right",
+        description="The file's frame: right-handed (motion files' usual; axes a rotation) or "
+        "left-handed (a Unity export, say; axes then mirror it, e.g. the default's y axis with "
+        "its sign changed). A left-handed file read as right-handed gives the body's mirror "
+        "image, which the mirrored sanity check flags.",
+    )
+
+    @model_validator(mode="after")
+    def _check_handedness(self) -> OrientedMotionConfig:
+        axes = getattr(self, "axes")  # noqa: B009 (each subclass declares its own default)
+        check_motion_axes(axes, left_handed=self.handedness == "left")
+        return self
 
 
 class RadarPowerConfig(RadarConfig):

@@ -297,21 +297,34 @@ def check_axes(axes: Sequence[str]) -> None:
         )
 
 
-def check_motion_axes(axes: Sequence[str]) -> None:
+def check_motion_axes(axes: Sequence[str], left_handed: bool = False) -> None:
     """A motion source's ``axes`` option (:func:`reorient`): :func:`check_axes`, and
     ``ValueError`` for a mirror (a determinant of -1), which would turn the body's left into
     its right: motion files (BVH, C3D, TRC, Kinect, DeepMimic) use right-handed axes, as the
-    project frame does, so only a rotation maps one onto the other."""
+    project frame does, so only a rotation maps one onto the other. A file whose frame is
+    declared left-handed (``left_handed``, a source's ``handedness = "left"``) is the other way
+    round: only a mirror maps it onto the project's frame, and a rotation is refused."""
     check_axes(axes)
     m = np.zeros((3, 3))
     for row, a in enumerate(axes):
         m[row, "xyz".index(a[-1])] = -1.0 if a.startswith("-") else 1.0
-    if np.linalg.det(m) < 0:
-        left = axes[1][1:] if axes[1].startswith("-") else f"-{axes[1]}"
+    mirror = bool(np.linalg.det(m) < 0)
+    if mirror == left_handed:
+        return
+    left = axes[1][1:] if axes[1].startswith("-") else f"-{axes[1]}"
+    other = [axes[0], left, axes[2]]
+    if left_handed:
         raise ValueError(
-            f"{list(axes)} mirror the body (its left would become its right): change the sign "
-            f"of one axis, e.g. of the one that becomes y (left): {[axes[0], left, axes[2]]}"
+            f"handedness = 'left' declares the file's frame left-handed, which only a mirror "
+            f"turns into the project's right-handed frame, but axes {list(axes)} are a "
+            f"rotation: change the sign of one axis, e.g. of the one that becomes y (left): "
+            f"{other}"
         )
+    raise ValueError(
+        f"{list(axes)} mirror the body (its left would become its right): change the sign "
+        f"of one axis, e.g. of the one that becomes y (left): {other}; or, if the file's frame "
+        "is left-handed (as Unity's is), declare it with handedness = 'left'"
+    )
 
 
 def check_canonical_keys(mapping: Mapping[str, Any] | None, field: str) -> None:

@@ -21,18 +21,17 @@ from mdframework import (
     DataFileError,
     DataPath,
     Motion,
-    MotionConfig,
     MotionSource,
     Skeleton,
     limits,
 )
-from mdframework.settings import FrameRate, MotionAxes
+from mdframework.settings import FrameRate, MotionAxes, OrientedMotionConfig
 from mdframework.skeleton import check_canonical_keys, group_means, reorient
 
 MarkerSetName = Literal["auto", "plug-in-gait", "cmu", "opensim-gait"]
 
 
-class MarkerFileConfig(MotionConfig):
+class MarkerFileConfig(OrientedMotionConfig):
     """Fields shared by the marker-file sources (``c3d``, ``trc``)."""
 
     file: DataPath = Field(description="The marker file; relative to the config file's folder.")

@@ -38,11 +38,10 @@ from mdframework import (
     DataFileError,
     DataPath,
     Motion,
-    MotionConfig,
     MotionSource,
     Skeleton,
 )
-from mdframework.settings import FrameRate, MotionAxes
+from mdframework.settings import FrameRate, MotionAxes, OrientedMotionConfig
 from mdframework.skeleton import Axis, check_canonical_keys, reorient
 
 from .bvh import bvh_forward_kinematics, read_bvh
@@ -189,7 +188,7 @@ def load_any_bvh(
     return names, pos, mapping, meta, rig, bvh.frame_time
 
 
-class BvhConfig(MotionConfig):
+class BvhConfig(OrientedMotionConfig):
     """A BVH file of any rig (CMU conversions, Mixamo, Biovision-named studio captures, or
     any rig with a joint map)."""
 

@@ -27,19 +27,18 @@ from mdframework import (
     DataFileError,
     DataPath,
     Motion,
-    MotionConfig,
     MotionSource,
     Skeleton,
     limits,
 )
-from mdframework.settings import MotionAxes
+from mdframework.settings import MotionAxes, OrientedMotionConfig
 from mdframework.skeleton import reorient
 
 #: Most cycles a ``"wrap"`` clip may be played.
 MAX_CYCLES = 10_000
 
 
-class DeepMimicConfig(MotionConfig):
+class DeepMimicConfig(OrientedMotionConfig):
     """A DeepMimic motion clip (JSON text) of the humanoid3d character."""
 
     kind: Literal["deepmimic"] = Field("deepmimic", description="Selects this source: 'deepmimic'.")

@@ -22,12 +22,11 @@ from mdframework import (
     DataFileError,
     DataPath,
     Motion,
-    MotionConfig,
     MotionSource,
     Skeleton,
     limits,
 )
-from mdframework.settings import FrameRate, MotionAxes
+from mdframework.settings import FrameRate, MotionAxes, OrientedMotionConfig
 from mdframework.skeleton import check_canonical_keys, group_means, reorient
 
 #: A value of a time column in its own unit (frame numbers, milliseconds, seconds); in seconds
@@ -39,7 +38,7 @@ ColumnTime = Annotated[float, Field(ge=-1e16, le=1e16)]
 UNITS_M = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254, "ft": 0.3048}
 
 
-class TableConfig(MotionConfig):
+class TableConfig(OrientedMotionConfig):
     """A plain joint-track table (CSV, TSV, whitespace text or NPZ; long or wide form)."""
 
     kind: Literal["table"] = Field("table", description="Selects this source: 'table'.")
