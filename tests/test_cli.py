@@ -579,6 +579,31 @@ def test_check_predicts_what_the_run_does(
         assert (plan["nfft"], plan["n_frames"], plan["window_pulses"]) == (1024, 75, 16)
 
 
+@pytest.mark.parametrize(
+    ("name", "rate", "record", "window"),
+    [
+        ("point_target.toml", "PRF 2.4 kHz", "4801 pulses", "window 256 pulses"),
+        ("cw_walk.toml", "slow time 2 kHz", "5701 samples", "window 256 samples"),
+        (
+            "fmcw_walk.toml",
+            "slow time 5.197 kHz (1440 pulses per second of record)",
+            "3600 pulses",
+            "window 16 samples",
+        ),
+    ],
+)
+def test_check_names_the_slow_time_as_the_radar_has_it(
+    name: str, rate: str, record: str, window: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`mdf check` calls a pulse-Doppler radar's slow-time rate its PRF and the samples pulses;
+    a CW radar's is its I/Q rate and its samples are no pulses; an FMCW radar's is its loop
+    rate, its pulses the chirps, 3 per loop and none between frames (48 per 33.3 ms frame)."""
+    assert cli.main(["check", str(EXAMPLES / name)]) == 0
+    out = capsys.readouterr().out
+    assert f"), {rate}\n" in out and f": {record}; " in out
+    assert f"spectrogram {window} (" in out
+
+
 def test_check_accepts_an_fmcw_record_shorter_than_the_stft_window(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

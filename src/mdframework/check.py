@@ -67,7 +67,9 @@ class RunPlan:
     record_start_s: float
     record_length_s: float
     n_pulses: int
-    prf_hz: float
+    prf_hz: float  # the slow-time sample rate: a PRF, a CW I/Q rate, an FMCW loop rate
+    pulse_rate_hz: float  # pulses (FMCW chirps) per second of a record, gaps included
+    pulsed: bool  # the radar's config has a ``prf``: its slow-time samples are its pulses
     carrier_frequency_hz: float
     wavelength_m: float
     n_joints: int
@@ -249,6 +251,8 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
         record_length_s=t_end - t_start,
         n_pulses=n_pulses,
         prf_hz=prf,
+        pulse_rate_hz=float(wf.pulse_rate),
+        pulsed="prf" in type(cfg.radar).model_fields,
         carrier_frequency_hz=fc,
         wavelength_m=lam,
         n_joints=body.n_joints,
@@ -286,16 +290,24 @@ def _mib(value: float) -> str:
 def format_plan(plan: RunPlan, source: str) -> str:
     """The plan as the lines ``mdf check`` prints."""
     p = plan
+    # a pulse-Doppler radar's slow time is its PRF; a CW radar's its I/Q rate, an FMCW radar's
+    # its loop rate (several chirps, its pulses, per sample; none between frames)
+    rate = f"PRF {_hz(p.prf_hz)}" if p.pulsed else f"slow time {_hz(p.prf_hz)}"
+    chirps = abs(p.pulse_rate_hz - p.prf_hz) > 1e-9 * p.prf_hz
+    if chirps:
+        rate += f" ({p.pulse_rate_hz:.4g} pulses per second of record)"
+    sample = "pulses" if p.pulsed else "samples"
+    pulses = "pulses" if p.pulsed or chirps else "samples"
     lines = [f"{source}: valid"]
     for section, chosen in p.plugins.items():
         lines.append(f"  {section:<12}{chosen}")
     lines += [
         f"  {'effects':<12}{', '.join(p.effects) or 'none'}",
         f"  {'carrier':<12}{_hz(p.carrier_frequency_hz)} (wavelength "
-        f"{p.wavelength_m * 100:.3g} cm), PRF {_hz(p.prf_hz)}",
+        f"{p.wavelength_m * 100:.3g} cm), {rate}",
         f"  {'record':<12}{p.record_length_s:.3f} s from {p.record_start_s:.3f} s: "
-        f"{p.n_pulses} pulses; joints: {p.n_joints}, scatterers: {p.n_scatterers}",
-        f"  {'spectrogram':<12}window {p.window_pulses} pulses "
+        f"{p.n_pulses} {pulses}; joints: {p.n_joints}, scatterers: {p.n_scatterers}",
+        f"  {'spectrogram':<12}window {p.window_pulses} {sample} "
         f"({1e3 * p.window_pulses / p.spectrum_rate_hz:.1f} ms), hop {p.hop_pulses:.4g} "
         f"({1e3 * p.hop_pulses / p.spectrum_rate_hz:.2f} ms), nfft {p.nfft}: {p.n_frames} frames",
         f"  {'resolution':<12}Doppler bin {p.doppler_bin_hz:.3g} Hz = "
