@@ -110,6 +110,23 @@ def test_thermal_noise_is_refused_without_the_range_equation() -> None:
     assert snr.metadata["effects"][0]["noise_power_w"] > 0
 
 
+def test_thermal_noise_with_a_cw_radar_takes_the_pages_pulse_width_and_bandwidth() -> None:
+    """docs/effects.md: the cw radar has neither a pulse width nor a bandwidth; mode thermal
+    without them is refused naming the field, and ``pulse_width = 1 / sample_rate`` with
+    ``bandwidth = sample_rate`` gives k T F times the I/Q rate, per sample, as the page says."""
+    from mdframework import SceneError
+
+    fs = 2400.0
+    cw = {"kind": "cw", "sample_rate": fs}
+    thermal = {"kind": "noise", "mode": "thermal"}
+    with pytest.raises(SceneError, match=r"^effects\.noise: mode 'thermal' needs pulse_width"):
+        run(APPROACHING, [thermal], radar_cfg=cw, duration=0.2)
+    given = {**thermal, "pulse_width": 1 / fs, "bandwidth": fs}
+    res = run(APPROACHING, [given], radar_cfg=cw, duration=0.2)
+    kt_f = BOLTZMANN * 290.0 * 10 ** (3.0 / 10)  # the effect's default T and F
+    assert res.metadata["effects"][0]["noise_power_w"] == pytest.approx(kt_f * fs, rel=1e-12)
+
+
 def test_noise_floor_in_spectrogram_is_sigma2_sum_w2() -> None:
     """The SNR is per pulse; in the spectrogram the floor per bin is sigma^2 sum(w^2)."""
     noisy = run(APPROACHING, [{"kind": "noise", "snr_db": 0.0}])
