@@ -603,6 +603,10 @@ def test_the_shipped_recordings_are_upright_as_the_page_says() -> None:
     lo, hi = (float(q) for q in quoted.groups())
     assert min(legs.values()) == pytest.approx(lo, abs=0.005), legs
     assert max(legs.values()) == pytest.approx(hi, abs=0.005), legs
+    # the options' descriptions (the config reference) quote the same ranges
+    fields = SanityConfig.model_fields
+    assert f"give {quoted.group(1)}-{quoted.group(2)} m" in str(fields["leg_length_m"].description)
+    assert f"give {low:g}-{high:g} m" in str(fields["upright_min_m"].description)
 
 
 def _mirrored_bvh(src: Path, dst: Path) -> Path:
@@ -666,7 +670,8 @@ def test_a_left_handed_file_is_read_as_the_body_it_holds(tmp_path: Path) -> None
     """The real 16_21 walk written as a left-handed exporter writes it (its X axis mirrored,
     the left joints' positions at -X): read as right-handed, the body is the walk's mirror
     image, flagged by the mirrored check; declared left-handed (handedness = "left", with the
-    default axes' left axis mirrored), it is the original walk to 1e-9 m, and nothing is said."""
+    default axes' left axis mirrored), it is the original walk to the last bit (sines of
+    negated angles and negated axes are exact), and nothing is said."""
     mirror = _mirrored_bvh(EXAMPLES / CMU["16_21"]["file"], tmp_path / "16_21.bvh")
     real, real_msgs = load({"kind": "bvh", "file": CMU["16_21"]["file"]})
     as_right, right_msgs = load({"kind": "bvh", "file": str(mirror)})
@@ -679,8 +684,8 @@ def test_a_left_handed_file_is_read_as_the_body_it_holds(tmp_path: Path) -> None
     assert as_left.metadata["sanity"]["mirrored"]["ok"] and left_msgs == real_msgs == []
     body, read = real.canonical(), as_left.canonical()
     assert np.array_equal(read.time, body.time)
-    np.testing.assert_allclose(read.positions, body.positions, rtol=0, atol=1e-9)
-    assert foot_facing_cosine(read) == pytest.approx(foot_facing_cosine(body), abs=1e-9)
+    assert np.array_equal(read.positions, body.positions)  # to the last bit, as the page says
+    assert foot_facing_cosine(read) == foot_facing_cosine(body)
 
 
 def test_a_body_read_in_the_wrong_length_unit_is_flagged() -> None:
