@@ -627,6 +627,12 @@ def test_antenna_after_multipath_weighs_each_path_by_its_own_directions() -> Non
     r_d, r_b = 3.0, np.hypot(3.0, 2.0)
     g_b = np.exp(-4 * np.log(2) * (np.degrees(np.arctan2(2.0, 3.0)) / bw) ** 2)  # one way
     assert 10 * np.log10(g_b) == pytest.approx(-34.17, abs=0.01)
+    from conftest import ROOT
+
+    page = " ".join((ROOT / "docs" / "effects.md").read_text().split())
+    below, two_way = np.degrees(np.arctan2(2.0, 3.0)), -20 * np.log10(g_b)
+    assert f"the image lies {below:.1f} deg below boresight" in page
+    assert f"with a {bw:g} deg Gaussian beam its two-way gain is {two_way:.1f} dB down" in page
     assert rcs["target0"] == pytest.approx(1.0, rel=1e-12)
     assert rcs["target0~image"] == pytest.approx(gamma**4 * g_b**2, rel=1e-9)
     r_m = (r_d + r_b) / 2  # a 0 deg reflection phase: no range offset
