@@ -27,6 +27,7 @@ from conftest import EXAMPLES, ROOT, project_distributions
 from mdframework import hookspecs
 from mdframework.config import validate_run_config
 from mdframework.docgen import _submodel, render
+from mdframework.pipeline import build_stages
 from mdframework.plugins import INTERFACES, OLD_HOOKS, build_registry, default_registry
 from mdframework.settings import RunConfigBase
 from mdframework.testing import check_plugin
@@ -247,8 +248,10 @@ TOML_BLOCKS = [b for b in blocks() if b.lang == "toml"]
 @pytest.mark.parametrize("block", TOML_BLOCKS, ids=[b.where for b in TOML_BLOCKS])
 def test_every_documented_config_parses(block: Block) -> None:
     """A block that names an example file (``# examples/x.toml``) must agree with it; run
-    configs validate against the installed plugins, dataset and experiment configs against
-    their models; fragments (``effects = [...]``) validate inside a minimal run config."""
+    configs validate against the installed plugins and build their plugins (refused as a run
+    refuses them before its first pulse: an effect order, a radar an effect cannot work with),
+    dataset and experiment configs against their models; fragments (``effects = [...]``)
+    validate inside a minimal run config."""
     from mdframework.dataset import DatasetConfig
     from mdframework.experiment import ExperimentConfig
 
@@ -285,7 +288,8 @@ def test_every_documented_config_parses(block: Block) -> None:
         }
         if "motion" not in data:
             data = {**minimal, **data}
-        validate_run_config(data, source=block.where, base_dir=base_dir)
+        config = validate_run_config(data, source=block.where, base_dir=base_dir)
+        build_stages(config)  # what a run refuses before its first pulse (effects' order, radar)
 
 
 def test_config_reference_is_current() -> None:

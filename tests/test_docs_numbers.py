@@ -316,3 +316,90 @@ def test_the_validation_page_quotes_the_walks_step_times() -> None:
     boulic_step = Gait(1.8, 1.0).cycle_duration / 2
     for shown, exact in zip(quoted.groups(), (cmu_step, boulic_step), strict=True):
         assert abs(float(shown) - exact) <= _half_unit(shown), (shown, exact)
+
+
+def test_the_datasets_page_shows_what_mdf_dataset_check_prints() -> None:
+    """docs/datasets.md shows `mdf dataset check examples/datasets/cmu.toml`, abridged (`...`):
+    each line it shows is a line the command prints."""
+    import subprocess
+    import sys
+
+    page = (ROOT / "docs" / "datasets.md").read_text()
+    shown = re.search(r"```text\n(examples/datasets/cmu\.toml: valid.*?)```", page, re.S)
+    assert shown is not None
+    done = subprocess.run(
+        [sys.executable, "-m", "mdframework.cli", "dataset", "check", "examples/datasets/cmu.toml"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    printed = done.stdout.splitlines()
+    lines = [line for line in shown.group(1).splitlines() if line.strip() != "..."]
+    assert len(lines) >= 3
+    assert all(line in printed for line in lines), (lines, printed)
+
+
+def test_the_getting_started_page_lists_the_exit_codes_mdf_help_lists() -> None:
+    """docs/getting-started.md and `mdf --help` give a script the same exit codes, with the
+    same meanings."""
+    from mdframework import cli
+
+    page = " ".join((ROOT / "docs" / "getting-started.md").read_text().split())
+    quoted = re.search(r"Exit codes, for scripts \(`mdf --help` lists them too\): (.*?)\.", page)
+    assert quoted is not None
+    codes = re.findall(r"(\d+) ([a-z ]+?)(?: \(|;|$)", quoted.group(1))
+    assert codes == [
+        ("0", "done"),
+        ("1", "internal error"),
+        ("2", "bad input"),
+        (str(cli.EXIT_INTERRUPTED), "interrupted"),
+        (str(cli.EXIT_TERMINATED), "terminated"),
+    ]
+
+
+def test_the_getting_started_page_quotes_mdf_checks_bytes_per_scatterer() -> None:
+    """docs/getting-started.md: `mdf check` counts about N bytes per scatterer and pulse."""
+    from mdframework.check import SCATTERER_PULSE_BYTES
+
+    page = " ".join((ROOT / "docs" / "getting-started.md").read_text().split())
+    quoted = re.search(r"at about (\d+) bytes per scatterer and pulse", page)
+    assert quoted is not None and int(quoted.group(1)) == SCATTERER_PULSE_BYTES
+
+
+def test_the_effects_page_quotes_the_thermal_noise_of_sqrt_rcs_amplitudes() -> None:
+    """docs/effects.md: with `amplitude = "sqrt_rcs"` a 1 m^2 target's signal is 1, and the
+    noise effect's thermal noise (the lfm radar's and the effect's defaults) would be some N dB
+    below it, which is why that mode is refused there."""
+    import math
+
+    from mdf_lfm.waveform import LfmConfig
+    from mdf_noise.noise import NoiseConfig, noise_power
+
+    page = " ".join((ROOT / "docs" / "effects.md").read_text().split())
+    quoted = re.search(r"the noise would be some (\d+) dB below a 1 m\^2 target", page)
+    assert quoted is not None
+    radar, noise = LfmConfig(), NoiseConfig()
+    power = noise_power(
+        "thermal",
+        noise_figure_db=noise.noise_figure_db,
+        temperature=noise.temperature,
+        pulse_width=radar.pulse_width,
+        bandwidth=radar.bandwidth,
+    )
+    assert abs(-10 * math.log10(power) - int(quoted.group(1))) < 1.5
+
+
+def test_the_benchmarks_page_speed_up_of_the_fmcw_clutter_is_its_tables() -> None:
+    """docs/benchmarks.md: the FMCW clutter's speed-ups are the ratios of the table's mean CPU
+    times before and after, to the page's rounding (it said 3.8 for 8.78 s -> 2.28 s)."""
+    page = (ROOT / "docs" / "benchmarks.md").read_text()
+    rows = re.findall(r"^\| (6|60) s \| ([\d.]+), ([\d.]+) \| ([\d.]+), ([\d.]+) \| ", page, re.M)
+    assert [r[0] for r in rows] == ["6", "60"]
+    quoted = re.search(
+        r"^([\d.]+) and ([\d.]+) times faster \(the means of the CPU times\)", page, re.M
+    )
+    assert quoted is not None
+    for (_, *times), shown in zip(rows, quoted.groups(), strict=True):
+        b1, b2, a1, a2 = (float(t) for t in times)
+        assert f"{(b1 + b2) / (a1 + a2):.1f}" == shown

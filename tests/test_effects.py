@@ -110,6 +110,23 @@ def test_thermal_noise_is_refused_without_the_range_equation() -> None:
     assert snr.metadata["effects"][0]["noise_power_w"] > 0
 
 
+def test_thermal_noise_with_a_cw_radar_takes_the_pages_pulse_width_and_bandwidth() -> None:
+    """docs/effects.md: the cw radar has neither a pulse width nor a bandwidth; mode thermal
+    without them is refused naming the field, and ``pulse_width = 1 / sample_rate`` with
+    ``bandwidth = sample_rate`` gives k T F times the I/Q rate, per sample, as the page says."""
+    from mdframework import SceneError
+
+    fs = 2400.0
+    cw = {"kind": "cw", "sample_rate": fs}
+    thermal = {"kind": "noise", "mode": "thermal"}
+    with pytest.raises(SceneError, match=r"^effects\.noise: mode 'thermal' needs pulse_width"):
+        run(APPROACHING, [thermal], radar_cfg=cw, duration=0.2)
+    given = {**thermal, "pulse_width": 1 / fs, "bandwidth": fs}
+    res = run(APPROACHING, [given], radar_cfg=cw, duration=0.2)
+    kt_f = BOLTZMANN * 290.0 * 10 ** (3.0 / 10)  # the effect's default T and F
+    assert res.metadata["effects"][0]["noise_power_w"] == pytest.approx(kt_f * fs, rel=1e-12)
+
+
 def test_noise_floor_in_spectrogram_is_sigma2_sum_w2() -> None:
     """The SNR is per pulse; in the spectrogram the floor per bin is sigma^2 sum(w^2)."""
     noisy = run(APPROACHING, [{"kind": "noise", "snr_db": 0.0}])
@@ -610,6 +627,12 @@ def test_antenna_after_multipath_weighs_each_path_by_its_own_directions() -> Non
     r_d, r_b = 3.0, np.hypot(3.0, 2.0)
     g_b = np.exp(-4 * np.log(2) * (np.degrees(np.arctan2(2.0, 3.0)) / bw) ** 2)  # one way
     assert 10 * np.log10(g_b) == pytest.approx(-34.17, abs=0.01)
+    from conftest import ROOT
+
+    page = " ".join((ROOT / "docs" / "effects.md").read_text().split())
+    below, two_way = np.degrees(np.arctan2(2.0, 3.0)), -20 * np.log10(g_b)
+    assert f"the image lies {below:.1f} deg below boresight" in page
+    assert f"with a {bw:g} deg Gaussian beam its two-way gain is {two_way:.1f} dB down" in page
     assert rcs["target0"] == pytest.approx(1.0, rel=1e-12)
     assert rcs["target0~image"] == pytest.approx(gamma**4 * g_b**2, rel=1e-9)
     r_m = (r_d + r_b) / 2  # a 0 deg reflection phase: no range offset

@@ -156,3 +156,14 @@ def test_a_plugin_made_with_a_dict_says_to_validate_it() -> None:
         name = cls.__name__
         with pytest.raises(TypeError, match=rf"{name}\.Config\.model_validate.*got dict"):
             cls(section)  # type: ignore[arg-type]
+
+
+def test_a_plugin_built_from_a_plain_dict_says_to_validate_it() -> None:
+    """docs/plugins.md: the base class's __init__ refuses a config section as read (a dict)
+    with a TypeError naming the plugin's Config, which validates it."""
+    from mdf_lfm import LfmPulseDoppler
+
+    with pytest.raises(TypeError, match=r"^LfmPulseDoppler takes an instance of LfmPulseDoppler"):
+        LfmPulseDoppler({"kind": "lfm"})  # type: ignore[arg-type]
+    radar = LfmPulseDoppler(LfmPulseDoppler.Config.model_validate({"kind": "lfm"}))
+    assert radar.config.kind == "lfm"
