@@ -132,12 +132,12 @@ def test_the_pulse_limit_names_the_memory_a_run_would_take() -> None:
     assert f"{n:.4g} pulses" in str(exc.value)
     assert f"about {mib:.3g} MiB of memory)" in str(exc.value)
     assert "motion.duration" in str(exc.value)
-    # keeping every scatterer adds positions, RCS and range per pulse and scatterer
+    # keeping every scatterer adds what a block holds per scatterer and pulse (mdf check's)
     cfg["processing"] = {"keep_scatterers": True}
     with pytest.raises(ConfigError) as exc:
         validate_run_config(cfg)
-    gib = n * (8 + 8 + 16 + 8 + 5 * 8 * 1) / 1024**2
-    assert f"about {gib:.3g} MiB of memory, keeping 1 scatterer(s) per pulse" in str(exc.value)
+    gib = n * (8 + 8 + 16 + 8 + 160 * 1) / 1024**3
+    assert f"about {gib:.3g} GiB of memory, keeping 1 scatterer(s) per pulse" in str(exc.value)
     del cfg["processing"]
     # just below the limit the config is valid
     cfg["motion"]["length"] = (limits.MAX_PULSES - 2) / 2400.0

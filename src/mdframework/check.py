@@ -29,6 +29,7 @@ import numpy as np
 from . import limits
 from .errors import MdfError
 from .interfaces import SceneContext
+from .limits import SCATTERER_PULSE_BYTES
 from .physics import interpolation, radar
 from .pipeline import (
     Stages,
@@ -51,11 +52,6 @@ from .settings import RunConfigBase
 from .skeleton import Skeleton
 
 MIB = 1024.0**2
-
-#: Bytes a block of the streaming pipeline holds per scatterer and pulse at its peak: the
-#: positions, ranges and RCS and the model's, the effects' and the radar's temporaries (traced
-#: peaks of 100 bytes for ellipsoids and 150 with multipath's bounced paths, analytic path).
-SCATTERER_PULSE_BYTES = 160
 
 
 @dataclass(frozen=True)

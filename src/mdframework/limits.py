@@ -86,7 +86,10 @@ MAX_PRODUCT_BYTES = 2**30
 #: every scatterer (``processing.keep_scatterers``: positions, RCS, range): the basis of the
 #: memory estimate in :func:`check_pulses`.
 _BYTES_PER_PULSE = 8 + 8 + 16 + 8
-_BYTES_PER_PULSE_SCATTERER = 5 * 8
+#: Bytes a block of the streaming pipeline holds per scatterer and pulse at its peak: the
+#: positions, ranges and RCS and the model's, the effects' and the radar's temporaries (traced
+#: peaks of 100 bytes for ellipsoids and 150 with multipath's bounced paths, analytic path).
+SCATTERER_PULSE_BYTES = 160
 
 
 def memory_estimate_bytes(
@@ -96,7 +99,7 @@ def memory_estimate_bytes(
     arrays of the streaming pipeline do not grow with it, unless every scatterer is kept)."""
     per_pulse = _BYTES_PER_PULSE
     if keep_scatterers:
-        per_pulse += _BYTES_PER_PULSE_SCATTERER * max(n_scatterers, 1)
+        per_pulse += SCATTERER_PULSE_BYTES * max(n_scatterers, 1)
     return n_pulses * per_pulse
 
 
