@@ -347,7 +347,7 @@ def plan_dataset(
     with its draws, and each label's first simulated record is planned (:func:`plan_run`), or
     with ``every`` each simulated record (what a run refuses stops the plan, naming the record,
     unless the config's ``on_error = "skip"``: then it is counted as the build would skip it)."""
-    from .dataset import plan_records, record_failure, validate_record
+    from .dataset import is_record_failure, plan_records, record_failure, validate_record
 
     specs = plan_records(config, base_dir)
     plan = DatasetPlan(len(specs), {}, {}, None)
@@ -362,7 +362,9 @@ def plan_dataset(
                 spec.run_config, where, spec.base_dir, spec.draws, spec.draw_origins
             )
             p = plan_run(run, registry)
-        except MdfError as exc:  # named as the build names it
+        except (MdfError, ValueError) as exc:
+            if not is_record_failure(exc):  # a bug, as in the build
+                raise
             named, cause, _ = record_failure(spec, exc)
             if spec.on_error != "skip":
                 raise MdfError(f"{named}: {cause}") from None

@@ -1327,12 +1327,19 @@ def record_failure(spec: RecordSpec, exc: Exception) -> tuple[str, str, tuple[st
     return where, cause, (file, start, length)
 
 
+def is_record_failure(exc: Exception) -> bool:
+    """Whether ``exc``, raised while a record was built or planned, is the record's own failure
+    (its config or data: named with :func:`record_failure`, or skipped with ``on_error =
+    "skip"``), not a bug: mdframework's errors, and a ``ValueError`` not out of a plugin."""
+    return isinstance(exc, MdfError) or (isinstance(exc, ValueError) and not is_plugin_bug(exc))
+
+
 def _record_or_skip(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     """:func:`build_record` but for its wait: the file may still be on its way to the disk."""
     try:
         return _build_record(spec, out_dir)
     except (MdfError, ValueError) as exc:
-        if not isinstance(exc, MdfError) and is_plugin_bug(exc):  # not the config's: a bug
+        if not is_record_failure(exc):  # not the config's: a bug
             exc.add_note(f"while building record {spec.record_id} of {spec.recording}")
             raise
         where, cause, (file, start, length) = record_failure(spec, exc)
