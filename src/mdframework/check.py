@@ -43,6 +43,7 @@ from .pipeline import (
     record_pulses,
     record_window,
     refuse_near,
+    refuse_untracked,
     spectrogram_geometry,
     start_record,
 )
@@ -128,6 +129,7 @@ def interpolated_radial_speed(
     a block at a time. ``body``: the placed body [m]; ``radar_position`` (3,) [m]."""
     frames = interpolation.window_frames(body.time, float(t[0]), float(t[-1]))
     near = body.select_frames(frames)
+    refuse_untracked(near, float(t[0]), float(t[-1]), float(body.time[0]))
     resample = interpolation.TrackResampler(near.time, near.positions, near.valid, method)
     n_frames = max(int(np.count_nonzero((near.time >= t[0]) & (near.time <= t[-1]))), 1)
     step = max(1, t.shape[0] // (SPEED_SAMPLES_PER_FRAME * n_frames))
