@@ -976,6 +976,15 @@ def test_an_fft_shorter_than_its_window_names_the_field(
     )
 
 
+def stop_and_skip(folder: Path, text: str) -> tuple[Path, Path]:
+    """The dataset config ``text`` written as is (``stop.toml``) and with ``on_error = "skip"``
+    (``skip.toml``) into ``folder``."""
+    stop, skip = folder / "stop.toml", folder / "skip.toml"
+    stop.write_text(text)
+    skip.write_text('on_error = "skip"\n' + text)
+    return stop, skip
+
+
 def test_dataset_check_all_finds_the_record_the_build_stops_at(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -990,9 +999,7 @@ def test_dataset_check_all_finds_the_record_the_build_stops_at(
         '[base.radar]\nkind = "lfm"\n[base.scatterers]\nkind = "ellipsoid"\n'
         "[base.scene]\nradar_position = [3.2, 0.0, 1.0]\n"
     )
-    stop, skip = tmp_path / "stop.toml", tmp_path / "skip.toml"
-    stop.write_text(text)
-    skip.write_text('on_error = "skip"\n' + text)
+    stop, skip = stop_and_skip(tmp_path, text)
     where = re.escape(f"(walk; source file {amc}, window 2.000-2.500 s): ")
     where = r"record 00004-[0-9a-f]{10} " + where
     code, _, err = run_cli(["dataset", "check", str(stop), "--all"], capsys)
@@ -1004,3 +1011,79 @@ def test_dataset_check_all_finds_the_record_the_build_stops_at(
     plan = json.loads(out)
     assert plan["n_planned"] == {"walk": 4} and plan["n_skipped"] == {"walk": 1}
     assert re.match(where, plan["skipped"]["walk"])
+
+
+def hand_lost_walk(folder: Path) -> str:
+    """The real UTKinect walk (file frames 252-390 at 60 Hz) written into ``folder`` with its
+    left hand lost after 0.8 s (file frame 300): a table motion section, inline TOML."""
+    ut = EXAMPLES / "data" / "kinect" / "utkinect" / "joints_s01_e01.txt"
+    rows = [line.split() for line in ut.read_text().splitlines() if line.strip()]
+    for row in rows:  # HandLeft, the eighth joint
+        if float(row[0]) > 300:
+            row[1 + 7 * 3 : 1 + 8 * 3] = ["0", "0", "0"]
+    table = folder / "walk.txt"
+    table.write_text("\n".join(" ".join(row) for row in rows) + "\n")
+    joints = ", ".join(
+        f'"{j}"'
+        for j in (
+            "HipCenter Spine ShoulderCenter Head ShoulderLeft ElbowLeft WristLeft HandLeft "
+            "ShoulderRight ElbowRight WristRight HandRight HipLeft KneeLeft AnkleLeft FootLeft "
+            "HipRight KneeRight AnkleRight FootRight"
+        ).split()
+    )
+    return (
+        f'kind = "table", file = "{table}", header = false, delimiter = "whitespace", '
+        f'time_column = "frame", frame_rate = 60.0, joints = [{joints}], joint_set = "kinect-v1", '
+        'axes = ["z", "x", "y"], zero_is_missing = true, time_range = [252, 390]'
+    )
+
+
+def test_dataset_check_names_a_record_the_run_cannot_interpolate_as_the_build_does(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The real UTKinect walk with its left hand lost after its first 0.8 s: the second
+    record's window has no track of it to interpolate (a ValueError of the core, not of a
+    plugin). The build names that record and its cause (exit 2), or skips it; `mdf dataset
+    check` said 'internal error' (exit 1), as it caught only mdframework's own errors."""
+    motion = hand_lost_walk(tmp_path)
+    text = (
+        f'seed = 1\n[[sources]]\nlabel = "walk"\nmotion = {{ {motion} }}\n'
+        '[record_lengths]\nwalk = 0.5\n[base.radar]\nkind = "lfm"\n[base.scatterers]\n'
+        'kind = "ellipsoid"\n[base.scene]\n'
+        'person = { motion = "recorded", position = [2.3, 0.0] }\n'
+    )
+    stop, skip = stop_and_skip(tmp_path, text)
+    cause = r"s\): motion: joint 'l_hand' is tracked only until 0\.800 s of the recording, but "
+    code, _, err = run_cli(["dataset", "build", str(stop), "--out", str(tmp_path / "d")], capsys)
+    assert code == 2 and re.search(r"mdf: error: .*record 0000[123]-.*" + cause, err), err
+    code, _, err = run_cli(["dataset", "check", str(stop), "--all"], capsys)
+    window = r"mdf: error: .*record 00001-.*window 0\.500-1\.000 "
+    assert code == 2 and re.search(window + cause + "the record runs from 0.500 to 1.000", err)
+    code, out, err = run_cli(["dataset", "check", str(skip), "--all", "--json"], capsys)
+    assert code == 0, err
+    plan = json.loads(out)
+    assert plan["n_skipped"] == {"walk": plan["records"]["walk"] - plan["n_planned"]["walk"]} != {}
+    assert re.search(cause, plan["skipped"]["walk"])
+
+
+def test_a_record_past_a_lost_joints_track_is_the_users_error(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The real UTKinect walk with its left hand lost after 0.8 s, a record from 1.0 s: the
+    run cannot interpolate that joint there. `mdf run` and `mdf check` said 'internal error:
+    ValueError ... joint 7 ...' (exit 1); it is the input's: one line naming the joint, when
+    it is tracked and the record's window (exit 2), before any pulse."""
+    config = tmp_path / "run.toml"
+    config.write_text(
+        f"motion = {{ {hand_lost_walk(tmp_path)}, start = 1.0, duration = 0.5 }}\n"
+        'scatterers = { kind = "ellipsoid" }\nradar = { kind = "lfm" }\n'
+        'scene = { person = { motion = "recorded", position = [2.3, 0.0] } }\n'
+    )
+    said = (
+        r"^mdf: error: .*run\.toml: motion: joint 'l_hand' is tracked only until 0\.800 s of "
+        r"the recording, but the record runs from 1\.000 to 1\.500 s"
+    )
+    for command in (["check"], ["run", "--out", str(tmp_path / "out"), "--no-figures"]):
+        code, _, err = run_cli([command[0], str(config), *command[1:]], capsys)
+        lines = [line for line in err.splitlines() if "warning" not in line]
+        assert code == 2 and len(lines) == 1 and re.search(said, lines[0]), err

@@ -828,8 +828,9 @@ def test_dataset_json_and_run_metadata_name_the_software_versions(tmp_path: Path
 
 def test_a_record_kept_from_other_software_versions_is_said(tmp_path: Path) -> None:
     """Each record names the versions that computed it; a build that keeps records computed
-    by other versions (their id covers the config, not the software) warns, naming how many
-    and what differs, so that a dataset mixing versions is never silent."""
+    by other versions (their id covers the config, not the software), or by a version before
+    records named theirs, warns, naming how many and what differs, so that a dataset mixing
+    versions is never silent."""
     from mdframework.plugins import versions
 
     config = point_dataset(tmp_path / "d.toml")  # five records of 0.5 s from a 2.5 s motion
@@ -856,3 +857,16 @@ def test_a_record_kept_from_other_software_versions_is_said(tmp_path: Path) -> N
     assert said[0].startswith(f"1 of 5 records (e.g. {files[1].stem}) were computed by ")
     assert f'mdframework: "0.0.1" -> "{versions()["mdframework"]}"' in said[0]
     assert files[1].read_bytes() == kept  # kept, not computed again
+    # records as a version before records named theirs wrote them (no versions) are said too
+    # (they were kept without a word: yesterday's records mixed with today's)
+    for file in files[2:4]:
+        arrays, meta = read_record(file)
+        del meta["versions"]
+        np.savez(file, **arrays, meta=np.array(json.dumps(meta)))
+    with pytest.warns(dataset.DatasetWarning) as caught:
+        build_dataset(cfg, base, out, workers=1, progress=False)
+    said = [str(w.message) for w in caught if "versions" in str(w.message)]
+    assert len(said) == 1, said
+    assert said[0].startswith(f"3 of 5 records (e.g. {files[1].stem}) were computed by ")
+    assert "(2 by a version from before records named their versions; mdframework: " in said[0]
+    assert files[1].read_bytes() == kept

@@ -353,6 +353,24 @@ def test_a_time_unit_that_makes_no_recording_rate_is_refused(tmp_path: Path) -> 
         read_table(ms, TableLayout(time_unit_s=1e-6))
 
 
+def test_consecutive_frame_numbers_read_as_seconds_are_refused(tmp_path: Path) -> None:
+    """The real UTKinect walk numbered frame by frame (0, 1, 2, ...) in its time column,
+    frame_rate forgotten: read as seconds it was a 1 frame/s recording, at the lowest rate
+    allowed, and ran 30 times too slowly without a word (the refusal caught only frame numbers
+    with gaps). A time column read in seconds whose frames are a whole second apart holds
+    frame numbers: refused naming frame_rate; given frame_rate = 30 it is the walk."""
+    ref = read_utkinect(UT)
+    numbered = _ut_table(tmp_path / "frames.csv", np.arange(ref.time.size, dtype=float), False)
+    with pytest.raises(DataFileError) as err:
+        read_table(numbered)
+    assert "1 s apart" in str(err.value) and "motion.frame_rate for frame numbers" in str(err.value)
+    walk = read_table(numbered, TableLayout(frame_rate=30.0))
+    assert walk.time[-1] - walk.time[0] == pytest.approx((ref.time.size - 1) / 30.0)
+    # frame numbers at a frame_rate of 1 Hz, given as such, are still a rate allowed
+    rows = read_table(numbered, TableLayout(frame_rate=1.0))
+    assert rows.time[1] - rows.time[0] == pytest.approx(1.0)
+
+
 def test_time_unit_and_frame_rate_together_are_refused(tmp_path: Path) -> None:
     """The real walk stamped in milliseconds, configured with time_unit_s = 0.001 and the
     capture's frame_rate = 60 beside it: frame_rate won silently, reading the milliseconds as

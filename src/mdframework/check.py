@@ -44,6 +44,7 @@ from .pipeline import (
     record_pulses,
     record_window,
     refuse_near,
+    refuse_untracked,
     spectrogram_geometry,
     start_record,
 )
@@ -126,6 +127,7 @@ def interpolated_radial_speed(
     a block at a time. ``body``: the placed body [m]; ``radar_position`` (3,) [m]."""
     frames = interpolation.window_frames(body.time, float(t[0]), float(t[-1]))
     near = body.select_frames(frames)
+    refuse_untracked(near, float(t[0]), float(t[-1]), float(body.time[0]))
     resample = interpolation.TrackResampler(near.time, near.positions, near.valid, method)
     n_frames = max(int(np.count_nonzero((near.time >= t[0]) & (near.time <= t[-1]))), 1)
     step = max(1, t.shape[0] // (SPEED_SAMPLES_PER_FRAME * n_frames))
@@ -355,7 +357,7 @@ def plan_dataset(
     with its draws, and each label's first simulated record is planned (:func:`plan_run`), or
     with ``every`` each simulated record (what a run refuses stops the plan, naming the record,
     unless the config's ``on_error = "skip"``: then it is counted as the build would skip it)."""
-    from .dataset import plan_records, record_failure, validate_record
+    from .dataset import is_record_failure, plan_records, record_failure, validate_record
 
     specs = plan_records(config, base_dir)
     plan = DatasetPlan(len(specs), {}, {}, None)
@@ -370,7 +372,9 @@ def plan_dataset(
                 spec.run_config, where, spec.base_dir, spec.draws, spec.draw_origins
             )
             p = plan_run(run, registry)
-        except MdfError as exc:  # named as the build names it
+        except (MdfError, ValueError) as exc:
+            if not is_record_failure(exc):  # a bug, as in the build
+                raise
             named, cause, _ = record_failure(spec, exc)
             if spec.on_error != "skip":
                 raise MdfError(f"{named}: {cause}") from None

@@ -1327,12 +1327,19 @@ def record_failure(spec: RecordSpec, exc: Exception) -> tuple[str, str, tuple[st
     return where, cause, (file, start, length)
 
 
+def is_record_failure(exc: Exception) -> bool:
+    """Whether ``exc``, raised while a record was built or planned, is the record's own failure
+    (its config or data: named with :func:`record_failure`, or skipped with ``on_error =
+    "skip"``), not a bug: mdframework's errors, and a ``ValueError`` not out of a plugin."""
+    return isinstance(exc, MdfError) or (isinstance(exc, ValueError) and not is_plugin_bug(exc))
+
+
 def _record_or_skip(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     """:func:`build_record` but for its wait: the file may still be on its way to the disk."""
     try:
         return _build_record(spec, out_dir)
     except (MdfError, ValueError) as exc:
-        if not isinstance(exc, MdfError) and is_plugin_bug(exc):  # not the config's: a bug
+        if not is_record_failure(exc):  # not the config's: a bug
             exc.add_note(f"while building record {spec.record_id} of {spec.recording}")
             raise
         where, cause, (file, start, length) = record_failure(spec, exc)
@@ -1537,8 +1544,8 @@ def _complete(
     config changed only those) is kept and rewritten with the new ones (atomically; its arrays
     are not recomputed), and so is its row. A record that cannot be read for want of
     permission is an error (it is not removed). A record computed by other software versions
-    than this process's is kept, its id, its versions and this process's added to
-    ``other_versions``."""
+    than this process's is kept, its id, its versions (``None``: a record written before
+    records named theirs) and this process's added to ``other_versions``."""
     import zipfile
 
     if not path.exists():
@@ -1549,7 +1556,7 @@ def _complete(
             raise ValueError(f"{path}: holds record {meta['id']}")
         made_by = meta.get("versions")  # None: by a version before records named theirs
         now = versions(used=_used_plugins(meta))
-        if other_versions is not None and made_by is not None and made_by != now:
+        if other_versions is not None and made_by != now:
             other_versions[spec.record_id] = (made_by, now)
         planned = _planned_meta(spec)
         if any(meta.get(k) != v for k, v in planned.items()):
@@ -1897,13 +1904,19 @@ def _used_plugins(meta: dict[str, Any]) -> list[tuple[str, str]]:
 
 def _warn_other_versions(made_by: dict[str, Any], n_records: int) -> None:
     """Warn once when records kept from the folder were computed by other software versions
-    (``made_by``: record id -> its ``versions`` and this process's for the same plugins): a
-    record's id covers its config, not the software, so a build after an upgrade keeps them."""
+    (``made_by``: record id -> its ``versions``, ``None`` for a record written before records
+    named theirs, and this process's for the same plugins): a record's id covers its config,
+    not the software, so a build after an upgrade keeps them."""
     if not made_by:
         return
-    first, (old, now) = next(iter(made_by.items()))
-    diff = config_differences(old, now)
-    shown = "; ".join(diff[:3]) + (f" and {len(diff) - 3} more" if len(diff) > 3 else "")
+    first = next(iter(made_by))
+    unnamed = sum(old is None for old, _ in made_by.values())
+    said = [f"{unnamed} by a version from before records named their versions"] if unnamed else []
+    named = next(((old, now) for old, now in made_by.values() if old is not None), None)
+    if named is not None:
+        diff = config_differences(*named)
+        said.append("; ".join(diff[:3]) + (f" and {len(diff) - 3} more" if len(diff) > 3 else ""))
+    shown = "; ".join(said)
     warnings.warn(
         f"{len(made_by)} of {n_records} records (e.g. {first}) were computed by other "
         f"software versions ({shown}) and are kept, as their config is the same: the dataset "

@@ -398,6 +398,7 @@ def _simulate_motion(
     spectrogram_geometry(wf, t.shape[0], proc)  # a record too short: refused before any pulse
     frames = interpolation.window_frames(body.time, float(t[0]), float(t[-1]))
     near = body.select_frames(frames)
+    refuse_untracked(near, float(t[0]), float(t[-1]), float(body.time[0]))
     exact_linear = motion.linear_tracks and body is motion.skeleton
     method = "linear" if exact_linear else proc.interpolation
     # The placement (where) comes from the whole recording and applies to the window alone.
@@ -597,6 +598,29 @@ def _inside(time_s: FloatArray, t_first: float, t_last: float) -> slice:
     lo = int(np.searchsorted(time_s, t_first - 1e-12, side="left"))
     hi = int(np.searchsorted(time_s, t_last + 1e-12, side="right"))
     return slice(min(lo, time_s.shape[0] - 1), max(hi, lo + 1))
+
+
+def refuse_untracked(near: Skeleton, t_first: float, t_last: float, origin: float) -> None:
+    """A :class:`SceneError` naming the first joint whose valid frames in ``near`` (the frames
+    the run interpolates, :func:`~mdframework.physics.interpolation.window_frames`) do not span
+    the pulses from ``t_first`` to ``t_last`` [s]: interpolation never extrapolates (it was the
+    interpolant's ValueError, an internal error of ``mdf run``). Times are said from the
+    recording's first frame at ``origin`` [s], as ``motion.start`` counts them."""
+    for j, name in enumerate(near.joint_names):
+        seen = near.time[near.valid[:, j]]
+        if seen.size >= 2 and seen[0] <= t_first + 1e-12 and seen[-1] >= t_last - 1e-12:
+            continue
+        if seen.size < 2:
+            where = "is not tracked near the record"
+        elif seen[0] > t_first + 1e-12:
+            where = f"is tracked only from {seen[0] - origin:.3f} s"
+        else:
+            where = f"is tracked only until {seen[-1] - origin:.3f} s"
+        raise SceneError(
+            f"motion: joint {name!r} {where} of the recording, but the record runs from "
+            f"{t_first - origin:.3f} to {t_last - origin:.3f} s, and interpolation never "
+            "extrapolates: choose a record (motion.start, motion.duration) where it is tracked"
+        )
 
 
 def _range_span(body: Skeleton, radar_pos: FloatArray) -> tuple[float, float]:

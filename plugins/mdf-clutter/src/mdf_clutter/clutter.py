@@ -30,7 +30,9 @@ Power: the summed clutter ``c(n)`` is scaled so that its mean power over the rec
 ``wind_fraction P_c`` for the wind-blown part, with ``P_c`` given by
 
 - ``power = "csr"``: the clutter-to-signal ratio ``csr_db`` = ``P_c`` over the mean power of the
-  compressed return at the gate (the same reference as the ``noise`` effect's SNR);
+  compressed return at the gate (the same reference as the ``noise`` effect's SNR), the
+  received signal as it comes: with a radar that adds receiver noise itself (the FMCW
+  radar's ``receiver_noise``) that noise is part of it;
 - ``power = "rcs"``: ``rcs_m2``, the clutter RCS of one range-resolution cell (``sigma_0`` times
   the illuminated ground area of the cell); each patch carries ``rcs_m2 x spacing/resolution``
   and ``P_c = sum_k sigma_k mean_n |g_k(n)|^2`` through the waveform's range equation.

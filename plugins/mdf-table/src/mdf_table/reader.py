@@ -318,19 +318,27 @@ def _check_frame_rate(path: Path, time: FloatArray, spec: TableLayout) -> None:
     """The frame rate the times give (the inverse of the median step between frames, which
     gaps do not move) within ``limits.MIN_FRAME_RATE_HZ .. MAX_FRAME_RATE_HZ``, as every
     recording's: milliseconds read as seconds (0.12 frames a second at 120 Hz) or frame
-    numbers read as seconds are refused with the unit they were read in."""
+    numbers read as seconds are refused with the unit they were read in. A time column read as
+    times whose frames are a whole second apart (1 frame/s, the lowest rate) holds frame numbers
+    (0, 1, 2, ...): refused too, unless ``frame_rate`` says they are frame numbers."""
     step = float(np.median(np.diff(time)))
     rate = 1.0 / step
-    if limits.MIN_FRAME_RATE_HZ <= rate <= limits.MAX_FRAME_RATE_HZ:
+    stamped = bool(spec.time_column) and spec.frame_rate is None  # times, not frame numbers
+    low = rate <= limits.MIN_FRAME_RATE_HZ if stamped else rate < limits.MIN_FRAME_RATE_HZ
+    if not low and rate <= limits.MAX_FRAME_RATE_HZ:
         return
-    side = "below" if rate < limits.MIN_FRAME_RATE_HZ else "above"
-    bound = limits.MIN_FRAME_RATE_HZ if side == "below" else limits.MAX_FRAME_RATE_HZ
+    if rate >= limits.MIN_FRAME_RATE_HZ and low:
+        rate_is = f"{rate:.4g} frames/s, as frame numbers read as seconds give"
+    else:
+        side, bound = (
+            ("below", limits.MIN_FRAME_RATE_HZ) if low else ("above", limits.MAX_FRAME_RATE_HZ)
+        )
+        rate_is = f"{rate:.4g} frames/s, {side} the {bound:g} frames/s of a motion recording"
     raise DataFileError(
         path,
-        f"the frames are {step:.4g} s apart (the median step, {_time_unit(spec)}): "
-        f"{rate:.4g} frames/s, {side} the {bound:g} frames/s of a motion recording: check the "
-        "time column's unit (motion.time_unit_s, 0.001 for milliseconds, or motion.frame_rate "
-        "for frame numbers)",
+        f"the frames are {step:.4g} s apart (the median step, {_time_unit(spec)}): {rate_is}: "
+        "check the time column's unit (motion.time_unit_s, 0.001 for milliseconds, or "
+        "motion.frame_rate for frame numbers)",
     )
 
 
