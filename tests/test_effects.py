@@ -410,6 +410,25 @@ def test_clutter_on_an_fmcw_radar_with_receiver_noise_holds_no_copy_of_that_nois
     assert dc_fraction > 0.999  # all of the stationary clutter at zero Doppler
 
 
+def test_a_radar_may_set_its_own_range_resolution() -> None:
+    """A radar plugin that sets ``self.range_resolution`` (as a third party's might, in its
+    ``__init__``) keeps it, and the clutter's cells follow it; else the config's bandwidth
+    gives it (``c / 2B``); the FMCW radar's is its sampled sweep's."""
+    from mdf_fmcw import FmcwRadar
+
+    class Coarse(LfmPulseDoppler):
+        def __init__(self, config: Any) -> None:
+            super().__init__(config)
+            self.range_resolution = 0.25
+
+    ctx = clutter_context(15.0, 10)
+    eff = GroundClutter(GroundClutter.Config())
+    assert eff.resolution(ctx) == pytest.approx(SPEED_OF_LIGHT / (2 * 150e6), rel=1e-12)
+    assert eff.resolution(dataclasses.replace(ctx, waveform=Coarse(Coarse.Config()))) == 0.25
+    fmcw = FmcwRadar(FmcwRadar.Config(preset="iwr1443_short_range_3d"))
+    assert fmcw.range_resolution == pytest.approx(0.043577, abs=1e-6)
+
+
 # --------------------------------------------------------------------------- multipath
 
 MP_RADAR = (10.0, 0.0, 5.0)

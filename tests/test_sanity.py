@@ -718,3 +718,18 @@ def test_a_body_read_in_the_wrong_length_unit_is_flagged() -> None:
     assert [m.split(": ", 1)[1][:30] for m in tiny_msgs] == ["the legs are 0.148 m long (hip"]
     with pytest.raises(DataFileError, match=r"motion sanity: the legs are 0\.376 m long"):
         load({**section, "unit_m": 0.0254}, size="error")
+
+
+@pytest.mark.parametrize("name", ["walk_cadence", "run_cadence", "leg_length_m"])
+def test_a_plausible_range_given_upside_down_is_refused(name: str) -> None:
+    """A range whose lower bound is above its upper one would flag every motion (or none):
+    refused naming the field."""
+    from mdframework.errors import ConfigError
+
+    lo, hi = getattr(SanityConfig(), name)
+    cfg = {
+        "motion": {"kind": "boulic", "duration": 1.0, "sanity": {name: [hi, lo]}},
+        "scatterers": {"kind": "points"},
+    }
+    with pytest.raises(ConfigError, match=rf"motion\.sanity\.{name}: the lower bound .* above"):
+        validate_run_config(cfg)

@@ -451,11 +451,18 @@ class RadarWaveform(Plugin):
     def range_resolution(self) -> float | None:
         """Range resolution ``c / (2 B)`` [m] of the compressed return (``B`` the swept
         bandwidth), or ``None`` for a radar without one (CW). Default: from the config's
-        ``bandwidth`` [Hz] when it has one."""
+        ``bandwidth`` [Hz] when it has one; a radar may set its own (``self.range_resolution =
+        ...``, e.g. in ``__init__``)."""
+        if "range_resolution" in self.__dict__:
+            return typing.cast("float | None", self.__dict__["range_resolution"])
         from .constants import SPEED_OF_LIGHT
 
         bandwidth = getattr(self.config, "bandwidth", None)
         return None if bandwidth is None else SPEED_OF_LIGHT / (2.0 * float(bandwidth))
+
+    @range_resolution.setter
+    def range_resolution(self, value: float | None) -> None:
+        self.__dict__["range_resolution"] = value
 
     @property
     def max_unambiguous_velocity(self) -> float:

@@ -206,6 +206,14 @@ class SanityConfig(StrictModel):
         "silently, or stop.",
     )
 
+    @model_validator(mode="after")
+    def _check_ranges(self) -> SanityConfig:
+        for name in ("walk_cadence", "run_cadence", "leg_length_m"):
+            lo, hi = getattr(self, name)
+            if lo > hi:
+                raise ValueError(f"{name}: the lower bound {lo:g} is above the upper {hi:g}")
+        return self
+
 
 class MotionConfig(PluginConfig):
     """Base of motion-source configs: every source can be cut to a time window, and its

@@ -316,6 +316,9 @@ class FmcwRadar(RadarWaveform):
         self.sequence = config.sequence()
         #: blocks hold whole frames
         self.block_multiple = self.sequence.chirps_per_frame
+        #: ``c / (2 B)`` [m] over the sampled part of the ramp (``B`` = slope x n_samples /
+        #: sample_rate)
+        self.range_resolution = self.sequence.range_resolution
 
     # ----------------------------------------------------------------- derived quantities
 
@@ -328,12 +331,6 @@ class FmcwRadar(RadarWaveform):
     def prf(self) -> float:
         """Slow-time rate of one virtual channel [Hz]: one chirp per loop, ``1 / (n_tx T_c)``."""
         return 1.0 / self.sequence.loop_period
-
-    @property
-    def range_resolution(self) -> float:
-        """``c / (2 B)`` [m] over the sampled part of the ramp (``B`` = slope x n_samples /
-        sample_rate)."""
-        return self.sequence.range_resolution
 
     @property
     def n_range(self) -> int:
