@@ -935,3 +935,39 @@ def test_each_scatterers_response_on_a_radar_without_its_own() -> None:
     for i in range(5):
         alone = receive_points(wf, ranges[:, i : i + 1], np.ones((300, 1)), gate).signal
         np.testing.assert_array_equal(each[i], alone)
+
+
+def test_the_default_receive_each_passes_each_scatterers_shape_along() -> None:
+    """The default ``receive_each`` gives the radar each scatterer with its shape fields
+    (``Scatterers.only``), for a radar that reads them."""
+    rng = np.random.default_rng(2)
+    n, k = 50, 3
+    scat = Scatterers(
+        rng.uniform(5, 6, (n, k, 3)),
+        np.ones((n, k)),
+        ("a", "b", "c"),
+        semi_axes=rng.uniform(0.05, 0.2, (k, 3)),
+        axes=rng.normal(size=(n, k, 3)),
+        centres=rng.uniform(5, 6, (n, k, 3)),
+        specular=np.array([True, False, True]),
+    )
+    one = scat.only(2)
+    assert one.names == ("c",) and one.positions.shape == (n, 1, 3)
+    assert one.semi_axes is not None and np.array_equal(one.semi_axes, scat.semi_axes[2:])
+    assert one.axes is not None and np.array_equal(one.axes, scat.axes[:, 2:])
+    assert one.centres is not None and np.array_equal(one.centres, scat.centres[:, 2:])
+    assert one.specular is not None and one.specular.tolist() == [True]
+
+    seen: list[tuple[str, ...]] = []
+
+    class Shaped(LfmPulseDoppler):
+        def receive_signal(self, block: PulseBlock) -> Any:
+            assert block.scatterers.semi_axes is not None and not block.receiver_noise
+            seen.append(block.scatterers.names)
+            return super().receive_signal(block)
+
+    wf = Shaped(LfmConfig(precision="float64"))
+    t = np.arange(n) / wf.prf
+    ranges = np.linalg.norm(scat.positions, axis=-1)
+    each = wf.receive_each(PulseBlock(0, t, scat, ranges, ranges[:, 0], np.zeros(3)))
+    assert each.shape == (k, n) and seen == [("a",), ("b",), ("c",)]

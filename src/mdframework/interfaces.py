@@ -311,6 +311,19 @@ class Scatterers:
         """A copy with some fields replaced (e.g. ``rcs``)."""
         return dataclasses.replace(self, **changes)
 
+    def only(self, i: int) -> Scatterers:
+        """Scatterer ``i`` alone (its arrays with one scatterer), its shape fields with it."""
+        one = slice(i, i + 1)
+        return Scatterers(
+            self.positions[:, one],
+            self.rcs[:, one],
+            self.names[one],
+            None if self.semi_axes is None else self.semi_axes[one],
+            None if self.axes is None else self.axes[:, one],
+            centres=None if self.centres is None else self.centres[:, one],
+            specular=None if self.specular is None else self.specular[one],
+        )
+
     def with_ranges(self, radar_position: FloatArray, ranges: FloatArray) -> Scatterers:
         """A copy that remembers ``ranges`` (n_pulses, n_scatterers) [m] of these positions from
         ``radar_position`` (3,) [m], so that :meth:`ranges` need not compute them again (a
@@ -523,10 +536,12 @@ class RadarWaveform(Plugin):
         sc = block.scatterers
         out = np.empty((sc.positions.shape[1], block.n_pulses), dtype=np.complex128)
         for i in range(out.shape[0]):
-            one = Scatterers(sc.positions[:, i : i + 1], sc.rcs[:, i : i + 1], sc.names[i : i + 1])
             out[i] = self.receive_signal(
                 dataclasses.replace(
-                    block, scatterers=one, ranges=block.ranges[:, i : i + 1], receiver_noise=False
+                    block,
+                    scatterers=sc.only(i),
+                    ranges=block.ranges[:, i : i + 1],
+                    receiver_noise=False,
                 )
             )
         return out
