@@ -894,6 +894,22 @@ def test_dataset_check_predicts_the_build(
     assert code == 2 and "a run config (it has `motion`), not a dataset config" in err
 
 
+def test_dataset_check_warns_once_and_sizes_no_spectrograms_of_recordings(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A motion planned again (its label's first record) does not repeat its warnings: the
+    sim-to-real dataset's 13_18 glitch is said once (it was said twice); a dataset of real
+    radar recordings only has no spectrograms to size (null, it said 0.0)."""
+    code, _, err = run_cli(
+        ["dataset", "check", str(EXAMPLES / "datasets" / "sim2real.toml")], capsys
+    )
+    assert code == 0 and err.count("13_18.amc: 3 single-frame glitch(es)") == 1, err
+    code, out, err = run_cli(
+        ["dataset", "check", str(EXAMPLES / "datasets" / "radhar.toml"), "--json"], capsys
+    )
+    assert code == 0 and json.loads(out)["spectrogram_mib"] is None, err
+
+
 def test_check_judges_aliasing_on_the_tracks_the_run_interpolates(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
