@@ -567,3 +567,101 @@ def test_map_noise_power_is_the_mean_noise_of_the_detection_map(
     assert total / n_frames == pytest.approx(expected, rel=0.02)
     if range_window == "hann":  # the coherent gains 2 n / 3 of the docs
         assert expected == pytest.approx(12 * p / (2 * 240 / 3) / (2 * 16 / 3), rel=1e-12)
+
+
+def _detect_points_reference(
+    rd: np.ndarray, ranges: np.ndarray, doppler: np.ndarray, settings: fmcw.Detection
+) -> np.ndarray:
+    """detect_points as it was before the frames were detected in blocks: one frame, the peak
+    grouping by concatenation (a slow reference)."""
+    power = np.sum(rd.real**2 + rd.imag**2, axis=0)
+    mask = power > 0
+    level = power + settings.noise_floor if settings.noise_floor > 0 else power
+    noise = np.full(power.shape, np.nan)
+    if settings.cfar_doppler is not None:
+        det, noise = fmcw.cfar(level, settings.cfar_doppler, axis=0, cyclic=True)
+        mask &= det
+    if settings.cfar_range is not None:
+        det, noise = fmcw.cfar(level, settings.cfar_range, axis=1, cyclic=False)
+        mask &= det
+    mask &= ((ranges >= settings.min_range) & (ranges <= settings.max_range))[None, :]
+    if settings.group_doppler:
+        mask &= (power >= np.roll(power, 1, axis=0)) & (power >= np.roll(power, -1, axis=0))
+    if settings.group_range:
+        left = np.concatenate([np.full((power.shape[0], 1), -np.inf), power[:, :-1]], axis=1)
+        right = np.concatenate([power[:, 1:], np.full((power.shape[0], 1), -np.inf)], axis=1)
+        mask &= (power >= left) & (power >= right)
+    di, ri = np.nonzero(mask)
+    snaps = np.ascontiguousarray(rd[:, di, ri].T)
+    fd = doppler[di]
+    if settings.tdm_compensation:
+        snaps = fmcw.tdm_compensation(snaps, fd, ANT.slot_of_virtual(SEQ), SEQ.chirp_period)
+    grid = fmcw.angle_grid(ANT.virtual, SEQ.wavelength)
+    which, ux, uz, _ = fmcw.estimate_angles(snaps, grid, settings.multi_peak)
+    r = ranges[ri][which]
+    uy = np.sqrt(np.clip(1.0 - ux**2 - uz**2, 0.0, None))
+    ref = np.maximum(np.nan_to_num(noise[di, ri], nan=1.0), np.finfo(np.float64).tiny)
+    snr = 10.0 * (np.log10(level[di, ri]) - np.log10(ref))[which]
+    return np.column_stack([r * ux, r * uy, r * uz, fd[which] * SEQ.wavelength / 2.0, snr])
+
+
+@pytest.mark.parametrize(
+    "settings",
+    [
+        fmcw.Detection(),
+        fmcw.Detection(
+            cfar_range=fmcw.Cfar("ca", 8, 2, 12.0),
+            cfar_doppler=fmcw.Cfar("go", 4, 1, 8.0),
+            group_range=True,
+            multi_peak=0.3,
+        ),
+        fmcw.Detection(
+            cfar_range=None, multi_peak=None, noise_floor=1e-3, tdm_compensation=False, max_range=3
+        ),
+    ],
+)
+def test_frames_detected_together_are_each_frame_detected_alone(
+    settings: fmcw.Detection,
+) -> None:
+    # five frames of three walkers' points in noise: the cubes, maps and points of the frames
+    # taken together are those of each frame alone (the same rows; the beam scan's matrix
+    # product over more rows may round differently: 1e-12 m)
+    gen = np.random.default_rng(3)
+    t = fmcw.chirp_times(SEQ, 0.0, 5 * SEQ.frame_period)
+    starts = [scene_point(r, az, el) for r, az, el in ((2.0, 10, 5), (3.1, -25, 0), (4.4, 40, -8))]
+    vel = np.array([[-1.2, 0.3, 0.0], [0.8, -0.5, 0.1], [0.0, 1.5, 0.0]])
+    pos = np.stack([s[None, :] + t[:, None] * v for s, v in zip(starts, vel, strict=True)], 1)
+    noise = gen.normal(0, 0.05, (t.size, 4, 240)) + 1j * gen.normal(0, 0.05, (t.size, 4, 240))
+    prof = fmcw.chirp_profiles(
+        pos,
+        np.ones(pos.shape[:2]),
+        RADAR,
+        AXES,
+        SEQ,
+        ANT,
+        window_name="hann",
+        n_fft=240,
+        path="analytic",
+        noise=noise,
+    ).reshape(5, SEQ.chirps_per_frame, 4, 240)
+    cubes = fmcw.virtual_cube(prof, SEQ, 3)
+    rds = fmcw.range_doppler(cubes, "hann", 16, clutter_removal=True)
+    ranges, doppler = fmcw.range_axis(SEQ, 240), fmcw.doppler_axis(SEQ, 16)
+    grid = fmcw.angle_grid(ANT.virtual, SEQ.wavelength)
+    slots = ANT.slot_of_virtual(SEQ)
+    frame, pts = fmcw.detect_frames(
+        rds, ranges, doppler, grid, slots, SEQ.chirp_period, SEQ.wavelength, settings
+    )
+    assert np.all(np.diff(frame) >= 0)
+    for f in range(5):
+        cube = fmcw.virtual_cube(prof[f], SEQ, 3)
+        rd = fmcw.range_doppler(cube, "hann", 16, clutter_removal=True)
+        assert np.array_equal(cubes[f], cube) and np.array_equal(rds[f], rd)
+        assert np.array_equal(fmcw.detection_map(rds)[f], fmcw.detection_map(rd))
+        ref = _detect_points_reference(rd, ranges, doppler, settings)
+        assert ref.shape[0] > 0
+        assert np.allclose(pts[frame == f], ref, rtol=0, atol=1e-12)
+        alone = fmcw.detect_points(
+            rd, ranges, doppler, grid, slots, SEQ.chirp_period, SEQ.wavelength, settings
+        )
+        assert np.allclose(alone, ref, rtol=0, atol=1e-12)
