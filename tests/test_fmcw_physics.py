@@ -665,3 +665,25 @@ def test_frames_detected_together_are_each_frame_detected_alone(
             rd, ranges, doppler, grid, slots, SEQ.chirp_period, SEQ.wavelength, settings
         )
         assert np.allclose(alone, ref, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("multi_peak", [None, 0.3])
+def test_angles_of_many_detections_in_chunks_are_those_of_one_scan(
+    monkeypatch: pytest.MonkeyPatch, multi_peak: float | None
+) -> None:
+    # 300 detections of one or two plane waves: the beam scan in chunks of ANGLE_CHUNK gives
+    # every detection's directions (and second peaks) as one scan of them all does
+    gen = np.random.default_rng(8)
+    virt = ANT.virtual
+    grid = fmcw.angle_grid(virt, SEQ.wavelength)
+    ux, uz = gen.uniform(-0.7, 0.7, (2, 300)), gen.uniform(-0.5, 0.5, (2, 300))
+    snaps = sum(
+        a[:, None] * fmcw.steering(virt, ux[j], uz[j], SEQ.wavelength)
+        for j, a in enumerate((np.ones(300), gen.uniform(0.5, 1.0, 300)))
+    ) + 0.05 * gen.normal(size=(300, 12))
+    chunked = fmcw.estimate_angles(snaps, grid, multi_peak)
+    monkeypatch.setattr(fmcw, "ANGLE_CHUNK", 10**6)
+    whole = fmcw.estimate_angles(snaps, grid, multi_peak)
+    assert chunked[0].size > (400 if multi_peak else 299)
+    for got, want in zip(chunked, whole, strict=True):
+        assert np.array_equal(got, want)

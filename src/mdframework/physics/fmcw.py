@@ -262,6 +262,14 @@ def window_transform(name: WindowName, n: int, nu: FloatArray) -> ComplexArray:
 # --------------------------------------------------------------------------- IF and range
 
 
+def _nonzero(mask: BoolArray) -> tuple[IntArray, ...]:
+    """``np.nonzero`` of a many-dimensional ``mask``, the same indices in the same order, found in
+    its flattened form (several times faster when few entries are set)."""
+    return tuple(
+        np.asarray(i, np.int64) for i in np.unravel_index(np.flatnonzero(mask), mask.shape)
+    )
+
+
 @dataclass(frozen=True)
 class _KernelOnBins:
     """The Dirichlet kernel ``D_n(k / n - x)`` of an unpadded FFT at the integer bins ``ext``
@@ -319,7 +327,7 @@ def _kernel_on_bins(n: int, x: FloatArray, ext: IntArray) -> _KernelOnBins:
     inv -= np.multiply.outer(np.sin(arg), np.cos(e_arg))
     near = np.abs(inv) < 1e-3
     q = np.where(ext % 2 == 0, 1.0, -1.0) * np.exp(1j * (n - 1) * e_arg)
-    idx = np.nonzero(near)
+    idx = _nonzero(near)
     inv[idx] = 1.0
     np.divide(1.0, inv, out=inv)
     inv[idx] = 0.0
@@ -707,25 +715,33 @@ def _second_peaks(maps: FloatArray, best: IntArray, fraction: float) -> tuple[In
     n_det, n_x, n_z = maps.shape
     peak = maps.reshape(n_det, n_x * n_z)[np.arange(n_det), best]
     with np.errstate(invalid="ignore"):  # 0 x an overflowed peak: NaN, no cell above it
-        d, i, k = np.nonzero(maps >= (fraction * peak)[:, None, None])
+        d, i, k = _nonzero(maps >= (fraction * peak)[:, None, None])
     value = maps[d, i, k]
-    local = np.isfinite(value) & (i > 0) & (i < n_x - 1)
+    inner = np.isfinite(value) & (i > 0) & (i < n_x - 1)
     if n_z > 1:
-        local &= (k > 0) & (k < n_z - 1)
-    for di in (-1, 0, 1):
-        ii = np.clip(i + di, 0, n_x - 1)
-        for dk in (-1, 0, 1):
-            if di or dk:
-                other = maps[d, ii, np.clip(k + dk, 0, n_z - 1)]
-                local &= np.isfinite(other) & (value >= other)
-    index = i * n_z + k
-    keep = local & (index != best[d])
+        inner &= (k > 0) & (k < n_z - 1)
+    d, index, value = d[inner], (i * n_z + k)[inner], value[inner]
+    # each neighbour in turn, on the cells that passed the ones before (most fail the first
+    # two, along u_x); an array without vertical extent has no neighbours along u_z
+    flat = maps.reshape(-1)
+    for di, dk in ((-1, 0), (1, 0), (0, -1), (0, 1), (-1, -1), (-1, 1), (1, -1), (1, 1)):
+        if dk and n_z == 1:
+            continue
+        other = flat[d * (n_x * n_z) + index + (di * n_z + dk)]
+        keep = np.isfinite(other) & (value >= other)
+        d, index, value = d[keep], index[keep], value[keep]
+    keep = index != best[d]
     d, index, value = d[keep], index[keep], value[keep]
     order = np.lexsort((-value, d))  # by detection, strongest first; stable: lower index first
     d, index = d[order], index[order]
     first = np.ones(d.size, dtype=np.bool_)
     first[1:] = d[1:] != d[:-1]
     return d[first].astype(np.int64), index[first].astype(np.int64)
+
+
+#: Detections whose beam maps :func:`estimate_angles` makes at once (64 x 2145 directions
+#: of the three-TX array's grid: 1 MiB a map array).
+ANGLE_CHUNK = 64
 
 
 def estimate_angles(
@@ -743,10 +759,19 @@ def estimate_angles(
     if n_det == 0:
         e = np.zeros(0)
         return np.zeros(0, np.int64), e, e.copy(), e.copy()
+    if n_det > ANGLE_CHUNK:  # each detection alone: chunks keep the beam maps in the cache
+        parts = [
+            estimate_angles(snapshots[lo : lo + ANGLE_CHUNK], grid, multi_peak)
+            for lo in range(0, n_det, ANGLE_CHUNK)
+        ]
+        starts = range(0, n_det, ANGLE_CHUNK)
+        det = np.concatenate([p[0] + lo for p, lo in zip(parts, starts, strict=True)])
+        ux_all, uz_all, power = (np.concatenate([p[j] for p in parts]) for j in (1, 2, 3))
+        return det.astype(np.int64), ux_all, uz_all, power
     product = snapshots @ grid.weights
     beams = (product.real**2 + product.imag**2) / snapshots.shape[1]
     maps = np.full((n_det, grid.ux.size, grid.uz.size), -np.inf)
-    maps[:, grid.ix, grid.iz] = beams
+    maps.reshape(n_det, -1)[:, grid.ix * grid.uz.size + grid.iz] = beams
     flat = maps.reshape(n_det, -1)
     det = np.arange(n_det)
     best = np.argmax(flat, axis=1)
@@ -874,7 +899,7 @@ def detect_frames(
         mask &= det
     mask &= (ranges >= settings.min_range) & (ranges <= settings.max_range)
     mask = peak_grouping(power, mask, doppler=settings.group_doppler, range_=settings.group_range)
-    fi, di, ri = np.nonzero(mask)
+    fi, di, ri = _nonzero(mask)
     cut = np.searchsorted(fi, np.arange(len(rd) + 1))
     snaps = np.concatenate([rd[f][:, di[a:b], ri[a:b]].T for f, (a, b) in enumerate(pairwise(cut))])
     fd = doppler[di]
