@@ -408,7 +408,8 @@ def range_profile(samples: ComplexArray, name: WindowName, n_fft: int) -> Comple
     docstring; bin ``k`` is range ``k c fs / (2 S n_fft)``)."""
     n = samples.shape[-1]
     w = window(name, n)
-    spec = np.fft.ifft(samples * w, n=n_fft, axis=-1) * (n_fft / float(np.sum(w)))
+    spec = np.fft.ifft(samples * w, n=n_fft, axis=-1)
+    spec *= n_fft / float(np.sum(w))
     return np.asarray(spec, dtype=np.complex128)
 
 
