@@ -542,7 +542,9 @@ def range_doppler(
     x = cube - cube.mean(axis=-2, keepdims=True) if clutter_removal else cube
     w = window(name, cube.shape[-2])
     spec = np.fft.fft(x * w[:, None], n=n_doppler, axis=-2)
-    spec /= float(np.sum(w))
+    # numpy divides a complex by a real as a complex by ``(s, 0)``, which for finite values is
+    # the product with ``1 / s``: the same values, several times faster
+    spec *= 1.0 / float(np.sum(w))
     return np.asarray(doppler_order(spec, -2), dtype=np.complex128)
 
 
