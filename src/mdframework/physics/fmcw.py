@@ -37,6 +37,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import lru_cache
 from itertools import pairwise
 from typing import Any, Literal
 
@@ -219,13 +220,22 @@ def window(name: WindowName, n: int) -> FloatArray:
 
     A one-sample window is ``[1]`` whatever its name (as scipy's and the STFT's): the formula
     would give a periodic Hann ``[0]``, which would null the only sample (``n_loops = 1``: the
-    Doppler FFT of one loop is the identity)."""
+    Doppler FFT of one loop is the identity). Each call returns a fresh copy of a table made
+    once per name and length (every frame needs the same few)."""
+    return _window_table(name, n).copy()
+
+
+@lru_cache(maxsize=64)
+def _window_table(name: WindowName, n: int) -> FloatArray:
+    """:func:`window`, computed (read-only: shared by every call)."""
     if n == 1:
-        return np.ones(1, dtype=np.float64)
-    m = np.arange(n, dtype=np.float64)
-    w = np.zeros(n, dtype=np.float64)
-    for c, a in enumerate(WINDOWS[name]):
-        w += (-1) ** c * a * np.cos(2.0 * np.pi * c * m / n)
+        w = np.ones(1, dtype=np.float64)
+    else:
+        m = np.arange(n, dtype=np.float64)
+        w = np.zeros(n, dtype=np.float64)
+        for c, a in enumerate(WINDOWS[name]):
+            w += (-1) ** c * a * np.cos(2.0 * np.pi * c * m / n)
+    w.flags.writeable = False
     return w
 
 
