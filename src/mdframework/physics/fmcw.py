@@ -38,7 +38,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
-from itertools import pairwise
 from typing import Any, Literal
 
 import numpy as np
@@ -528,40 +527,38 @@ def doppler_order(spectrum: NDArray[Any], axis: int) -> NDArray[Any]:
 def virtual_cube(profiles: ComplexArray, seq: ChirpSequence, n_tx_total: int) -> ComplexArray:
     """Rearrange one frame's range profiles into the virtual-array cube.
 
-    ``profiles`` (chirps_per_frame, n_rx, n_bins), chirps in time order, or several frames'
-    (n_frames, chirps_per_frame, n_rx, n_bins). Returns (n_tx_total * n_rx, n_loops, n_bins)
-    (with the frames' axis first when given): virtual antenna ``tx * n_rx + rx`` (by TX index,
-    not slot); TXs that the TDM order never uses stay zero.
+    ``profiles`` (chirps_per_frame, n_rx, n_bins), chirps in time order. Returns
+    (n_tx_total * n_rx, n_loops, n_bins): virtual antenna ``tx * n_rx + rx`` (by TX index, not
+    slot); TXs that the TDM order never uses stay zero.
     """
-    lead, (n_rx, n_bins) = profiles.shape[:-3], profiles.shape[-2:]
-    by_slot = profiles.reshape(*lead, seq.n_loops, seq.n_tx, n_rx, n_bins)
-    cube = np.zeros((*lead, n_tx_total, n_rx, seq.n_loops, n_bins), dtype=np.complex128)
+    n_rx, n_bins = profiles.shape[1], profiles.shape[2]
+    by_slot = profiles.reshape(seq.n_loops, seq.n_tx, n_rx, n_bins)
+    cube = np.zeros((n_tx_total, n_rx, seq.n_loops, n_bins), dtype=np.complex128)
     for slot, tx in enumerate(seq.tdm_order):
-        cube[..., tx, :, :, :] = np.moveaxis(by_slot[..., slot, :, :], -3, -2)
-    return cube.reshape(*lead, n_tx_total * n_rx, seq.n_loops, n_bins)
+        cube[tx] = np.moveaxis(by_slot[:, slot], 0, 1)
+    return cube.reshape(n_tx_total * n_rx, seq.n_loops, n_bins)
 
 
 def range_doppler(
     cube: ComplexArray, name: WindowName, n_doppler: int, clutter_removal: bool = False
 ) -> ComplexArray:
-    """Doppler FFT over loops: (n_virt, n_loops, n_bins) -> (n_virt, n_doppler, n_bins)
-    (any leading axes, such as frames, kept), rows in the order of :func:`doppler_axis` (zero
-    Doppler at ``(n_doppler - 1) // 2``), normalised so that a lone on-bin target of amplitude
-    ``a`` peaks at ``a``. ``clutter_removal`` subtracts each channel's and bin's mean over the
-    loops first (static clutter removal)."""
-    x = cube - cube.mean(axis=-2, keepdims=True) if clutter_removal else cube
-    w = window(name, cube.shape[-2])
-    spec = np.fft.fft(x * w[:, None], n=n_doppler, axis=-2)
+    """Doppler FFT over loops: (n_virt, n_loops, n_bins) -> (n_virt, n_doppler, n_bins),
+    rows in the order of :func:`doppler_axis` (zero Doppler at ``(n_doppler - 1) // 2``),
+    normalised so that a lone on-bin target of amplitude ``a`` peaks at ``a``.
+    ``clutter_removal`` subtracts each channel's and bin's mean over the loops first (static
+    clutter removal)."""
+    x = cube - cube.mean(axis=1, keepdims=True) if clutter_removal else cube
+    w = window(name, cube.shape[1])
+    spec = np.fft.fft(x * w[None, :, None], n=n_doppler, axis=1)
     # numpy divides a complex by a real as a complex by ``(s, 0)``, which for finite values is
     # the product with ``1 / s``: the same values, several times faster
     spec *= 1.0 / float(np.sum(w))
-    return np.asarray(doppler_order(spec, -2), dtype=np.complex128)
+    return np.asarray(doppler_order(spec, 1), dtype=np.complex128)
 
 
 def detection_map(rd: ComplexArray) -> FloatArray:
-    """Non-coherent sum of ``|RD|^2`` over virtual antennas, (n_doppler, n_bins) [W] (any
-    leading axes of ``rd`` (..., n_virt, n_doppler, n_bins), such as frames, kept)."""
-    return np.asarray(np.sum(rd.real**2 + rd.imag**2, axis=-3), dtype=np.float64)
+    """Non-coherent sum of ``|RD|^2`` over virtual antennas, (n_doppler, n_bins) [W]."""
+    return np.asarray(np.sum(rd.real**2 + rd.imag**2, axis=0), dtype=np.float64)
 
 
 # --------------------------------------------------------------------------- detection
@@ -632,15 +629,15 @@ def cfar(
 
 
 def peak_grouping(power: FloatArray, mask: BoolArray, *, doppler: bool, range_: bool) -> BoolArray:
-    """Keep a detection of a (n_doppler, n_bins) map (or of several, (..., n_doppler, n_bins))
-    only where its power is at least that of its neighbours along Doppler (cyclic) and/or range
-    (TI's peak grouping)."""
+    """Keep a detection of a (n_doppler, n_bins) map only where its power is at least that of
+    its neighbours along Doppler (cyclic) and/or range (TI's peak grouping)."""
     keep = mask.copy()
     if doppler:
-        keep &= (power >= np.roll(power, 1, axis=-2)) & (power >= np.roll(power, -1, axis=-2))
+        keep &= (power >= np.roll(power, 1, axis=0)) & (power >= np.roll(power, -1, axis=0))
     if range_:
-        keep[..., 1:] &= power[..., 1:] >= power[..., :-1]
-        keep[..., :-1] &= power[..., :-1] >= power[..., 1:]
+        left = np.concatenate([np.full((power.shape[0], 1), -np.inf), power[:, :-1]], axis=1)
+        right = np.concatenate([power[:, 1:], np.full((power.shape[0], 1), -np.inf)], axis=1)
+        keep &= (power >= left) & (power >= right)
     return keep
 
 
@@ -876,45 +873,20 @@ def detect_points(
     at ``1 + SNR`` over its estimate, as with noise. A noise estimate of 0 (no floor) counts as
     the smallest positive float, so the intensity stays finite.
     """
-    _, points = detect_frames(
-        [rd], ranges, doppler, grid, slot_of_virtual, chirp_period, wavelength, settings
-    )
-    return points
-
-
-def detect_frames(
-    rd: Sequence[ComplexArray] | ComplexArray,
-    ranges: FloatArray,
-    doppler: FloatArray,
-    grid: AngleGrid,
-    slot_of_virtual: IntArray,
-    chirp_period: float,
-    wavelength: float,
-    settings: Detection,
-    power: FloatArray | None = None,
-) -> tuple[IntArray, FloatArray]:
-    """:func:`detect_points` of several frames at once: ``rd`` the frames' cubes, each
-    (n_virt, n_doppler, n_bins) (a list, or an array with the frames first); ``power`` their
-    :func:`detection_map` (n_frames, n_doppler, n_bins) when already computed. Returns the frame
-    (index into ``rd``) of each point (n_points,) int64, ascending, and the points (n_points, 5)
-    float64, each frame's in the order :func:`detect_points` gives them (the same values: every
-    step works on each frame, or each detected cell, alone)."""
-    if power is None:
-        power = np.stack([detection_map(x) for x in rd])  # (n_frames, n_doppler, n_bins)
+    power = detection_map(rd)
     mask = power > 0
     level = power + settings.noise_floor if settings.noise_floor > 0 else power
     noise = np.full(power.shape, np.nan)
     if settings.cfar_doppler is not None:
-        det, noise = cfar(level, settings.cfar_doppler, axis=-2, cyclic=True)
+        det, noise = cfar(level, settings.cfar_doppler, axis=0, cyclic=True)
         mask &= det
     if settings.cfar_range is not None:
-        det, noise = cfar(level, settings.cfar_range, axis=-1, cyclic=False)
+        det, noise = cfar(level, settings.cfar_range, axis=1, cyclic=False)
         mask &= det
-    mask &= (ranges >= settings.min_range) & (ranges <= settings.max_range)
+    mask &= ((ranges >= settings.min_range) & (ranges <= settings.max_range))[None, :]
     mask = peak_grouping(power, mask, doppler=settings.group_doppler, range_=settings.group_range)
-    fi, di, ri = _nonzero(mask)
-    cut = np.searchsorted(fi, np.arange(len(rd) + 1))
-    snaps = np.concatenate([rd[f][:, di[a:b], ri[a:b]].T for f, (a, b) in enumerate(pairwise(cut))])
+    di, ri = _nonzero(mask)
+    snaps = np.ascontiguousarray(rd[:, di, ri].T)
     fd = doppler[di]
     if settings.tdm_compensation:
         snaps = tdm_compensation(snaps, fd, slot_of_virtual, chirp_period)
@@ -922,10 +894,9 @@ def detect_frames(
     r = ranges[ri][which]
     uy = np.sqrt(np.clip(1.0 - ux**2 - uz**2, 0.0, None))
     v = fd[which] * wavelength / 2.0
-    ref = np.maximum(np.nan_to_num(noise[fi, di, ri], nan=1.0), np.finfo(np.float64).tiny)
-    snr = 10.0 * (np.log10(level[fi, di, ri]) - np.log10(ref))[which]
-    points = np.column_stack([r * ux, r * uy, r * uz, v, snr]).astype(np.float64)
-    return fi[which].astype(np.int64), points
+    ref = np.maximum(np.nan_to_num(noise[di, ri], nan=1.0), np.finfo(np.float64).tiny)
+    snr = 10.0 * (np.log10(level[di, ri]) - np.log10(ref))[which]
+    return np.column_stack([r * ux, r * uy, r * uz, v, snr]).astype(np.float64)
 
 
 # --------------------------------------------------------------------------- geometry

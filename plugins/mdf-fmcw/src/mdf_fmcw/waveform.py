@@ -303,10 +303,6 @@ def _cfar(c: CfarConfig | None) -> fmcw.Cfar | None:
 #: Hann range window (the rectangular window's ripple is +-8 % even at eight).
 FLAT_GATE_RESOLUTIONS = 4.0
 
-#: Frames whose point clouds :meth:`FmcwRadar.receive` detects at once (their range-Doppler
-#: cubes held meanwhile: 11.5 MiB for the IWR1443 preset's).
-DETECT_FRAMES = 16
-
 
 class FmcwRadar(RadarWaveform):
     """Chirp-sequence FMCW radar (TDM-MIMO): slow-time signal, range-Doppler maps, points."""
@@ -515,16 +511,11 @@ class FmcwRadar(RadarWaveform):
         signal = np.empty(ranges.shape[0], dtype=np.complex128)
         maps: list[NDArray[np.float32]] = []
         frames: list[tuple[int, float, FloatArray]] = []
-        n_rx, per_frame = antennas.rx.shape[0], seq.chirps_per_frame
-        step = seq.range_resolution / 2
-        # the point detection works on DETECT_FRAMES frames at once (each frame alone, the
-        # same values), the range profiles and cubes frame by frame (smaller arrays, faster)
-        cubes: list[NDArray[np.complex128]] = []
-        powers: list[FloatArray] = []
         for f in range(n_frames):
-            sl = slice(f * per_frame, (f + 1) * per_frame)
+            sl = slice(f * seq.chirps_per_frame, (f + 1) * seq.chirps_per_frame)
             index = first_frame + f
             gate = block.gate_range[sl]
+            step = seq.range_resolution / 2
             extra = np.arange(gate.min() - c.gate_width / 2, gate.max() + c.gate_width / 2, step)
             profiles = fmcw.chirp_profiles(
                 positions[sl],
@@ -538,7 +529,7 @@ class FmcwRadar(RadarWaveform):
                 path=c.path,
                 margin=c.analytic_margin,
                 extra_ranges=extra,
-                noise=self._noise(index, n_rx) if block.receiver_noise else None,
+                noise=self._noise(index, antennas.rx.shape[0]) if block.receiver_noise else None,
             )
             signal[sl] = fmcw.gate_signal(
                 profiles, raxis, gate, c.gate_width, c.range_window, c.n_samples
@@ -548,16 +539,10 @@ class FmcwRadar(RadarWaveform):
             cube = fmcw.virtual_cube(profiles, seq, antennas.tx.shape[0])
             rd = fmcw.range_doppler(cube, c.doppler_window, self.n_doppler, c.clutter_removal)
             if want_maps:
-                power = fmcw.detection_map(rd)
-                maps.append(power.astype(np.float32))
-                if every and want_points:
-                    powers.append(power)
-            if not want_points:
-                continue
-            cubes.append(rd if every else rd[used])
-            if len(cubes) == DETECT_FRAMES or f == n_frames - 1:
-                which, pts = fmcw.detect_frames(
-                    cubes,
+                maps.append(fmcw.detection_map(rd).astype(np.float32))
+            if want_points:
+                pts = fmcw.detect_points(
+                    rd if every else rd[used],
                     raxis,
                     axes["doppler_hz"],
                     grid,
@@ -565,13 +550,8 @@ class FmcwRadar(RadarWaveform):
                     seq.chirp_period,
                     seq.wavelength,
                     detection,
-                    power=np.stack(powers) if powers else None,
                 )
-                first = index + 1 - len(cubes)
-                split = np.searchsorted(which, np.arange(1, len(cubes)))
-                for g, p in enumerate(np.split(pts, split), start=first):
-                    frames.append((g, g * seq.frame_period, p))
-                cubes, powers = [], []
+                frames.append((index, index * seq.frame_period, pts))
         out: dict[str, NDArray[Any]] = {}
         if want_maps:
             out["range_doppler"] = (
