@@ -15,7 +15,7 @@ relative to each frame's peak, and the mean number of points per frame of each.
 earlier commit exported with ``git archive``: its core and built-in plugins go first on the
 path), the analytic path with points, in fresh processes alternating this, other, this, ...
 (``--rounds`` of each), on ``--scene walk`` (the scene above) or ``room`` (the sim-to-real
-dataset's simulated room: the same walk, away from the sensor 1 m behind the subject, with its
+dataset's simulated room: the same walk, away from the sensor 1 m in front of the subject, with its
 12 static reflectors, antenna pattern and 1 W; many more points a frame). It prints both
 medians of the CPU ms per frame, the median ratio of the rounds, and whether the two gave the
 same slow-time signal and point clouds (their largest difference).
@@ -52,7 +52,7 @@ SCENE = ROOT / "examples" / "fmcw_walk.toml"
 CHIRPS_PER_FRAME = 48
 #: ``--scene room``: the simulated room of examples/datasets/sim2real.toml (its base radar,
 #: static reflectors and antenna pattern) around the walk of SCENE, walking away from a sensor
-#: 1 m behind the subject
+#: 1 m in front of the subject
 ROOM: dict[str, Any] = {
     "radar": {
         "kind": "fmcw",
@@ -62,7 +62,7 @@ ROOM: dict[str, Any] = {
         "boresight_azimuth_deg": 180.0,
     },
     "scene": {
-        "radar_position": [-1.0, 0.0, 1.0],
+        "radar_position": [1.0, 0.0, 1.0],
         "min_range": 0.25,
         "person": {"motion": "recorded", "position": [0.0, 0.0], "aspect_deg": 180.0},
     },
