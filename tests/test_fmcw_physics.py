@@ -674,3 +674,38 @@ def test_angles_of_many_detections_in_chunks_are_those_of_one_scan(
     assert chunked[0].size > (400 if multi_peak else 299)
     for got, want in zip(chunked, whole, strict=True):
         assert np.array_equal(got, want)
+
+
+def test_cfar_matches_a_cell_by_cell_reference() -> None:
+    # each cell's training cells summed one by one (wrapping on a cyclic axis, only those that
+    # exist on the other), for random maps, modes, widths (some wider than the axis) and axes
+    rng = np.random.default_rng(4)
+    for _ in range(150):
+        shape = (int(rng.integers(1, 12)), int(rng.integers(1, 40)))
+        p = rng.exponential(size=shape)
+        mode = str(rng.choice(["ca", "so", "go"]))
+        t, g = int(rng.integers(1, 10)), int(rng.integers(0, 6))
+        axis, cyclic = int(rng.integers(0, 2)), bool(rng.integers(0, 2))
+        det, est = fmcw.cfar(p, fmcw.Cfar(mode, t, g, 5.0), axis=axis, cyclic=cyclic)  # type: ignore[arg-type]
+        x = np.moveaxis(p, axis, -1)
+        n = x.shape[-1]
+        for row in np.ndindex(x.shape[:-1]):
+            for j in range(n):
+                sides = []
+                for cells in (range(j - g - t, j - g), range(j + g + 1, j + g + t + 1)):
+                    idx = [c % n for c in cells] if cyclic else [c for c in cells if 0 <= c < n]
+                    sides.append([x[row][c] for c in idx])
+                means = [np.mean(s) if s else np.nan for s in sides]
+                if mode == "ca":
+                    both = sides[0] + sides[1]
+                    want = np.mean(both) if both else np.nan
+                else:
+                    pick = np.nanmin if mode == "so" else np.nanmax
+                    want = np.nan if np.all(np.isnan(means)) else pick(means)
+                got = np.moveaxis(est, axis, -1)[row][j]
+                hit = np.moveaxis(det, axis, -1)[row][j]
+                if np.isnan(want):
+                    assert np.isnan(got) and not hit
+                else:
+                    assert got == pytest.approx(want, rel=1e-9)
+                    assert hit == (x[row][j] > 10**0.5 * want)

@@ -602,11 +602,16 @@ def cfar(
         cp = np.concatenate([np.zeros(pad), ones, np.zeros(pad)])
     cs = np.concatenate([np.zeros((*x.shape[:-1], 1)), np.cumsum(xp, axis=-1)], axis=-1)
     cc = np.concatenate([[0.0], np.cumsum(cp)])
-    i = np.arange(n) + pad  # index of each cell in the padded arrays
-    left_sum = cs[..., i - g] - cs[..., i - g - t]
-    right_sum = cs[..., i + g + t + 1] - cs[..., i + g + 1]
-    left_n = cc[i - g] - cc[i - g - t]
-    right_n = cc[i + g + t + 1] - cc[i + g + 1]
+
+    # cell j sits at pad + j in the padded arrays: its training sums as differences of
+    # cumulative sums, each a slice of n
+    def at(a: FloatArray, offset: int) -> FloatArray:
+        return a[..., pad + offset : pad + offset + n]
+
+    left_sum = at(cs, -g) - at(cs, -g - t)
+    right_sum = at(cs, g + t + 1) - at(cs, g + 1)
+    left_n = at(cc, -g) - at(cc, -g - t)
+    right_n = at(cc, g + t + 1) - at(cc, g + 1)
     with np.errstate(invalid="ignore", divide="ignore"):
         left = np.where(left_n > 0, left_sum / np.maximum(left_n, 1), np.nan)
         right = np.where(right_n > 0, right_sum / np.maximum(right_n, 1), np.nan)
