@@ -11,7 +11,17 @@ development machine is shared: wall time there measures the other jobs too). Agr
 raw and analytic paths on this scene: the largest difference of their range-Doppler maps
 relative to each frame's peak, and the mean number of points per frame of each.
 
+``--against OTHER`` times this checkout against another one (its root or its ``src``, e.g. an
+earlier commit exported with ``git archive``: its core and built-in plugins go first on the
+path), the analytic path with points, in fresh processes alternating this, other, this, ...
+(``--rounds`` of each), on ``--scene walk`` (the scene above) or ``room`` (the sim-to-real
+dataset's simulated room: the same walk, away from the sensor 1 m in front of the subject, with its
+12 static reflectors, antenna pattern and 1 W; many more points a frame). It prints both
+medians of the CPU ms per frame, the median ratio of the rounds, and whether the two gave the
+same slow-time signal and point clouds (their largest difference).
+
     .venv/bin/python benchmarks/bench_fmcw.py [--repeats 3] [--duration 2.0]
+    .venv/bin/python benchmarks/bench_fmcw.py --against OTHER [--scene walk|room] [--rounds 5]
 """
 
 from __future__ import annotations
@@ -22,7 +32,11 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 import argparse  # noqa: E402
+import json  # noqa: E402
 import statistics  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
@@ -34,6 +48,42 @@ from mdframework.pipeline import RunResult, build_stages, load_motion, simulate_
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "examples" / "fmcw_walk.toml"
+#: Chirps a frame of the IWR1443 preset (both scenes)
+CHIRPS_PER_FRAME = 48
+#: ``--scene room``: the simulated room of examples/datasets/sim2real.toml (its base radar,
+#: static reflectors and antenna pattern) around the walk of SCENE, walking away from a sensor
+#: 1 m in front of the subject
+ROOM: dict[str, Any] = {
+    "radar": {
+        "kind": "fmcw",
+        "preset": "iwr1443_short_range_3d",
+        "transmit_power": 1.0,
+        "save_range_doppler": False,
+        "boresight_azimuth_deg": 180.0,
+    },
+    "scene": {
+        "radar_position": [1.0, 0.0, 1.0],
+        "min_range": 0.25,
+        "person": {"motion": "recorded", "position": [0.0, 0.0], "aspect_deg": 180.0},
+    },
+    "effects": [
+        {
+            "kind": "static_scene",
+            "count": 12,
+            "distance_m": [0.5, 3.5],
+            "spread_deg": 60.0,
+            "height_m": [0.0, 2.0],
+            "rcs_m2": [0.01, 1.0],
+        },
+        {
+            "kind": "antenna",
+            "pointing": "angles",
+            "azimuth_deg": 180.0,
+            "beamwidth_az_deg": 90.0,
+            "beamwidth_el_deg": 40.0,
+        },
+    ],
+}
 
 
 def run(data: dict[str, Any], repeats: int) -> tuple[float, RunResult]:
@@ -52,11 +102,92 @@ def run(data: dict[str, Any], repeats: int) -> tuple[float, RunResult]:
     return statistics.median(times), result
 
 
+def scene(name: str, duration: float) -> dict[str, Any]:
+    """The config of ``--scene`` ``name`` with a record of ``duration`` [s]."""
+    base = read_config_file(SCENE)
+    base["motion"]["duration"] = duration
+    return {**base, **ROOM} if name == "room" else base
+
+
+def child(name: str, duration: float, repeats: int, out: str) -> None:
+    """In a fresh process: the median CPU ms per frame of the analytic path with points; the
+    signal and points saved to ``out``."""
+    seconds, res = run(scene(name, duration), repeats)
+    import mdf_fmcw
+
+    import mdframework
+
+    n_frames = res.received.signal.shape[0] // CHIRPS_PER_FRAME
+    points = res.received.products["points"]
+    np.savez(out, signal=res.received.signal, points=points)
+    modules = [str(mdframework.__file__), str(mdf_fmcw.__file__)]
+    print(
+        json.dumps(
+            {"ms": seconds / n_frames * 1e3, "frames": n_frames, "points": len(points)}
+            | {"modules": modules}
+        )
+    )
+
+
+def against(other: str, name: str, duration: float, repeats: int, rounds: int) -> None:
+    """Alternate this checkout and ``other``; print the medians, the ratio and the agreement."""
+    from bench_records import other_paths
+
+    paths = os.pathsep.join(str(p) for p in other_paths(other))
+    env_other = {**os.environ, "PYTHONPATH": paths, "PYTHONWARNINGS": "ignore"}
+    env_this = {**os.environ, "PYTHONWARNINGS": "ignore"}
+    times: dict[str, list[float]] = {"this": [], "other": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        for k in range(rounds):
+            for who, env in (("this", env_this), ("other", env_other)):
+                argv = ["--child", name, str(duration), str(repeats), f"{tmp}/{who}.npz"]
+                proc = subprocess.run(
+                    [sys.executable, __file__, *argv], capture_output=True, text=True, env=env
+                )
+                if proc.returncode:
+                    sys.exit(f"{who} failed:\n{proc.stderr[-2000:]}")
+                got = json.loads(proc.stdout.strip().splitlines()[-1])
+                root = str(Path(paths.split(os.pathsep)[0]).parent) + os.sep
+                if (who == "other") != all(m.startswith(root) for m in got["modules"]):
+                    sys.exit(f"{who} imported {got['modules']}")
+                times[who].append(got["ms"])
+            print(
+                f"round {k + 1}: this {times['this'][-1]:.2f}, other {times['other'][-1]:.2f} "
+                f"ms a frame ({got['frames']} frames, {got['points']} points)",
+                flush=True,
+            )
+        a, b = np.load(f"{tmp}/this.npz"), np.load(f"{tmp}/other.npz")
+        same_signal = bool(np.array_equal(a["signal"], b["signal"]))
+        same_rows = a["points"].shape == b["points"].shape
+        diff = float(np.max(np.abs(a["points"] - b["points"]), initial=0.0)) if same_rows else None
+    ratios = [t / o for t, o in zip(times["this"], times["other"], strict=True)]
+    print(
+        f"scene {name}, {duration} s, CPU ms a frame, median of {rounds} rounds (each the median "
+        f"of {repeats}): this {statistics.median(times['this']):.2f}, other "
+        f"{statistics.median(times['other']):.2f}, median ratio {statistics.median(ratios):.3f} "
+        f"({min(ratios):.3f} to {max(ratios):.3f})"
+    )
+    print(
+        f"slow-time signal bitwise equal: {same_signal}; points: "
+        + (f"the same rows, largest difference {diff:.1e}" if same_rows else "DIFFERENT rows")
+    )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--duration", type=float, default=2.0, help="record length [s]")
+    parser.add_argument("--against", default=None, help="another checkout (root or src)")
+    parser.add_argument("--scene", choices=["walk", "room"], default="walk")
+    parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--child", nargs=4, default=None, help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.child is not None:
+        child(args.child[0], float(args.child[1]), int(args.child[2]), args.child[3])
+        return
+    if args.against is not None:
+        against(args.against, args.scene, args.duration, args.repeats, args.rounds)
+        return
     base = read_config_file(SCENE)
     base["motion"]["duration"] = args.duration
     rows = []

@@ -567,3 +567,145 @@ def test_map_noise_power_is_the_mean_noise_of_the_detection_map(
     assert total / n_frames == pytest.approx(expected, rel=0.02)
     if range_window == "hann":  # the coherent gains 2 n / 3 of the docs
         assert expected == pytest.approx(12 * p / (2 * 240 / 3) / (2 * 16 / 3), rel=1e-12)
+
+
+def _detect_points_reference(
+    rd: np.ndarray, ranges: np.ndarray, doppler: np.ndarray, settings: fmcw.Detection
+) -> np.ndarray:
+    """detect_points as it was (np.nonzero of the masks; a slow reference)."""
+    power = np.sum(rd.real**2 + rd.imag**2, axis=0)
+    mask = power > 0
+    level = power + settings.noise_floor if settings.noise_floor > 0 else power
+    noise = np.full(power.shape, np.nan)
+    if settings.cfar_doppler is not None:
+        det, noise = fmcw.cfar(level, settings.cfar_doppler, axis=0, cyclic=True)
+        mask &= det
+    if settings.cfar_range is not None:
+        det, noise = fmcw.cfar(level, settings.cfar_range, axis=1, cyclic=False)
+        mask &= det
+    mask &= ((ranges >= settings.min_range) & (ranges <= settings.max_range))[None, :]
+    if settings.group_doppler:
+        mask &= (power >= np.roll(power, 1, axis=0)) & (power >= np.roll(power, -1, axis=0))
+    if settings.group_range:
+        left = np.concatenate([np.full((power.shape[0], 1), -np.inf), power[:, :-1]], axis=1)
+        right = np.concatenate([power[:, 1:], np.full((power.shape[0], 1), -np.inf)], axis=1)
+        mask &= (power >= left) & (power >= right)
+    di, ri = np.nonzero(mask)
+    snaps = np.ascontiguousarray(rd[:, di, ri].T)
+    fd = doppler[di]
+    if settings.tdm_compensation:
+        snaps = fmcw.tdm_compensation(snaps, fd, ANT.slot_of_virtual(SEQ), SEQ.chirp_period)
+    grid = fmcw.angle_grid(ANT.virtual, SEQ.wavelength)
+    which, ux, uz, _ = fmcw.estimate_angles(snaps, grid, settings.multi_peak)
+    r = ranges[ri][which]
+    uy = np.sqrt(np.clip(1.0 - ux**2 - uz**2, 0.0, None))
+    ref = np.maximum(np.nan_to_num(noise[di, ri], nan=1.0), np.finfo(np.float64).tiny)
+    snr = 10.0 * (np.log10(level[di, ri]) - np.log10(ref))[which]
+    return np.column_stack([r * ux, r * uy, r * uz, fd[which] * SEQ.wavelength / 2.0, snr])
+
+
+@pytest.mark.parametrize(
+    "settings",
+    [
+        fmcw.Detection(),
+        fmcw.Detection(
+            cfar_range=fmcw.Cfar("ca", 8, 2, 12.0),
+            cfar_doppler=fmcw.Cfar("go", 4, 1, 8.0),
+            group_range=True,
+            multi_peak=0.3,
+        ),
+        fmcw.Detection(
+            cfar_range=None, multi_peak=None, noise_floor=1e-3, tdm_compensation=False, max_range=3
+        ),
+    ],
+)
+def test_points_are_those_of_the_reference_detection(settings: fmcw.Detection) -> None:
+    # five frames of three walkers' points in noise: detect_points (its cells found through the
+    # flattened masks, its second beam peaks tested neighbour by neighbour) gives the points of
+    # the slow reference, bit for bit
+    gen = np.random.default_rng(3)
+    t = fmcw.chirp_times(SEQ, 0.0, 5 * SEQ.frame_period)
+    starts = [scene_point(r, az, el) for r, az, el in ((2.0, 10, 5), (3.1, -25, 0), (4.4, 40, -8))]
+    vel = np.array([[-1.2, 0.3, 0.0], [0.8, -0.5, 0.1], [0.0, 1.5, 0.0]])
+    pos = np.stack([s[None, :] + t[:, None] * v for s, v in zip(starts, vel, strict=True)], 1)
+    noise = gen.normal(0, 0.05, (t.size, 4, 240)) + 1j * gen.normal(0, 0.05, (t.size, 4, 240))
+    prof = fmcw.chirp_profiles(
+        pos,
+        np.ones(pos.shape[:2]),
+        RADAR,
+        AXES,
+        SEQ,
+        ANT,
+        window_name="hann",
+        n_fft=240,
+        path="analytic",
+        noise=noise,
+    ).reshape(5, SEQ.chirps_per_frame, 4, 240)
+    ranges, doppler = fmcw.range_axis(SEQ, 240), fmcw.doppler_axis(SEQ, 16)
+    grid = fmcw.angle_grid(ANT.virtual, SEQ.wavelength)
+    slots = ANT.slot_of_virtual(SEQ)
+    for f in range(5):
+        rd = fmcw.range_doppler(fmcw.virtual_cube(prof[f], SEQ, 3), "hann", 16, True)
+        ref = _detect_points_reference(rd, ranges, doppler, settings)
+        assert ref.shape[0] > 0
+        pts = fmcw.detect_points(
+            rd, ranges, doppler, grid, slots, SEQ.chirp_period, SEQ.wavelength, settings
+        )
+        assert np.array_equal(pts, ref)
+
+
+@pytest.mark.parametrize("multi_peak", [None, 0.3])
+def test_angles_of_many_detections_in_chunks_are_those_of_one_scan(
+    monkeypatch: pytest.MonkeyPatch, multi_peak: float | None
+) -> None:
+    # 300 detections of one or two plane waves: the beam scan in chunks of ANGLE_CHUNK gives
+    # every detection's directions (and second peaks) as one scan of them all does
+    gen = np.random.default_rng(8)
+    virt = ANT.virtual
+    grid = fmcw.angle_grid(virt, SEQ.wavelength)
+    ux, uz = gen.uniform(-0.7, 0.7, (2, 300)), gen.uniform(-0.5, 0.5, (2, 300))
+    snaps = sum(
+        a[:, None] * fmcw.steering(virt, ux[j], uz[j], SEQ.wavelength)
+        for j, a in enumerate((np.ones(300), gen.uniform(0.5, 1.0, 300)))
+    ) + 0.05 * gen.normal(size=(300, 12))
+    chunked = fmcw.estimate_angles(snaps, grid, multi_peak)
+    monkeypatch.setattr(fmcw, "ANGLE_CHUNK", 10**6)
+    whole = fmcw.estimate_angles(snaps, grid, multi_peak)
+    assert chunked[0].size > (400 if multi_peak else 299)
+    for got, want in zip(chunked, whole, strict=True):
+        assert np.array_equal(got, want)
+
+
+def test_cfar_matches_a_cell_by_cell_reference() -> None:
+    # each cell's training cells summed one by one (wrapping on a cyclic axis, only those that
+    # exist on the other), for random maps, modes, widths (some wider than the axis) and axes
+    rng = np.random.default_rng(4)
+    for _ in range(150):
+        shape = (int(rng.integers(1, 12)), int(rng.integers(1, 40)))
+        p = rng.exponential(size=shape)
+        mode = str(rng.choice(["ca", "so", "go"]))
+        t, g = int(rng.integers(1, 10)), int(rng.integers(0, 6))
+        axis, cyclic = int(rng.integers(0, 2)), bool(rng.integers(0, 2))
+        det, est = fmcw.cfar(p, fmcw.Cfar(mode, t, g, 5.0), axis=axis, cyclic=cyclic)  # type: ignore[arg-type]
+        x = np.moveaxis(p, axis, -1)
+        n = x.shape[-1]
+        for row in np.ndindex(x.shape[:-1]):
+            for j in range(n):
+                sides = []
+                for cells in (range(j - g - t, j - g), range(j + g + 1, j + g + t + 1)):
+                    idx = [c % n for c in cells] if cyclic else [c for c in cells if 0 <= c < n]
+                    sides.append([x[row][c] for c in idx])
+                means = [np.mean(s) if s else np.nan for s in sides]
+                if mode == "ca":
+                    both = sides[0] + sides[1]
+                    want = np.mean(both) if both else np.nan
+                else:
+                    pick = np.nanmin if mode == "so" else np.nanmax
+                    want = np.nan if np.all(np.isnan(means)) else pick(means)
+                got = np.moveaxis(est, axis, -1)[row][j]
+                hit = np.moveaxis(det, axis, -1)[row][j]
+                if np.isnan(want):
+                    assert np.isnan(got) and not hit
+                else:
+                    assert got == pytest.approx(want, rel=1e-9)
+                    assert hit == (x[row][j] > 10**0.5 * want)

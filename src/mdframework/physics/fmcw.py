@@ -37,6 +37,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any, Literal
 
 import numpy as np
@@ -218,13 +219,22 @@ def window(name: WindowName, n: int) -> FloatArray:
 
     A one-sample window is ``[1]`` whatever its name (as scipy's and the STFT's): the formula
     would give a periodic Hann ``[0]``, which would null the only sample (``n_loops = 1``: the
-    Doppler FFT of one loop is the identity)."""
+    Doppler FFT of one loop is the identity). Each call returns a fresh copy of a table made
+    once per name and length (every frame needs the same few)."""
+    return _window_table(name, n).copy()
+
+
+@lru_cache(maxsize=64)
+def _window_table(name: WindowName, n: int) -> FloatArray:
+    """:func:`window`, computed (read-only: shared by every call)."""
     if n == 1:
-        return np.ones(1, dtype=np.float64)
-    m = np.arange(n, dtype=np.float64)
-    w = np.zeros(n, dtype=np.float64)
-    for c, a in enumerate(WINDOWS[name]):
-        w += (-1) ** c * a * np.cos(2.0 * np.pi * c * m / n)
+        w = np.ones(1, dtype=np.float64)
+    else:
+        m = np.arange(n, dtype=np.float64)
+        w = np.zeros(n, dtype=np.float64)
+        for c, a in enumerate(WINDOWS[name]):
+            w += (-1) ** c * a * np.cos(2.0 * np.pi * c * m / n)
+    w.flags.writeable = False
     return w
 
 
@@ -259,6 +269,14 @@ def window_transform(name: WindowName, n: int, nu: FloatArray) -> ComplexArray:
 
 
 # --------------------------------------------------------------------------- IF and range
+
+
+def _nonzero(mask: BoolArray) -> tuple[IntArray, ...]:
+    """``np.nonzero`` of a many-dimensional ``mask``, the same indices in the same order, found in
+    its flattened form (several times faster when few entries are set)."""
+    return tuple(
+        np.asarray(i, np.int64) for i in np.unravel_index(np.flatnonzero(mask), mask.shape)
+    )
 
 
 @dataclass(frozen=True)
@@ -318,7 +336,7 @@ def _kernel_on_bins(n: int, x: FloatArray, ext: IntArray) -> _KernelOnBins:
     inv -= np.multiply.outer(np.sin(arg), np.cos(e_arg))
     near = np.abs(inv) < 1e-3
     q = np.where(ext % 2 == 0, 1.0, -1.0) * np.exp(1j * (n - 1) * e_arg)
-    idx = np.nonzero(near)
+    idx = _nonzero(near)
     inv[idx] = 1.0
     np.divide(1.0, inv, out=inv)
     inv[idx] = 0.0
@@ -399,7 +417,8 @@ def range_profile(samples: ComplexArray, name: WindowName, n_fft: int) -> Comple
     docstring; bin ``k`` is range ``k c fs / (2 S n_fft)``)."""
     n = samples.shape[-1]
     w = window(name, n)
-    spec = np.fft.ifft(samples * w, n=n_fft, axis=-1) * (n_fft / float(np.sum(w)))
+    spec = np.fft.ifft(samples * w, n=n_fft, axis=-1)
+    spec *= n_fft / float(np.sum(w))
     return np.asarray(spec, dtype=np.complex128)
 
 
@@ -530,7 +549,10 @@ def range_doppler(
     clutter removal)."""
     x = cube - cube.mean(axis=1, keepdims=True) if clutter_removal else cube
     w = window(name, cube.shape[1])
-    spec = np.fft.fft(x * w[None, :, None], n=n_doppler, axis=1) / float(np.sum(w))
+    spec = np.fft.fft(x * w[None, :, None], n=n_doppler, axis=1)
+    # numpy divides a complex by a real as a complex by ``(s, 0)``, which for finite values is
+    # the product with ``1 / s``: the same values, several times faster
+    spec *= 1.0 / float(np.sum(w))
     return np.asarray(doppler_order(spec, 1), dtype=np.complex128)
 
 
@@ -580,11 +602,16 @@ def cfar(
         cp = np.concatenate([np.zeros(pad), ones, np.zeros(pad)])
     cs = np.concatenate([np.zeros((*x.shape[:-1], 1)), np.cumsum(xp, axis=-1)], axis=-1)
     cc = np.concatenate([[0.0], np.cumsum(cp)])
-    i = np.arange(n) + pad  # index of each cell in the padded arrays
-    left_sum = cs[..., i - g] - cs[..., i - g - t]
-    right_sum = cs[..., i + g + t + 1] - cs[..., i + g + 1]
-    left_n = cc[i - g] - cc[i - g - t]
-    right_n = cc[i + g + t + 1] - cc[i + g + 1]
+
+    # cell j sits at pad + j in the padded arrays: its training sums as differences of
+    # cumulative sums, each a slice of n
+    def at(a: FloatArray, offset: int) -> FloatArray:
+        return a[..., pad + offset : pad + offset + n]
+
+    left_sum = at(cs, -g) - at(cs, -g - t)
+    right_sum = at(cs, g + t + 1) - at(cs, g + 1)
+    left_n = at(cc, -g) - at(cc, -g - t)
+    right_n = at(cc, g + t + 1) - at(cc, g + 1)
     with np.errstate(invalid="ignore", divide="ignore"):
         left = np.where(left_n > 0, left_sum / np.maximum(left_n, 1), np.nan)
         right = np.where(right_n > 0, right_sum / np.maximum(right_n, 1), np.nan)
@@ -703,25 +730,33 @@ def _second_peaks(maps: FloatArray, best: IntArray, fraction: float) -> tuple[In
     n_det, n_x, n_z = maps.shape
     peak = maps.reshape(n_det, n_x * n_z)[np.arange(n_det), best]
     with np.errstate(invalid="ignore"):  # 0 x an overflowed peak: NaN, no cell above it
-        d, i, k = np.nonzero(maps >= (fraction * peak)[:, None, None])
+        d, i, k = _nonzero(maps >= (fraction * peak)[:, None, None])
     value = maps[d, i, k]
-    local = np.isfinite(value) & (i > 0) & (i < n_x - 1)
+    inner = np.isfinite(value) & (i > 0) & (i < n_x - 1)
     if n_z > 1:
-        local &= (k > 0) & (k < n_z - 1)
-    for di in (-1, 0, 1):
-        ii = np.clip(i + di, 0, n_x - 1)
-        for dk in (-1, 0, 1):
-            if di or dk:
-                other = maps[d, ii, np.clip(k + dk, 0, n_z - 1)]
-                local &= np.isfinite(other) & (value >= other)
-    index = i * n_z + k
-    keep = local & (index != best[d])
+        inner &= (k > 0) & (k < n_z - 1)
+    d, index, value = d[inner], (i * n_z + k)[inner], value[inner]
+    # each neighbour in turn, on the cells that passed the ones before (most fail the first
+    # two, along u_x); an array without vertical extent has no neighbours along u_z
+    flat = maps.reshape(-1)
+    for di, dk in ((-1, 0), (1, 0), (0, -1), (0, 1), (-1, -1), (-1, 1), (1, -1), (1, 1)):
+        if dk and n_z == 1:
+            continue
+        other = flat[d * (n_x * n_z) + index + (di * n_z + dk)]
+        keep = np.isfinite(other) & (value >= other)
+        d, index, value = d[keep], index[keep], value[keep]
+    keep = index != best[d]
     d, index, value = d[keep], index[keep], value[keep]
     order = np.lexsort((-value, d))  # by detection, strongest first; stable: lower index first
     d, index = d[order], index[order]
     first = np.ones(d.size, dtype=np.bool_)
     first[1:] = d[1:] != d[:-1]
     return d[first].astype(np.int64), index[first].astype(np.int64)
+
+
+#: Detections whose beam maps :func:`estimate_angles` makes at once (64 x 2145 directions
+#: of the three-TX array's grid: 1 MiB a map array).
+ANGLE_CHUNK = 64
 
 
 def estimate_angles(
@@ -739,10 +774,19 @@ def estimate_angles(
     if n_det == 0:
         e = np.zeros(0)
         return np.zeros(0, np.int64), e, e.copy(), e.copy()
+    if n_det > ANGLE_CHUNK:  # each detection alone: chunks keep the beam maps in the cache
+        parts = [
+            estimate_angles(snapshots[lo : lo + ANGLE_CHUNK], grid, multi_peak)
+            for lo in range(0, n_det, ANGLE_CHUNK)
+        ]
+        starts = range(0, n_det, ANGLE_CHUNK)
+        det = np.concatenate([p[0] + lo for p, lo in zip(parts, starts, strict=True)])
+        ux_all, uz_all, power = (np.concatenate([p[j] for p in parts]) for j in (1, 2, 3))
+        return det.astype(np.int64), ux_all, uz_all, power
     product = snapshots @ grid.weights
     beams = (product.real**2 + product.imag**2) / snapshots.shape[1]
     maps = np.full((n_det, grid.ux.size, grid.uz.size), -np.inf)
-    maps[:, grid.ix, grid.iz] = beams
+    maps.reshape(n_det, -1)[:, grid.ix * grid.uz.size + grid.iz] = beams
     flat = maps.reshape(n_det, -1)
     det = np.arange(n_det)
     best = np.argmax(flat, axis=1)
@@ -846,7 +890,7 @@ def detect_points(
         mask &= det
     mask &= ((ranges >= settings.min_range) & (ranges <= settings.max_range))[None, :]
     mask = peak_grouping(power, mask, doppler=settings.group_doppler, range_=settings.group_range)
-    di, ri = np.nonzero(mask)
+    di, ri = _nonzero(mask)
     snaps = np.ascontiguousarray(rd[:, di, ri].T)
     fd = doppler[di]
     if settings.tdm_compensation:
