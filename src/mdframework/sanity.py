@@ -174,7 +174,7 @@ def find_glitches(
     e, _ = deviations(time, positions, valid)
     measured = _measured(time, valid, e.shape)
     back = e * return_ratio >= turns(time, positions)
-    return _glitch_mask(e, measured, min_m, ratio, local_ratio) & back
+    return _glitch_mask(e, measured, back, min_m, ratio, local_ratio)
 
 
 def turns(time: FloatArray, positions: FloatArray) -> FloatArray:
@@ -216,11 +216,17 @@ def _measured(time: FloatArray, valid: BoolArray | None, shape: tuple[int, ...])
 
 
 def _glitch_mask(
-    e: FloatArray, measured: BoolArray, min_m: float, ratio: float, local_ratio: float
+    e: FloatArray,
+    measured: BoolArray,
+    back: BoolArray,
+    min_m: float,
+    ratio: float,
+    local_ratio: float,
 ) -> BoolArray:
-    """:func:`find_glitches` from the deviations ``e`` (n_frames, n_joints) [m] and where they
-    are measured (:func:`_measured`): a frame is judged only where it and both
-    neighbours are measured, against the median of the measured deviations around it."""
+    """:func:`find_glitches` from the deviations ``e`` (n_frames, n_joints) [m], where they
+    are measured (:func:`_measured`) and where the joint comes back to its path (``back``, from
+    :func:`turns`): a frame is judged only where it and both neighbours are measured, against
+    the median of the measured deviations around it."""
     from scipy.ndimage import maximum_filter, median_filter
 
     mask = np.zeros(e.shape, dtype=bool)
@@ -230,7 +236,7 @@ def _glitch_mask(
     judged[1:-1] = measured[:-2] & measured[1:-1] & measured[2:]
     neighbours = np.zeros(e.shape)
     neighbours[1:-1] = np.maximum(e[:-2], e[2:])
-    mask = judged & (e >= min_m) & (e >= ratio * neighbours)
+    mask = judged & back & (e >= min_m) & (e >= ratio * neighbours)
     local = median_filter(e, size=(_LOCAL_FRAMES, 1), mode="nearest")
     # a window that reaches an unmeasured deviation (a gap, the record's ends): the median of
     # the measured ones in it
@@ -452,8 +458,9 @@ def leg_length(body: Skeleton) -> float | None:
     ratio (2.54 for inches and centimetres, 10, 100, 1000)."""
     lengths = []
     for side in ("l", "r"):
-        hip, knee, ankle = (body.joint(f"{side}_{j}") for j in ("hip", "knee", "ankle"))
-        ok = np.all(body.valid[:, [body.index(f"{side}_{j}") for j in ("hip", "knee", "ankle")]], 1)
+        names = [f"{side}_{j}" for j in ("hip", "knee", "ankle")]
+        hip, knee, ankle = (body.joint(n) for n in names)
+        ok = np.all(body.valid[:, [body.index(n) for n in names]], axis=1)
         thigh = np.linalg.norm(hip - knee, axis=1)
         shin = np.linalg.norm(knee - ankle, axis=1)
         lengths.append((thigh + shin)[ok])
@@ -511,9 +518,10 @@ def check_motion(motion: Motion, config: SanityConfig) -> Motion:
 
     e, acc = deviations(body.time, body.positions, body.valid)  # once for the checks below
     measured = _measured(body.time, body.valid, e.shape)
+    back = e * config.glitch_return_ratio >= turns(body.time, body.positions)
     mask = _glitch_mask(
-        e, measured, config.glitch_min_m, config.glitch_ratio, config.glitch_local_ratio
-    ) & (e * config.glitch_return_ratio >= turns(body.time, body.positions))
+        e, measured, back, config.glitch_min_m, config.glitch_ratio, config.glitch_local_ratio
+    )
     frames, joints = np.nonzero(mask)
     items = [
         {
