@@ -138,8 +138,6 @@ def interpolated_radial_speed(
     speed, block = 0.0, 1 << 16
     for lo in range(0, ts.shape[0] - 1, block):
         tb = ts[lo : lo + block + 1]  # one sample of overlap: every difference is seen
-        if tb.shape[0] < 2:
-            break
         ranges = radar.distances(resample(tb), radar_position)
         speed = max(speed, float(np.max(np.abs(np.diff(ranges, axis=0)) / np.diff(tb)[:, None])))
     return speed

@@ -82,9 +82,9 @@ MAX_FRAME_CELLS = 2**24
 MAX_PRODUCT_BYTES = 2**30
 
 #: Bytes the streaming pipeline holds per pulse of a record (time, gate range, the complex
-#: slow-time signal and its float32 STFT input), and per pulse and scatterer when the result keeps
-#: every scatterer (``processing.keep_scatterers``: positions, RCS, range): the basis of the
-#: memory estimate in :func:`check_pulses`.
+#: slow-time signal and its float32 STFT input): with :data:`SCATTERER_PULSE_BYTES` per
+#: scatterer when the result keeps every scatterer (``processing.keep_scatterers``), the basis
+#: of the memory estimate in :func:`check_pulses`.
 _BYTES_PER_PULSE = 8 + 8 + 16 + 8
 #: Bytes a block of the streaming pipeline holds per scatterer and pulse at its peak: the
 #: positions, ranges and RCS and the model's, the effects' and the radar's temporaries (traced

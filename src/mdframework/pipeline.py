@@ -608,14 +608,14 @@ def refuse_untracked(near: Skeleton, t_first: float, t_last: float, origin: floa
     recording's first frame at ``origin`` [s], as ``motion.start`` counts them."""
     for j, name in enumerate(near.joint_names):
         seen = near.time[near.valid[:, j]]
-        if seen.size >= 2 and seen[0] <= t_first + 1e-12 and seen[-1] >= t_last - 1e-12:
-            continue
         if seen.size < 2:
             where = "is not tracked near the record"
         elif seen[0] > t_first + 1e-12:
             where = f"is tracked only from {seen[0] - origin:.3f} s"
-        else:
+        elif seen[-1] < t_last - 1e-12:
             where = f"is tracked only until {seen[-1] - origin:.3f} s"
+        else:
+            continue
         raise SceneError(
             f"motion: joint {name!r} {where} of the recording, but the record runs from "
             f"{t_first - origin:.3f} to {t_last - origin:.3f} s, and interpolation never "
