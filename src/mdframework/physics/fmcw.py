@@ -1025,10 +1025,8 @@ def chirp_profiles(
     """
     n = positions.shape[0]
     n_rx = antennas.rx.shape[0]
-    slots = np.arange(n) % seq.n_tx
-    tx_index = np.asarray(seq.tdm_order, dtype=np.int64)[slots]
     if path == "raw":
-        tx_pos = antenna_positions(antennas.tx, radar_position, axes)[tx_index]
+        tx_pos = antenna_positions(antennas.tx, radar_position, axes)[_chirp_tx(seq, n)]
         rx_pos = antenna_positions(antennas.rx, radar_position, axes)
         delays = channel_delays(positions, tx_pos, rx_pos)
         samples = np.empty((n, n_rx, seq.n_samples), dtype=np.complex128)
@@ -1037,7 +1035,7 @@ def chirp_profiles(
         if noise is not None:
             samples += noise
         return range_profile(samples, window_name, n_fft)
-    dist, delays, phasors = _far_field(positions, radar_position, axes, seq, antennas, tx_index)
+    dist, delays, phasors = _far_field(positions, radar_position, axes, seq, antennas)
     near = (
         np.concatenate([dist.ravel(), np.asarray(extra_ranges, np.float64).ravel()])
         if extra_ranges is not None
@@ -1056,17 +1054,22 @@ def chirp_profiles(
     return out
 
 
+def _chirp_tx(seq: ChirpSequence, n: int) -> IntArray:
+    """The TX of each of ``n`` chirps from a loop's first, (n,) int64 (the TDM order)."""
+    return np.asarray(seq.tdm_order, dtype=np.int64)[np.arange(n) % seq.n_tx]
+
+
 def _far_field(
     positions: FloatArray,
     radar_position: FloatArray,
     axes: FloatArray,
     seq: ChirpSequence,
     antennas: Antennas,
-    tx_index: IntArray,
 ) -> tuple[FloatArray, FloatArray, ComplexArray]:
     """The analytic path's geometry: ranges (n_chirps, n_scat) [m], delays (n_chirps, n_scat)
-    [s] to the chirp's TX (``tx_index`` (n_chirps,)) and the receive array's centre, and each
-    RX's phasor (n_chirps, n_rx, n_scat) (:func:`chirp_profiles`)."""
+    [s] to the chirp's TX (:func:`_chirp_tx`) and the receive array's centre, and each RX's
+    phasor (n_chirps, n_rx, n_scat) (:func:`chirp_profiles`)."""
+    tx_index = _chirp_tx(seq, positions.shape[0])
     rel = positions - radar_position[None, None, :]
     dist = np.sqrt(np.sum(rel * rel, axis=-1))
     u = rel / dist[..., None]
@@ -1100,9 +1103,7 @@ def gate_responses(
     scatterer (no noise), for all scatterers at once. Only the gate's bins are computed, the
     ones the gate signal sums. Arguments as for :func:`chirp_profiles` and
     :func:`gate_signal`."""
-    n = positions.shape[0]
-    tx_index = np.asarray(seq.tdm_order, dtype=np.int64)[np.arange(n) % seq.n_tx]
-    _, delays, phasors = _far_field(positions, radar_position, axes, seq, antennas, tx_index)
+    _, delays, phasors = _far_field(positions, radar_position, axes, seq, antennas)
     raxis = range_axis(seq, n_fft)
     weights = gate_weights(raxis, gate_range, width, window_name, seq.n_samples)
     bins = np.flatnonzero(np.any(weights != 0, axis=0))
