@@ -389,8 +389,9 @@ class PulseBlock:
     pipeline. ``gate_range`` (n,) float64 [m]. ``radar_position`` (3,) float64 [m].
     ``receiver_noise``: whether a waveform that adds receiver noise itself
     (:attr:`RadarWaveform.adds_receiver_noise`) adds it to this block; False asks for the
-    scatterers' response alone (:func:`receive_points` for e.g. clutter patches, whose
-    responses are summed and rescaled: noise in each would be summed with them).
+    scatterers' response alone (:func:`receive_points` by default, and
+    :meth:`RadarWaveform.receive_each` for e.g. clutter patches, whose responses are summed and
+    rescaled: noise in each would be summed with them).
     """
 
     start: int

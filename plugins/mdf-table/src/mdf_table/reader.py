@@ -324,19 +324,18 @@ def _check_frame_rate(path: Path, time: FloatArray, spec: TableLayout) -> None:
     step = float(np.median(np.diff(time)))
     rate = 1.0 / step
     stamped = bool(spec.time_column) and spec.frame_rate is None  # times, not frame numbers
-    low = rate <= limits.MIN_FRAME_RATE_HZ if stamped else rate < limits.MIN_FRAME_RATE_HZ
-    if not low and rate <= limits.MAX_FRAME_RATE_HZ:
-        return
-    if rate >= limits.MIN_FRAME_RATE_HZ and low:
-        rate_is = f"{rate:.4g} frames/s, as frame numbers read as seconds give"
+    if stamped and rate == limits.MIN_FRAME_RATE_HZ:
+        why = "as frame numbers read as seconds give"
+    elif rate < limits.MIN_FRAME_RATE_HZ:
+        why = f"below the {limits.MIN_FRAME_RATE_HZ:g} frames/s of a motion recording"
+    elif rate > limits.MAX_FRAME_RATE_HZ:
+        why = f"above the {limits.MAX_FRAME_RATE_HZ:g} frames/s of a motion recording"
     else:
-        side, bound = (
-            ("below", limits.MIN_FRAME_RATE_HZ) if low else ("above", limits.MAX_FRAME_RATE_HZ)
-        )
-        rate_is = f"{rate:.4g} frames/s, {side} the {bound:g} frames/s of a motion recording"
+        return
     raise DataFileError(
         path,
-        f"the frames are {step:.4g} s apart (the median step, {_time_unit(spec)}): {rate_is}: "
+        f"the frames are {step:.4g} s apart (the median step, {_time_unit(spec)}): "
+        f"{rate:.4g} frames/s, {why}: "
         "check the time column's unit (motion.time_unit_s, 0.001 for milliseconds, or "
         "motion.frame_rate for frame numbers)",
     )
