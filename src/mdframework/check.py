@@ -295,8 +295,9 @@ def format_plan(plan: RunPlan, source: str) -> str:
     chirps = abs(p.pulse_rate_hz - p.prf_hz) > 1e-9 * p.prf_hz
     if chirps:
         rate += f" ({p.pulse_rate_hz:.4g} pulses per second of record)"
-    sample = "pulses" if p.pulsed else "samples"
-    pulses = "pulses" if p.pulsed or chirps else "samples"
+    # the spectrogram's window counts slow-time samples, the record its pulses (chirps)
+    window_unit = "pulses" if p.pulsed else "samples"
+    record_unit = "pulses" if p.pulsed or chirps else "samples"
     lines = [f"{source}: valid"]
     for section, chosen in p.plugins.items():
         lines.append(f"  {section:<12}{chosen}")
@@ -305,8 +306,8 @@ def format_plan(plan: RunPlan, source: str) -> str:
         f"  {'carrier':<12}{_hz(p.carrier_frequency_hz)} (wavelength "
         f"{p.wavelength_m * 100:.3g} cm), {rate}",
         f"  {'record':<12}{p.record_length_s:.3f} s from {p.record_start_s:.3f} s: "
-        f"{p.n_pulses} {pulses}; joints: {p.n_joints}, scatterers: {p.n_scatterers}",
-        f"  {'spectrogram':<12}window {p.window_pulses} {sample} "
+        f"{p.n_pulses} {record_unit}; joints: {p.n_joints}, scatterers: {p.n_scatterers}",
+        f"  {'spectrogram':<12}window {p.window_pulses} {window_unit} "
         f"({1e3 * p.window_pulses / p.spectrum_rate_hz:.1f} ms), hop {p.hop_pulses:.4g} "
         f"({1e3 * p.hop_pulses / p.spectrum_rate_hz:.2f} ms), nfft {p.nfft}: {p.n_frames} frames",
         f"  {'resolution':<12}Doppler bin {p.doppler_bin_hz:.3g} Hz = "

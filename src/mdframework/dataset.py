@@ -1536,7 +1536,7 @@ def _planned_meta(spec: RecordSpec) -> dict[str, Any]:
 
 
 def _complete(
-    path: Path, spec: RecordSpec, other_versions: dict[str, Any] | None = None
+    path: Path, spec: RecordSpec, other_versions: dict[str, Any]
 ) -> dict[str, Any] | None:
     """The index row of a finished record, or None if it must be (re)built: a record cut
     short, corrupt, or whose metadata lacks a field or names another record is removed. A
@@ -1556,7 +1556,7 @@ def _complete(
             raise ValueError(f"{path}: holds record {meta['id']}")
         made_by = meta.get("versions")  # None: by a version before records named theirs
         now = versions(used=_used_plugins(meta))
-        if other_versions is not None and made_by != now:
+        if made_by != now:
             other_versions[spec.record_id] = (made_by, now)
         planned = _planned_meta(spec)
         if any(meta.get(k) != v for k, v in planned.items()):
