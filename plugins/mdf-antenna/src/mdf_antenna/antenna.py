@@ -163,11 +163,11 @@ def bounce_legs(names: Sequence[str]) -> tuple[NDArray[np.intp], ...]:
     """Indices ``(bounce, direct, image)`` of every single-bounce scatterer ``name~bounce`` whose
     ``name`` and ``name~image`` are among ``names``, each (n_bounce,)."""
     index = {n: i for i, n in enumerate(names)}
-    rows = [
-        (i, index[n[: -len(BOUNCE)]], index[n[: -len(BOUNCE)] + IMAGE])
-        for i, n in enumerate(names)
-        if n.endswith(BOUNCE) and n[: -len(BOUNCE)] in index and n[: -len(BOUNCE)] + IMAGE in index
-    ]
+    rows = []
+    for i, n in enumerate(names):
+        direct = n.removesuffix(BOUNCE)
+        if direct != n and direct in index and direct + IMAGE in index:
+            rows.append((i, index[direct], index[direct + IMAGE]))
     table = np.asarray(rows, dtype=np.intp).reshape(-1, 3)
     return table[:, 0], table[:, 1], table[:, 2]
 
