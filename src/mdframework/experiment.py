@@ -908,8 +908,8 @@ def _report(
     every report file into ``out``. The figures are drawn together at the end, once every number
     is computed (matplotlib loads only then). ``summary.json`` ends with the experiment's config
     (``config``, every default filled in, the dataset's path absolute: it repeats the
-    experiment) and the software's
-    ``versions`` (:func:`mdframework.plugins.versions` of ``registry``)."""
+    experiment) and the software's ``versions`` (:func:`mdframework.plugins.versions` of
+    ``registry``)."""
     from .figures import plot_confusion, plot_feature_scatter
 
     figures: list[Callable[[], None]] = []  # drawn at the end
