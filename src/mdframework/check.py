@@ -31,7 +31,7 @@ import numpy as np
 
 from . import limits
 from .errors import MdfError
-from .interfaces import SceneContext
+from .interfaces import Motion, SceneContext
 from .limits import SCATTERER_PULSE_BYTES
 from .physics import interpolation, radar
 from .pipeline import (
@@ -122,7 +122,7 @@ SPEED_SAMPLES_PER_FRAME = 16
 
 
 def interpolated_radial_speed(
-    body: Skeleton, t: np.ndarray, method: Any, radar_position: np.ndarray
+    body: Skeleton, t: np.ndarray, method: interpolation.Method, radar_position: np.ndarray
 ) -> float:
     """Largest |d range / dt| [m/s] of any joint on the tracks a run resamples at its pulse
     times ``t`` (n_pulses,) [s] (``method``: ``processing.interpolation``), taken at every
@@ -167,7 +167,7 @@ def memory_estimate(
 def count_scatterers(
     config: RunConfigBase,
     stages: Stages,
-    motion: Any,
+    motion: Motion,
     body: Skeleton,
     t: np.ndarray,
 ) -> int:
