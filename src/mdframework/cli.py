@@ -42,6 +42,7 @@ from .plugins import (
     default_registry,
     disabled_by_user,
     installed_names,
+    mdframework_version,
     reset_default_registry,
     suggest,
 )
@@ -353,13 +354,7 @@ def add_command(
 
 
 def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        v = version("mdframework")
-    except PackageNotFoundError:  # pragma: no cover - running from a source tree
-        from . import __version__ as v
-    return f"mdf (mdframework) {v}, Python {sys.version.split()[0]}"
+    return f"mdf (mdframework) {mdframework_version()}, Python {sys.version.split()[0]}"
 
 
 def _run_arguments(parser: argparse.ArgumentParser) -> None:

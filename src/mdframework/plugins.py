@@ -270,12 +270,10 @@ def versions(
     Python, NumPy, SciPy and scikit-learn (``None`` when not installed), and ``plugins``, every
     plugin distribution of ``registry`` (default: the installed plugins) as ``"name version"``,
     sorted; with ``used`` (interface, kind) pairs, only the distributions providing those."""
-    from . import __version__
-
     reg = default_registry() if registry is None else registry
     wanted = None if used is None else set(used)
     return {
-        "mdframework": _distribution_version("mdframework") or __version__,
+        "mdframework": mdframework_version(),
         "python": "{}.{}.{}".format(*sys.version_info[:3]),
         "numpy": _distribution_version("numpy"),
         "scipy": _distribution_version("scipy"),
@@ -289,6 +287,14 @@ def versions(
             }
         ),
     }
+
+
+def mdframework_version() -> str:
+    """mdframework's version: its installed distribution's, else the source tree's
+    ``__version__``."""
+    from . import __version__
+
+    return _distribution_version("mdframework") or __version__
 
 
 @cache
