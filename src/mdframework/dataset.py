@@ -1234,14 +1234,7 @@ def _build_recorded(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         "recording": dict(rec.metadata),
         "units": RECORD_UNITS,
     }
-    meta["versions"] = versions(used=_used_plugins(meta))
-    atomic_savez(
-        Path(out_dir) / RECORDS / f"{spec.record_id}.npz",
-        in_background=True,
-        **arrays,
-        meta=np.array(json.dumps(meta)),
-    )
-    return _row(meta, arrays["features"])
+    return _write_record(out_dir, spec, meta, arrays)
 
 
 def _span(motion: dict[str, Any], start: float, end: float) -> tuple[float, float | None] | None:
@@ -1434,16 +1427,23 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         "run_config": json.loads(cfg.model_dump_json()),
         **extra_meta,
     }
+    return _write_record(out_dir, spec, meta, {**spectrogram, "features": feats, **extra})
+
+
+def _write_record(
+    out_dir: str, spec: RecordSpec, meta: dict[str, Any], arrays: dict[str, Any]
+) -> dict[str, Any]:
+    """Write a record's ``arrays`` (``features`` among them) and ``meta``, with the versions of
+    the software that computed it, to its file (in the background, :func:`atomic_savez`), and
+    return its index row."""
     meta["versions"] = versions(used=_used_plugins(meta))
     atomic_savez(
         Path(out_dir) / RECORDS / f"{spec.record_id}.npz",
         in_background=True,
-        **spectrogram,
-        features=feats,
-        **extra,
+        **arrays,
         meta=np.array(json.dumps(meta)),
     )
-    return _row(meta, feats)
+    return _row(meta, arrays["features"])
 
 
 def _simulated_cloud(result: Any, config: Any, record: str) -> PointCloud:
