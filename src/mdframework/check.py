@@ -36,11 +36,11 @@ from .limits import SCATTERER_PULSE_BYTES
 from .physics import interpolation, radar
 from .pipeline import (
     Stages,
-    _apply_effects,
-    _gate,
-    _inside,
+    apply_effects,
     build_stages,
     effect_generators,
+    frames_inside,
+    gate_ranges,
     load_motion,
     placed,
     prepare_body,
@@ -186,9 +186,9 @@ def count_scatterers(
         )
     generators = effect_generators(config.seed, stages.effects)
     rng = generators[0] if generators else np.random.default_rng(config.seed)
-    gate = _gate(config.scene.gate, at_pulses, radar_pos)
+    gate = gate_ranges(config.scene.gate, at_pulses, radar_pos)
     context = SceneContext(radar_pos, wf.prf, wf.carrier_frequency, tb, gate, at_pulses, wf, rng, 0)
-    scat = _apply_effects(stages, "scatterers", scat, context, generators)
+    scat = apply_effects(stages, "scatterers", scat, context, generators)
     return int(scat.positions.shape[1])
 
 
@@ -213,7 +213,7 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
     t = record_pulses(wf, t_start, t_end)
     n_pulses = int(t.shape[0])
     geometry = spectrogram_geometry(wf, n_pulses, proc)
-    record_body = body.select_frames(_inside(body.time, t_start, t_end))
+    record_body = body.select_frames(frames_inside(body.time, t_start, t_end))
     start_record(stages, record_body, t, radar_pos)  # what the radar refuses before a pulse
 
     inside = (body.time >= t_start - 1e-9) & (body.time <= t_end + 1e-9)

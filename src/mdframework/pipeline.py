@@ -152,13 +152,16 @@ def effect_generators(seed: int, effects: Sequence[Effect]) -> tuple[np.random.G
     return tuple(streams)
 
 
-def _apply_effects(
+def apply_effects(
     stages: Stages,
     stage: str,
     data: Any,
     context: SceneContext,
     generators: Sequence[np.random.Generator],
 ) -> Any:
+    """``data`` (a block's ``Scatterers`` or the record's ``Received``) through the effects of
+    ``stage`` (``"scatterers"`` or ``"received"``) in the listed order, each with its own
+    generator (:func:`effect_generators`); an effect's exception is named as its plugin's bug."""
     for effect, rng in zip(stages.effects, generators, strict=True):
         if effect.stage == stage:
             try:
@@ -410,13 +413,13 @@ def _simulate_motion(
     else:
         near = placed(near, where)
         resample = interpolation.TrackResampler(near.time, near.positions, near.valid, method)
-    record_body = near.select_frames(_inside(near.time, t_start, t_end))
+    record_body = near.select_frames(frames_inside(near.time, t_start, t_end))
     start_record(stages, record_body, t, radar_pos)
     timings["prepare"] = time.perf_counter() - clock
 
     n = t.shape[0]
     generators = effect_generators(config.seed, stages.effects)
-    # the contexts' generator: _apply_effects gives each effect its own in its place
+    # the contexts' generator: apply_effects gives each effect its own in its place
     rng = generators[0] if generators else np.random.default_rng(config.seed)
     stream = _Stream(n, proc.keep_scatterers, proc.aliasing, wf, sc.min_range, t)
     losses = emptiness.Losses()
@@ -432,13 +435,13 @@ def _simulate_motion(
         with blame(model, "scatterers"):
             scat = model.scatterers(motion, at_pulses, radar_pos, lam)
             rcs_model = scat.rcs
-        gate = _gate(sc.gate, at_pulses, radar_pos)
+        gate = gate_ranges(sc.gate, at_pulses, radar_pos)
         context = SceneContext(
             radar_pos, wf.prf, wf.carrier_frequency, tb, gate, at_pulses, wf, rng, lo
         )
         if early_effects:  # the body itself within scene.min_range: refused before any effect
             stream.check_near(lo, scat, scat.ranges(radar_pos))
-        scat = _apply_effects(stages, "scatterers", scat, context, generators)
+        scat = apply_effects(stages, "scatterers", scat, context, generators)
         ranges = scat.ranges(radar_pos)
         stream.check(lo, scat, ranges)
         s = slice(None, None, emptiness.SAMPLE_EVERY)
@@ -464,7 +467,7 @@ def _simulate_motion(
         received = replace(received, products={**received.products, **wf.product_axes()})
     echo = received.signal.copy()  # the target's echo, before noise and clutter
     context = SceneContext(radar_pos, wf.prf, wf.carrier_frequency, t, stream.gate, None, wf, rng)
-    received = _apply_effects(stages, "received", received, context, generators)
+    received = apply_effects(stages, "received", received, context, generators)
     _check_empty(echo, losses, proc, fixed_gate=sc.gate != "track")
     effects_ran = _describe(stages, "scatterers") + _describe(stages, "received")
     timings["received_effects"] = time.perf_counter() - clock
@@ -593,7 +596,7 @@ def _blocks(n: int, size: int, multiple: int) -> list[tuple[int, int]]:
     return [(lo, min(lo + step, n)) for lo in range(0, n, step)]
 
 
-def _inside(time_s: FloatArray, t_first: float, t_last: float) -> slice:
+def frames_inside(time_s: FloatArray, t_first: float, t_last: float) -> slice:
     """The frames with ``t_first <= time <= t_last`` (at least the nearest one)."""
     lo = int(np.searchsorted(time_s, t_first - 1e-12, side="left"))
     hi = int(np.searchsorted(time_s, t_last + 1e-12, side="right"))
@@ -782,7 +785,7 @@ def _join(blocks: list[NDArray[Any]]) -> NDArray[Any]:
     return out
 
 
-def _gate(gate: str | float, at_pulses: Skeleton, radar_pos: FloatArray) -> FloatArray:
+def gate_ranges(gate: str | float, at_pulses: Skeleton, radar_pos: FloatArray) -> FloatArray:
     """Range gate per pulse [m]: tracking the hip centre (or the first joint), or fixed."""
     if gate == "track":
         ref = at_pulses.index("base") if "base" in at_pulses.joint_names else 0
