@@ -448,27 +448,20 @@ def analytic_range_profile(
     coef.real = amplitudes * np.cos(phase)
     coef.imag = amplitudes * np.sin(phase)
     scale = 1.0 / float(np.sum(window(name, seq.n_samples)))
-    if separate:
-        if phasors is not None:
-            coef = coef * phasors
-        if n_fft != seq.n_samples:
-            nu = np.asarray(bins, np.float64)[None, None, :] / n_fft - x[:, :, None]
-            kern = window_transform(name, seq.n_samples, nu)
-            return np.asarray(coef[:, :, None] * kern * scale, np.complex128)
-        sel = np.asarray(bins, np.int64)
-        ext = _window_bins(name, seq.n_samples, sel)
-        kernel = _kernel_on_bins(seq.n_samples, x, ext)
-        each = kernel.inv_sine * kernel.q  # D / factor on the bins, (n_chirps, n_scat, n_ext)
-        chirp, scat, pos = kernel.near
-        each[chirp, scat, pos] = kernel.near_value
-        each *= (coef * kernel.factor)[:, :, None]
-        return _window_combine(name, seq.n_samples, each, ext, sel) * scale
+    if separate and phasors is not None:
+        coef = coef * phasors
     if n_fft == seq.n_samples:
         # the window is a combination of Dirichlet kernels on neighbouring bins, a linear map
         # that commutes with the sum over scatterers: sum first, combine the bins after
         sel = np.asarray(bins, np.int64)
         ext = _window_bins(name, seq.n_samples, sel)
         kernel = _kernel_on_bins(seq.n_samples, x, ext)
+        if separate:
+            each = kernel.inv_sine * kernel.q  # D / factor on the bins, (n_chirps, n_scat, n_ext)
+            chirp, scat, pos = kernel.near
+            each[chirp, scat, pos] = kernel.near_value
+            each *= (coef * kernel.factor)[:, :, None]
+            return _window_combine(name, seq.n_samples, each, ext, sel) * scale
         coef = coef * kernel.factor
         weights = coef[:, None, :] if phasors is None else phasors * coef[:, None, :]
         summed = kernel.weighted_sum(weights)
@@ -478,6 +471,8 @@ def analytic_range_profile(
         return np.asarray(total * scale, np.complex128)
     nu = np.asarray(bins, np.float64)[None, None, :] / n_fft - x[:, :, None]
     kern = window_transform(name, seq.n_samples, nu)
+    if separate:
+        return np.asarray(coef[:, :, None] * kern * scale, np.complex128)
     if phasors is None:
         return np.asarray(np.einsum("cs,csk->ck", coef, kern) * scale, np.complex128)
     total = np.einsum("crs,csk->crk", phasors * coef[:, None, :], kern)
