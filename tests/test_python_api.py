@@ -36,6 +36,22 @@ def test_skeleton_leaves_the_callers_arrays_writeable() -> None:
         sk.valid[0, 0] = False
 
 
+def test_a_write_to_the_callers_arrays_leaves_a_checked_skeleton_as_it_was() -> None:
+    """The caller's writeable arrays are copied, so a later write to them (a NaN where the
+    skeleton says valid, a time stamp out of order) cannot break what the skeleton checked; a
+    skeleton's own read-only arrays are shared, not copied again."""
+    t = np.arange(5) / 100.0
+    pos = np.zeros((5, 2, 3))
+    pos[:, 1, 0] = np.arange(5)
+    sk = Skeleton(t, pos, ("a", "b"))
+    pos[2, 1, 0] = np.nan
+    t[3] = 0.0
+    assert sk.positions[2, 1, 0] == 2.0 and sk.valid[2, 1]
+    assert np.all(np.diff(sk.time) > 0)
+    moved = sk.with_positions(sk.positions)
+    assert moved.positions is sk.positions and moved.time is sk.time
+
+
 def test_features_of_a_db_map_say_it_is_db_not_silence() -> None:
     from mdframework.features import envelopes, spectrogram_features
     from mdframework.physics.spectrogram import power_to_db

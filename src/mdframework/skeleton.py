@@ -10,10 +10,12 @@ Arrays and units:
   that frame (its position must then not be used).
 - ``joint_names``: tuple of ``n_joints`` strings.
 
-A skeleton's arrays are read-only views of the arrays it was given (not copies; the arrays
-given stay writeable): stages share skeletons (and datasets cache them across records), so a
-stage that wants different positions builds a new skeleton (:meth:`Skeleton.with_positions`)
-instead of changing one in place.
+A skeleton's arrays are read-only: stages share skeletons (and datasets cache them across
+records), so a stage that wants different positions builds a new skeleton
+(:meth:`Skeleton.with_positions`) instead of changing one in place. An array given that can
+still be written (the caller's own) is copied, so that the caller keeps a writeable array and a
+later write to it cannot change a checked skeleton; a read-only one (another skeleton's) is
+shared.
 
 The canonical body is Chen's 17-point set used with the Boulic walking model (V. C. Chen, "The
 Micro-Doppler Effect in Radar", 2011): base (hip centre), neck, head, left/right shoulder, elbow,
@@ -124,9 +126,11 @@ class Skeleton:
                 raise SkeletonError(f"valid must have shape {pos.shape[:2]}, got {valid.shape}")
             if not np.all(finite | ~valid[:, :, None]):
                 raise SkeletonError("positions marked valid must be finite")
-        # shared between stages (and cached): never mutated; read-only views, so that the
-        # caller's own arrays stay writeable
-        time, pos, valid = (_read_only(a) for a in (time, pos, valid))
+        # shared between stages (and cached): never mutated, and the caller's arrays, which
+        # stay theirs to write, are not held
+        time = _frozen(time, fresh=time is not self.time)
+        pos = _frozen(pos, fresh=pos is not self.positions)
+        valid = _frozen(valid, fresh=valid is not self.valid)
         object.__setattr__(self, "time", time)
         object.__setattr__(self, "positions", pos)
         object.__setattr__(self, "joint_names", names)
@@ -226,6 +230,22 @@ class Skeleton:
     def with_positions(self, positions: FloatArray) -> Skeleton:
         """Same time stamps, names and validity with new positions."""
         return Skeleton(self.time, positions, self.joint_names, self.valid)
+
+
+def _frozen(array: NDArray[Any], fresh: bool) -> NDArray[Any]:
+    """``array`` made read-only: itself when ``fresh`` (made here) or when nothing can write it
+    (it and every array it views are read-only), else a read-only copy."""
+    if not fresh:
+        seen: Any = array
+        while isinstance(seen, np.ndarray):
+            if seen.flags.writeable:
+                array = array.copy()
+                break
+            seen = seen.base
+        else:
+            return array
+    array.flags.writeable = False
+    return array
 
 
 def _read_only(array: NDArray[Any]) -> NDArray[Any]:
