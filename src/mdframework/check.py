@@ -21,9 +21,6 @@ no faster than the fastest joint.
 
 from __future__ import annotations
 
-import warnings
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
@@ -192,8 +189,11 @@ def count_scatterers(
     return int(scat.positions.shape[1])
 
 
-def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan:
-    """Resolve ``config`` into a :class:`RunPlan` (see the module docstring)."""
+def plan_run(
+    config: RunConfigBase, registry: Registry | None = None, motion: Motion | None = None
+) -> RunPlan:
+    """Resolve ``config`` into a :class:`RunPlan` (see the module docstring); ``motion``: its
+    source's motion when already loaded (a dataset's records share their recording's)."""
     reg = registry or default_registry()
     cfg: Any = config
     stages = build_stages(config, reg)
@@ -203,7 +203,8 @@ def plan_run(config: RunConfigBase, registry: Registry | None = None) -> RunPlan
     radar_pos = np.asarray(config.scene.radar_position, dtype=np.float64)
     proc = config.processing
 
-    motion = load_motion(stages.source)
+    if motion is None:
+        motion = load_motion(stages.source)
     body, _, _, where = prepare_body(config, stages, motion, radar_pos)
     body = placed(body, where)
     t_start, t_end = record_window(body, cfg.motion.start, cfg.motion.duration)
@@ -351,22 +352,6 @@ class DatasetPlan:
         return asdict(self)
 
 
-@contextmanager
-def _each_warning_once() -> Iterator[None]:
-    """Show each warning (category and message) once while the block runs."""
-    seen: set[tuple[type, str]] = set()
-    show = warnings.showwarning
-
-    def once(message: Any, category: type, *args: Any, **kwargs: Any) -> None:
-        if (category, str(message)) not in seen:
-            seen.add((category, str(message)))
-            show(message, category, *args, **kwargs)
-
-    with warnings.catch_warnings():
-        warnings.showwarning = once
-        yield
-
-
 def plan_dataset(
     config: Any, base_dir: Any, registry: Registry | None = None, *, every: bool = False
 ) -> DatasetPlan:
@@ -375,39 +360,44 @@ def plan_dataset(
     with its draws, and each label's first simulated record is planned (:func:`plan_run`), or
     with ``every`` each simulated record (what a run refuses stops the plan, naming the record,
     unless the config's ``on_error = "skip"``: then it is counted as the build would skip it)."""
-    from .dataset import is_record_failure, plan_records, record_failure, validate_record
+    from .dataset import (
+        is_record_failure,
+        plan_records,
+        record_failure,
+        record_motion,
+        validate_record,
+    )
 
-    with _each_warning_once():  # a motion planned again warns again
-        specs = plan_records(config, base_dir)
-        plan = DatasetPlan(len(specs), {}, {}, None)
-        for spec in specs:
-            label = spec.label
-            plan.records[label] = plan.records.get(label, 0) + 1
-            if (label in plan.first and not every) or "recording" in spec.run_config:
-                continue
-            where = f"record {spec.record_id}"
-            try:
-                run = validate_record(
-                    spec.run_config, where, spec.base_dir, spec.draws, spec.draw_origins
-                )
-                p = plan_run(run, registry)
-            except (MdfError, ValueError) as exc:
-                if not is_record_failure(exc):  # a bug, as in the build
-                    raise
-                named, cause, _ = record_failure(spec, exc)
-                if spec.on_error != "skip":
-                    raise MdfError(f"{named}: {cause}") from None
-                plan.skipped.setdefault(label, f"{named}: {cause}")
-                plan.n_skipped[label] = plan.n_skipped.get(label, 0) + 1
-                continue
-            plan.first.setdefault(label, p)
-            if every:
-                plan.n_planned[label] = plan.n_planned.get(label, 0) + 1
-                plan.n_aliasing[label] = plan.n_aliasing.get(label, 0) + int(p.aliasing)
-                plan.max_memory_mib[label] = max(plan.max_memory_mib.get(label, 0.0), p.memory_mib)
-        if config.representation != "histogram" and plan.first:
-            cells = sum(plan.records[k] * p.nfft * p.n_frames for k, p in plan.first.items())
-            plan = replace(plan, spectrogram_mib=cells * 4 / MIB)
+    specs = plan_records(config, base_dir)
+    plan = DatasetPlan(len(specs), {}, {}, None)
+    for spec in specs:
+        label = spec.label
+        plan.records[label] = plan.records.get(label, 0) + 1
+        if (label in plan.first and not every) or "recording" in spec.run_config:
+            continue
+        where = f"record {spec.record_id}"
+        try:
+            run = validate_record(
+                spec.run_config, where, spec.base_dir, spec.draws, spec.draw_origins
+            )
+            p = plan_run(run, registry, record_motion(spec))
+        except (MdfError, ValueError) as exc:
+            if not is_record_failure(exc):  # a bug, as in the build
+                raise
+            named, cause, _ = record_failure(spec, exc)
+            if spec.on_error != "skip":
+                raise MdfError(f"{named}: {cause}") from None
+            plan.skipped.setdefault(label, f"{named}: {cause}")
+            plan.n_skipped[label] = plan.n_skipped.get(label, 0) + 1
+            continue
+        plan.first.setdefault(label, p)
+        if every:
+            plan.n_planned[label] = plan.n_planned.get(label, 0) + 1
+            plan.n_aliasing[label] = plan.n_aliasing.get(label, 0) + int(p.aliasing)
+            plan.max_memory_mib[label] = max(plan.max_memory_mib.get(label, 0.0), p.memory_mib)
+    if config.representation != "histogram" and plan.first:
+        cells = sum(plan.records[k] * p.nfft * p.n_frames for k, p in plan.first.items())
+        plan = replace(plan, spectrogram_mib=cells * 4 / MIB)
     return plan
 
 

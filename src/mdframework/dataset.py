@@ -1352,18 +1352,21 @@ def _record_or_skip(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         raise
 
 
+def record_motion(spec: RecordSpec) -> Motion:
+    """The motion a simulated record is cut from, before its augmentations: loaded once per
+    process (:func:`_load_motion`; the records of one recording share it)."""
+    section = {k: v for k, v in spec.run_config["motion"].items() if k not in ("start", "duration")}
+    return _load_motion(json.dumps(section, sort_keys=True), spec.base_dir)
+
+
 def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     if "recording" in spec.run_config:
         return _build_recorded(spec, out_dir)
     run_config = spec.run_config
-    motion_section = {
-        k: v for k, v in run_config["motion"].items() if k not in ("start", "duration", "height")
-    }
-    motion_section.update({k: v for k, v in run_config["motion"].items() if k == "height"})
     where = f"record {spec.record_id}"
     # the record's config first: a drawn value its field refuses is named as the draw
     config = validate_record(run_config, where, spec.base_dir, spec.draws, spec.draw_origins)
-    motion = _load_motion(json.dumps(motion_section, sort_keys=True), spec.base_dir)
+    motion = record_motion(spec)
     draws = spec.draws or {}
     if any(k in draws for k in ("speed", "body_scale", "mirror", "time_warp")):
         motion, start = _augmented(
