@@ -83,7 +83,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
         from .output import run_folder, write_run
         from .pipeline import simulate
 
-        config = load_run_config(args.config)
+        config = load_run_config(args.config, overrides=args.overrides)
     if args.no_figures:
         figures = config.figures.model_copy(update={"enabled": False})
         config = config.model_copy(update={"figures": figures})
@@ -106,7 +106,7 @@ def _cmd_show(args: argparse.Namespace) -> int:
         from .preview import check_frame_rate, check_instants, stage_preview
 
         check_frame_rate(args.format, args.fps)  # before anything is simulated or written
-        config = load_run_config(args.config)
+        config = load_run_config(args.config, overrides=args.overrides)
     with run_folder(args.out, force=args.force, staging_dir=args.staging_dir) as folder:
         with _naming(args.config):
             result = simulate(config, progress=progress)
@@ -190,13 +190,14 @@ def _cmd_check(args: argparse.Namespace) -> int:
         from .check import format_plan, plan_run
         from .config import load_run_config
 
-        config = load_run_config(args.config)
+        config = load_run_config(args.config, overrides=args.overrides)
         with _naming(args.config):
             plan = plan_run(config)
     if args.json:
         print(json.dumps(plan.as_dict(), indent=2))
     else:
-        print(format_plan(plan, args.config))
+        sets = "".join(f" --set {item}" for item in args.overrides)
+        print(format_plan(plan, args.config + sets))
     return 0
 
 
@@ -357,6 +358,20 @@ def _version() -> str:
     return f"mdf (mdframework) {mdframework_version()}, Python {sys.version.split()[0]}"
 
 
+SET_HELP = (
+    "change one config field for this run, as if the file said so: KEY is a dotted path "
+    "(radar.prf, effects.0.snr_db), VALUE a TOML value (4000, 7.7e10, true, '\"hann\"'; other "
+    "text is a string); repeatable, applied in order; config.resolved.json holds the result"
+)
+
+
+def _set_argument(parser: argparse.ArgumentParser) -> None:
+    """``--set KEY=VALUE`` of the commands that read a run config."""
+    parser.add_argument(
+        "--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE", help=SET_HELP
+    )
+
+
 def _run_arguments(parser: argparse.ArgumentParser) -> None:
     """The arguments `mdf run` and `mdf show` share: the config, the output folder and how it
     is written, and progress."""
@@ -365,6 +380,7 @@ def _run_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--force", action="store_true", help=FORCE_HELP)
     parser.add_argument("--staging-dir", default=None, help=STAGING_HELP)
     parser.add_argument("--no-progress", action="store_true", help=PROGRESS_HELP)
+    _set_argument(parser)
 
 
 def _build_arguments(parser: argparse.ArgumentParser, workers_help: str) -> None:
@@ -433,6 +449,7 @@ def build_parser() -> argparse.ArgumentParser:
             "mdf run examples/point_target.toml --out out/pt",
             "mdf run examples/cmu_walk.toml --out out/walk --debug",
             "mdf run examples/point_target.toml --out out/pt-arrays --no-figures",
+            "mdf run examples/cmu_walk.toml --out out/walk-4k --set radar.prf=4000",
         ],
     )
     _run_arguments(run)
@@ -475,9 +492,11 @@ def build_parser() -> argparse.ArgumentParser:
         [
             "mdf check examples/cmu_walk.toml",
             "mdf check examples/point_target.toml --json",
+            "mdf check examples/cmu_walk.toml --set radar.prf=1000",
         ],
     )
     _check_arguments(check, "run config file (.toml, .yaml or .json)")
+    _set_argument(check)
     check.set_defaults(func=_cmd_check)
 
     dataset = add_command(

@@ -11,12 +11,13 @@ Relative paths inside a config are relative to the config file's folder.
 
 from __future__ import annotations
 
+import copy
 import difflib
 import json
 import re
 import stat
 import tomllib
-from collections.abc import Hashable
+from collections.abc import Hashable, Sequence
 from functools import lru_cache
 from pathlib import Path
 from typing import Annotated, Any, Union, get_args
@@ -550,11 +551,102 @@ def _kinds(registry: Registry, interface: str) -> str:
     return f" (installed kinds: {names}{registry.disabled_note()})"
 
 
-def load_run_config(path: str | Path, registry: Registry | None = None) -> RunConfigBase:
-    """Read and validate a run config file."""
+def _override_key(item: str) -> tuple[list[str], str]:
+    """``KEY=VALUE`` -> (the key's parts, the value's text); a malformed item is a
+    :class:`ConfigError` naming it."""
+    key, sep, value = item.partition("=")
+    key = key.strip()
+    if not sep or not key:
+        raise ConfigError(f"--set {item}: expected KEY=VALUE (e.g. --set radar.prf=4000)")
+    try:  # a TOML dotted key: bare or quoted parts
+        parsed: Any = tomllib.loads(f"{key} = 0")
+    except tomllib.TOMLDecodeError:
+        raise ConfigError(f"--set {item}: {key!r} is not a dotted key like radar.prf") from None
+    parts: list[str] = []
+    while isinstance(parsed, dict):
+        (name, parsed), *_ = parsed.items()
+        parts.append(name)
+    return parts, value.strip()
+
+
+def _override_value(text: str) -> Any:
+    """A ``--set`` value as TOML reads it (``4000``, ``7.7e10``, ``true``, ``"a b"``,
+    ``[1, 2]``, ``{kind = "noise"}``); text that is not a TOML value is a string."""
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
+
+
+def apply_overrides(data: dict[str, Any], overrides: Sequence[str]) -> dict[str, Any]:
+    """A config's data with ``KEY=VALUE`` overrides (``mdf run --set``) applied in order.
+
+    ``KEY`` is a dotted path (``radar.prf``, ``effects.0.snr_db``: an integer part indexes a
+    list); tables on the way are made when missing. ``VALUE`` is read as a TOML value, else as a
+    string, and means what it would written in the config file (a relative path is relative to
+    the config file's folder). ``data`` is not changed. A key that runs through a value that is
+    not a table, or an index beyond a list, is a :class:`ConfigError` naming the override.
+    """
+    result: dict[str, Any] = copy.deepcopy(data)
+    for item in overrides:
+        parts, text = _override_key(item)
+        node: Any = result
+        for depth, part in enumerate(parts):
+            last = depth == len(parts) - 1
+            where = ".".join(parts[:depth]) or "the top level"
+            if isinstance(node, list):
+                if not part.isdigit() or int(part) >= len(node):
+                    has = f"a list of {len(node)}: index it with 0..{len(node) - 1}, or"
+                    raise ConfigError(
+                        f"--set {item}: {where} is {has if node else 'an empty list:'} set the "
+                        "whole list"
+                    )
+                index = int(part)
+                if last:
+                    node[index] = _override_value(text)
+                else:
+                    node = node[index]
+            elif isinstance(node, dict):
+                if last:
+                    node[part] = _override_value(text)
+                elif part not in node and parts[depth + 1].isdigit():
+                    here = ".".join(parts[: depth + 1])
+                    raise ConfigError(
+                        f"--set {item}: {here} is not in the config: set the whole list"
+                    )
+                else:
+                    node = node.setdefault(part, {})
+            else:
+                raise ConfigError(f"--set {item}: {where} is {_short(node)}, not a table")
+    return result
+
+
+def _blame_override(exc: ConfigError, source: str, overrides: Sequence[str]) -> ConfigError:
+    """An error about a field that an override set names the override instead of the file."""
+    message = str(exc)
+    rest = message.removeprefix(f"{source}: ")
+    if rest == message:
+        return exc
+    field = rest.partition(": ")[0]
+    for item in reversed(overrides):  # the last override of a key is the one that counts
+        key = ".".join(_override_key(item)[0])
+        if key == field or key.startswith(f"{field}.") or field.startswith(f"{key}."):
+            return ConfigError(f"--set {item.strip()}: {rest}")
+    return exc
+
+
+def load_run_config(
+    path: str | Path, registry: Registry | None = None, overrides: Sequence[str] = ()
+) -> RunConfigBase:
+    """Read and validate a run config file, with ``overrides`` (``KEY=VALUE``, see
+    :func:`apply_overrides`) applied first; an invalid field that an override set is blamed on
+    the override."""
     p = Path(path)
-    data = read_config_file(p, "run")
-    return validate_run_config(data, source=str(p), base_dir=p.parent, registry=registry)
+    data = apply_overrides(read_config_file(p, "run"), overrides)
+    try:
+        return validate_run_config(data, source=str(p), base_dir=p.parent, registry=registry)
+    except ConfigError as exc:
+        raise _blame_override(exc, str(p), overrides) from None
 
 
 def validate_run_config(

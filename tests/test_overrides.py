@@ -1,0 +1,159 @@
+"""``--set KEY=VALUE``: a config field changed from the command line, as if the file said so."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import EXAMPLES
+
+from mdframework import cli
+from mdframework.config import apply_overrides, load_run_config, read_config_file
+from mdframework.errors import ConfigError
+
+POINT = EXAMPLES / "point_target.toml"
+
+
+def mdf(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    code = cli.main(args)
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_values_are_read_as_toml_and_other_text_as_a_string() -> None:
+    data = {"radar": {"kind": "lfm", "prf": 2400.0}, "effects": [{"kind": "noise"}]}
+    got = apply_overrides(
+        data,
+        [
+            "radar.prf=4000",
+            "radar.fc = 7.7e10",
+            "processing.window=hann",
+            'scene.person.motion="recorded"',
+            "scene.radar_position=[10.0, 0.0, 2.0]",
+            "effects.0.snr_db=10",
+            "figures.enabled=false",
+            'motion."a.b"=1',
+        ],
+    )
+    assert got["radar"] == {"kind": "lfm", "prf": 4000, "fc": 7.7e10}
+    assert isinstance(got["radar"]["prf"], int) and isinstance(got["radar"]["fc"], float)
+    assert got["processing"] == {"window": "hann"}  # a table made on the way
+    assert got["scene"] == {"person": {"motion": "recorded"}, "radar_position": [10.0, 0.0, 2.0]}
+    assert got["effects"] == [{"kind": "noise", "snr_db": 10}]
+    assert got["figures"] == {"enabled": False}
+    assert got["motion"] == {"a.b": 1}  # a quoted part keeps its dot
+    assert data == {"radar": {"kind": "lfm", "prf": 2400.0}, "effects": [{"kind": "noise"}]}
+
+
+def test_overrides_apply_in_order_and_a_whole_table_replaces_the_old() -> None:
+    data = {"radar": {"kind": "lfm", "prf": 2400.0, "fc": 15e9}}
+    assert apply_overrides(data, ["radar.prf=1", "radar.prf=2"])["radar"]["prf"] == 2
+    assert apply_overrides(data, ['radar={kind = "cw"}'])["radar"] == {"kind": "cw"}
+    assert apply_overrides(data, ['radar={kind = "cw"}', "radar.fc=1e9"])["radar"] == {
+        "kind": "cw",
+        "fc": 1e9,
+    }
+
+
+@pytest.mark.parametrize(
+    ("item", "message"),
+    [
+        ("radar", "--set radar: expected KEY=VALUE (e.g. --set radar.prf=4000)"),
+        ("=4", "--set =4: expected KEY=VALUE (e.g. --set radar.prf=4000)"),
+        ("radar..prf=4", "--set radar..prf=4: 'radar..prf' is not a dotted key like radar.prf"),
+        ("seed.x=1", "--set seed.x=1: seed is 7, not a table"),
+        (
+            "effects.1.snr_db=1",
+            "--set effects.1.snr_db=1: effects is a list of 1: index it "
+            "with 0..0, or set the whole list",
+        ),
+        (
+            "effects.x=1",
+            "--set effects.x=1: effects is a list of 1: index it with 0..0, or set the whole list",
+        ),
+        (
+            "scene.effects.0.x=1",
+            "--set scene.effects.0.x=1: scene.effects is not in the config: set the whole list",
+        ),
+    ],
+)
+def test_malformed_overrides_are_one_line_naming_the_override(item: str, message: str) -> None:
+    data = {"seed": 7, "effects": [{"kind": "noise"}]}
+    with pytest.raises(ConfigError) as info:
+        apply_overrides(data, [item])
+    assert str(info.value) == message
+
+
+def test_an_override_runs_as_the_same_edit_in_the_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The same record, to the bit, as a file that says what the overrides say."""
+    edited = read_config_file(POINT)
+    edited["radar"]["prf"] = 1200.0
+    edited["scene"]["radar_position"] = [8.0, 1.0, 1.5]
+    edited_file = tmp_path / "edited.json"
+    edited_file.write_text(json.dumps(edited))
+    assert (
+        mdf(["run", str(edited_file), "--out", str(tmp_path / "file"), "--no-figures"], capsys)[0]
+        == 0
+    )
+    code, _, err = mdf(
+        ["run", str(POINT), "--out", str(tmp_path / "set"), "--no-figures",
+         "--set", "radar.prf=1200", "--set", "scene.radar_position=[8.0, 1.0, 1.5]"],
+        capsys,
+    )  # fmt: skip
+    assert code == 0, err
+    resolved = json.loads((tmp_path / "set" / "config.resolved.json").read_text())
+    assert resolved["radar"]["prf"] == 1200.0
+    assert resolved["scene"]["radar_position"] == [8.0, 1.0, 1.5]
+    with (
+        np.load(tmp_path / "file" / "result.npz") as a,
+        np.load(tmp_path / "set" / "result.npz") as b,
+    ):
+        assert np.array_equal(a["signal"], b["signal"])
+        assert np.array_equal(a["spectrogram_db"], b["spectrogram_db"])
+        # and not the example's own record: half the pulses of its PRF 2400 Hz
+        assert len(b["signal"]) == 2401
+
+
+def test_an_invalid_value_names_the_override_and_writes_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "out"
+    code, stdout, err = mdf(
+        ["run", str(POINT), "--out", str(out), "--set", "radar.prf=4000", "--set", "radar.prf=-1"],
+        capsys,
+    )
+    assert code == 2 and stdout == ""
+    assert err == "mdf: error: --set radar.prf=-1: radar.prf: must be at least 1 (got -1)\n"
+    assert not out.exists()
+    code, _, err = mdf(["check", str(POINT), "--set", "radar.prff=1"], capsys)
+    assert code == 2
+    assert err == (
+        "mdf: error: --set radar.prff=1: radar.prff: unknown field 'prff' (did you mean 'prf'?)\n"
+    )
+    # a field the override did not touch is still blamed on the file
+    code, _, err = mdf(
+        ["check", str(POINT), "--set", "radar.prf=1000", "--set", "radar.bogus=1"], capsys
+    )
+    assert code == 2 and err.startswith("mdf: error: --set radar.bogus=1: radar.bogus: unknown")
+
+
+def test_check_reports_the_overridden_run(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = mdf(["check", str(POINT), "--set", "radar.prf=1200"], capsys)
+    assert code == 0
+    assert out.splitlines()[0] == f"{POINT} --set radar.prf=1200: valid"
+    assert "PRF 1.2 kHz" in out and "2401 pulses" in out
+    assert "+-6 m/s" in out  # lambda PRF / 4 = 0.02 m * 1200 / 4 (the example's 2400: +-12)
+
+
+def test_a_relative_path_is_relative_to_the_config_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    config = load_run_config(
+        EXAMPLES / "cmu_walk.toml", overrides=["motion.file=data/cmu/asf-amc/09_06.amc"]
+    )
+    assert config.motion.file == EXAMPLES / "data" / "cmu" / "asf-amc" / "09_06.amc"  # type: ignore[attr-defined]
