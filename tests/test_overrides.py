@@ -157,3 +157,71 @@ def test_a_relative_path_is_relative_to_the_config_file(
         EXAMPLES / "cmu_walk.toml", overrides=["motion.file=data/cmu/asf-amc/09_06.amc"]
     )
     assert config.motion.file == EXAMPLES / "data" / "cmu" / "asf-amc" / "09_06.amc"  # type: ignore[attr-defined]
+
+
+DATASET = EXAMPLES / "datasets" / "cmu.toml"
+
+
+def test_a_dataset_plan_takes_the_override(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = mdf(["dataset", "check", str(DATASET), "--json"], capsys)
+    assert code == 0, err
+    assert json.loads(out)["first"]["walk"]["n_pulses"] == 2401  # the config's PRF, 2400 Hz
+    code, out, err = mdf(
+        ["dataset", "check", str(DATASET), "--json", "--set", "base.radar.prf=1000",
+         "--set", "variations.aspect_deg=[0.0]"],
+        capsys,
+    )  # fmt: skip
+    assert code == 0, err
+    plan = json.loads(out)
+    assert plan["first"]["walk"]["n_pulses"] == 1001
+    assert plan["n_records"] == 280 // 4  # one aspect of the config's four
+
+
+def test_an_invalid_dataset_or_experiment_override_names_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, _, err = mdf(["dataset", "check", str(DATASET), "--set", "base.radar.prf=-1"], capsys)
+    assert code == 2
+    assert err.splitlines()[-1] == (
+        "mdf: error: --set base.radar.prf=-1: sources[0] record 0: base.radar.prf: must be at "
+        "least 1 (got -1)"
+    )
+    out = tmp_path / "ds"
+    code, _, err = mdf(
+        ["dataset", "build", str(DATASET), "--out", str(out), "--set", "seed=-1"], capsys
+    )
+    assert (code, err) == (2, "mdf: error: --set seed=-1: seed: must be at least 0 (got -1)\n")
+    assert not out.exists()
+    experiment = EXAMPLES / "experiment_cmu.toml"
+    out = tmp_path / "exp"
+    code, _, err = mdf(
+        ["experiment", str(experiment), "--out", str(out), "--set", "classifier.k=0"], capsys
+    )
+    assert (code, err) == (
+        2,
+        "mdf: error: --set classifier.k=0: classifier.k: must be at least 1 (got 0)\n",
+    )
+    assert not out.exists()
+
+
+def test_a_dataset_built_with_an_override_keeps_it_and_resumes_only_with_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    config = tmp_path / "ds.toml"
+    walk = EXAMPLES / "data" / "cmu" / "asf-amc" / "02_01.amc"
+    config.write_text(
+        f'seed = 7\n[[sources]]\nlabel = "walk"\nmotion = {{ kind = "cmu", file = "{walk}" }}\n'
+        "max_records = 2\n[record_lengths]\nwalk = 1.0\n[base.processing]\nnfft = 256\n"
+    )
+    out = tmp_path / "ds"
+    build = ["dataset", "build", str(config), "--out", str(out), "--workers", "1", "--no-progress"]
+    code, _, err = mdf([*build, "--set", "base.radar.prf=1200"], capsys)
+    assert code == 0, err
+    manifest = json.loads((out / "dataset.json").read_text())
+    assert manifest["config"]["base"]["radar"]["prf"] == 1200
+    with np.load(next((out / "records").glob("*.npz"))) as record:
+        # lambda PRF / 4 = 6 m/s at PRF 1200 Hz (12 m/s at the default 2400 Hz)
+        assert 5.9 < record["velocity_mps"].max() <= 6.0
+    assert mdf([*build, "--set", "base.radar.prf=1200"], capsys)[0] == 0  # resumes: done
+    code, _, err = mdf(build, capsys)  # the file's own PRF is another config
+    assert code == 2 and "different config" in err

@@ -204,15 +204,17 @@ def _cmd_check(args: argparse.Namespace) -> int:
 def _cmd_dataset_check(args: argparse.Namespace) -> int:
     with _progress(args).step("reading the config, the installed plugins and the motions"):
         from .check import format_dataset_plan, plan_dataset
+        from .config import blaming_overrides
         from .dataset import load_dataset_config
 
-        config, base = load_dataset_config(args.config)
-        with _naming(args.config):
+        config, base = load_dataset_config(args.config, args.overrides)
+        with blaming_overrides(args.config, args.overrides), _naming(args.config):
             plan = plan_dataset(config, base, every=args.all)
     if args.json:
         print(json.dumps(plan.as_dict(), indent=2))
     else:
-        print(format_dataset_plan(plan, args.config))
+        sets = "".join(f" --set {item}" for item in args.overrides)
+        print(format_dataset_plan(plan, args.config + sets))
     return 0
 
 
@@ -265,10 +267,11 @@ def _cmd_schema(args: argparse.Namespace) -> int:
 
 
 def _cmd_dataset_build(args: argparse.Namespace) -> int:
+    from .config import blaming_overrides
     from .dataset import build_dataset, load_dataset_config
 
-    config, base = load_dataset_config(args.config)
-    with _naming(args.config):
+    config, base = load_dataset_config(args.config, args.overrides)
+    with blaming_overrides(args.config, args.overrides), _naming(args.config):
         rows = build_dataset(
             config,
             base,
@@ -286,14 +289,15 @@ def _cmd_dataset_build(args: argparse.Namespace) -> int:
 
 
 def _cmd_experiment(args: argparse.Namespace) -> int:
+    from .config import blaming_overrides
     from .experiment import load_experiment_config, run_experiment
     from .progress import note
 
     note("reading the experiment config and the installed plugins", not args.no_progress)
-    config = load_experiment_config(args.config)
+    config = load_experiment_config(args.config, args.overrides)
     if args.workers is not None:
         config = config.model_copy(update={"workers": args.workers})
-    with _naming(args.config):
+    with blaming_overrides(args.config, args.overrides), _naming(args.config):
         run_experiment(
             config,
             Path(args.out),
@@ -361,7 +365,7 @@ def _version() -> str:
 SET_HELP = (
     "change one config field for this run, as if the file said so: KEY is a dotted path "
     "(radar.prf, effects.0.snr_db), VALUE a TOML value (4000, 7.7e10, true, '\"hann\"'; other "
-    "text is a string); repeatable, applied in order; config.resolved.json holds the result"
+    "text is a string); repeatable, applied in order; the output keeps the config that ran"
 )
 
 
@@ -400,6 +404,7 @@ def _check_arguments(parser: argparse.ArgumentParser, config_help: str) -> None:
     parser.add_argument("config", help=config_help)
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
     parser.add_argument("--no-progress", action="store_true", help=PROGRESS_HELP)
+    _set_argument(parser)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -496,7 +501,6 @@ def build_parser() -> argparse.ArgumentParser:
         ],
     )
     _check_arguments(check, "run config file (.toml, .yaml or .json)")
-    _set_argument(check)
     check.set_defaults(func=_cmd_check)
 
     dataset = add_command(
@@ -529,6 +533,7 @@ def build_parser() -> argparse.ArgumentParser:
     _build_arguments(build, "local processes")
     build.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     build.add_argument("--force", action="store_true", help=FORCE_DATASET_HELP)
+    _set_argument(build)
     build.set_defaults(func=_cmd_dataset_build)
 
     dcheck = add_command(
@@ -574,6 +579,7 @@ def build_parser() -> argparse.ArgumentParser:
         "code: use only with configs you trust); default: scikit-learn's classifiers only",
     )
     experiment.add_argument("--force", action="store_true", help=FORCE_DATASET_HELP)
+    _set_argument(experiment)
     experiment.add_argument("--staging-dir", default=None, help=STAGING_HELP)
     _build_arguments(
         experiment, "local processes building the dataset (default: the config's workers)"

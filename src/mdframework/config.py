@@ -17,7 +17,8 @@ import json
 import re
 import stat
 import tomllib
-from collections.abc import Hashable, Sequence
+from collections.abc import Hashable, Iterator, Sequence
+from contextlib import contextmanager
 from functools import lru_cache
 from pathlib import Path
 from typing import Annotated, Any, Union, get_args
@@ -246,13 +247,17 @@ def _a(word: str) -> str:
     return f"an {word}" if word[0] in "aeiou" else f"a {word}"
 
 
-def read_config_file(path: str | Path, kind: str | None = None) -> dict[str, Any]:
+def read_config_file(
+    path: str | Path, kind: str | None = None, overrides: Sequence[str] = ()
+) -> dict[str, Any]:
     """Parse a TOML, YAML or JSON file into a dict; errors name the file and line.
 
     The file must be UTF-8 (a byte-order mark is allowed), at most ``limits.MAX_CONFIG_BYTES``
     long, with tables and lists nested at most ``limits.MAX_CONFIG_DEPTH`` deep. ``kind``
     (``"run"``, ``"dataset"``, ``"experiment"``): a config of another kind is refused, naming
-    the command that reads it.
+    the command that reads it. ``overrides`` (``KEY=VALUE``, the command line's ``--set``) are
+    applied last (:func:`apply_overrides`); validate the result within
+    :func:`blaming_overrides`.
     """
     p = Path(path)
     suffix = p.suffix.lower()
@@ -304,7 +309,7 @@ def read_config_file(path: str | Path, kind: str | None = None) -> dict[str, Any
     _check_depth(p, data)
     if kind is not None:
         _check_kind(p, data, kind)
-    return data
+    return apply_overrides(data, overrides) if overrides else data
 
 
 #: top-level fields of run configs (a TOML key written after a [table] header lands in it)
@@ -621,18 +626,24 @@ def apply_overrides(data: dict[str, Any], overrides: Sequence[str]) -> dict[str,
     return result
 
 
-def _blame_override(exc: ConfigError, source: str, overrides: Sequence[str]) -> ConfigError:
-    """An error about a field that an override set names the override instead of the file."""
-    message = str(exc)
-    rest = message.removeprefix(f"{source}: ")
-    if rest == message:
-        return exc
-    field = rest.partition(": ")[0]
-    for item in reversed(overrides):  # the last override of a key is the one that counts
-        key = ".".join(_override_key(item)[0])
-        if key == field or key.startswith(f"{field}.") or field.startswith(f"{key}."):
-            return ConfigError(f"--set {item.strip()}: {rest}")
-    return exc
+@contextmanager
+def blaming_overrides(source: str, overrides: Sequence[str]) -> Iterator[None]:
+    """A :class:`ConfigError` about a field that an override set (``source: field: ...`` or
+    ``source: sources[0] record 3: field: ...``, or a field above or below it) names the
+    override instead of the file ``source``."""
+    try:
+        yield
+    except ConfigError as exc:
+        rest = str(exc).removeprefix(f"{source}: ")
+        if rest == str(exc):
+            raise
+        fields = rest.split(": ")[:-1]  # the message's places, outermost first
+        for item in reversed(overrides):  # the last override of a key is the one that counts
+            key = ".".join(_override_key(item)[0])
+            for field in fields:
+                if key == field or key.startswith(f"{field}.") or field.startswith(f"{key}."):
+                    raise ConfigError(f"--set {item.strip()}: {rest}") from None
+        raise
 
 
 def load_run_config(
@@ -642,11 +653,9 @@ def load_run_config(
     :func:`apply_overrides`) applied first; an invalid field that an override set is blamed on
     the override."""
     p = Path(path)
-    data = apply_overrides(read_config_file(p, "run"), overrides)
-    try:
+    data = read_config_file(p, "run", overrides)
+    with blaming_overrides(str(p), overrides):
         return validate_run_config(data, source=str(p), base_dir=p.parent, registry=registry)
-    except ConfigError as exc:
-        raise _blame_override(exc, str(p), overrides) from None
 
 
 def validate_run_config(

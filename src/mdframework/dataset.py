@@ -44,7 +44,7 @@ import json
 import os
 import re
 import warnings
-from collections.abc import Callable, Generator, Iterator, Mapping
+from collections.abc import Callable, Generator, Iterator, Mapping, Sequence
 from concurrent.futures import as_completed
 from contextlib import AbstractContextManager, closing, contextmanager, nullcontext
 from dataclasses import dataclass, replace
@@ -58,7 +58,12 @@ from pydantic import Field, ValidationError, field_validator, model_validator
 
 from . import limits
 from .augment import augment_motion, warp_function
-from .config import format_validation_error, read_config_file, validate_run_config
+from .config import (
+    blaming_overrides,
+    format_validation_error,
+    read_config_file,
+    validate_run_config,
+)
 from .errors import ConfigError, DataFileError, MdfError, OutputError, SceneError
 from .features import FEATURE_NAMES, band_edge_frames, envelopes, features_from_envelopes
 from .interfaces import Motion, Recording, RecordingSource
@@ -348,19 +353,25 @@ class RecordSpec:
     window: tuple[str, float, float] | None = None
 
 
-def load_dataset_config(path: str | Path) -> tuple[DatasetConfig, Path]:
-    """Read and validate a dataset config; returns it and its folder (for relative paths)."""
+def load_dataset_config(
+    path: str | Path, overrides: Sequence[str] = ()
+) -> tuple[DatasetConfig, Path]:
+    """Read and validate a dataset config, with ``overrides`` (``KEY=VALUE``, the command
+    line's ``--set``) applied; returns it and its folder (for relative paths)."""
     p = Path(path)
-    data = read_config_file(p, "dataset")
-    if "scheduler" in data:
-        raise ConfigError(
-            f"{p}: scheduler: a shared config cannot choose where records are computed; give "
-            f"the Dask scheduler with --scheduler or the {SCHEDULER_ENV} environment variable"
-        )
-    try:
-        return DatasetConfig.model_validate(data), p.parent
-    except ValidationError as exc:
-        raise ConfigError(format_validation_error(exc, str(p), data, DatasetConfig)) from None
+    data = read_config_file(p, "dataset", overrides)
+    with blaming_overrides(str(p), overrides):
+        if "scheduler" in data:
+            raise ConfigError(
+                f"{p}: scheduler: a shared config cannot choose where records are computed; "
+                f"give the Dask scheduler with --scheduler or the {SCHEDULER_ENV} environment "
+                "variable"
+            )
+        try:
+            return DatasetConfig.model_validate(data), p.parent
+        except ValidationError as exc:
+            message = format_validation_error(exc, str(p), data, DatasetConfig)
+            raise ConfigError(message) from None
 
 
 _MOTIONS: dict[tuple[str, str], Motion] = {}  # this process's motions, oldest first

@@ -50,7 +50,7 @@ from .classify import (
     optimistic_select,
     wrapper_select,
 )
-from .config import format_validation_error, read_config_file
+from .config import blaming_overrides, format_validation_error, read_config_file
 from .dataset import INDEX, Dataset, build_dataset, load_dataset, load_dataset_config
 from .errors import ConfigError, DataFileError, MdfError
 from .features import FEATURE_NAMES
@@ -217,10 +217,16 @@ class ExperimentConfig(StrictModel):
     workers: Workers | None = Field(None, description="Processes for building the dataset.")
 
 
-def load_experiment_config(path: str | Path) -> ExperimentConfig:
-    """Read and validate an experiment config; relative paths become relative to its folder."""
+def load_experiment_config(path: str | Path, overrides: Sequence[str] = ()) -> ExperimentConfig:
+    """Read and validate an experiment config, with ``overrides`` (``KEY=VALUE``, the command
+    line's ``--set``) applied; relative paths become relative to its folder."""
     p = Path(path)
-    data = read_config_file(p, "experiment")
+    data = read_config_file(p, "experiment", overrides)
+    with blaming_overrides(str(p), overrides):
+        return _experiment_config(p, data)
+
+
+def _experiment_config(p: Path, data: dict[str, Any]) -> ExperimentConfig:
     ds = data.get("dataset")
     if isinstance(ds, dict):
         data["dataset"] = {
