@@ -20,7 +20,8 @@ representation simulated records get with ``representation = "histogram"``.
                            aspect_deg, radar_x/y/z_m, height_m, seed, band_edge_frames
                            (:func:`~mdframework.features.band_edge_frames`), the 7 features, then
                            draw.<name> for every randomised parameter
-    DIR/dataset.json       the config, the feature names and units, the record count
+    DIR/dataset.json       the config, the feature names and units, the record count, the
+                           SHA-256 of index.csv (load_dataset refuses an index changed since)
 
 Records are independent pure functions of their spec (including a seed derived from the
 dataset seed and the record's index), so the result is identical whatever the number of workers
@@ -108,6 +109,8 @@ SKIPPED = "skipped.csv"
 TEXT_COLUMNS = ("id", "label", "group", "source", "file", "subject", "recording", "dataset")
 INDEX = "index.csv"
 MANIFEST = "dataset.json"
+#: the key of dataset.json that holds the SHA-256 of index.csv as the build wrote it
+INDEX_DIGEST = "index_sha256"
 #: Environment variables that choose a Dask scheduler (when --scheduler is not given) and its
 #: connection timeout [s].
 SCHEDULER_ENV = "MDF_DASK_SCHEDULER"
@@ -2106,7 +2109,8 @@ def _write_index(
     writer = csv.DictWriter(buf, fieldnames=fields, lineterminator="\n", restval="")
     writer.writeheader()
     writer.writerows(rows)
-    atomic_write_text(out / INDEX, buf.getvalue())
+    index_text = buf.getvalue()
+    atomic_write_text(out / INDEX, index_text)
     skipped = skipped or []
     if skipped:
         sbuf = io.StringIO()
@@ -2125,6 +2129,8 @@ def _write_index(
         "labels": sorted({r["label"] for r in rows}),
         "config": json.loads(config.model_dump_json()),
         "versions": versions(),  # of the build that wrote the index (records may be older)
+        # what load_dataset checks the index against: one cut short or edited is refused
+        INDEX_DIGEST: hashlib.sha256(index_text.encode("utf-8")).hexdigest(),
     }
     atomic_write_text(out / MANIFEST, json.dumps(manifest, indent=2) + "\n")
 
@@ -2170,6 +2176,53 @@ def _load_record(path: Path) -> dict[str, NDArray[Any]]:
     )
 
 
+def _verified_index(root: Path) -> str:
+    """The text of the dataset's ``index.csv``, checked against what the build wrote: the digest
+    in ``dataset.json`` (builds since November 2026; an index cut short or edited since the build
+    would otherwise give an experiment wrong records, labels or features without a word), and a
+    header's number of fields on every row. Anything else is a :class:`DataFileError` that says
+    how to fix it: the same ``mdf dataset build``, run again, rewrites both files from the
+    records."""
+    index = root / INDEX
+    rebuild = "run the same `mdf dataset build` again to rewrite it from the records"
+    data = index.read_bytes()
+    manifest_path = root / MANIFEST
+    try:
+        manifest = json.loads(manifest_path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise DataFileError(manifest_path, f"missing, though {INDEX} is there; {rebuild}") from None
+    except (ValueError, UnicodeDecodeError) as exc:
+        raise DataFileError(
+            manifest_path, f"not valid JSON ({' '.join(str(exc).split())}); {rebuild}"
+        ) from None
+    digest = manifest.get(INDEX_DIGEST) if isinstance(manifest, dict) else None
+    if not isinstance(manifest, dict) or (digest is not None and not isinstance(digest, str)):
+        raise DataFileError(manifest_path, f"not the file a build writes; {rebuild}")
+    if digest is not None and hashlib.sha256(data).hexdigest() != digest:
+        raise DataFileError(
+            index,
+            f"not the file the build wrote (cut short or edited since: it does not match the "
+            f"digest in {MANIFEST}); {rebuild}",
+        )
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise DataFileError(index, f"not UTF-8 text ({exc.reason}); {rebuild}") from None
+    if text and not text.endswith("\n"):  # a build ends every row with one
+        raise DataFileError(index, f"cut short (its last row is incomplete); {rebuild}")
+    reader = csv.reader(io.StringIO(text, newline=""))
+    header = next(reader, [])
+    for row in reader:
+        if len(row) != len(header):
+            raise DataFileError(
+                index,
+                f"{len(row)} fields where the header has {len(header)} (cut short or edited "
+                f"since the build); {rebuild}",
+                reader.line_num,
+            )
+    return text
+
+
 def load_dataset(
     path: str | Path, *, spectrograms: bool = True, histograms: bool = False
 ) -> Dataset:
@@ -2183,8 +2236,7 @@ def load_dataset(
             f"{root}: the build stopped while it wrote {INDEX}, {SKIPPED} and {MANIFEST} (they "
             "may not match); run the same `mdf dataset build` again to finish it"
         )
-    with index.open(newline="", encoding="utf-8") as fh:
-        rows = list(csv.DictReader(fh))
+    rows = list(csv.DictReader(io.StringIO(_verified_index(root), newline="")))
     if not rows:
         raise MdfError(f"{index}: the dataset has no records")
     table: dict[str, NDArray[Any]] = {}

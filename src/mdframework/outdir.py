@@ -107,19 +107,29 @@ def _write_temporary(
 ) -> tuple[Any, str]:
     """A temporary file beside ``path`` (``prefix`` + ``*`` + ``suffix``), written by
     ``write(fh)`` and left open for :func:`_put_in_place`: the open file and its path. Removed
-    if writing fails."""
-    fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=suffix, dir=path.parent)
+    if writing fails; the error then names ``path`` (a note ``while writing PATH``: a full disk
+    otherwise names no file, or the temporary one)."""
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=suffix, dir=path.parent)
+    except BaseException as exc:
+        exc.add_note(f"while writing {path}")
+        raise
     try:
         fh = os.fdopen(fd, "wb")
-    except BaseException:
+    except BaseException as exc:
         os.close(fd)
         Path(tmp).unlink(missing_ok=True)
+        exc.add_note(f"while writing {path}")
         raise
     try:
         write(fh)
-    except BaseException:
-        fh.close()
+    except BaseException as exc:
+        try:
+            fh.close()  # a full disk can fail this too
+        except OSError:
+            pass
         Path(tmp).unlink(missing_ok=True)
+        exc.add_note(f"while writing {path}")
         raise
     return fh, tmp
 
