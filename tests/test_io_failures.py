@@ -119,7 +119,9 @@ def test_an_index_changed_since_the_build_is_refused_and_a_rebuild_restores_it(
     index.write_text(changed)
     with pytest.raises(DataFileError, match=r"index\.csv: not the file the build wrote"):
         load_dataset(data)
-    line = _one_error(["experiment", str(_experiment(data, tmp_path)), "--out", "o"], capsys)
+    line = _one_error(
+        ["experiment", str(_experiment(data, tmp_path)), "--out", str(tmp_path / "o")], capsys
+    )
     assert line == (
         f"mdf: error: {index}: not the file the build wrote (cut short or edited since: it "
         "does not match the digest in dataset.json); run the same `mdf dataset build` again to "
@@ -242,3 +244,42 @@ def test_a_full_disk_during_a_run_names_out_and_keeps_the_earlier_output(
         "--out) and run the command again"
     )
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+
+
+def test_a_dataset_that_a_build_is_writing_is_not_loaded(
+    built: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Another process holds the dataset folder's lock (a resumed or --force build writing it:
+    records removed, index.csv and dataset.json replaced one after the other): an experiment on
+    it is one line naming that process (it read whatever was there, or said `not a built
+    dataset (no index.csv); run mdf dataset build` during a first build); once the holder has
+    ended, it loads."""
+    import subprocess
+    import sys
+
+    data = _copy(built, tmp_path)
+    holder = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import sys; from pathlib import Path; from mdframework.outdir import acquire_lock; "
+            f"acquire_lock(Path({str(data)!r}), 'mdf dataset'); print('locked', flush=True); "
+            "sys.stdin.read()",
+        ],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert holder.stdout is not None and holder.stdout.readline() == "locked\n"
+        line = _one_error(
+            ["experiment", str(_experiment(data, tmp_path)), "--out", str(tmp_path / "o")], capsys
+        )
+        assert line.startswith(
+            f"mdf: error: {tmp_path / 'e.toml'}: {data}: being written by process {holder.pid} "
+            "(mdf dataset, started "
+        )
+        assert line.endswith("); wait for it to finish and try again")
+    finally:
+        holder.communicate("")
+    assert load_dataset(data, spectrograms=False).features.shape == (4, 7)

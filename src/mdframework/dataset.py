@@ -67,6 +67,8 @@ from .outdir import (
     OutputFolder,
     atomic_savez,
     atomic_write_text,
+    describe_holder,
+    lock_holder,
     marker_name,
     output_folder,
     safe_name,
@@ -2229,6 +2231,13 @@ def load_dataset(
     """Load a built dataset in one call (arrays plus the index table)."""
     root = Path(path)
     index = root / INDEX
+    holder = lock_holder(root)
+    # a build (or another command given the folder as --out) is writing it; not this process
+    if holder is not None and holder.get("pid") != os.getpid():
+        raise MdfError(
+            f"{root}: being written by {describe_holder(holder)}; wait for it to finish and "
+            "try again"
+        )
     if not index.exists():
         raise MdfError(f"{root}: not a built dataset (no {INDEX}); run `mdf dataset build`")
     if _index_half_written(root):

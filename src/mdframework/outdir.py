@@ -302,6 +302,38 @@ def _read_holder(path: Path) -> dict[str, Any]:
     return {}
 
 
+def describe_holder(info: dict[str, Any]) -> str:
+    """A lock holder as :func:`lock_holder` gives it, in words: ``process 4242 (mdf run,
+    started ..., host ...)``, or ``another process`` when its details are unknown."""
+    if not info:
+        return "another process"
+    return (
+        f"process {info.get('pid')} ({info.get('command', 'mdf')}, started "
+        f"{info.get('started', '?')}, host {info.get('host', '?')})"
+    )
+
+
+def lock_holder(folder: Path) -> dict[str, Any] | None:
+    """The details of the command that holds ``folder``'s lock now (``{}`` when it wrote none),
+    or None when no command holds it, for a reader of an output (``load_dataset``) that must
+    not read one a command is writing. Reads only: nothing is created, and the lock is tried
+    for an instant (shared), not kept."""
+    path = folder / LOCK
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:
+        return None  # no lock file: no command holds the folder
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except OSError as exc:
+        if exc.errno in (errno.EAGAIN, errno.EACCES, errno.EWOULDBLOCK):
+            return _read_holder(path)
+        return None  # a file system without locks: nothing to tell
+    finally:
+        os.close(fd)  # (releases the lock taken, if any)
+    return None
+
+
 def acquire_lock(folder: Path, command: str) -> int:
     """Take the folder's lock; returns its file descriptor. Raises :class:`OutputError` naming
     the holder when another process holds it. A lock file left by a dead process is taken
@@ -321,13 +353,7 @@ def acquire_lock(folder: Path, command: str) -> int:
             os.close(fd)
             if exc.errno not in (errno.EAGAIN, errno.EACCES, errno.EWOULDBLOCK):
                 raise
-            info = _read_holder(path)
-            who = (
-                f"process {info.get('pid')} ({info.get('command', 'mdf')}, started "
-                f"{info.get('started', '?')}, host {info.get('host', '?')})"
-                if info
-                else "another process"
-            )
+            who = describe_holder(_read_holder(path))
             raise OutputError(
                 f"--out {folder}: in use by {who}; wait for it to finish or choose another folder"
             ) from None
