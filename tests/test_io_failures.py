@@ -283,3 +283,31 @@ def test_a_dataset_that_a_build_is_writing_is_not_loaded(
     finally:
         holder.communicate("")
     assert load_dataset(data, spectrograms=False).features.shape == (4, 7)
+
+
+def test_a_file_system_without_locks_warns_and_the_command_goes_on(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An NFS mount whose lock service does not answer makes every ``flock`` fail with ENOLCK:
+    `mdf run` was an internal error (exit 1) on any folder there. Now it warns once, naming
+    --out, and writes its output; the lock file is gone afterwards."""
+    import fcntl
+
+    import mdframework.outdir as outdir
+
+    def no_locks(fd: int, operation: int) -> None:
+        raise OSError(errno.ENOLCK, "No locks available")
+
+    monkeypatch.setattr(outdir.fcntl, "flock", no_locks)
+    assert outdir.fcntl is fcntl
+    out = tmp_path / "walk"
+    config = str(EXAMPLES / "point_target.toml")
+    assert main(["run", config, "--out", str(out), "--no-progress", "--no-figures"]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        f"mdf: warning: --out {out}: cannot lock the folder (No locks available: its file "
+        "system does not support file locks); nothing keeps another command from writing into "
+        "it at the same time, so run one command at a time on it"
+    ]
+    assert (out / "result.npz").is_file() and not (out / ".mdf.lock").exists()
+    assert not any(p.name.startswith(".mdf-staging-") for p in out.iterdir())

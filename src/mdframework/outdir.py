@@ -14,7 +14,8 @@ it through :func:`output_folder`, before any work starts:
 - One lock file (``.mdf.lock``) per folder: a second command on the same folder is refused and
   told the holder's process id and start time. The lock is an advisory ``flock`` on that file, so
   the kernel drops it when its holder dies, however it dies: a lock left by a killed process is
-  stale by construction and the next command takes it over.
+  stale by construction and the next command takes it over. A file system without locks
+  (``flock`` fails with ENOLCK) gets a warning, and the command goes on unlocked.
 - Files are staged in a ``.mdf-staging-*`` folder inside ``--out`` (or in a folder the user
   chooses on the same file system), locked by its command while it lives, and moved into place
   in one swap (:meth:`OutputFolder.commit`) once every new file is complete. A command killed
@@ -40,6 +41,7 @@ import stat
 import tempfile
 import threading
 import time
+import warnings
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -326,12 +328,44 @@ def lock_holder(folder: Path) -> dict[str, Any] | None:
     try:
         fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
     except OSError as exc:
-        if exc.errno in (errno.EAGAIN, errno.EACCES, errno.EWOULDBLOCK):
+        if exc.errno in _BUSY:
             return _read_holder(path)
         return None  # a file system without locks: nothing to tell
     finally:
         os.close(fd)  # (releases the lock taken, if any)
     return None
+
+
+#: what ``flock`` raises when another process holds the lock
+_BUSY = (errno.EAGAIN, errno.EACCES, errno.EWOULDBLOCK)
+
+
+class LockWarning(UserWarning):
+    """The file system of an output folder has no working file locks (an NFS mount without its
+    lock service, some network or FUSE file systems): the command goes on unlocked."""
+
+
+def _warn_no_locks(folder: Path, exc: OSError) -> None:
+    warnings.warn(
+        f"--out {folder}: cannot lock the folder ({exc.strerror or exc}: its file system does "
+        "not support file locks); nothing keeps another command from writing into it at the "
+        "same time, so run one command at a time on it",
+        LockWarning,
+        stacklevel=3,
+    )
+
+
+def _write_holder(fd: int, command: str) -> int:
+    """Write this process's details into the lock file ``fd``; returns ``fd``."""
+    info = {
+        "pid": os.getpid(),
+        "command": command,
+        "started": _process_start(os.getpid()),
+        "host": socket.gethostname(),
+    }
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, (json.dumps(info) + "\n").encode(), 0)
+    return fd
 
 
 def acquire_lock(folder: Path, command: str) -> int:
@@ -350,9 +384,10 @@ def acquire_lock(folder: Path, command: str) -> int:
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as exc:
+            if exc.errno not in _BUSY:
+                _warn_no_locks(folder, exc)
+                return _write_holder(fd, command)  # removed at the end, as a lock is
             os.close(fd)
-            if exc.errno not in (errno.EAGAIN, errno.EACCES, errno.EWOULDBLOCK):
-                raise
             who = describe_holder(_read_holder(path))
             raise OutputError(
                 f"--out {folder}: in use by {who}; wait for it to finish or choose another folder"
@@ -365,15 +400,7 @@ def acquire_lock(folder: Path, command: str) -> int:
         if not same:
             os.close(fd)
             continue
-        info = {
-            "pid": os.getpid(),
-            "command": command,
-            "started": _process_start(os.getpid()),
-            "host": socket.gethostname(),
-        }
-        os.ftruncate(fd, 0)
-        os.pwrite(fd, (json.dumps(info) + "\n").encode(), 0)
-        return fd
+        return _write_holder(fd, command)
     raise OutputError(f"--out {folder}: could not take the lock {path}; try again")
 
 
@@ -420,8 +447,11 @@ class OutputFolder:
         stage = Path(tempfile.mkdtemp(prefix=f"{STAGING_PREFIX}{self.command}-", dir=where))
         self._stages.append(stage)
         fd = os.open(stage, os.O_RDONLY)
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # new: nobody else holds it
         self._stage_locks.append(fd)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # new: nobody else holds it
+        except OSError:  # no locks here (warned when --out was locked): never swept as stale
+            pass
         return stage
 
     def previous_files(self) -> list[str]:
