@@ -311,3 +311,34 @@ def test_a_file_system_without_locks_warns_and_the_command_goes_on(
     ]
     assert (out / "result.npz").is_file() and not (out / ".mdf.lock").exists()
     assert not any(p.name.startswith(".mdf-staging-") for p in out.iterdir())
+
+
+def test_an_experiment_whose_dataset_build_stopped_resumes_it(
+    built: tuple[Path, Path],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """An experiment that builds its dataset (`[dataset] config`) stopped by a full disk (or a
+    batch system's time limit) after two records: the same command, run again, was refused
+    (`--out ...: the folder is not empty ('dataset') and holds no earlier mdf experiment
+    output`); now it keeps the two records, finishes the build and writes the report."""
+    config, reference = built
+    e = tmp_path / "e.toml"
+    e.write_text(
+        f'seed = 0\nworkers = 1\n[dataset]\nconfig = "{config}"\n'
+        '[classifier]\nkind = "knn"\nk = 1\n[selection]\nmethod = "none"\n'
+        "[evaluation]\nrepeats = 2\ntest_fraction = 0.5\n"
+    )
+    out = tmp_path / "o"
+    _disk_fills_after(monkeypatch, "savez", 2)
+    _one_error(["experiment", str(e), "--out", str(out)], capsys)
+    records = out / "dataset" / "records"
+    kept = {p.name: p.stat().st_ino for p in records.iterdir()}
+    assert len(kept) == 2
+    monkeypatch.undo()
+    assert main(["experiment", str(e), "--out", str(out), "--no-progress"]) == 0
+    assert {n: (records / n).stat().st_ino for n in kept} == kept  # not recomputed
+    assert (out / "report.md").is_file()
+    index = (out / "dataset" / "index.csv").read_bytes()
+    assert index == (reference / "index.csv").read_bytes()
