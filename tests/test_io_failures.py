@@ -342,3 +342,33 @@ def test_an_experiment_whose_dataset_build_stopped_resumes_it(
     assert (out / "report.md").is_file()
     index = (out / "dataset" / "index.csv").read_bytes()
     assert index == (reference / "index.csv").read_bytes()
+
+
+def test_a_full_disk_while_relabelling_keeps_every_record(
+    built: tuple[Path, Path],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A --force rebuild that only renames a label rewrites each kept record's metadata; the
+    disk full during that rewrite deleted the record (it was taken for a corrupt file) and the
+    build went on to simulate it again. Now the build stops there, naming the record, and every
+    record stays as it was; with room again, the rename completes without simulating anything."""
+    config, _ = built
+    data = _copy(built, tmp_path)
+    before = {p.name: p.read_bytes() for p in (data / "records").iterdir()}
+    renamed = tmp_path / "renamed.toml"
+    renamed.write_text(
+        config.read_text()
+        .replace('label = "walk"', 'label = "stroll"')
+        .replace("walk = 1.0", "stroll = 1.0")
+    )
+    _disk_fills_after(monkeypatch, "savez", 0)
+    argv = ["dataset", "build", str(renamed), "--out", str(data), "--force", "--workers", "1"]
+    line = _one_error(argv, capsys)
+    assert "No space left on device; free some space and run the same command again" in line
+    assert {p.name: p.read_bytes() for p in (data / "records").iterdir()} == before
+    monkeypatch.undo()
+    assert main([*argv, "--no-progress"]) == 0
+    assert sorted(p.name for p in (data / "records").iterdir()) == sorted(before)
+    assert sorted(set(load_dataset(data, spectrograms=False).labels)) == ["boxing", "stroll"]

@@ -1567,19 +1567,28 @@ def _complete(
         if made_by != now:
             other_versions[spec.record_id] = (made_by, now)
         planned = _planned_meta(spec)
-        if any(meta.get(k) != v for k, v in planned.items()):
-            meta.update(planned)
-            stored: dict[str, Any] = {**arrays, "meta": np.array(json.dumps(meta))}
-            atomic_savez(path, **stored)
-        return _row(meta, arrays["features"])
+        renamed = any(meta.get(k) != v for k, v in planned.items())
+        meta.update(planned)
+        row = _row(meta, arrays["features"])  # (a field missing: a corrupt record)
     except PermissionError as exc:
-        raise OutputError(
-            f"{path}: {exc.strerror or exc}: a record of this dataset must be readable and "
-            "writable by you to resume it; fix its permissions or build into another --out"
-        ) from None
+        raise _not_yours(path, exc) from None
     except (OSError, EOFError, ValueError, KeyError, TypeError, zipfile.BadZipFile):
         path.unlink(missing_ok=True)
         return None
+    if renamed:  # a failure to write (a full disk) stops the build; the record stays as it was
+        stored: dict[str, Any] = {**arrays, "meta": np.array(json.dumps(meta))}
+        try:
+            atomic_savez(path, **stored)
+        except PermissionError as exc:
+            raise _not_yours(path, exc) from None
+    return row
+
+
+def _not_yours(path: Path, exc: PermissionError) -> OutputError:
+    return OutputError(
+        f"{path}: {exc.strerror or exc}: a record of this dataset must be readable and "
+        "writable by you to resume it; fix its permissions or build into another --out"
+    )
 
 
 def scheduler_address(given: str | None) -> str | None:
