@@ -10,6 +10,7 @@ from __future__ import annotations
 import errno
 import hashlib
 import json
+import os
 import shutil
 from pathlib import Path
 
@@ -372,3 +373,27 @@ def test_a_full_disk_while_relabelling_keeps_every_record(
     assert main([*argv, "--no-progress"]) == 0
     assert sorted(p.name for p in (data / "records").iterdir()) == sorted(before)
     assert sorted(set(load_dataset(data, spectrograms=False).labels)) == ["boxing", "stroll"]
+
+
+@pytest.mark.parametrize("code", [errno.EIO, errno.ESTALE])
+def test_a_failing_disk_is_one_line_not_an_internal_error(
+    built: tuple[Path, Path],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    code: int,
+) -> None:
+    """An I/O error of the disk, or a network file system's stale handle, while a record is
+    written is the environment's failure, not a bug of mdf's: one line naming the record, exit
+    2 (it was `mdf: internal error: OSError ...`, exit 1)."""
+    import numpy as np
+
+    def failing(file: object, *args: object, **kwargs: object) -> None:
+        raise OSError(code, os.strerror(code))
+
+    monkeypatch.setattr(np, "savez", failing)
+    out = tmp_path / "ds"
+    argv = ["dataset", "build", str(built[0]), "--out", str(out), "--workers", "1"]
+    line = _one_error(argv, capsys)
+    first = sorted((built[1] / "records").iterdir())[0].name
+    assert line == f"mdf: error: {out / 'records' / first}: {os.strerror(code)}"

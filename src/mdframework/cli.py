@@ -180,9 +180,19 @@ def _output_path(text: str) -> str:
     return text
 
 
-#: errors of the file system a command writes to (a full disk, a read-only or forbidden
-#: folder): one line naming the file, exit code 2, like bad input
-_WRITE_ERRNOS = (errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.EPERM, errno.EFBIG)
+#: errors of the file system a command writes to (a full disk or quota, a read-only or
+#: forbidden folder, a failing disk or a network file system's stale handle): one line naming
+#: the file, exit code 2, like bad input (not a bug of mdf's)
+_WRITE_ERRNOS = (
+    errno.ENOSPC,
+    errno.EDQUOT,
+    errno.EROFS,
+    errno.EACCES,
+    errno.EPERM,
+    errno.EFBIG,
+    errno.EIO,
+    errno.ESTALE,
+)
 
 
 #: the errors of a full disk or quota: the command can be run again once there is room
