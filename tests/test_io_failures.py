@@ -397,3 +397,22 @@ def test_a_failing_disk_is_one_line_not_an_internal_error(
     line = _one_error(argv, capsys)
     first = sorted((built[1] / "records").iterdir())[0].name
     assert line == f"mdf: error: {out / 'records' / first}: {os.strerror(code)}"
+
+
+def test_a_folder_in_place_of_a_record_is_one_line_and_kept(
+    built: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A folder with a record's name in records/ (made by hand, or by a tool unpacking the
+    .npz): a resumed build was an internal error (IsADirectoryError); now one line naming it,
+    and the folder is left alone."""
+    data = _copy(built, tmp_path)
+    record = sorted((data / "records").iterdir())[1]
+    record.unlink()
+    record.mkdir()
+    (record / "mine.txt").write_text("x")
+    line = _one_error(["dataset", "build", str(built[0]), "--out", str(data)], capsys)
+    assert line == (
+        f"mdf: error: {record}: a folder where the dataset has a record's file; move it away "
+        "and run the build again"
+    )
+    assert (record / "mine.txt").read_text() == "x"

@@ -1556,6 +1556,11 @@ def _complete(
     records named theirs) and this process's added to ``other_versions``."""
     import zipfile
 
+    if path.is_dir() and not path.is_symlink():  # not ours to delete
+        raise OutputError(
+            f"{path}: a folder where the dataset has a record's file; move it away and run the "
+            "build again"
+        )
     if not path.exists():
         return None
     try:
