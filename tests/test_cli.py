@@ -101,8 +101,11 @@ def test_a_full_disk_is_one_line_naming_the_file(
         ["run", str(EXAMPLES / "point_target.toml"), "--out", str(out), "--no-figures"], capsys
     )
     assert code == 2 and len(err.strip().splitlines()) == 1, err
-    assert err.startswith("mdf: error: No space left on device: ")
-    assert err.strip().endswith("result.npz")
+    # the file by the name it was to have in --out (not its staging folder's), and what to do
+    assert err.strip() == (
+        f"mdf: error: {out / 'result.npz'}: No space left on device; free some space (or choose "
+        "another --out) and run the command again"
+    )
     assert list(tmp_path.iterdir()) == []  # no output folder, no staging debris
 
 

@@ -586,6 +586,10 @@ def test_a_feature_that_is_not_a_number_names_the_index_line(
     cells[header.index("upper_max")] = ""
     lines[3] = ",".join(cells)
     (data / "index.csv").write_text("\n".join(lines) + "\n")
+    # a dataset built before dataset.json held the index's digest (which now refuses any edit)
+    manifest = json.loads((data / "dataset.json").read_text())
+    del manifest["index_sha256"]
+    (data / "dataset.json").write_text(json.dumps(manifest))
     e = _experiment(data, tmp_path, '[selection]\nmethod = "none"\n[evaluation]\nrepeats = 2\n')
     _fails_with_one_line(
         e,

@@ -389,6 +389,11 @@ def test_dataset_into_a_folder_of_other_files(
     lines = index.read_text().splitlines()
     first = lines[1].split(",", 1)
     index.write_text("\n".join([lines[0], "../../todo," + first[1], *lines[2:]]) + "\n")
+    with pytest.raises(DataFileError, match=r"index\.csv: not the file the build wrote"):
+        load_dataset(out)  # edited since the build (dataset.json holds the index's digest)
+    manifest = json.loads((out / "dataset.json").read_text())
+    del manifest["index_sha256"]  # as a dataset of a build before the digest
+    (out / "dataset.json").write_text(json.dumps(manifest))
     with pytest.raises(DataFileError, match=r"index\.csv:2: record id '\.\./\.\./todo'"):
         load_dataset(out)
 

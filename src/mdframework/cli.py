@@ -180,9 +180,50 @@ def _output_path(text: str) -> str:
     return text
 
 
-#: errors of the file system a command writes to (a full disk, a read-only or forbidden
-#: folder): one line naming the file, exit code 2, like bad input
-_WRITE_ERRNOS = (errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.EPERM, errno.EFBIG)
+#: errors of the file system a command writes to (a full disk or quota, a read-only or
+#: forbidden folder, a failing disk or a network file system's stale handle): one line naming
+#: the file, exit code 2, like bad input (not a bug of mdf's)
+_WRITE_ERRNOS = (
+    errno.ENOSPC,
+    errno.EDQUOT,
+    errno.EROFS,
+    errno.EACCES,
+    errno.EPERM,
+    errno.EFBIG,
+    errno.EIO,
+    errno.ESTALE,
+)
+
+
+#: the errors of a full disk or quota: the command can be run again once there is room
+_NO_ROOM = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)
+
+
+def _write_failure(exc: OSError, args: argparse.Namespace) -> str:
+    """One line for a file-system error (:data:`_WRITE_ERRNOS`): the file being written (the
+    note ``while writing PATH`` that mdframework's writers add, else the error's own file name;
+    a file in a staging folder by its name in ``--out``; else ``--out`` itself), the cause, and,
+    for a full disk or quota, what to do. A dataset build keeps the records it wrote."""
+    notes = [str(n) for n in getattr(exc, "__notes__", ())]
+    writing = next(
+        (n[len("while writing ") :] for n in notes if n.startswith("while writing ")), None
+    )
+    out = getattr(args, "out", None)
+    named = exc.filename if isinstance(exc.filename, (str, bytes, os.PathLike)) else None
+    path = writing or (os.fsdecode(named) if named is not None else None)
+    if path is not None and out is not None and Path(path).parent.name.startswith(".mdf-staging-"):
+        path = str(Path(out) / Path(path).name)  # where the file was to go
+    where = path if path is not None else (f"--out {out}" if out is not None else None)
+    text = exc.strerror or str(exc)
+    line = f"{where}: {text}" if where is not None else text
+    if exc.errno in _NO_ROOM and getattr(args, "func", None) is _cmd_dataset_build:
+        line += (
+            "; free some space and run the same command again: it resumes from the records "
+            "written so far"
+        )
+    elif exc.errno in _NO_ROOM:
+        line += "; free some space (or choose another --out) and run the command again"
+    return line
 
 
 def _cmd_check(args: argparse.Namespace) -> int:
@@ -827,8 +868,7 @@ def _main(argv: list[str], debug: bool) -> int:
             raise
         retract()
         if isinstance(exc, OSError) and exc.errno in _WRITE_ERRNOS:
-            where = f": {exc.filename}" if exc.filename else ""
-            say(f"mdf: error: {exc.strerror}{where}")
+            say(f"mdf: error: {_write_failure(exc, args)}")
             return EXIT_USAGE
         notes = "".join(f"{_one_line(note)}; " for note in getattr(exc, "__notes__", ()))
         say(

@@ -20,7 +20,8 @@ representation simulated records get with ``representation = "histogram"``.
                            aspect_deg, radar_x/y/z_m, height_m, seed, band_edge_frames
                            (:func:`~mdframework.features.band_edge_frames`), the 7 features, then
                            draw.<name> for every randomised parameter
-    DIR/dataset.json       the config, the feature names and units, the record count
+    DIR/dataset.json       the config, the feature names and units, the record count, the
+                           SHA-256 of index.csv (load_dataset refuses an index changed since)
 
 Records are independent pure functions of their spec (including a seed derived from the
 dataset seed and the record's index), so the result is identical whatever the number of workers
@@ -71,6 +72,8 @@ from .outdir import (
     OutputFolder,
     atomic_savez,
     atomic_write_text,
+    describe_holder,
+    lock_holder,
     marker_name,
     output_folder,
     safe_name,
@@ -113,6 +116,8 @@ SKIPPED = "skipped.csv"
 TEXT_COLUMNS = ("id", "label", "group", "source", "file", "subject", "recording", "dataset")
 INDEX = "index.csv"
 MANIFEST = "dataset.json"
+#: the key of dataset.json that holds the SHA-256 of index.csv as the build wrote it
+INDEX_DIGEST = "index_sha256"
 #: Environment variables that choose a Dask scheduler (when --scheduler is not given) and its
 #: connection timeout [s].
 SCHEDULER_ENV = "MDF_DASK_SCHEDULER"
@@ -1562,6 +1567,11 @@ def _complete(
     records named theirs) and this process's added to ``other_versions``."""
     import zipfile
 
+    if path.is_dir() and not path.is_symlink():  # not ours to delete
+        raise OutputError(
+            f"{path}: a folder where the dataset has a record's file; move it away and run the "
+            "build again"
+        )
     if not path.exists():
         return None
     try:
@@ -1573,19 +1583,28 @@ def _complete(
         if made_by != now:
             other_versions[spec.record_id] = (made_by, now)
         planned = _planned_meta(spec)
-        if any(meta.get(k) != v for k, v in planned.items()):
-            meta.update(planned)
-            stored: dict[str, Any] = {**arrays, "meta": np.array(json.dumps(meta))}
-            atomic_savez(path, **stored)
-        return _row(meta, arrays["features"])
+        renamed = any(meta.get(k) != v for k, v in planned.items())
+        meta.update(planned)
+        row = _row(meta, arrays["features"])  # (a field missing: a corrupt record)
     except PermissionError as exc:
-        raise OutputError(
-            f"{path}: {exc.strerror or exc}: a record of this dataset must be readable and "
-            "writable by you to resume it; fix its permissions or build into another --out"
-        ) from None
+        raise _not_yours(path, exc) from None
     except (OSError, EOFError, ValueError, KeyError, TypeError, zipfile.BadZipFile):
         path.unlink(missing_ok=True)
         return None
+    if renamed:  # a failure to write (a full disk) stops the build; the record stays as it was
+        stored: dict[str, Any] = {**arrays, "meta": np.array(json.dumps(meta))}
+        try:
+            atomic_savez(path, **stored)
+        except PermissionError as exc:
+            raise _not_yours(path, exc) from None
+    return row
+
+
+def _not_yours(path: Path, exc: PermissionError) -> OutputError:
+    return OutputError(
+        f"{path}: {exc.strerror or exc}: a record of this dataset must be readable and "
+        "writable by you to resume it; fix its permissions or build into another --out"
+    )
 
 
 def scheduler_address(given: str | None) -> str | None:
@@ -2117,7 +2136,8 @@ def _write_index(
     writer = csv.DictWriter(buf, fieldnames=fields, lineterminator="\n", restval="")
     writer.writeheader()
     writer.writerows(rows)
-    atomic_write_text(out / INDEX, buf.getvalue())
+    index_text = buf.getvalue()
+    atomic_write_text(out / INDEX, index_text)
     skipped = skipped or []
     if skipped:
         sbuf = io.StringIO()
@@ -2136,6 +2156,8 @@ def _write_index(
         "labels": sorted({r["label"] for r in rows}),
         "config": json.loads(config.model_dump_json()),
         "versions": versions(),  # of the build that wrote the index (records may be older)
+        # what load_dataset checks the index against: one cut short or edited is refused
+        INDEX_DIGEST: hashlib.sha256(index_text.encode("utf-8")).hexdigest(),
     }
     atomic_write_text(out / MANIFEST, json.dumps(manifest, indent=2) + "\n")
 
@@ -2181,12 +2203,66 @@ def _load_record(path: Path) -> dict[str, NDArray[Any]]:
     )
 
 
+def _verified_index(root: Path) -> str:
+    """The text of the dataset's ``index.csv``, checked against what the build wrote: the digest
+    in ``dataset.json`` (builds since November 2026; an index cut short or edited since the build
+    would otherwise give an experiment wrong records, labels or features without a word), and a
+    header's number of fields on every row. Anything else is a :class:`DataFileError` that says
+    how to fix it: the same ``mdf dataset build``, run again, rewrites both files from the
+    records."""
+    index = root / INDEX
+    rebuild = "run the same `mdf dataset build` again to rewrite it from the records"
+    data = index.read_bytes()
+    manifest_path = root / MANIFEST
+    try:
+        manifest = json.loads(manifest_path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise DataFileError(manifest_path, f"missing, though {INDEX} is there; {rebuild}") from None
+    except (ValueError, UnicodeDecodeError) as exc:
+        raise DataFileError(
+            manifest_path, f"not valid JSON ({' '.join(str(exc).split())}); {rebuild}"
+        ) from None
+    digest = manifest.get(INDEX_DIGEST) if isinstance(manifest, dict) else None
+    if not isinstance(manifest, dict) or (digest is not None and not isinstance(digest, str)):
+        raise DataFileError(manifest_path, f"not the file a build writes; {rebuild}")
+    if digest is not None and hashlib.sha256(data).hexdigest() != digest:
+        raise DataFileError(
+            index,
+            f"not the file the build wrote (cut short or edited since: it does not match the "
+            f"digest in {MANIFEST}); {rebuild}",
+        )
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise DataFileError(index, f"not UTF-8 text ({exc.reason}); {rebuild}") from None
+    if text and not text.endswith("\n"):  # a build ends every row with one
+        raise DataFileError(index, f"cut short (its last row is incomplete); {rebuild}")
+    reader = csv.reader(io.StringIO(text, newline=""))
+    header = next(reader, [])
+    for row in reader:
+        if len(row) != len(header):
+            raise DataFileError(
+                index,
+                f"{len(row)} fields where the header has {len(header)} (cut short or edited "
+                f"since the build); {rebuild}",
+                reader.line_num,
+            )
+    return text
+
+
 def load_dataset(
     path: str | Path, *, spectrograms: bool = True, histograms: bool = False
 ) -> Dataset:
     """Load a built dataset in one call (arrays plus the index table)."""
     root = Path(path)
     index = root / INDEX
+    holder = lock_holder(root)
+    # a build (or another command given the folder as --out) is writing it; not this process
+    if holder is not None and holder.get("pid") != os.getpid():
+        raise MdfError(
+            f"{root}: being written by {describe_holder(holder)}; wait for it to finish and "
+            "try again"
+        )
     if not index.exists():
         raise MdfError(f"{root}: not a built dataset (no {INDEX}); run `mdf dataset build`")
     if _index_half_written(root):
@@ -2194,8 +2270,7 @@ def load_dataset(
             f"{root}: the build stopped while it wrote {INDEX}, {SKIPPED} and {MANIFEST} (they "
             "may not match); run the same `mdf dataset build` again to finish it"
         )
-    with index.open(newline="", encoding="utf-8") as fh:
-        rows = list(csv.DictReader(fh))
+    rows = list(csv.DictReader(io.StringIO(_verified_index(root), newline="")))
     if not rows:
         raise MdfError(f"{index}: the dataset has no records")
     table: dict[str, NDArray[Any]] = {}

@@ -879,6 +879,8 @@ def run_experiment(
         if cfg.dataset.config is not None:
             dcfg, base = load_dataset_config(cfg.dataset.config)
             data_dir = folder.path / "dataset"
+            if not folder.previous:  # a rerun after a stop (a full disk, a time limit) is ours
+                folder.write_marker()  # and resumes the build; the report's files come later
             build_dataset(
                 dcfg,
                 base,

@@ -14,7 +14,8 @@ it through :func:`output_folder`, before any work starts:
 - One lock file (``.mdf.lock``) per folder: a second command on the same folder is refused and
   told the holder's process id and start time. The lock is an advisory ``flock`` on that file, so
   the kernel drops it when its holder dies, however it dies: a lock left by a killed process is
-  stale by construction and the next command takes it over.
+  stale by construction and the next command takes it over. A file system without locks
+  (``flock`` fails with ENOLCK) gets a warning, and the command goes on unlocked.
 - Files are staged in a ``.mdf-staging-*`` folder inside ``--out`` (or in a folder the user
   chooses on the same file system), locked by its command while it lives, and moved into place
   in one swap (:meth:`OutputFolder.commit`) once every new file is complete. A command killed
@@ -40,6 +41,7 @@ import stat
 import tempfile
 import threading
 import time
+import warnings
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -107,19 +109,29 @@ def _write_temporary(
 ) -> tuple[Any, str]:
     """A temporary file beside ``path`` (``prefix`` + ``*`` + ``suffix``), written by
     ``write(fh)`` and left open for :func:`_put_in_place`: the open file and its path. Removed
-    if writing fails."""
-    fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=suffix, dir=path.parent)
+    if writing fails; the error then names ``path`` (a note ``while writing PATH``: a full disk
+    otherwise names no file, or the temporary one)."""
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=suffix, dir=path.parent)
+    except BaseException as exc:
+        exc.add_note(f"while writing {path}")
+        raise
     try:
         fh = os.fdopen(fd, "wb")
-    except BaseException:
+    except BaseException as exc:
         os.close(fd)
         Path(tmp).unlink(missing_ok=True)
+        exc.add_note(f"while writing {path}")
         raise
     try:
         write(fh)
-    except BaseException:
-        fh.close()
+    except BaseException as exc:
+        try:
+            fh.close()  # a full disk can fail this too
+        except OSError:
+            pass
         Path(tmp).unlink(missing_ok=True)
+        exc.add_note(f"while writing {path}")
         raise
     return fh, tmp
 
@@ -292,6 +304,70 @@ def _read_holder(path: Path) -> dict[str, Any]:
     return {}
 
 
+def describe_holder(info: dict[str, Any]) -> str:
+    """A lock holder as :func:`lock_holder` gives it, in words: ``process 4242 (mdf run,
+    started ..., host ...)``, or ``another process`` when its details are unknown."""
+    if not info:
+        return "another process"
+    return (
+        f"process {info.get('pid')} ({info.get('command', 'mdf')}, started "
+        f"{info.get('started', '?')}, host {info.get('host', '?')})"
+    )
+
+
+def lock_holder(folder: Path) -> dict[str, Any] | None:
+    """The details of the command that holds ``folder``'s lock now (``{}`` when it wrote none),
+    or None when no command holds it, for a reader of an output (``load_dataset``) that must
+    not read one a command is writing. Reads only: nothing is created, and the lock is tried
+    for an instant (shared), not kept."""
+    path = folder / LOCK
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:
+        return None  # no lock file: no command holds the folder
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except OSError as exc:
+        if exc.errno in _BUSY:
+            return _read_holder(path)
+        return None  # a file system without locks: nothing to tell
+    finally:
+        os.close(fd)  # (releases the lock taken, if any)
+    return None
+
+
+#: what ``flock`` raises when another process holds the lock
+_BUSY = (errno.EAGAIN, errno.EACCES, errno.EWOULDBLOCK)
+
+
+class LockWarning(UserWarning):
+    """The file system of an output folder has no working file locks (an NFS mount without its
+    lock service, some network or FUSE file systems): the command goes on unlocked."""
+
+
+def _warn_no_locks(folder: Path, exc: OSError) -> None:
+    warnings.warn(
+        f"--out {folder}: cannot lock the folder ({exc.strerror or exc}: its file system does "
+        "not support file locks); nothing keeps another command from writing into it at the "
+        "same time, so run one command at a time on it",
+        LockWarning,
+        stacklevel=3,
+    )
+
+
+def _write_holder(fd: int, command: str) -> int:
+    """Write this process's details into the lock file ``fd``; returns ``fd``."""
+    info = {
+        "pid": os.getpid(),
+        "command": command,
+        "started": _process_start(os.getpid()),
+        "host": socket.gethostname(),
+    }
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, (json.dumps(info) + "\n").encode(), 0)
+    return fd
+
+
 def acquire_lock(folder: Path, command: str) -> int:
     """Take the folder's lock; returns its file descriptor. Raises :class:`OutputError` naming
     the holder when another process holds it. A lock file left by a dead process is taken
@@ -308,16 +384,11 @@ def acquire_lock(folder: Path, command: str) -> int:
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as exc:
+            if exc.errno not in _BUSY:
+                _warn_no_locks(folder, exc)
+                return _write_holder(fd, command)  # removed at the end, as a lock is
             os.close(fd)
-            if exc.errno not in (errno.EAGAIN, errno.EACCES, errno.EWOULDBLOCK):
-                raise
-            info = _read_holder(path)
-            who = (
-                f"process {info.get('pid')} ({info.get('command', 'mdf')}, started "
-                f"{info.get('started', '?')}, host {info.get('host', '?')})"
-                if info
-                else "another process"
-            )
+            who = describe_holder(_read_holder(path))
             raise OutputError(
                 f"--out {folder}: in use by {who}; wait for it to finish or choose another folder"
             ) from None
@@ -329,15 +400,7 @@ def acquire_lock(folder: Path, command: str) -> int:
         if not same:
             os.close(fd)
             continue
-        info = {
-            "pid": os.getpid(),
-            "command": command,
-            "started": _process_start(os.getpid()),
-            "host": socket.gethostname(),
-        }
-        os.ftruncate(fd, 0)
-        os.pwrite(fd, (json.dumps(info) + "\n").encode(), 0)
-        return fd
+        return _write_holder(fd, command)
     raise OutputError(f"--out {folder}: could not take the lock {path}; try again")
 
 
@@ -384,8 +447,11 @@ class OutputFolder:
         stage = Path(tempfile.mkdtemp(prefix=f"{STAGING_PREFIX}{self.command}-", dir=where))
         self._stages.append(stage)
         fd = os.open(stage, os.O_RDONLY)
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # new: nobody else holds it
         self._stage_locks.append(fd)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # new: nobody else holds it
+        except OSError:  # no locks here (warned when --out was locked): never swept as stale
+            pass
         return stage
 
     def previous_files(self) -> list[str]:
