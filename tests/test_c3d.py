@@ -10,6 +10,8 @@ head markers, and the source must say so), and the bad-input rules on damaged co
 from __future__ import annotations
 
 import struct
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -277,3 +279,51 @@ def test_more_than_255_markers_take_their_labels_from_labels2(tmp_path: Path) ->
     ref = TrcSource(TrcConfig(file=trc)).load()
     assert body.metadata["marker_set"] == "opensim-gait"
     np.testing.assert_allclose(body.skeleton.positions, ref.skeleton.positions, atol=1e-6)
+
+
+#: a child process that reads a C3D file: exit 2 with the error's line, 0 when it reads
+READ_IN_CHILD = """
+import sys
+from pathlib import Path
+from mdframework import DataFileError
+from mdf_c3d import read_c3d
+try:
+    read_c3d(Path(sys.argv[1]))
+except DataFileError as exc:
+    print(exc, file=sys.stderr)
+    sys.exit(2)
+"""
+
+
+@pytest.mark.parametrize(
+    ("where", "value", "message"),
+    [
+        # found by benchmarks/fuzz_motion.py: MOMENT_UNITS' group id made negative (a group
+        # record then) crashed ezc3d with a segmentation fault
+        (1048, 200, "the record at byte 1047 holds more than fits before the next record"),
+        # POINT:LABELS said 255 labels of 30 characters where 124 fit before the next record
+        (1132, 255, "the record at byte 1120 holds more than fits before the next record"),
+        # POINT:LABELS' offset to the next record pointing far beyond the parameter section
+        (
+            1129,
+            0x7F,
+            "the record at byte 1120 points to its next record at 33783, outside the section",
+        ),
+        # POINT:UNITS with type 3, which is none of -1, 1, 2, 4
+        (999, 3, "the record at byte 990 has type 3 and 1 dimensions"),
+    ],
+)
+def test_a_damaged_parameter_section_is_one_line_not_a_crash(
+    tmp_path: Path, where: int, value: int, message: str
+) -> None:
+    """The parameter section is walked in Python before ezc3d trusts its sizes and offsets;
+    each damage is read in a child process, so a crash would show as its exit code."""
+    raw = bytearray(REAL.read_bytes())
+    raw[where] = value
+    path = tmp_path / "damaged.c3d"
+    path.write_bytes(bytes(raw))
+    done = subprocess.run(
+        [sys.executable, "-c", READ_IN_CHILD, str(path)], capture_output=True, text=True
+    )
+    assert done.returncode == 2, done.stderr[-500:]
+    assert done.stderr == f"{path}: parameter section: {message}: the file is damaged\n"

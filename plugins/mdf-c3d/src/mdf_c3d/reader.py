@@ -138,7 +138,78 @@ def read_c3d_header(path: Path) -> C3dHeader:
             f"samples from block {data_block} ({need:,} bytes), but the file holds {size:,} "
             "bytes: the file is truncated or its header is wrong",
         )
+    check_parameter_section(path, head[0], data_block, order)
     return C3dHeader(n_points, n_analog, first, last, data_block, processor, floats)
+
+
+#: C3D parameter types: byte count per value (-1: characters)
+_PARAM_TYPES = {-1: 1, 1: 1, 2: 2, 4: 4}
+
+
+def check_parameter_section(path: Path, block: int, data_block: int, order: str) -> None:
+    """Walk the parameter section (the 512-byte blocks from ``block`` up to the first data
+    block ``data_block``; ``order`` ``"<"`` or ``">"``) as the C3D User Guide lays it out,
+    before ezc3d reads it: ezc3d trusts its sizes and offsets, and a damaged section can crash
+    the process instead of raising.
+
+    Each record: the name's length (a signed byte; 0 ends the section) and the group id (a
+    signed byte: negative for a group, positive for a parameter of that group), the name, and a
+    16-bit offset from itself to the next record (0: the last record). A group then holds its
+    description (a length byte, then the text); a parameter its type (-1 characters, 1 byte,
+    2 integer, 4 float), its number of dimensions (at most 7), the dimensions, the values and
+    its description. Every record must lie inside the section's blocks and end before the next
+    begins, and names must be printable ASCII.
+
+    Raises
+    ------
+    mdframework.DataFileError
+        Naming the byte offset of the first record that breaks these rules.
+    """
+    try:
+        with path.open("rb") as f:
+            f.seek((block - 1) * 512)
+            section = f.read(255 * 512)
+    except OSError as exc:
+        raise DataFileError(path, f"cannot read: {exc.strerror or exc}") from None
+    start = (block - 1) * 512
+    end = min(len(section), (data_block - block) * 512) if len(section) >= 4 else 0
+    pos = 3 + section[0] if len(section) >= 4 else 0
+
+    def bad(at: int, what: str) -> DataFileError:
+        return DataFileError(
+            path, f"parameter section: the record at byte {start + at} {what}: the file is damaged"
+        )
+
+    while True:
+        if pos + 2 > end:
+            raise bad(pos, "starts beyond the parameter section, which ends at the data")
+        n_chars, group_id = struct.unpack_from("bb", section, pos)
+        if n_chars == 0:
+            break
+        name = section[pos + 2 : pos + 2 + abs(n_chars)]
+        at = pos + 2 + abs(n_chars)  # the offset field
+        if at + 2 > end:
+            raise bad(pos, "runs past the parameter section's end")
+        if group_id in (0, -128) or not all(0x20 <= c < 0x7F for c in name):
+            raise bad(pos, f"has group id {group_id} and name {bytes(name)!r}")
+        (offset,) = struct.unpack_from(order + "h", section, at)
+        limit = end if offset == 0 else at + offset
+        if offset != 0 and not at + 2 <= limit <= end:
+            raise bad(pos, f"points to its next record at {start + limit}, outside the section")
+        body = at + 2
+        if group_id > 0:  # a parameter: type, dimensions, values
+            if body + 2 > limit:
+                raise bad(pos, "ends before its type")
+            kind, n_dims = struct.unpack_from("bB", section, body)
+            if kind not in _PARAM_TYPES or n_dims > 7 or body + 2 + n_dims > limit:
+                raise bad(pos, f"has type {kind} and {n_dims} dimensions")
+            count = math.prod(section[body + 2 : body + 2 + n_dims])
+            body += 2 + n_dims + count * _PARAM_TYPES[kind]
+        if body + 1 > limit or body + 1 + section[body] > limit:
+            raise bad(pos, "holds more than fits before the next record")
+        if offset == 0:
+            break
+        pos = limit
 
 
 def _param(params: Any, group: str, name: str) -> Any:
