@@ -21,7 +21,8 @@ import pytest
 from conftest import EXAMPLES
 from helpers import point_dataset
 
-from mdframework import dataset
+from mdframework import cli, dataset
+from mdframework import workers as pool_workers
 from mdframework.dataset import (
     RECORDS,
     Dataset,
@@ -146,6 +147,61 @@ def test_same_result_with_one_and_two_workers_and_dask(
     monkeypatch.setattr(dataset, "_MOTIONS", {})
     build_dataset(cfg, base, tmp_path / "dask", workers=2, scheduler="local", progress=False)
     assert_same(tmp_path / "one", tmp_path / "dask")
+
+
+@pytest.mark.parametrize("start_method", ["spawn", "forkserver"], indirect=True)
+def test_workers_that_are_not_forked_build_the_same_dataset_and_say_the_same(
+    start_method: str,
+    tmp_path: Path,
+    capfd: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Workers started afresh (macOS spawns them; Python 3.14 defaults to a fork server on
+    Linux) build the records a forked worker builds, to the bit, and the command says the same:
+    they are given the motions planning loaded, so the motion warnings are shown once, by the
+    build's process (spawned workers loaded the motions again and printed the warnings in
+    Python's own format; a fork server's workers exited at once: "a process in the process
+    pool was terminated abruptly")."""
+    config = write_config(tmp_path / "d.toml")
+    err = {}
+    for method in ("fork", start_method):
+        monkeypatch.setenv(pool_workers.START_METHOD_ENV, method)
+        dataset._forget_loaded()
+        capfd.readouterr()
+        out = tmp_path / method
+        assert cli.main(["dataset", "build", str(config), "--out", str(out), "--workers", "2"]) == 0
+        err[method] = capfd.readouterr().err
+    assert err["fork"] == err[start_method]
+    assert err["fork"].count("mdf: warning: ") == 2, err  # the boxing motion's two warnings
+    assert "Warning: " not in err["fork"]
+    assert_same(tmp_path / "fork", tmp_path / start_method)
+
+
+def test_workers_are_forked_on_linux_whatever_pythons_default(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """On Linux the pool forks its workers (fast, and they inherit what the build loaded) even
+    where Python's default is another method (Python 3.14: forkserver); MDF_START_METHOD
+    chooses, and a method this platform lacks is one line naming the variable."""
+    import multiprocessing
+
+    monkeypatch.delenv(pool_workers.START_METHOD_ENV, raising=False)
+    before = multiprocessing.get_start_method(allow_none=True)
+    try:
+        multiprocessing.set_start_method("forkserver", force=True)
+        expected = "fork" if sys.platform.startswith("linux") else "forkserver"
+        assert pool_workers.start_method() == expected
+        with pool_workers.worker_pool(1) as pool:
+            pool.submit(int).result()
+            (proc,) = pool._processes.values()  # type: ignore[attr-defined]
+            assert type(proc).__name__ == f"{expected.capitalize()}Process"
+    finally:
+        multiprocessing.set_start_method(before, force=True)
+    monkeypatch.setenv(pool_workers.START_METHOD_ENV, "spawn")
+    assert pool_workers.start_method() == "spawn"
+    monkeypatch.setenv(pool_workers.START_METHOD_ENV, "vfork")
+    with pytest.raises(MdfError, match=r"^MDF_START_METHOD='vfork': not a start method"):
+        pool_workers.start_method()
 
 
 def test_a_local_dask_cluster_leaves_port_8787_free(tmp_path: Path) -> None:
@@ -374,11 +430,13 @@ def test_motions_loaded_in_parallel_plan_the_same_records(
     assert [t.split(": ")[0] for t in glitches] == files, shown2
 
 
+@pytest.mark.parametrize("start_method", ["fork", "spawn"], indirect=True)
 def test_parallel_loading_keeps_errors_and_warning_filters(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    start_method: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """A motion that fails to load, or whose warning the filters turn into an error, stops
-    planning with the same error whether it was loaded in another process or not."""
+    planning with the same error whether it was loaded in another process or not (a spawned
+    process is given the filters: with Python's own, it showed the warning and went on)."""
     (tmp_path / "02.asf").write_bytes((CMU / "asf-amc" / "02.asf").read_bytes())
     amc = (CMU / "asf-amc" / "02_01.amc").read_text().split("\n")
     (tmp_path / "02_01.amc").write_text("\n".join(amc[:60]) + "\n")  # ends inside frame 3

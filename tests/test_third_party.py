@@ -545,14 +545,28 @@ OVERFLOWING_RECEIVE = (
 )
 
 
-@pytest.mark.parametrize("how", [["--workers", "1"], ["--workers", "2"], ["--scheduler", "local"]])
+@pytest.mark.parametrize(
+    ("how", "start_method"),
+    [
+        (["--workers", "1"], "fork"),
+        (["--workers", "2"], "fork"),
+        (["--workers", "2"], "spawn"),
+        (["--scheduler", "local"], "fork"),
+    ],
+    indirect=["start_method"],
+)
 def test_a_numerical_warning_in_a_record_stops_the_build_however_it_runs(
-    how: list[str], installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    how: list[str],
+    start_method: str,
+    installed: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
 ) -> None:
     """mdf stops at a numerical warning in its own or a plugin's code rather than write a
-    result it cannot trust: in the build's process and its forked workers, and also on a local
-    Dask cluster, whose workers start afresh (they wrote every record and the build succeeded,
-    so the same config gave a dataset or an error depending on --scheduler)."""
+    result it cannot trust: in the build's process and its forked workers, in workers spawned
+    afresh (as on macOS: they wrote every record with Python's own warning filters), and also on
+    a local Dask cluster, whose workers start afresh (they wrote every record and the build
+    succeeded, so the same config gave a dataset or an error depending on --scheduler)."""
     if how[0] == "--scheduler":
         pytest.importorskip("distributed")
     base = "import numpy as np\nfrom mdf_lfm.waveform import LfmPulseDoppler as Base\n"
