@@ -204,6 +204,32 @@ def test_workers_are_forked_on_linux_whatever_pythons_default(
         pool_workers.start_method()
 
 
+def test_a_build_forks_its_workers_from_a_process_of_one_thread(tmp_path: Path) -> None:
+    """No thread of the command is alive when a build forks its workers (in the child, a lock
+    such a thread held stays held): the progress bar's monitor thread was (tqdm starts one for
+    every bar, a disabled one too), and Python 3.12 and later warned "This process is
+    multi-threaded, use of fork() may lead to deadlocks in the child" once per worker."""
+    script = (
+        "import os, sys, threading\n"
+        "seen = []\n"
+        "os.register_at_fork(before=lambda: seen.append([t.name for t in threading.enumerate()]))\n"
+        "from mdframework.cli import main\n"
+        "code = main(sys.argv[1:])\n"
+        "print(seen)\n"
+        "sys.exit(code)\n"
+    )
+    config = write_config(tmp_path / "d.toml")
+    args = ["dataset", "build", str(config), "--out", str(tmp_path / "ds"), "--workers", "2"]
+    env = {**os.environ, pool_workers.START_METHOD_ENV: "fork"}
+    done = subprocess.run(
+        [sys.executable, "-c", script, *args], capture_output=True, text=True, env=env
+    )
+    assert done.returncode == 0, done.stderr
+    seen = json.loads(done.stdout.strip().splitlines()[-1].replace("'", '"'))
+    assert len(seen) == 4, seen  # 2 workers to load the motions, 2 to build the records
+    assert all(threads == ["MainThread"] for threads in seen), seen
+
+
 def test_a_local_dask_cluster_leaves_port_8787_free(tmp_path: Path) -> None:
     """A local Dask cluster has no dashboard, and the HTTP server its scheduler still starts
     (health and metrics routes) runs on a free loopback port, not on Dask's default 8787: a

@@ -86,7 +86,7 @@ from .pointcloud import (
     histogram_features,
     velocity_bins,
 )
-from .progress import note, printed, progress_enabled
+from .progress import note, printed, progress_enabled, tqdm_bar
 from .randomize import Randomization, set_path
 from .settings import (
     AngleDeg,
@@ -1968,8 +1968,6 @@ def build_dataset(
     also accepts other folders (writing only the dataset's files) and other configs (rebuilt;
     the old dataset stays whole until the new index is written, then its records are removed).
     """
-    from tqdm import tqdm
-
     check_scheduler_address(scheduler_address(scheduler))
     with dataset_folder(out_dir, force=force) as folder:
         _refuse_names_in_the_way(folder.path)
@@ -2008,7 +2006,7 @@ def build_dataset(
                 rows[spec.record_id] = row
         _warn_other_versions(other_versions, len(specs))
         printed()
-        bar = tqdm(
+        bar = tqdm_bar(
             total=len(specs),
             initial=len(rows),
             desc="records",
