@@ -112,6 +112,22 @@ def test_an_unusable_plugin_is_switched_off_and_mdf_works(
     assert run_point_target(tmp_path) == 0
 
 
+@pytest.mark.parametrize("start_method", ["fork", "spawn"], indirect=True)
+def test_a_build_warns_of_an_unusable_plugin_once_however_its_workers_start(
+    start_method: str, installed: Path, tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """The build's process says that a plugin is switched off; its workers do not say it again
+    (each spawned worker, which loads the plugins afresh, did)."""
+    body, why = BROKEN["a number"]
+    _make_distribution(installed, "xyzzy-fx", "mdf_test_xyzzy", HEADER + body, "xyzzy_fx")
+    config = point_dataset(tmp_path / "d.toml")
+    capfd.readouterr()
+    args = ["dataset", "build", str(config), "--out", str(tmp_path / "ds"), "--workers", "2"]
+    assert cli.main(args) == 0
+    warned = [line for line in capfd.readouterr().err.splitlines() if "xyzzy" in line]
+    assert len(warned) == 1 and why in warned[0], warned
+
+
 CLASH = (
     HEADER
     + """

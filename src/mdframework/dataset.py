@@ -77,7 +77,7 @@ from .outdir import (
     wait_for_files,
 )
 from .pipeline import build_stages, load_motion, simulate_motion
-from .plugins import blame, default_registry, is_plugin_bug, versions
+from .plugins import PluginWarning, blame, default_registry, is_plugin_bug, versions
 from .pointcloud import (
     IWR1443_BIN_WIDTH,
     HistogramSettings,
@@ -471,7 +471,7 @@ def _preload_motions(config: DatasetConfig, base_dir: Path, workers: int) -> Non
     # splines that make the Boulic walkers and resample every body motion in every record (the
     # build's workers fork from this process later and inherit it too).
     default_registry()
-    with worker_pool(n) as pool:
+    with worker_pool(n, _start_fresh_worker, ({},)) as pool:
         for key, (motion, caught) in zip(todo, pool.map(_load_elsewhere, todo), strict=True):
             if motion is not None:
                 _keep_motion(key, motion)
@@ -485,6 +485,16 @@ def _receive_motions(motions: dict[tuple[str, str], Motion]) -> None:
     and so do the recordings it loads afresh."""
     _load_recordings.cache_clear()
     _MOTIONS.update(motions)
+
+
+def _start_fresh_worker(motions: dict[tuple[str, str], Motion]) -> None:
+    """Give a local worker that is not forked what a forked one inherits: the plugins, loaded
+    without their warnings (the build's process has shown them once; each worker repeated
+    them), and the ``motions`` planning loaded (:func:`_receive_motions`)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PluginWarning)
+        default_registry()
+    _receive_motions(motions)
 
 
 def _forget_loaded() -> None:
@@ -1729,7 +1739,7 @@ def _executor(
             return
         # Ctrl-C or an error (the generator closed): the queued records are dropped. Workers
         # that are not forked (macOS) are sent the motions planning loaded, as Dask's are.
-        with worker_pool(n, _receive_motions, (dict(_MOTIONS),)) as pool:
+        with worker_pool(n, _start_fresh_worker, (dict(_MOTIONS),)) as pool:
 
             def run_local(specs: list[RecordSpec], out: str) -> Iterator[dict[str, Any]]:
                 chunks = record_chunks(specs, n)
