@@ -102,6 +102,16 @@ def test_a_c_locale_refuses_a_config_file_name_it_cannot_hold_in_one_line(tmp_pa
     assert done.returncode == 2, done.stderr
     assert len(lines) == 1 and lines[0].startswith("mdf: error: "), lines
     assert "file names cannot hold (ascii); set a UTF-8 locale" in lines[0], lines
+    # a motion file so named: it said "file not found"
+    (tmp_path / "r.toml").write_text(
+        (EXAMPLES / "cmu_walk.toml").read_text().replace("data/cmu/asf-amc", "dätä"),
+        encoding="utf-8",
+    )
+    done = shell(f'$MDF run "{tmp_path / "r.toml"}" --out "{tmp_path / "o"}"', **c_locale)
+    lines = without_third_party_warnings(done.stderr.strip().splitlines())
+    assert done.returncode == 2, done.stderr
+    assert len(lines) == 1 and lines[0].startswith("mdf: error: "), lines
+    assert "motion.file: " in lines[0] and "cannot hold (ascii)" in lines[0], lines
 
 
 #: receivers whose ``open`` opens no text file (zip and gzip members, file descriptors)
