@@ -122,3 +122,20 @@ def fresh_default_registry() -> object:
     reset_default_registry()
     yield None
     reset_default_registry()
+
+
+@pytest.fixture
+def start_method(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> object:
+    """Worker processes start by ``request.param`` (``fork``, ``spawn``, ``forkserver``; use
+    with indirect parametrization): ``MDF_START_METHOD`` says so, and so does Python's default
+    (for any pool that would not ask mdf)."""
+    import multiprocessing
+
+    from mdframework.workers import START_METHOD_ENV
+
+    method = request.param
+    monkeypatch.setenv(START_METHOD_ENV, method)
+    before = multiprocessing.get_start_method(allow_none=True)
+    multiprocessing.set_start_method(method, force=True)
+    yield method
+    multiprocessing.set_start_method(before, force=True)

@@ -89,6 +89,31 @@ def test_a_c_locale_builds_and_loads_a_non_ascii_label(tmp_path: Path) -> None:
     assert loaded.stdout.strip() == ascii(["gehen-ü"])
 
 
+def test_a_c_locale_refuses_a_config_file_name_it_cannot_hold_in_one_line(tmp_path: Path) -> None:
+    """Under the same ASCII locale, an experiment whose dataset config has a non-ASCII name (the
+    experiment config is UTF-8; the system's file names are ASCII) is one line naming it and
+    the remedy, exit 2 (it was an internal error, UnicodeEncodeError)."""
+    (tmp_path / "e.toml").write_text(
+        '[dataset]\nconfig = "dü.toml"\n[classifier]\nkind = "knn"\nk = 1\n', encoding="utf-8"
+    )
+    c_locale = {"LC_ALL": "C", "PYTHONUTF8": "0", "PYTHONCOERCECLOCALE": "0"}
+    done = shell(f'$MDF experiment "{tmp_path / "e.toml"}" --out "{tmp_path / "o"}"', **c_locale)
+    lines = without_third_party_warnings(done.stderr.strip().splitlines())
+    assert done.returncode == 2, done.stderr
+    assert len(lines) == 1 and lines[0].startswith("mdf: error: "), lines
+    assert "file names cannot hold (ascii); set a UTF-8 locale" in lines[0], lines
+    # a motion file so named: it said "file not found"
+    (tmp_path / "r.toml").write_text(
+        (EXAMPLES / "cmu_walk.toml").read_text().replace("data/cmu/asf-amc", "dätä"),
+        encoding="utf-8",
+    )
+    done = shell(f'$MDF run "{tmp_path / "r.toml"}" --out "{tmp_path / "o"}"', **c_locale)
+    lines = without_third_party_warnings(done.stderr.strip().splitlines())
+    assert done.returncode == 2, done.stderr
+    assert len(lines) == 1 and lines[0].startswith("mdf: error: "), lines
+    assert "motion.file: " in lines[0] and "cannot hold (ascii)" in lines[0], lines
+
+
 #: receivers whose ``open`` opens no text file (zip and gzip members, file descriptors)
 BINARY_OPENERS = {"os", "archive", "z", "gzip"}
 

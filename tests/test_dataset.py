@@ -21,7 +21,8 @@ import pytest
 from conftest import EXAMPLES
 from helpers import point_dataset
 
-from mdframework import dataset
+from mdframework import cli, dataset
+from mdframework import workers as pool_workers
 from mdframework.dataset import (
     RECORDS,
     Dataset,
@@ -37,6 +38,14 @@ from mdframework.features import FEATURE_NAMES
 from mdframework.sanity import MotionSanityWarning
 
 CMU = EXAMPLES / "data" / "cmu"
+
+
+def ignore_fork_with_threads() -> None:
+    """Ignore Python's (3.12 and later) warning that a process with threads forks, as
+    pyproject.toml's filters do, where a test's own filters would show it: in a test process the
+    local Dask cluster of an earlier test leaves a thread (Dask's offload thread); a command's
+    own process has none (the test of a build forking from one thread)."""
+    warnings.filterwarnings("ignore", r"This process .* is multi-threaded", DeprecationWarning)
 
 
 def write_config(path: Path, *, boxing_records: int = 2, aspects: str = "[0.0, 45.0]") -> Path:
@@ -146,6 +155,88 @@ def test_same_result_with_one_and_two_workers_and_dask(
     monkeypatch.setattr(dataset, "_MOTIONS", {})
     build_dataset(cfg, base, tmp_path / "dask", workers=2, scheduler="local", progress=False)
     assert_same(tmp_path / "one", tmp_path / "dask")
+
+
+@pytest.mark.parametrize("start_method", ["spawn", "forkserver"], indirect=True)
+def test_workers_that_are_not_forked_build_the_same_dataset_and_say_the_same(
+    start_method: str,
+    tmp_path: Path,
+    capfd: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Workers started afresh (macOS spawns them; Python 3.14 defaults to a fork server on
+    Linux) build the records a forked worker builds, to the bit, and the command says the same:
+    they are given the motions planning loaded, so the motion warnings are shown once, by the
+    build's process (spawned workers loaded the motions again and printed the warnings in
+    Python's own format; a fork server's workers exited at once: "a process in the process
+    pool was terminated abruptly")."""
+    config = write_config(tmp_path / "d.toml")
+    err = {}
+    for method in ("fork", start_method):
+        monkeypatch.setenv(pool_workers.START_METHOD_ENV, method)
+        dataset._forget_loaded()
+        capfd.readouterr()
+        out = tmp_path / method
+        args = ["dataset", "build", str(config), "--out", str(out), "--workers", "2"]
+        assert cli.main(args) == 0
+        err[method] = capfd.readouterr().err
+    assert err["fork"] == err[start_method]
+    assert err["fork"].count("mdf: warning: ") == 2, err  # the boxing motion's two warnings
+    assert "Warning: " not in err["fork"]
+    assert_same(tmp_path / "fork", tmp_path / start_method)
+
+
+def test_workers_are_forked_on_linux_whatever_pythons_default(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """On Linux the pool forks its workers (fast, and they inherit what the build loaded) even
+    where Python's default is another method (Python 3.14: forkserver); MDF_START_METHOD
+    chooses, and a method this platform lacks is one line naming the variable."""
+    import multiprocessing
+
+    monkeypatch.delenv(pool_workers.START_METHOD_ENV, raising=False)
+    before = multiprocessing.get_start_method(allow_none=True)
+    try:
+        multiprocessing.set_start_method("forkserver", force=True)
+        expected = "fork" if sys.platform.startswith("linux") else "forkserver"
+        assert pool_workers.start_method() == expected
+        with pool_workers.worker_pool(1) as pool:
+            pool.submit(int).result()
+            (proc,) = pool._processes.values()  # type: ignore[attr-defined]
+            assert type(proc).__name__ == f"{expected.capitalize()}Process"
+    finally:
+        multiprocessing.set_start_method(before, force=True)
+    monkeypatch.setenv(pool_workers.START_METHOD_ENV, "spawn")
+    assert pool_workers.start_method() == "spawn"
+    monkeypatch.setenv(pool_workers.START_METHOD_ENV, "vfork")
+    with pytest.raises(MdfError, match=r"^MDF_START_METHOD='vfork': not a start method"):
+        pool_workers.start_method()
+
+
+def test_a_build_forks_its_workers_from_a_process_of_one_thread(tmp_path: Path) -> None:
+    """No thread of the command is alive when a build forks its workers (in the child, a lock
+    such a thread held stays held): the progress bar's monitor thread was (tqdm starts one for
+    every bar, a disabled one too), and Python 3.12 and later warned "This process is
+    multi-threaded, use of fork() may lead to deadlocks in the child" once per worker."""
+    script = (
+        "import os, sys, threading\n"
+        "seen = []\n"
+        "os.register_at_fork(before=lambda: seen.append([t.name for t in threading.enumerate()]))\n"
+        "from mdframework.cli import main\n"
+        "code = main(sys.argv[1:])\n"
+        "print(seen)\n"
+        "sys.exit(code)\n"
+    )
+    config = write_config(tmp_path / "d.toml")
+    args = ["dataset", "build", str(config), "--out", str(tmp_path / "ds"), "--workers", "2"]
+    env = {**os.environ, pool_workers.START_METHOD_ENV: "fork"}
+    done = subprocess.run(
+        [sys.executable, "-c", script, *args], capture_output=True, text=True, env=env
+    )
+    assert done.returncode == 0, done.stderr
+    seen = json.loads(done.stdout.strip().splitlines()[-1].replace("'", '"'))
+    assert len(seen) == 4, seen  # 2 workers to load the motions, 2 to build the records
+    assert all(threads == ["MainThread"] for threads in seen), seen
 
 
 def test_a_local_dask_cluster_leaves_port_8787_free(tmp_path: Path) -> None:
@@ -344,6 +435,7 @@ def _plan_fresh(
     monkeypatch.setattr(dataset, "load_motion", lambda src: calls.append(src) or real(src))
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
+        ignore_fork_with_threads()
         specs = plan_records(cfg, base, workers=workers)
     shown = [(w.category, str(w.message)) for w in caught]
     return specs, dict(dataset._MOTIONS), shown, len(calls)
@@ -374,11 +466,13 @@ def test_motions_loaded_in_parallel_plan_the_same_records(
     assert [t.split(": ")[0] for t in glitches] == files, shown2
 
 
+@pytest.mark.parametrize("start_method", ["fork", "spawn"], indirect=True)
 def test_parallel_loading_keeps_errors_and_warning_filters(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    start_method: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """A motion that fails to load, or whose warning the filters turn into an error, stops
-    planning with the same error whether it was loaded in another process or not."""
+    planning with the same error whether it was loaded in another process or not (a spawned
+    process is given the filters: with Python's own, it showed the warning and went on)."""
     (tmp_path / "02.asf").write_bytes((CMU / "asf-amc" / "02.asf").read_bytes())
     amc = (CMU / "asf-amc" / "02_01.amc").read_text().split("\n")
     (tmp_path / "02_01.amc").write_text("\n".join(amc[:60]) + "\n")  # ends inside frame 3

@@ -670,8 +670,20 @@ def start_build(tmp_path: Path, *extra: str) -> tuple[subprocess.Popen[str], Pat
     raise AssertionError(f"the build did not get going: {proc.communicate()[1]}")
 
 
-@pytest.mark.parametrize("scheduler", [[], ["--scheduler", "local"]], ids=["pool", "dask"])
-def test_workers_end_when_the_parent_is_killed(tmp_path: Path, scheduler: list[str]) -> None:
+#: how a build's workers run: (scheduler options, start method of the pool's workers)
+HOW_WORKERS_RUN = pytest.mark.parametrize(
+    ("scheduler", "start_method"),
+    [([], "fork"), ([], "spawn"), ([], "forkserver"), (["--scheduler", "local"], "fork")],
+    ids=["pool", "pool-spawn", "pool-forkserver", "dask"],
+    indirect=["start_method"],
+)
+
+
+@HOW_WORKERS_RUN
+def test_workers_end_when_the_parent_is_killed(
+    tmp_path: Path, scheduler: list[str], start_method: str
+) -> None:
+    """Also workers that are not forked: a fork server's are its children, not the build's."""
     if scheduler:
         pytest.importorskip("distributed")
     proc, out, workers = start_build(tmp_path, *scheduler)
@@ -694,9 +706,12 @@ def test_workers_end_when_the_parent_is_killed(tmp_path: Path, scheduler: list[s
     assert not (out / LOCK).exists()
 
 
-@pytest.mark.parametrize("scheduler", [[], ["--scheduler", "local"]], ids=["pool", "dask"])
-def test_ctrl_c_during_a_build_is_one_line(tmp_path: Path, scheduler: list[str]) -> None:
-    """Also with a local Dask cluster, whose log of the cancelled tasks used to come first."""
+@HOW_WORKERS_RUN
+def test_ctrl_c_during_a_build_is_one_line(
+    tmp_path: Path, scheduler: list[str], start_method: str
+) -> None:
+    """Also with a local Dask cluster, whose log of the cancelled tasks used to come first, and
+    with workers that are not forked."""
     if scheduler:
         pytest.importorskip("distributed")
     proc, out, workers = start_build(tmp_path, *scheduler)

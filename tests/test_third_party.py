@@ -112,6 +112,22 @@ def test_an_unusable_plugin_is_switched_off_and_mdf_works(
     assert run_point_target(tmp_path) == 0
 
 
+@pytest.mark.parametrize("start_method", ["fork", "spawn"], indirect=True)
+def test_a_build_warns_of_an_unusable_plugin_once_however_its_workers_start(
+    start_method: str, installed: Path, tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """The build's process says that a plugin is switched off; its workers do not say it again
+    (each spawned worker, which loads the plugins afresh, did)."""
+    body, why = BROKEN["a number"]
+    _make_distribution(installed, "xyzzy-fx", "mdf_test_xyzzy", HEADER + body, "xyzzy_fx")
+    config = point_dataset(tmp_path / "d.toml")
+    capfd.readouterr()
+    args = ["dataset", "build", str(config), "--out", str(tmp_path / "ds"), "--workers", "2"]
+    assert cli.main(args) == 0
+    warned = [line for line in capfd.readouterr().err.splitlines() if "xyzzy" in line]
+    assert len(warned) == 1 and why in warned[0], warned
+
+
 CLASH = (
     HEADER
     + """
@@ -545,14 +561,28 @@ OVERFLOWING_RECEIVE = (
 )
 
 
-@pytest.mark.parametrize("how", [["--workers", "1"], ["--workers", "2"], ["--scheduler", "local"]])
+@pytest.mark.parametrize(
+    ("how", "start_method"),
+    [
+        (["--workers", "1"], "fork"),
+        (["--workers", "2"], "fork"),
+        (["--workers", "2"], "spawn"),
+        (["--scheduler", "local"], "fork"),
+    ],
+    indirect=["start_method"],
+)
 def test_a_numerical_warning_in_a_record_stops_the_build_however_it_runs(
-    how: list[str], installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    how: list[str],
+    start_method: str,
+    installed: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
 ) -> None:
     """mdf stops at a numerical warning in its own or a plugin's code rather than write a
-    result it cannot trust: in the build's process and its forked workers, and also on a local
-    Dask cluster, whose workers start afresh (they wrote every record and the build succeeded,
-    so the same config gave a dataset or an error depending on --scheduler)."""
+    result it cannot trust: in the build's process and its forked workers, in workers spawned
+    afresh (as on macOS: they wrote every record with Python's own warning filters), and also on
+    a local Dask cluster, whose workers start afresh (they wrote every record and the build
+    succeeded, so the same config gave a dataset or an error depending on --scheduler)."""
     if how[0] == "--scheduler":
         pytest.importorskip("distributed")
     base = "import numpy as np\nfrom mdf_lfm.waveform import LfmPulseDoppler as Base\n"

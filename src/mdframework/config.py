@@ -26,7 +26,7 @@ from typing import Annotated, Any, Union, get_args
 from pydantic import BaseModel, Field, ValidationError, create_model, model_validator
 
 from . import limits
-from .errors import ConfigError, SceneError
+from .errors import ConfigError, SceneError, unnameable
 from .interfaces import PluginConfig, RadarConfig
 from .plugins import Registry, default_registry, suggest
 from .settings import MotionConfig, RunConfigBase
@@ -278,6 +278,8 @@ def read_config_file(
             raw = fh.read(limits.MAX_CONFIG_BYTES + 1)
     except OSError as exc:
         raise ConfigError(f"{p}: cannot read: {exc.strerror or exc}") from None
+    except UnicodeEncodeError:
+        raise ConfigError(f"{p}: cannot read: {unnameable(p)}") from None
     if len(raw) > limits.MAX_CONFIG_BYTES:  # grew while reading, or not a regular file
         raise ConfigError(f"{p}: a config file may hold at most {limits.MAX_CONFIG_BYTES:,} bytes")
     text = _decode(p, raw)

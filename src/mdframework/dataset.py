@@ -80,7 +80,7 @@ from .outdir import (
     wait_for_files,
 )
 from .pipeline import build_stages, load_motion, simulate_motion
-from .plugins import blame, default_registry, is_plugin_bug, versions
+from .plugins import PluginWarning, blame, default_registry, is_plugin_bug, versions
 from .pointcloud import (
     IWR1443_BIN_WIDTH,
     HistogramSettings,
@@ -89,7 +89,7 @@ from .pointcloud import (
     histogram_features,
     velocity_bins,
 )
-from .progress import note, printed, progress_enabled
+from .progress import note, printed, progress_enabled, tqdm_bar
 from .randomize import Randomization, set_path
 from .settings import (
     AngleDeg,
@@ -399,8 +399,9 @@ _MOTION_WHERE = "dataset motion"
 def _load_motion(motion_json: str, base_dir: str) -> Motion:
     """Load a motion once per process (records of one recording share it). Local worker
     processes are forked after planning and inherit the motions the planner loaded (in
-    parallel, :func:`_preload_motions`); Dask workers are sent them when the build starts
-    (:func:`_receive_motions`), and load any other motion they meet once. The cache holds far
+    parallel, :func:`_preload_motions`); local workers that are not forked (macOS,
+    :func:`mdframework.workers.start_method`) and Dask workers are sent them when the build
+    starts (:func:`_receive_motions`), and load any other motion they meet once. The cache holds far
     more recordings than a dataset config lists, so records scheduled in any order never evict
     one. A motion loaded by another process shows its warnings here, when first asked for."""
     key = (motion_json, base_dir)
@@ -443,7 +444,8 @@ def _motion_key(section: dict[str, Any]) -> str:
 def _load_elsewhere(key: tuple[str, str]) -> tuple[Motion | None, list[_Caught]]:
     """Load a motion in a planning worker: the motion and the warnings that the filters (the
     planner's, inherited) let through, or (None, []) if it fails (a warning filtered as an
-    error included): the planner then loads it itself and raises the error there."""
+    error included): the planner then loads it itself and raises the error there (a worker
+    that is not forked is given the planner's filters, :func:`mdframework.workers.worker_pool`)."""
     with warnings.catch_warnings(record=True) as caught:
         try:
             motion = _load_motion(*key)
@@ -474,7 +476,7 @@ def _preload_motions(config: DatasetConfig, base_dir: Path, workers: int) -> Non
     # splines that make the Boulic walkers and resample every body motion in every record (the
     # build's workers fork from this process later and inherit it too).
     default_registry()
-    with worker_pool(n) as pool:
+    with worker_pool(n, _start_fresh_worker, ({},)) as pool:
         for key, (motion, caught) in zip(todo, pool.map(_load_elsewhere, todo), strict=True):
             if motion is not None:
                 _keep_motion(key, motion)
@@ -482,11 +484,22 @@ def _preload_motions(config: DatasetConfig, base_dir: Path, workers: int) -> Non
 
 
 def _receive_motions(motions: dict[tuple[str, str], Motion]) -> None:
-    """Keep the motions the planner loaded (run on each Dask worker as a build starts): they
+    """Keep the motions the planner loaded (run on each Dask worker, and each local worker
+    that is not forked, as a build starts): they
     replace any this worker kept from an earlier build, whose files may have changed since,
     and so do the recordings it loads afresh."""
     _load_recordings.cache_clear()
     _MOTIONS.update(motions)
+
+
+def _start_fresh_worker(motions: dict[tuple[str, str], Motion]) -> None:
+    """Give a local worker that is not forked what a forked one inherits: the plugins, loaded
+    without their warnings (the build's process has shown them once; each worker repeated
+    them), and the ``motions`` planning loaded (:func:`_receive_motions`)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PluginWarning)
+        default_registry()
+    _receive_motions(motions)
 
 
 def _forget_loaded() -> None:
@@ -1733,7 +1746,7 @@ def _executor(
     are closed afterwards). Local worker processes end when this process ends, however it ends
     (:func:`mdframework.workers.die_with_parent` for the process pool; a local Dask cluster's
     workers watch their parent themselves; both tested by killing the parent)."""
-    from .workers import worker_pool
+    from .workers import warning_filters, worker_pool
 
     address = scheduler_address(scheduler)
     n = build_workers(config, workers)
@@ -1743,8 +1756,9 @@ def _executor(
                 row for chunk in record_chunks(specs, 1) for row in build_records(chunk, out)
             )
             return
-        # Ctrl-C or an error (the generator closed): the queued records are dropped
-        with worker_pool(n) as pool:
+        # Ctrl-C or an error (the generator closed): the queued records are dropped. Workers
+        # that are not forked (macOS) are sent the motions planning loaded, as Dask's are.
+        with worker_pool(n, _start_fresh_worker, (dict(_MOTIONS),)) as pool:
 
             def run_local(specs: list[RecordSpec], out: str) -> Iterator[dict[str, Any]]:
                 chunks = record_chunks(specs, n)
@@ -1780,7 +1794,7 @@ def _executor(
         client = _connect(Client, cluster, address)
         try:
             if cluster is not None:
-                client.run(_quiet_dask_worker, warnings.showwarning, _warning_filters())
+                client.run(_quiet_dask_worker, warnings.showwarning, warning_filters())
             client.run(_receive_motions, dict(_MOTIONS))  # each worker gets what planning loaded
 
             def run_dask(specs: list[RecordSpec], out: str) -> Iterator[dict[str, Any]]:
@@ -1818,16 +1832,6 @@ def _quiet_dask_logs() -> Iterator[None]:
             log.setLevel(level)
 
 
-def _warning_filters() -> list[tuple[Any, ...]]:
-    """This process's warning filters, newest first, as arguments of
-    :func:`warnings.filterwarnings` (a filter holds its patterns compiled or as text)."""
-
-    def text(pattern: Any) -> str:
-        return str(getattr(pattern, "pattern", pattern) or "")
-
-    return [(f[0], text(f[1]), f[2], text(f[3]), f[4]) for f in warnings.filters]
-
-
 def _quiet_dask_worker(show: Callable[..., None], filters: list[tuple[Any, ...]]) -> bool:
     """:func:`_quiet_dask_logs` in a local cluster's worker process, for its lifetime, and
     Ctrl-C ignored there, as in the process pool's workers: the build's process handles it
@@ -1842,11 +1846,10 @@ def _quiet_dask_worker(show: Callable[..., None], filters: list[tuple[Any, ...]]
     import signal
     import threading
 
+    from .workers import take_warnings
+
     logging.getLogger("distributed").setLevel(logging.CRITICAL)
-    warnings.resetwarnings()
-    for action, message, category, module, lineno in reversed(filters):
-        warnings.filterwarnings(action, message, category, module, lineno)
-    warnings.showwarning = show
+    take_warnings(show, filters)
     if threading.current_thread() is not threading.main_thread():
         return False
     signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -1994,8 +1997,6 @@ def build_dataset(
     also accepts other folders (writing only the dataset's files) and other configs (rebuilt;
     the old dataset stays whole until the new index is written, then its records are removed).
     """
-    from tqdm import tqdm
-
     check_scheduler_address(scheduler_address(scheduler))
     with dataset_folder(out_dir, force=force) as folder:
         _refuse_names_in_the_way(folder.path)
@@ -2034,7 +2035,7 @@ def build_dataset(
                 rows[spec.record_id] = row
         _warn_other_versions(other_versions, len(specs))
         printed()
-        bar = tqdm(
+        bar = tqdm_bar(
             total=len(specs),
             initial=len(rows),
             desc="records",

@@ -2,7 +2,23 @@
 
 from __future__ import annotations
 
+import os
+import sys
 from pathlib import Path
+
+
+def unnameable(path: str | Path) -> str | None:
+    """Why this system cannot name the file ``path``: a character its file names cannot hold
+    (a UTF-8 config naming a non-ASCII file, under an ASCII or Latin-1 locale without Python's
+    UTF-8 mode); None if it can."""
+    try:
+        os.fsencode(path)
+    except UnicodeEncodeError:
+        return (
+            "the name has characters that this system's file names cannot hold "
+            f"({sys.getfilesystemencoding()}); set a UTF-8 locale, or PYTHONUTF8=1"
+        )
+    return None
 
 
 class MdfError(Exception):

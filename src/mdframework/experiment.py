@@ -58,7 +58,7 @@ from .interfaces import Classifier
 from .outdir import output_folder, safe_name
 from .plugins import Registry, default_registry, versions
 from .pointcloud import histogram_vector, histogram_vector_names, velocity_bins
-from .progress import note, progress_enabled
+from .progress import note, progress_enabled, tqdm_bar
 from .settings import Seed, StrictModel, Workers
 
 #: every name an experiment writes in its folder (group names are made safe by ``safe_name``)
@@ -617,9 +617,7 @@ def within_source(
         raise _too_few_classes(untested)
     mats, optimistic, subsets, tested = [], [], [], []
     predictions: list[tuple[int, NDArray[np.intp], NDArray[Any]]] = []
-    from tqdm import tqdm
-
-    bar = tqdm(
+    bar = tqdm_bar(
         splits,
         desc=progress,
         unit="split",

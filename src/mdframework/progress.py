@@ -223,9 +223,7 @@ class Progress:
         if not self.enabled:
             yield _ignore
             return
-        from tqdm import tqdm
-
-        bar: Any = tqdm(
+        bar: Any = tqdm_bar(
             total=total,
             desc=f"mdf: {label}",
             unit=unit,
@@ -238,6 +236,24 @@ class Progress:
             yield bar.update
         finally:
             bar.close()
+
+
+_BAR_CLASS: Any = None
+
+
+def tqdm_bar(*args: Any, **kwargs: Any) -> Any:
+    """``tqdm(*args, **kwargs)`` without tqdm's monitor thread (which every bar starts, even
+    a disabled one, and which lives on for a while after it): a thread that holds a lock when
+    the worker processes of a build are forked would leave it held in them, and Python 3.12
+    and later warn of it ("This process is multi-threaded, use of fork() may lead to
+    deadlocks in the child"). The monitor only adjusts how often a bar that has stalled is
+    redrawn."""
+    global _BAR_CLASS
+    if _BAR_CLASS is None:
+        from tqdm import tqdm
+
+        _BAR_CLASS = type("MdfBar", (tqdm,), {"monitor_interval": 0})
+    return _BAR_CLASS(*args, **kwargs)
 
 
 #: Progress that reports nothing (the default of library calls).

@@ -29,6 +29,7 @@ from pydantic import (
 )
 
 from . import limits
+from .errors import unnameable
 from .interfaces import ConfigSection, FloatArray, PluginConfig, RadarConfig
 from .physics import radar
 from .physics.interpolation import Method
@@ -77,6 +78,9 @@ def _resolve_path(value: Path, info: ValidationInfo) -> Path:
     path = Path(value).expanduser()
     if not path.is_absolute() and base is not None:
         path = Path(base) / path
+    why = unnameable(path)
+    if why is not None:
+        raise ValueError(f"{path}: {why}")
     if not path.exists():
         raise ValueError(f"file not found: {path}")
     if path.is_dir():
