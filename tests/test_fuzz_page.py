@@ -24,3 +24,18 @@ def test_input_rules_quotes_the_recorded_fuzz_runs() -> None:
         options = r["command"].split("fuzz_scenes.py ", 1)[1]  # e.g. --examples 5000 --seed 1
         examples, seed = options.split(" --seed ")
         assert f"`{examples}`" in page and f"`--seed {seed}`" in page
+
+
+def test_input_rules_quotes_the_recorded_motion_fuzz_run() -> None:
+    """The damaged-motion-file fuzz (benchmarks/fuzz_motion.py --json) as the page quotes it."""
+    run = json.loads((ROOT / "docs" / "data" / "fuzz_motion_results.json").read_text())
+    page = " ".join((ROOT / "docs" / "input-rules.md").read_text().split())
+    outcomes = run["outcomes"]
+    assert outcomes["failed"] == 0 and outcomes["ok"] + outcomes["refused"] == run["cases"]
+    assert sum(sum(f.values()) for f in run["by_format"].values()) == run["cases"]
+    options = run["command"].split("fuzz_motion.py ", 1)[1]
+    assert (
+        f"it ran {run['cases']:,} damaged files (`{options}`, commit {run['commit']}): "
+        f"{outcomes['ok']:,} were read and ran, {outcomes['refused']:,} were refused with one "
+        "line naming the file, and none failed" in page
+    )
