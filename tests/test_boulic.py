@@ -380,3 +380,41 @@ def test_spectrogram_torso_line_and_leg_peak(registry: Registry) -> None:
     envelope = np.array([res.velocity[1:-1][np.nonzero(col)[0]].max() for col in peak.T])
     assert envelope.max() == pytest.approx(radial.max(), abs=resolution)
     assert radial.max() > 4.0  # it is the fast leg, not the torso
+
+
+@pytest.mark.parametrize(("rv", "chen"), [(0.3, True), (0.3, False), (1.0, True), (2.2, False)])
+def test_closed_form_tracks_follow_the_pages_formulas(rv: float, chen: bool) -> None:
+    """The closed-form trajectories of physics.md 3.2, written out here, at one rv per gait
+    class (away from rv = 1, where a dropped rv factor is invisible): vertical, lateral,
+    forward/backward, pelvis rotations, torsion and shoulder flexion, to 1e-12. The corrected
+    mode flips the sign of gait a's lateral and forward amplitudes (Q2)."""
+    p = np.linspace(0.0, 1.0, 1001, endpoint=False)
+    g = Gait(H, rv, chen_compatible=chen)
+    got = g.tracks(p)
+    two_pi, a = 2 * np.pi, rv < 0.5
+    dsmod = (0.752 * 1.346 / np.sqrt(rv) - 0.143) / (1.346 / np.sqrt(rv))
+    sign = 1.0 if chen else -1.0
+    al = sign * (-0.128 * rv**2 + 0.128 * rv) if a else -0.032
+    aa = sign * (-0.084 * rv**2 + 0.084 * rv) if a else -0.021
+    a1 = -8 * rv**2 + 8 * rv if a else 2.0
+    a2, av, a_s = 1.66 * rv, 0.015 * rv, 9.88 * rv
+    leftright = np.select(
+        [p < 0.15, p < 0.5, p < 0.65],
+        [
+            -a2 + a2 * np.cos(two_pi * 10 * p / 3),
+            -a2 - a2 * np.cos(two_pi * 10 * (p - 0.15) / 7),
+            a2 - a2 * np.cos(two_pi * 10 * (p - 0.5) / 3),
+        ],
+        a2 + a2 * np.cos(two_pi * 10 * (p - 0.65) / 7),
+    )
+    expected = {
+        "vertical": -av + av * np.sin(two_pi * (2 * p - 0.35)),
+        "lateral": al * np.sin(two_pi * (p - 0.1)),
+        "forward": aa * np.sin(two_pi * (2 * p + 2 * (0.625 - dsmod))),
+        "rot_forback": -a1 + a1 * np.sin(two_pi * (2 * p - 0.1)),
+        "rot_leftright": leftright,
+        "torsion": -4 * rv * np.cos(two_pi * p),
+        "shoulder": 3 - a_s / 2 - a_s * np.cos(two_pi * p),
+    }
+    for name, want in expected.items():
+        np.testing.assert_allclose(got[name], want, rtol=0, atol=1e-12, err_msg=name)

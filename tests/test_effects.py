@@ -761,3 +761,23 @@ def test_metadata_records_effects_in_stage_order() -> None:
     ]
     assert res.scatterers.names == ("target0", "target0~image", "target0~bounce")
     assert np.all(np.isfinite(res.spectrogram_db))
+
+
+def test_multipath_over_a_raised_ground_mirrors_in_that_plane() -> None:
+    """Ground plane at z = 0.5 m, Gamma real (phase 0, so no range offset): the image scatterer
+    lies at the range of the target mirrored in z = 0.5, R_b = hypot(10, (5 - 0.5) + (z - 0.5)),
+    and the single-bounce one at (R_d + R_b) / 2, to 1e-9 m at every pulse (the default ground
+    at z = 0 cannot tell 2h - z from h - z)."""
+    res = run(
+        MP_TARGET,
+        [{"kind": "multipath", "ground_height": 0.5, "reflection_phase_deg": 0.0}],
+        radar_position=MP_RADAR,
+        duration=0.2,
+    )
+    names = res.scatterers.names
+    ranges = res.scatterers.ranges(np.array(MP_RADAR))
+    z = 1.0 + 2.0 * res.pulse_times
+    rd, rb = np.hypot(10.0, 5.0 - z), np.hypot(10.0, (5.0 - 0.5) + (z - 0.5))
+    np.testing.assert_allclose(ranges[:, names.index("target0")], rd, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(ranges[:, names.index("target0~image")], rb, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(ranges[:, names.index("target0~bounce")], (rd + rb) / 2, atol=1e-9)

@@ -226,3 +226,27 @@ def test_envelopes_of_a_long_record_take_little_memory_beside_it(
             monkeypatch.setattr(features, "ENVELOPE_CELLS", power.size)
             for a, b in zip(chunked.__dict__.values(), whole.__dict__.values(), strict=True):
                 np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("percentiles", [(25.0, 50.0), (10.0, 60.0), (3.0, 97.0)])
+def test_percentile_envelopes_are_the_inverted_cdf_quantiles(
+    percentiles: tuple[float, float],
+) -> None:
+    """The percentile method's lower and upper envelopes and its median torso are, per column,
+    the first velocity where the cumulative power reaches the fraction: numpy's weighted
+    quantile (inverted CDF) of the velocities with the column's power as weights, on random
+    columns (all above the floor) and on a flat column of 64 equal bins, where 25 % is reached
+    exactly at bin 15 and 50 % at bin 31. Asymmetric percentiles catch an upper envelope
+    taken as 1 - the lower percentile."""
+    rng = np.random.default_rng(11)
+    v = np.linspace(-4.0, 4.0, 64)
+    power = rng.uniform(0.5, 2.0, (64, 12))
+    power[:, 0] = 1.0
+    env = envelopes(power, v, method="percentile", percentiles=percentiles, floor_db=-60.0)
+    for col in range(power.shape[1]):
+        q = [p / 100.0 for p in (*percentiles, 50.0)]
+        ref = [np.quantile(v, x, weights=power[:, col], method="inverted_cdf") for x in q]
+        got = [env.lower[col], env.upper[col], env.torso[col]]
+        np.testing.assert_array_equal(got, ref)
+    if percentiles == (25.0, 50.0):
+        assert (env.lower[0], env.upper[0]) == (v[15], v[31])

@@ -709,3 +709,22 @@ def test_cfar_matches_a_cell_by_cell_reference() -> None:
                 else:
                     assert got == pytest.approx(want, rel=1e-9)
                     assert hit == (x[row][j] > 10**0.5 * want)
+
+
+def test_clutter_removal_removes_the_static_target_and_keeps_the_moving_one() -> None:
+    """Static clutter removal subtracts each channel's and range bin's mean over the loops: a
+    still target on range bin 20 (the same value in every loop) vanishes from the
+    range-Doppler map, while a target on range bin 40 moving at Doppler bin +3 keeps its
+    amplitude a on its own cell to 1e-9 (its slow-time mean over whole cycles is zero)."""
+    a, d = 0.37, 3
+    n_loops, n_virt, n_bins = 16, 4, 64
+    loops = np.arange(n_loops)
+    cube = np.zeros((n_virt, n_loops, n_bins), dtype=np.complex128)
+    cube[:, :, 20] = 1.5 * np.exp(0.7j)  # still: one value in every loop
+    cube[:, :, 40] = a * np.exp(2j * np.pi * d * loops / n_loops)  # Doppler bin +3
+    rd = fmcw.range_doppler(cube, "hann", n_loops, clutter_removal=True)
+    assert np.max(np.abs(rd[:, :, 20])) < 1e-12
+    row = (n_loops - 1) // 2 + d
+    np.testing.assert_allclose(np.abs(rd[:, row, 40]), a, rtol=1e-9)
+    kept = fmcw.range_doppler(cube, "hann", n_loops)  # without removal the still target stays
+    np.testing.assert_allclose(np.abs(kept[:, (n_loops - 1) // 2, 20]), 1.5, rtol=1e-9)

@@ -272,3 +272,38 @@ def test_constant_velocity_targets_resample_linearly_as_exactly_as_a_spline() ->
         config, build_stages(config), dataclasses.replace(motion, linear_tracks=False)
     ).received.signal
     assert np.max(np.abs(linear - spline)) <= 1e-9 * np.max(np.abs(spline))
+
+
+@pytest.mark.parametrize("facing_deg", [0.0, 90.0, 180.0, -60.0])
+def test_facing_heading_is_a_quarter_turn_clockwise_from_the_hip_line(facing_deg: float) -> None:
+    """Scene frame right-handed, z up: a body facing heading h has its left hip on the side of
+    h + 90 deg, so hips at +-0.1 m along h + 90 deg (plus a common offset and height) face h
+    (a right/left mix-up, or the wrong quarter turn, faces the body away from the radar)."""
+    from mdframework.physics.scene import facing_heading
+
+    h = np.radians(facing_deg)
+    side = 0.1 * np.array([np.cos(h + np.pi / 2), np.sin(h + np.pi / 2), 0.0])
+    centre = np.array([[2.0, -1.0, 0.9], [2.1, -1.0, 0.92]])
+    got = facing_heading(centre + side, centre - side)
+    assert np.angle(np.exp(1j * (got - h))) == pytest.approx(0.0, abs=1e-12)
+
+
+@pytest.mark.parametrize("mode", ["treadmill", "straight"])
+def test_placement_removes_the_drift_whatever_the_turn(mode: str) -> None:
+    """A recording drifting at (0.8, -0.5) m/s with a sway, turned from heading 0.3 rad to
+    1.4 rad (a turn that is not a half turn): placed on a treadmill, its base's least-squares
+    drift is zero to 1e-12 m/s; moved straight at 1.2 m/s it is 1.2 m/s along the new heading.
+    The drift is fitted to the turned recording, so turning it the other way would leave
+    part of it."""
+    from mdframework.physics.scene import linear_drift_rate, placement
+
+    t = np.linspace(0.0, 4.0, 121)
+    base = np.stack([1.0 + 0.8 * t, 2.0 - 0.5 * t + 0.03 * np.sin(4 * t), 0.9 + 0.0 * t], axis=1)
+    p = placement(
+        t, base, heading_now=0.3, heading=1.4, position=np.array([5.0, 6.0]), mode=mode, speed=1.2
+    )
+    placed = p.apply(t, base)
+    speed = 1.2 if mode == "straight" else 0.0
+    expected = speed * np.array([np.cos(1.4), np.sin(1.4)])
+    np.testing.assert_allclose(linear_drift_rate(t, placed[:, :2]), expected, atol=1e-12)
+    np.testing.assert_allclose(placed[0, :2], [5.0, 6.0], atol=1e-12)

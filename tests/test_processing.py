@@ -160,3 +160,19 @@ def test_other_windows_come_from_scipy_and_unknown_names_fail() -> None:
     assert np.array_equal(w, get_window("flattop", 128, fftbins=True))
     with pytest.raises(ValueError):
         spectrogram.stft_window("nosuchwindow", 8)
+
+
+@pytest.mark.parametrize("nfft", [255, 257])
+def test_odd_fft_size_puts_a_tone_on_its_own_bin(nfft: int) -> None:
+    """An odd FFT size (bins -(N-1)/2 .. (N-1)/2, centred by fftshift): tones on bins +-17 and
+    a tone at 0 Hz peak on the Doppler axis at their own frequencies, k fs / N, in every frame
+    (ifftshift instead of fftshift would move them one bin)."""
+    fs = 2400.0
+    n = np.arange(3000)
+    for k in (17, -17, 0):
+        f = k * fs / nfft
+        s = spectrogram.spectrogram(
+            np.exp(2j * np.pi * f * n / fs), fs, window_length=255, nfft=nfft
+        )
+        assert s.doppler.size == nfft and s.doppler[(nfft - 1) // 2] == 0.0
+        np.testing.assert_allclose(s.doppler[np.argmax(s.power, axis=0)], f, atol=1e-9)

@@ -273,3 +273,42 @@ def test_summing_range_bins_gives_the_phase_only_return(x: float) -> None:
     total = complex(np.sum(radar.matched_filter(echo, fs, **kw)) / tau * bandwidth / fs)
     assert abs(total / phase_only) == pytest.approx(1.0, abs=0.02)
     assert abs(np.angle(total / phase_only)) < 0.01
+
+
+@pytest.mark.parametrize("precision", ["float32", "float64"])
+def test_analytic_amplitude_is_the_range_equation_with_gain_and_losses(precision: str) -> None:
+    """A still point in the tracking gate gives |y| = sqrt(P_t G^2 lambda^2 sigma / ((4 pi)^3
+    R^4 L_s L_a)) (physics.md 1.3), written out here with G = 10^(dBi/10) and each loss
+    10^(dB/10): P_t = 2 W, 20 dBi, L_s = 3 dB, L_a = 1 dB, sigma = 0.5 m^2, R = 10 m, to the
+    precision's rounding. The analytic path builds this product itself (not through
+    radar.range_equation_amplitude), so a gain taken once, a dBi read as an amplitude ratio or
+    a loss that divides the other by the wrong sign each shows here."""
+    lam = SPEED_OF_LIGHT / FC
+    g, loss = 10.0 ** (20.0 / 10), 10.0 ** (3.0 / 10) * 10.0 ** (1.0 / 10)
+    expected = np.sqrt(2.0 * g**2 * lam**2 * 0.5 / ((4 * np.pi) ** 3 * 10.0**4 * loss))
+    powered = {"transmit_power": 2.0, "gain_dbi": 20.0, "system_loss_db": 3.0}
+    res = point_run(
+        [{"position": [10.0, 0, 0], "velocity": [0.0, 0, 0], "rcs": 0.5}],
+        duration=0.2,
+        radar={**powered, "atmospheric_loss_db": 1.0, "precision": precision},
+    )
+    rtol = 1e-6 if precision == "float32" else 1e-12
+    np.testing.assert_allclose(np.abs(res.received.signal), expected, rtol=rtol)
+
+
+@pytest.mark.parametrize("precision", ["float32", "float64"])
+def test_analytic_sinc_gate_weights_a_point_half_a_metre_away_by_0_636(precision: str) -> None:
+    """gate_response = "sinc" on the plugin's analytic path (its own float32/float64 code, not
+    radar.gate_weights): a still point 0.5 m beyond a fixed 10 m gate is weighted by
+    sinc(2 B (0.5 m) / c) = sinc(0.5 / 0.9993) = 0.636 (physics.md 1.4), relative to the
+    range-equation amplitude at its own range."""
+    res = point_run(
+        [{"position": [10.5, 0, 0], "velocity": [0.0, 0, 0]}],
+        duration=0.2,
+        radar={"gate_response": "sinc", "precision": precision},
+        scene={"gate": 10.0},
+    )
+    a = radar.range_equation_amplitude(1.0, 10.5, wavelength=SPEED_OF_LIGHT / FC)
+    weight = np.abs(res.received.signal) / float(a)
+    np.testing.assert_allclose(weight, np.sinc(2 * 150e6 * 0.5 / SPEED_OF_LIGHT), rtol=1e-5)
+    assert weight[0] == pytest.approx(0.636, abs=1e-3)

@@ -160,3 +160,68 @@ def test_part_geometry_in_coordinate_planes(placement: str) -> None:
         body.part_geometry(parts, joints[:, :15])
     with pytest.raises(ValueError, match="3 along axis -1"):
         body.part_geometry(parts, joints, joint_axis=-1)
+
+
+#: physics.md 2.3, Chen's 16 parts: (part, a = b [m], segment length / H, position as
+#: (joint, weight) pairs, axis as (tail, tip)); the lower leg with its own length (Q5 fixed).
+CHEN16_TABLE = [
+    ("head", 0.10, 0.130, {"head": 1.0}, ("neck", "head")),
+    ("torso", 0.15, 0.288, {"neck": 0.5, "base": 0.5}, ("base", "neck")),
+    ("shoulder", 0.06, 0.1295, {"{s}_shoulder": 1.0}, ("neck", "{s}_shoulder")),
+    (
+        "upper_arm",
+        0.06,
+        0.188,
+        {"{s}_shoulder": 0.5, "{s}_elbow": 0.5},
+        ("{s}_elbow", "{s}_shoulder"),
+    ),
+    ("lower_arm", 0.05, 0.152, {"{s}_hand": 1.0}, ("{s}_hand", "{s}_elbow")),
+    ("hip", 0.07, 0.0955, {"{s}_hip": 1.0}, ("base", "{s}_hip")),
+    ("upper_leg", 0.07, 0.245, {"{s}_hip": 0.5, "{s}_knee": 0.5}, ("{s}_hip", "{s}_knee")),
+    ("lower_leg", 0.06, 0.246, {"{s}_knee": 0.5, "{s}_ankle": 0.5}, ("{s}_knee", "{s}_ankle")),
+    ("foot", 0.05, 0.143, {"{s}_toe": 1.0}, ("{s}_ankle", "{s}_toe")),
+]
+
+
+def test_chen16_every_part_follows_the_table() -> None:
+    """Every one of the 16 parts (head as Chen's spheroid) against physics.md 2.3 written out
+    here: position (joint or segment midpoint) and axis on random joints, so that no two
+    joints coincide, to 1e-15 m (the axis up to its sign, which the RCS and the specular
+    point do not see), a = b and c = half the segment length at H = 1.7 m to 1e-15 m."""
+    rng = np.random.default_rng(5)
+    joints = rng.uniform(-1.0, 1.0, (3, 17, 3))
+    parts = body.body_parts("chen16", "spheroid")
+    pos, axes = body.part_geometry(parts, joints)
+    a, c = body.part_semi_axes(parts, 1.7)
+    j = {n: joints[:, i] for i, n in enumerate(CANONICAL_JOINTS)}
+    rows = [(name, row) for name, *row in CHEN16_TABLE if name in ("head", "torso")]
+    for side in ("l", "r"):
+        rows += [(f"{side}_{name}", row) for name, *row in CHEN16_TABLE[2:]]
+    assert sorted(p.name for p in parts) == sorted(name for name, _ in rows)
+    names = [p.name for p in parts]
+    for name, (radius, fraction, where, (tail, tip)) in rows:
+        side = name[0]
+        i = names.index(name)
+        want = sum(w * j[k.format(s=side)] for k, w in where.items())
+        np.testing.assert_allclose(pos[:, i], want, rtol=0, atol=1e-15, err_msg=name)
+        seg = j[tip.format(s=side)] - j[tail.format(s=side)]
+        sign = np.sign(np.sum(axes[:, i] * seg, axis=-1))[:, None]
+        np.testing.assert_allclose(sign * axes[:, i], seg, rtol=0, atol=1e-15, err_msg=name)
+        assert (a[i], c[i]) == pytest.approx((radius, fraction * 1.7 / 2), abs=1e-15), name
+
+
+@pytest.mark.parametrize(("kind", "sigma"), [("mie", 0.032015), ("optical", 0.0314159265)])
+def test_ellipsoid_model_head_sphere_rcs_at_the_radar_wavelength(kind: str, sigma: float) -> None:
+    """The ellipsoid model's spherical head (r = 0.1 m) at the radar's 15 GHz wavelength:
+    Mie 0.032015 m^2 (+1.9 % over pi r^2, physics.md 2.1), optical pi r^2, at every pulse and
+    whatever the aspect (at twice the wavelength, ka = 15.7, Mie gives 4.5 % more)."""
+    from mdf_ellipsoid.model import EllipsoidBody, EllipsoidConfig
+
+    from mdframework.skeleton import Skeleton
+
+    joints = np.repeat(_standing_body(), 3, axis=0)
+    skel = Skeleton(np.arange(3) / 2400.0, joints, CANONICAL_JOINTS)
+    model = EllipsoidBody(EllipsoidConfig(sphere_rcs=kind, head="sphere", height=1.8))  # type: ignore[arg-type]
+    model.start_record(skel)
+    scat = model.scatterers(None, skel, np.array([10.0, 3.0, 1.0]), LAMBDA_15GHZ)  # type: ignore[arg-type]
+    np.testing.assert_allclose(scat.rcs[:, scat.names.index("head")], sigma, rtol=2e-4)
