@@ -213,6 +213,36 @@ def test_workers_are_forked_on_linux_whatever_pythons_default(
         pool_workers.start_method()
 
 
+@pytest.mark.parametrize(
+    ("variable", "value", "message"),
+    [
+        ("MDF_START_METHOD", "vfork", "MDF_START_METHOD='vfork': not a start method of this "
+         "platform; use one of "),
+        ("MDF_DASK_TIMEOUT", "-1", "MDF_DASK_TIMEOUT='-1': give a timeout in seconds, "
+         "0 < t <= 3600"),
+    ],
+)  # fmt: skip
+def test_a_bad_environment_variable_is_named_alone_not_as_the_configs(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    variable: str,
+    value: str,
+    message: str,
+) -> None:
+    """The line names the variable, not the config file, which says nothing of it."""
+    monkeypatch.setenv(variable, value)
+    config = write_config(tmp_path / "d.toml", boxing_records=1, aspects="[0.0]")
+    out = tmp_path / "out"
+    args = ["dataset", "build", str(config), "--out", str(out), "--workers", "2", "--no-progress"]
+    if variable == "MDF_DASK_TIMEOUT":
+        args += ["--scheduler", "tcp://127.0.0.1:1"]
+    assert cli.main(args) == 2
+    err = capsys.readouterr().err.splitlines()[-1]
+    assert err.startswith(f"mdf: error: {message}"), err
+    assert "d.toml" not in err
+
+
 def test_a_build_forks_its_workers_from_a_process_of_one_thread(tmp_path: Path) -> None:
     """No thread of the command is alive when a build forks its workers (in the child, a lock
     such a thread held stays held): the progress bar's monitor thread was (tqdm starts one for

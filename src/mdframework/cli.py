@@ -27,6 +27,7 @@ from .errors import (
     DataFileError,
     MdfError,
     OutputError,
+    SettingError,
     caused_by_interrupt,
     interrupt_seen,
     note_interrupt,
@@ -66,7 +67,9 @@ def _naming(config_file: str) -> Iterator[None]:
     try:
         yield
     except MdfError as exc:
-        if isinstance(exc, (DataFileError, OutputError)) or str(exc).startswith(config_file):
+        if isinstance(exc, (DataFileError, OutputError, SettingError)) or str(exc).startswith(
+            config_file
+        ):
             raise
         raise type(exc)(f"{config_file}: {exc}") from exc
 

@@ -65,7 +65,7 @@ from .config import (
     read_config_file,
     validate_run_config,
 )
-from .errors import ConfigError, DataFileError, MdfError, OutputError, SceneError
+from .errors import ConfigError, DataFileError, MdfError, OutputError, SceneError, SettingError
 from .features import FEATURE_NAMES, band_edge_frames, envelopes, features_from_envelopes
 from .interfaces import Motion, Recording, RecordingSource
 from .outdir import (
@@ -1637,13 +1637,13 @@ def check_scheduler_address(address: str | None) -> None:
     try:
         from distributed.comm.addressing import parse_address, parse_host_port
     except ImportError:
-        raise MdfError("a Dask scheduler needs `pip install mdframework[dask]`") from None
+        raise SettingError("a Dask scheduler needs `pip install mdframework[dask]`") from None
     try:
         scheme, location = parse_address(address)
         if scheme != "inproc":
             parse_host_port(location)
     except ValueError as exc:
-        raise MdfError(
+        raise SettingError(
             f"Dask scheduler {address!r}: not an address ({' '.join(str(exc).split())}); give "
             f"HOST:PORT, tcp://HOST:PORT or 'local' with --scheduler or {SCHEDULER_ENV}"
         ) from None
@@ -1661,7 +1661,7 @@ def scheduler_timeout() -> float:
     except ValueError:
         value = float("nan")
     if not 0 < value <= 3600:
-        raise MdfError(
+        raise SettingError(
             f"{SCHEDULER_TIMEOUT_ENV}={text!r}: give a timeout in seconds, 0 < t <= 3600"
         )
     return value
@@ -1677,13 +1677,13 @@ def _connect(client_cls: Any, cluster: Any, address: str) -> Any:
         return client_cls(address, timeout=timeout)
     except (OSError, TimeoutError, ValueError, TypeError) as exc:
         reason = " ".join(str(exc).split()) or type(exc).__name__
-        raise MdfError(
+        raise SettingError(
             f"cannot connect to the Dask scheduler {address!r} within {timeout:g} s ({reason}); "
             f"check --scheduler or {SCHEDULER_ENV}, or set {SCHEDULER_TIMEOUT_ENV}"
         ) from None
     except Exception as exc:  # whatever answers there is not a Dask scheduler
         reason = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
-        raise MdfError(
+        raise SettingError(
             f"the Dask scheduler {address!r} gave an answer Dask cannot read ({reason[:200]}): "
             f"it is not a Dask scheduler, or not of this version; check --scheduler or "
             f"{SCHEDULER_ENV}"
@@ -1772,7 +1772,7 @@ def _executor(
         from distributed import Client, LocalCluster
         from distributed import as_completed as dask_completed
     except ImportError:
-        raise MdfError("a Dask scheduler needs `pip install mdframework[dask]`") from None
+        raise SettingError("a Dask scheduler needs `pip install mdframework[dask]`") from None
     import dask
 
     with _quiet_dask_logs() if address == "local" else nullcontext():

@@ -44,6 +44,11 @@ class SceneError(MdfError):
     a record shorter than the STFT window, ...)."""
 
 
+class SettingError(MdfError):
+    """A setting of how a command runs, not of what it computes, cannot be used (an environment
+    variable such as ``MDF_START_METHOD``, a Dask scheduler); the message names the setting."""
+
+
 class OutputError(MdfError):
     """An output folder cannot be used as given (a file, not writable, another command's or the
     user's files, in use by another command); the message names ``--out`` and what to do."""

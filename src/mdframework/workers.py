@@ -34,7 +34,7 @@ from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
 from typing import Any
 
-from .errors import MdfError
+from .errors import SettingError
 
 #: the environment variable that chooses how worker processes start
 START_METHOD_ENV = "MDF_START_METHOD"
@@ -178,13 +178,13 @@ def limit_blas_threads(n_workers: int) -> None:
 
 def start_method() -> str:
     """How worker processes start: ``MDF_START_METHOD`` if set, else ``fork`` on Linux, else
-    the platform's default (``spawn`` on macOS). Raises :class:`MdfError` for a method this
+    the platform's default (``spawn`` on macOS). Raises :class:`SettingError` for a method this
     platform lacks."""
     chosen = os.environ.get(START_METHOD_ENV, "").strip()
     available = multiprocessing.get_all_start_methods()
     if chosen:
         if chosen not in available:
-            raise MdfError(
+            raise SettingError(
                 f"{START_METHOD_ENV}={chosen!r}: not a start method of this platform; "
                 f"use one of {', '.join(available)}"
             )
