@@ -112,6 +112,62 @@ def test_oni_reads_survive_repeated_fresh_processes() -> None:
     assert not failures, failures
 
 
+#: a child process that reads a recording's depth frames: exit 2 with the error's line
+READ_DEPTH = """
+import sys
+from pathlib import Path
+from mdframework import DataFileError
+from mdf_kinect import read_oni_depth
+try:
+    read_oni_depth(Path(sys.argv[1]))
+except DataFileError as exc:
+    print(exc, file=sys.stderr)
+    sys.exit(2)
+"""
+
+
+def _damaged(tmp_path: Path, where: int, value: int) -> Path:
+    raw = bytearray(ONI.read_bytes())
+    raw[where] = value
+    path = tmp_path / "damaged.oni"
+    path.write_bytes(bytes(raw))
+    return path
+
+
+def test_a_recording_that_crashes_openni2_is_one_line(tmp_path: Path) -> None:
+    """Found by benchmarks/fuzz_motion.py's kind of damage: one byte of a property's name
+    (PhysicalDeviceName, 'c' -> 0xE0) leaves the record chain sound, and OpenNI2 crashes the
+    process (a segmentation fault) playing it. `mdf kinect info` plays it in a child process,
+    so the crash is one line naming the file (run here in a child too, so that a regression
+    fails this test instead of killing the test process)."""
+    path = _damaged(tmp_path, 375, 0xE0)
+    scan_oni(path)  # the structure is sound: the Python checks cannot see this damage
+    done = subprocess.run(
+        [sys.executable, "-m", "mdframework.cli", "kinect", "info", str(path)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 2, (done.returncode, done.stderr[-500:])
+    assert done.stderr == (
+        f"mdf: error: {path}: OpenNI2 crashed while playing this recording (its structure is "
+        "sound, so a record's contents are damaged)\n"
+    )
+
+
+def test_a_depth_frame_that_decodes_short_is_one_line(tmp_path: Path) -> None:
+    """One byte of frame 8's compressed depth changed (0xE2 -> 0xD8): OpenNI2 decodes it to 2
+    pixels fewer than 480 x 640, which was an internal error (a reshape's ValueError)."""
+    path = _damaged(tmp_path, 1395424, 0xD8)
+    done = subprocess.run(
+        [sys.executable, "-c", READ_DEPTH, str(path)], capture_output=True, text=True, timeout=120
+    )
+    assert done.returncode == 2, (done.returncode, done.stderr[-500:])
+    assert done.stderr == (
+        f"{path}: depth frame 8 decodes to 307198 pixels, not 480 x 640: the recording is damaged\n"
+    )
+
+
 def _s(text: str) -> bytes:
     b = text.encode() + b"\0"
     return struct.pack("<I", len(b)) + b

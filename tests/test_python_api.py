@@ -183,3 +183,17 @@ def test_a_plugin_built_from_a_plain_dict_says_to_validate_it() -> None:
         LfmPulseDoppler({"kind": "lfm"})  # type: ignore[arg-type]
     radar = LfmPulseDoppler(LfmPulseDoppler.Config.model_validate({"kind": "lfm"}))
     assert radar.config.kind == "lfm"
+
+
+def test_a_data_file_error_pickles_with_its_file_line_and_message() -> None:
+    """An error raised in a worker process (a dataset build's, or the child that plays an .oni
+    recording) reaches the command as it was raised: a DataFileError's own arguments pickle."""
+    import pickle
+
+    from mdframework import DataFileError
+
+    error = DataFileError("./walk.bvh", "frame 3 has 5 values", line=12)
+    again = pickle.loads(pickle.dumps(error))
+    assert type(again) is DataFileError
+    assert str(again) == str(error) == "./walk.bvh:12: frame 3 has 5 values"
+    assert (again.path, again.line, again.message) == (Path("walk.bvh"), 12, error.message)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import sys
 from pathlib import Path
+from typing import Any
 
 
 def unnameable(path: str | Path) -> str | None:
@@ -35,8 +36,15 @@ class DataFileError(MdfError):
     def __init__(self, path: str | Path, message: str, line: int | None = None) -> None:
         self.path = Path(path)
         self.line = line
+        self.message = message
+        self._named = str(path)  # as given: the message names it so
         where = f"{path}:{line}" if line is not None else f"{path}"
         super().__init__(f"{where}: {message}")
+
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
+        """Pickled with its own arguments (an error raised in a worker process reaches the
+        command as it was raised)."""
+        return type(self), (self._named, self.message, self.line)
 
 
 class SceneError(MdfError):

@@ -23,7 +23,7 @@ from .device import (
     initialize_nite,
     initialize_openni,
     nite_redist,
-    oni_info,
+    oni_info_isolated,
     open_device,
     scan_oni,
 )
@@ -99,7 +99,7 @@ def cmd_info(args: argparse.Namespace) -> int:
     path = Path(args.file)
     if not path.exists():
         raise DataFileError(path, "file not found")
-    info = oni_info(path)
+    info = oni_info_isolated(path)
     if args.json:
         print(json.dumps(info, indent=2))
         return 0

@@ -415,6 +415,12 @@ def read_oni_depth(path: Path) -> list[DepthFrame]:
     with closing(iter_oni_frames(path, "depth")) as frames:
         for f in frames:
             buf = np.frombuffer(bytes(f.get_buffer_as_uint8()), dtype="<u2")
+            if buf.size != f.height * (f.stride // 2):  # a damaged frame decodes short
+                raise DataFileError(
+                    path,
+                    f"depth frame {int(f.frameIndex)} decodes to {buf.size} pixels, not "
+                    f"{f.height} x {f.stride // 2}: the recording is damaged",
+                )
             depth = buf.reshape(f.height, f.stride // 2)[:, : f.width].copy()
             out.append(DepthFrame(int(f.frameIndex), int(f.timestamp), depth))
     return out
@@ -444,6 +450,29 @@ def _stream_info(frames: Iterator[Any]) -> dict[str, Any]:
         "measured_fps": rate,
         "timestamps_increasing": bool(np.all(np.diff(stamps) > 0)),
     }
+
+
+def oni_info_isolated(path: Path, timeout_s: float = 2.0) -> dict[str, Any]:
+    """:func:`oni_info` in a child process, as ``mdf kinect info`` reads a recording: OpenNI2
+    crashes the whole process (a segmentation fault) on some damaged recordings that pass
+    :func:`scan_oni` (a damaged property name, for one), and a crash of the child is one
+    :class:`~mdframework.DataFileError` here. Errors the child raises come back as raised."""
+    from concurrent.futures import ProcessPoolExecutor
+    from concurrent.futures.process import BrokenProcessPool
+    from multiprocessing import get_context
+
+    from mdframework.workers import start_method
+
+    scan_oni(path)  # the structural checks here first: one line each, no process started
+    with ProcessPoolExecutor(1, mp_context=get_context(start_method())) as pool:
+        try:
+            return pool.submit(oni_info, path, timeout_s).result()
+        except BrokenProcessPool:
+            raise DataFileError(
+                path,
+                "OpenNI2 crashed while playing this recording (its structure is sound, so a "
+                "record's contents are damaged)",
+            ) from None
 
 
 def oni_info(path: Path, timeout_s: float = 2.0) -> dict[str, Any]:
