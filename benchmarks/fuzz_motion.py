@@ -11,9 +11,13 @@ refused. Anything else (an internal error, a traceback, another exit code) is a 
 first few are printed, and the exit code is 1.
 
 The C3D reader (a C library underneath) gets its own damaged copies of the shipped treadmill
-walk: each is read in a child process, so that a crash in the library is a failure too.
+walk: each is read in a child process, so that a crash in the library is a failure too. So does
+the Kinect plugin's OpenNI2 playback: each damaged copy of the shipped ``.oni`` recording goes
+through ``mdf kinect info``, in this process (the command plays the file in a child process of
+its own, and reports a crash of OpenNI2 as one line).
 
-    .venv/bin/python benchmarks/fuzz_motion.py [--cases 600] [--c3d 150] [--seed 0] [--json PATH]
+    .venv/bin/python benchmarks/fuzz_motion.py [--cases 600] [--c3d 150] [--oni 100] [--seed 0]
+        [--json PATH]
 
 Reports the outcomes per format and in all; ``--json`` also writes them, with the command, the
 date and the wall time (``docs/data/fuzz_motion_results.json`` holds the run that
@@ -54,6 +58,7 @@ FORMATS: dict[str, tuple[str, str, tuple[str, ...], str | None]] = {
     "table": ("table_utkinect_walk.toml", "data/kinect/utkinect/joints_s01_e01.txt", (), None),
 }  # fmt: skip
 C3D = EXAMPLES / "data" / "c3d" / "treadmill_events.c3d"
+ONI = EXAMPLES / "data" / "kinect" / "oni" / "test.oni"
 NUMBER = re.compile(rb"-?\d+(?:\.\d+)?(?:e-?\d+)?")
 REPLACEMENTS = (b"nan", b"inf", b"-inf", b"1e308", b"-1e308", b"0", b"", b"x", b"1e-320",
                 b"99999999999999999999", b"-0", b"1.5", b"-1")  # fmt: skip
@@ -162,11 +167,28 @@ def run_c3d_case(case: Path, rng: random.Random) -> tuple[str, str]:
     return "failed", f"{what}: exit {done.returncode}: {' | '.join(lines[-3:])[:300]}"
 
 
+def run_oni_case(case: Path, rng: random.Random) -> tuple[str, str]:
+    """Damage the shipped .oni recording and run ``mdf kinect info`` on it; (outcome, note)."""
+    damaged, what = damage_binary(ONI.read_bytes(), rng)
+    path = case / ONI.name
+    path.write_bytes(damaged)
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        code = cli.main(["kinect", "info", str(path)])
+    errors = [line for line in err.getvalue().splitlines() if not line.startswith("mdf: warning")]
+    if code == 0:
+        return "ok", what
+    if code == 2 and len(errors) == 1 and str(path) in errors[0]:
+        return "refused", what
+    return "failed", f"{what}: exit {code}: {' | '.join(errors)[:300]}"
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the fuzzer; returns 1 if any case failed."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", type=int, default=600, help="damaged text files, in all")
     parser.add_argument("--c3d", type=int, default=150, help="damaged C3D files")
+    parser.add_argument("--oni", type=int, default=100, help="damaged .oni recordings")
     parser.add_argument("--seed", type=int, default=0, help="seed of the damage")
     parser.add_argument("--json", type=Path, default=None, help="write the figures to this file")
     args = parser.parse_args(argv)
@@ -176,12 +198,15 @@ def main(argv: list[str] | None = None) -> int:
     failures: list[str] = []
     formats = list(FORMATS)
     with tempfile.TemporaryDirectory(prefix="mdf-fuzz-motion-") as tmp:
-        for i in range(args.cases + args.c3d):
-            fmt = "c3d" if i >= args.cases else formats[i % len(formats)]
+        kinds = [formats[i % len(formats)] for i in range(args.cases)]
+        kinds += ["c3d"] * args.c3d + ["oni"] * args.oni
+        for i, fmt in enumerate(kinds):
             case = Path(tmp) / f"case{i}"
             case.mkdir()
             if fmt == "c3d":
                 outcome, note = run_c3d_case(case, rng)
+            elif fmt == "oni":
+                outcome, note = run_oni_case(case, rng)
             else:
                 outcome, note = run_case(fmt, case, rng)
             counts[fmt, outcome] += 1
@@ -191,7 +216,7 @@ def main(argv: list[str] | None = None) -> int:
     outcomes: collections.Counter[str] = collections.Counter()
     for (_, outcome), n in counts.items():
         outcomes[outcome] += n
-    for fmt in [*formats, "c3d"]:
+    for fmt in [*formats, "c3d", "oni"]:
         row = {o: counts[fmt, o] for o in ("ok", "refused", "failed")}
         print(f"{fmt:<10} {row}")
     total = sum(outcomes.values())
@@ -202,7 +227,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.json:
         report = {
             "command": f"benchmarks/fuzz_motion.py --cases {args.cases} --c3d {args.c3d} "
-            f"--seed {args.seed}",
+            f"--oni {args.oni} --seed {args.seed}",
             "commit": subprocess.run(
                 ["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True
             ).stdout.strip(),
@@ -211,7 +236,7 @@ def main(argv: list[str] | None = None) -> int:
             "outcomes": {o: outcomes[o] for o in ("ok", "refused", "failed")},
             "by_format": {
                 fmt: {o: counts[fmt, o] for o in ("ok", "refused", "failed")}
-                for fmt in [*formats, "c3d"]
+                for fmt in [*formats, "c3d", "oni"]
             },
             "wall_s": round(time.time() - started, 1),
         }
