@@ -10,7 +10,9 @@ run finds only in the pulses (an empty range gate, an effect's own checks) it ca
 The memory estimate counts the scatterers a run's pulses get: the scatterer model's and those
 the scatterer-stage effects add (``static_scene``'s reflectors, ``multipath``'s bounced paths),
 found by passing the record's first two pulse times through the model and those effects (no
-radar, no received signal).
+radar, no received signal), and what the radar says it holds beside them
+(:meth:`~mdframework.interfaces.RadarWaveform.working_memory`: the raw path's fast-time arrays,
+an FMCW radar's kept range-Doppler maps).
 
 The aliasing risk is judged from the radial speed of the body's joints on the tracks the run
 resamples (``processing.interpolation``, whose cubic spline overshoots the frames' differences:
@@ -240,6 +242,7 @@ def plan_run(
         proc.keep_scatterers,
         4 if proc.precision == "float32" else 8,
     )
+    terms.update({name: size / MIB for name, size in wf.working_memory().items()})
     return RunPlan(
         plugins={
             "motion": _provider(reg, "motion", cfg.motion.kind),

@@ -504,6 +504,13 @@ class RadarWaveform(Plugin):
         record and the smallest and largest distance [m] of the body's joints to the radar over
         it (e.g. to fix a range-time window for every block). Default: nothing."""
 
+    def working_memory(self) -> Mapping[str, int]:
+        """Bytes this radar holds at once beyond the pipeline's own arrays (the slow-time signal
+        and a block's scatterers), by what holds them: a raw path's fast-time samples, an FMCW
+        radar's kept range-Doppler maps. ``mdf check`` adds them to its memory estimate; called
+        after :meth:`start_record`. Default: none."""
+        return {}
+
     def pulse_times(self, start: float, end: float) -> FloatArray:
         """Slow-time instants (n_pulses,) float64 [s] of a record from ``start`` to ``end``
         (scene clock, inclusive). Default: uniform at :attr:`prf` from ``start``."""

@@ -345,7 +345,8 @@ def check_radar_waveform(waveform: RadarWaveform) -> None:
     is left out of all these receives). The pulses are the radar's own ``pulse_times`` and the
     Doppler is read from the phase steps between consecutive pulses at
     most 1.5 / prf apart, so radars whose slow time has gaps (FMCW frames) are checked too.
-    The spectrogram of the signal has the geometry ``spectrogram_geometry`` reports."""
+    The spectrogram of the signal has the geometry ``spectrogram_geometry`` reports, and
+    ``working_memory`` names byte counts."""
     who = _label(waveform)
     fc, prf = waveform.carrier_frequency, waveform.prf
     assert fc > 0 and prf > 0, f"{who}: carrier and PRF must be > 0"
@@ -356,6 +357,10 @@ def check_radar_waveform(waveform: RadarWaveform) -> None:
     ranges = (5.0 - v * (t - t[0]))[:, None]
     received = receive_points(waveform, ranges, np.ones_like(ranges), ranges[:, 0], times=t)
     assert isinstance(received, Received), f"{who}: receive() must return Received"
+    memory = dict(waveform.working_memory())
+    assert all(isinstance(k, str) and isinstance(b, int) and b >= 0 for k, b in memory.items()), (
+        f"{who}: working_memory() must name byte counts >= 0, got {memory}"
+    )
     y = received.signal
     assert y.shape == (n,) and np.iscomplexobj(y), f"{who}: signal must be (n_pulses,) complex"
     _check_dtypes(who, "receive()", received)

@@ -416,6 +416,7 @@ class FmcwRadar(RadarWaveform):
                 UserWarning,
                 stacklevel=2,
             )
+        self._maps_bytes = 0
         if self.config.save_range_doppler:
             n_frames = times.shape[0] // self.sequence.chirps_per_frame
             size = 4.0 * n_frames * self.n_doppler * self.n_range  # float32 maps
@@ -425,6 +426,13 @@ class FmcwRadar(RadarWaveform):
                 f"{self.n_range} each)",
                 "radar.save_range_doppler",
             )
+            self._maps_bytes = int(size)
+
+    def working_memory(self) -> dict[str, int]:
+        """The record's range-Doppler maps (``radar.save_range_doppler``), twice: the blocks'
+        maps and their join into one array at the record's end."""
+        maps = getattr(self, "_maps_bytes", 0)
+        return {"range-Doppler maps": 2 * maps} if maps else {}
 
     def sensor_axes(self, radar_position: FloatArray) -> FloatArray:
         """Sensor axes (rows x right, y boresight, z up) in the scene frame."""

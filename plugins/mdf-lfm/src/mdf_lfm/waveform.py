@@ -125,6 +125,19 @@ class LfmPulseDoppler(RadarWaveform):
         ``range_margin`` on either side."""
         self._span = range_span
 
+    def working_memory(self) -> dict[str, int]:
+        """The raw path's fast-time arrays of :data:`RAW_BLOCK` pulses: the sampled echoes, the
+        chirp's terms and the matched filter's FFTs, about four complex arrays of (fast-time
+        samples + filter length) per pulse (measured with ``tracemalloc``); none on the
+        analytic path."""
+        c = self.config
+        if c.path != "raw" or not hasattr(self, "_span"):
+            return {}
+        fs = c.sample_rate or 2.0 * c.bandwidth
+        n_fast = self.fast_time_grid(*self._span).size
+        n_filter = 2 * int(np.floor(c.pulse_width / 2.0 * fs)) + 1
+        return {"fast time": 4 * RAW_BLOCK * (n_fast + n_filter) * 16}
+
     def receive(self, block: PulseBlock) -> Received:
         """Compressed slow-time return at the gate (and a range-time map on the raw path)."""
         c = self.config
