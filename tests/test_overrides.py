@@ -225,3 +225,19 @@ def test_a_dataset_built_with_an_override_keeps_it_and_resumes_only_with_it(
     assert mdf([*build, "--set", "base.radar.prf=1200"], capsys)[0] == 0  # resumes: done
     code, _, err = mdf(build, capsys)  # the file's own PRF is another config
     assert code == 2 and "different config" in err
+
+
+@pytest.mark.parametrize(
+    ("item", "rest"),
+    [
+        ("sources.0.motion.file=nope.amc", "sources[0].motion.file: file not found: "),
+        ('sources.0.motion.kind="bvh"', "sources[0].motion: file must be a .bvh file, got "),
+    ],
+)
+def test_a_dataset_planning_error_names_the_override_that_caused_it(
+    item: str, rest: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # planning names a source as sources[0], validation as sources.0: both are the override's
+    code, _, err = mdf(["dataset", "check", str(DATASET), "--set", item], capsys)
+    assert code == 2
+    assert err.splitlines()[-1].startswith(f"mdf: error: --set {item}: {rest}")

@@ -639,7 +639,9 @@ def blaming_overrides(source: str, overrides: Sequence[str]) -> Iterator[None]:
         rest = str(exc).removeprefix(f"{source}: ")
         if rest == str(exc):
             raise
-        fields = rest.split(": ")[:-1]  # the message's places, outermost first
+        # the message's places, outermost first (a list item as planning names it,
+        # sources[0], as a key names it, sources.0)
+        fields = [re.sub(r"\[(\d+)\]", r".\1", place) for place in rest.split(": ")[:-1]]
         for item in reversed(overrides):  # the last override of a key is the one that counts
             key = ".".join(_override_key(item)[0])
             for field in fields:
