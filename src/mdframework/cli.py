@@ -307,11 +307,23 @@ def _cmd_schema(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check_build_environment(args: argparse.Namespace) -> None:
+    """How a build's records are computed (``--scheduler``, ``MDF_DASK_SCHEDULER``,
+    ``MDF_START_METHOD``), checked before any folder is made, outside :func:`_naming`: a bad
+    setting is not the config's fault."""
+    from .dataset import check_scheduler_address, scheduler_address
+    from .workers import start_method
+
+    check_scheduler_address(scheduler_address(args.scheduler))
+    start_method()
+
+
 def _cmd_dataset_build(args: argparse.Namespace) -> int:
     from .config import blaming_overrides
     from .dataset import build_dataset, load_dataset_config
 
     config, base = load_dataset_config(args.config, args.overrides)
+    _check_build_environment(args)
     with blaming_overrides(args.config, args.overrides), _naming(args.config):
         rows = build_dataset(
             config,
@@ -338,6 +350,8 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
     config = load_experiment_config(args.config, args.overrides)
     if args.workers is not None:
         config = config.model_copy(update={"workers": args.workers})
+    if config.dataset.config is not None:  # (a built dataset is only read)
+        _check_build_environment(args)
     with blaming_overrides(args.config, args.overrides), _naming(args.config):
         run_experiment(
             config,
