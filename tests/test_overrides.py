@@ -241,3 +241,11 @@ def test_a_dataset_planning_error_names_the_override_that_caused_it(
     code, _, err = mdf(["dataset", "check", str(DATASET), "--set", item], capsys)
     assert code == 2
     assert err.splitlines()[-1].startswith(f"mdf: error: --set {item}: {rest}")
+
+
+def test_a_key_may_index_a_list_as_dataset_errors_name_it() -> None:
+    """Dataset errors name a source sources[0]; the docs tell users to write the key as errors
+    name it, and sources[0].hop was refused as not a dotted key."""
+    data = {"sources": [{"hop": 0.5}, {"hop": 0.5}]}
+    got = apply_overrides(data, ["sources[1].hop=0.25", "sources.0.hop=1.0"])
+    assert got == {"sources": [{"hop": 1.0}, {"hop": 0.25}]}

@@ -558,6 +558,12 @@ def _kinds(registry: Registry, interface: str) -> str:
     return f" (installed kinds: {names}{registry.disabled_note()})"
 
 
+def _dotted(place: str) -> str:
+    """A place as some errors write it (``sources[0].hop``) as a key writes it
+    (``sources.0.hop``)."""
+    return re.sub(r"\[(\d+)\]", r".\1", place)
+
+
 def _override_key(item: str) -> tuple[list[str], str]:
     """``KEY=VALUE`` -> (the key's parts, the value's text); a malformed item is a
     :class:`ConfigError` naming it."""
@@ -568,7 +574,10 @@ def _override_key(item: str) -> tuple[list[str], str]:
     try:  # a TOML dotted key: bare or quoted parts
         parsed: Any = tomllib.loads(f"{key} = 0")
     except tomllib.TOMLDecodeError:
-        raise ConfigError(f"--set {item}: {key!r} is not a dotted key like radar.prf") from None
+        try:  # a list indexed as errors write it: sources[0].hop
+            parsed = tomllib.loads(f"{_dotted(key)} = 0")
+        except tomllib.TOMLDecodeError:
+            raise ConfigError(f"--set {item}: {key!r} is not a dotted key like radar.prf") from None
     parts: list[str] = []
     while isinstance(parsed, dict):
         (name, parsed), *_ = parsed.items()
@@ -639,9 +648,8 @@ def blaming_overrides(source: str, overrides: Sequence[str]) -> Iterator[None]:
         rest = str(exc).removeprefix(f"{source}: ")
         if rest == str(exc):
             raise
-        # the message's places, outermost first (a list item as planning names it,
-        # sources[0], as a key names it, sources.0)
-        fields = [re.sub(r"\[(\d+)\]", r".\1", place) for place in rest.split(": ")[:-1]]
+        # the message's places, outermost first
+        fields = [_dotted(place) for place in rest.split(": ")[:-1]]
         for item in reversed(overrides):  # the last override of a key is the one that counts
             key = ".".join(_override_key(item)[0])
             for field in fields:
