@@ -249,3 +249,25 @@ def test_a_key_may_index_a_list_as_dataset_errors_name_it() -> None:
     data = {"sources": [{"hop": 0.5}, {"hop": 0.5}]}
     got = apply_overrides(data, ["sources[1].hop=0.25", "sources.0.hop=1.0"])
     assert got == {"sources": [{"hop": 1.0}, {"hop": 0.25}]}
+
+
+def test_an_error_between_two_fields_names_the_override_of_the_other(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A window longer than the file's nfft is reported at processing.nfft, naming
+    window_length: the override of window_length caused it, not the file (it was blamed)."""
+    item = "processing.window_length=60000"
+    code, _, err = mdf(["check", str(POINT), "--set", item], capsys)
+    assert code == 2
+    assert err.startswith(f"mdf: error: --set {item}: processing.nfft: "), err
+    # not a sibling that the message merely mentions as a word ("the window's length")
+    code, _, err = mdf(
+        ["check", str(POINT), "--set", item, "--set", "processing.window=hann"], capsys
+    )
+    assert err.startswith(f"mdf: error: --set {item}: processing.nfft: "), err
+    # nor one in the list of a table's names: the unknown field is the file's
+    config = tmp_path / "typo.toml"
+    config.write_text(POINT.read_text().replace("prf = 2400.0", "prf = 2400.0\nfoo = 1"))
+    code, _, err = mdf(["check", str(config), "--set", "radar.prf=3000"], capsys)
+    assert err.startswith(f"mdf: error: {config}: radar.foo: unknown field 'foo' (allowed: "), err
+    assert "prf" in err

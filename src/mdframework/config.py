@@ -640,8 +640,9 @@ def apply_overrides(data: dict[str, Any], overrides: Sequence[str]) -> dict[str,
 @contextmanager
 def blaming_overrides(source: str, overrides: Sequence[str]) -> Iterator[None]:
     """A :class:`ConfigError` about a field that an override set (``source: field: ...`` or
-    ``source: sources[0] record 3: field: ...``, or a field above or below it) names the
-    override instead of the file ``source``."""
+    ``source: sources[0] record 3: field: ...``, a field above or below it, or a field of the
+    same table whose message names the override's field) names the override instead of the
+    file ``source``."""
     try:
         yield
     except ConfigError as exc:
@@ -652,8 +653,18 @@ def blaming_overrides(source: str, overrides: Sequence[str]) -> Iterator[None]:
         fields = [_dotted(place) for place in rest.split(": ")[:-1]]
         for item in reversed(overrides):  # the last override of a key is the one that counts
             key = ".".join(_override_key(item)[0])
+            table, _, name = key.rpartition(".")
+            # an error between two fields of a table names the other: processing.nfft: 1024 is
+            # shorter than window_length 60000 (not in a list of names: "(allowed: ...)")
+            said = re.sub(r"\([^)]*\)", "", rest)
+            named = bool(table) and re.search(rf"(?<![\w.]){re.escape(name)}(?![\w'])", said)
             for field in fields:
-                if key == field or key.startswith(f"{field}.") or field.startswith(f"{key}."):
+                if (
+                    key == field
+                    or key.startswith(f"{field}.")
+                    or field.startswith(f"{key}.")
+                    or (named and field.rpartition(".")[0] == table)
+                ):
                     raise ConfigError(f"--set {item.strip()}: {rest}") from None
         raise
 
