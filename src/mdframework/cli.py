@@ -203,7 +203,8 @@ def _write_failure(exc: OSError, args: argparse.Namespace) -> str:
     """One line for a file-system error (:data:`_WRITE_ERRNOS`): the file being written (the
     note ``while writing PATH`` that mdframework's writers add, else the error's own file name;
     a file in a staging folder by its name in ``--out``; else ``--out`` itself), the cause, and,
-    for a full disk or quota, what to do. A dataset build keeps the records it wrote."""
+    for a full disk or quota, what to do. A dataset build (an experiment's too) keeps the
+    records it wrote."""
     notes = [str(n) for n in getattr(exc, "__notes__", ())]
     writing = next(
         (n[len("while writing ") :] for n in notes if n.startswith("while writing ")), None
@@ -216,7 +217,14 @@ def _write_failure(exc: OSError, args: argparse.Namespace) -> str:
     where = path if path is not None else (f"--out {out}" if out is not None else None)
     text = exc.strerror or str(exc)
     line = f"{where}: {text}" if where is not None else text
-    if exc.errno in _NO_ROOM and getattr(args, "func", None) is _cmd_dataset_build:
+    func = getattr(args, "func", None)
+    building = func is _cmd_dataset_build or (  # an experiment's dataset resumes as well
+        func is _cmd_experiment
+        and path is not None
+        and out is not None
+        and Path(out, "dataset") in Path(path).parents
+    )
+    if exc.errno in _NO_ROOM and building:
         line += (
             "; free some space and run the same command again: it resumes from the records "
             "written so far"
