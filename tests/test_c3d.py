@@ -327,3 +327,35 @@ def test_a_damaged_parameter_section_is_one_line_not_a_crash(
     )
     assert done.returncode == 2, done.stderr[-500:]
     assert done.stderr == f"{path}: parameter section: {message}: the file is damaged\n"
+
+
+def test_a_parameter_section_starting_with_two_zero_bytes_reads_as_qualisys_writes_it(
+    tmp_path: Path,
+) -> None:
+    """Qualisys writes 0, 0 where the C3D User Guide has the first record's block (1) and the
+    key 0x50; ezc3d reads such a file as if they were 1, 0x50, and so must the walk that runs
+    before it (it refused the file as damaged)."""
+    raw = bytearray(REAL.read_bytes())
+    start = (raw[0] - 1) * 512
+    assert raw[start : start + 2] == b"\x01\x50"
+    raw[start : start + 2] = b"\x00\x00"
+    path = tmp_path / "qualisys.c3d"
+    path.write_bytes(bytes(raw))
+    got, ref = read_c3d(path), read_c3d(REAL)
+    assert got.labels == ref.labels
+    np.testing.assert_array_equal(got.positions, ref.positions)
+
+
+def test_a_parameter_of_more_than_32_kib_is_read(tmp_path: Path) -> None:
+    """A record's offset to the next is 16 bits that ezc3d reads unsigned: a parameter of 50 KB
+    (250 notes of 200 characters, which ezc3d writes and reads) is no damage (the walk read the
+    offset signed and refused the file)."""
+    import ezc3d
+
+    c3d = ezc3d.c3d(str(REAL))
+    c3d.add_parameter("NOTES", "TEXT", ["x" * 200] * 250)
+    path = tmp_path / "big.c3d"
+    c3d.write(str(path))
+    got, ref = read_c3d(path), read_c3d(REAL)
+    assert got.labels == ref.labels
+    np.testing.assert_array_equal(got.positions, ref.positions)

@@ -243,6 +243,32 @@ def test_a_bad_environment_variable_is_named_alone_not_as_the_configs(
     assert "d.toml" not in err
 
 
+@pytest.mark.parametrize("command", ["dataset build", "experiment"])
+def test_a_bad_start_method_is_blamed_on_the_variable_not_the_config(
+    command: str,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """MDF_START_METHOD (and MDF_DASK_SCHEDULER) are not the config's fields: a bad one is
+    named alone (it was prefixed with the config file's name), before any folder is made."""
+    config = write_config(tmp_path / "d.toml")
+    if command == "experiment":
+        config = tmp_path / "e.toml"
+        config.write_text('[dataset]\nconfig = "d.toml"\n[classifier]\nkind = "knn"\n')
+    out = tmp_path / "out"
+    args = [*command.split(), str(config), "--out", str(out), "--workers", "2", "--no-progress"]
+    monkeypatch.setenv(pool_workers.START_METHOD_ENV, "vfork")
+    assert cli.main(args) == 2
+    assert capsys.readouterr().err.startswith("mdf: error: MDF_START_METHOD='vfork': not a ")
+    assert not out.exists()
+    monkeypatch.delenv(pool_workers.START_METHOD_ENV)
+    monkeypatch.setenv(dataset.SCHEDULER_ENV, "bogus::")
+    assert cli.main(args) == 2
+    assert capsys.readouterr().err.startswith("mdf: error: Dask scheduler 'bogus::': not an ")
+    assert not out.exists()
+
+
 def test_a_build_forks_its_workers_from_a_process_of_one_thread(tmp_path: Path) -> None:
     """No thread of the command is alive when a build forks its workers (in the child, a lock
     such a thread held stays held): the progress bar's monitor thread was (tqdm starts one for

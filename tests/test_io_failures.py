@@ -333,7 +333,12 @@ def test_an_experiment_whose_dataset_build_stopped_resumes_it(
     )
     out = tmp_path / "o"
     _disk_fills_after(monkeypatch, "savez", 2)
-    _one_error(["experiment", str(e), "--out", str(out)], capsys)
+    line = _one_error(["experiment", str(e), "--out", str(out)], capsys)
+    # not "(or choose another --out)": that would build the dataset anew
+    assert line.endswith(
+        ": No space left on device; free some space and run the same command again: it resumes "
+        "from the records written so far"
+    ), line
     records = out / "dataset" / "records"
     kept = {p.name: p.stat().st_ino for p in records.iterdir()}
     assert len(kept) == 2

@@ -225,3 +225,49 @@ def test_a_dataset_built_with_an_override_keeps_it_and_resumes_only_with_it(
     assert mdf([*build, "--set", "base.radar.prf=1200"], capsys)[0] == 0  # resumes: done
     code, _, err = mdf(build, capsys)  # the file's own PRF is another config
     assert code == 2 and "different config" in err
+
+
+@pytest.mark.parametrize(
+    ("item", "rest"),
+    [
+        ("sources.0.motion.file=nope.amc", "sources[0].motion.file: file not found: "),
+        ('sources.0.motion.kind="bvh"', "sources[0].motion: file must be a .bvh file, got "),
+    ],
+)
+def test_a_dataset_planning_error_names_the_override_that_caused_it(
+    item: str, rest: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # planning names a source as sources[0], validation as sources.0: both are the override's
+    code, _, err = mdf(["dataset", "check", str(DATASET), "--set", item], capsys)
+    assert code == 2
+    assert err.splitlines()[-1].startswith(f"mdf: error: --set {item}: {rest}")
+
+
+def test_a_key_may_index_a_list_as_dataset_errors_name_it() -> None:
+    """Dataset errors name a source sources[0]; the docs tell users to write the key as errors
+    name it, and sources[0].hop was refused as not a dotted key."""
+    data = {"sources": [{"hop": 0.5}, {"hop": 0.5}]}
+    got = apply_overrides(data, ["sources[1].hop=0.25", "sources.0.hop=1.0"])
+    assert got == {"sources": [{"hop": 1.0}, {"hop": 0.25}]}
+
+
+def test_an_error_between_two_fields_names_the_override_of_the_other(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A window longer than the file's nfft is reported at processing.nfft, naming
+    window_length: the override of window_length caused it, not the file (it was blamed)."""
+    item = "processing.window_length=60000"
+    code, _, err = mdf(["check", str(POINT), "--set", item], capsys)
+    assert code == 2
+    assert err.startswith(f"mdf: error: --set {item}: processing.nfft: "), err
+    # not a sibling that the message merely mentions as a word ("the window's length")
+    code, _, err = mdf(
+        ["check", str(POINT), "--set", item, "--set", "processing.window=hann"], capsys
+    )
+    assert err.startswith(f"mdf: error: --set {item}: processing.nfft: "), err
+    # nor one in the list of a table's names: the unknown field is the file's
+    config = tmp_path / "typo.toml"
+    config.write_text(POINT.read_text().replace("prf = 2400.0", "prf = 2400.0\nfoo = 1"))
+    code, _, err = mdf(["check", str(config), "--set", "radar.prf=3000"], capsys)
+    assert err.startswith(f"mdf: error: {config}: radar.foo: unknown field 'foo' (allowed: "), err
+    assert "prf" in err

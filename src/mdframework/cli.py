@@ -206,7 +206,8 @@ def _write_failure(exc: OSError, args: argparse.Namespace) -> str:
     """One line for a file-system error (:data:`_WRITE_ERRNOS`): the file being written (the
     note ``while writing PATH`` that mdframework's writers add, else the error's own file name;
     a file in a staging folder by its name in ``--out``; else ``--out`` itself), the cause, and,
-    for a full disk or quota, what to do. A dataset build keeps the records it wrote."""
+    for a full disk or quota, what to do. A dataset build (an experiment's too) keeps the
+    records it wrote."""
     notes = [str(n) for n in getattr(exc, "__notes__", ())]
     writing = next(
         (n[len("while writing ") :] for n in notes if n.startswith("while writing ")), None
@@ -219,7 +220,14 @@ def _write_failure(exc: OSError, args: argparse.Namespace) -> str:
     where = path if path is not None else (f"--out {out}" if out is not None else None)
     text = exc.strerror or str(exc)
     line = f"{where}: {text}" if where is not None else text
-    if exc.errno in _NO_ROOM and getattr(args, "func", None) is _cmd_dataset_build:
+    func = getattr(args, "func", None)
+    building = func is _cmd_dataset_build or (  # an experiment's dataset resumes as well
+        func is _cmd_experiment
+        and path is not None
+        and out is not None
+        and Path(out, "dataset") in Path(path).parents
+    )
+    if exc.errno in _NO_ROOM and building:
         line += (
             "; free some space and run the same command again: it resumes from the records "
             "written so far"
@@ -310,11 +318,23 @@ def _cmd_schema(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check_build_environment(args: argparse.Namespace) -> None:
+    """How a build's records are computed (``--scheduler``, ``MDF_DASK_SCHEDULER``,
+    ``MDF_START_METHOD``), checked before any folder is made, outside :func:`_naming`: a bad
+    setting is not the config's fault."""
+    from .dataset import check_scheduler_address, scheduler_address
+    from .workers import start_method
+
+    check_scheduler_address(scheduler_address(args.scheduler))
+    start_method()
+
+
 def _cmd_dataset_build(args: argparse.Namespace) -> int:
     from .config import blaming_overrides
     from .dataset import build_dataset, load_dataset_config
 
     config, base = load_dataset_config(args.config, args.overrides)
+    _check_build_environment(args)
     with blaming_overrides(args.config, args.overrides), _naming(args.config):
         rows = build_dataset(
             config,
@@ -341,6 +361,8 @@ def _cmd_experiment(args: argparse.Namespace) -> int:
     config = load_experiment_config(args.config, args.overrides)
     if args.workers is not None:
         config = config.model_copy(update={"workers": args.workers})
+    if config.dataset.config is not None:  # (a built dataset is only read)
+        _check_build_environment(args)
     with blaming_overrides(args.config, args.overrides), _naming(args.config):
         run_experiment(
             config,

@@ -558,6 +558,12 @@ def _kinds(registry: Registry, interface: str) -> str:
     return f" (installed kinds: {names}{registry.disabled_note()})"
 
 
+def _dotted(place: str) -> str:
+    """A place as some errors write it (``sources[0].hop``) as a key writes it
+    (``sources.0.hop``)."""
+    return re.sub(r"\[(\d+)\]", r".\1", place)
+
+
 def _override_key(item: str) -> tuple[list[str], str]:
     """``KEY=VALUE`` -> (the key's parts, the value's text); a malformed item is a
     :class:`ConfigError` naming it."""
@@ -568,7 +574,10 @@ def _override_key(item: str) -> tuple[list[str], str]:
     try:  # a TOML dotted key: bare or quoted parts
         parsed: Any = tomllib.loads(f"{key} = 0")
     except tomllib.TOMLDecodeError:
-        raise ConfigError(f"--set {item}: {key!r} is not a dotted key like radar.prf") from None
+        try:  # a list indexed as errors write it: sources[0].hop
+            parsed = tomllib.loads(f"{_dotted(key)} = 0")
+        except tomllib.TOMLDecodeError:
+            raise ConfigError(f"--set {item}: {key!r} is not a dotted key like radar.prf") from None
     parts: list[str] = []
     while isinstance(parsed, dict):
         (name, parsed), *_ = parsed.items()
@@ -631,19 +640,31 @@ def apply_overrides(data: dict[str, Any], overrides: Sequence[str]) -> dict[str,
 @contextmanager
 def blaming_overrides(source: str, overrides: Sequence[str]) -> Iterator[None]:
     """A :class:`ConfigError` about a field that an override set (``source: field: ...`` or
-    ``source: sources[0] record 3: field: ...``, or a field above or below it) names the
-    override instead of the file ``source``."""
+    ``source: sources[0] record 3: field: ...``, a field above or below it, or a field of the
+    same table whose message names the override's field) names the override instead of the
+    file ``source``."""
     try:
         yield
     except ConfigError as exc:
         rest = str(exc).removeprefix(f"{source}: ")
         if rest == str(exc):
             raise
-        fields = rest.split(": ")[:-1]  # the message's places, outermost first
+        # the message's places, outermost first
+        fields = [_dotted(place) for place in rest.split(": ")[:-1]]
         for item in reversed(overrides):  # the last override of a key is the one that counts
             key = ".".join(_override_key(item)[0])
+            table, _, name = key.rpartition(".")
+            # an error between two fields of a table names the other: processing.nfft: 1024 is
+            # shorter than window_length 60000 (not in a list of names: "(allowed: ...)")
+            said = re.sub(r"\([^)]*\)", "", rest)
+            named = bool(table) and re.search(rf"(?<![\w.]){re.escape(name)}(?![\w'])", said)
             for field in fields:
-                if key == field or key.startswith(f"{field}.") or field.startswith(f"{key}."):
+                if (
+                    key == field
+                    or key.startswith(f"{field}.")
+                    or field.startswith(f"{key}.")
+                    or (named and field.rpartition(".")[0] == table)
+                ):
                     raise ConfigError(f"--set {item.strip()}: {rest}") from None
         raise
 

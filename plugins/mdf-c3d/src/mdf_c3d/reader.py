@@ -153,12 +153,12 @@ def check_parameter_section(path: Path, block: int, data_block: int, order: str)
     the process instead of raising.
 
     Each record: the name's length (a signed byte; 0 ends the section) and the group id (a
-    signed byte: negative for a group, positive for a parameter of that group), the name, and a
-    16-bit offset from itself to the next record (0: the last record). A group then holds its
-    description (a length byte, then the text); a parameter its type (-1 characters, 1 byte,
-    2 integer, 4 float), its number of dimensions (at most 7), the dimensions, the values and
-    its description. Every record must lie inside the section's blocks and end before the next
-    begins, and names must be printable ASCII.
+    signed byte: negative for a group, positive for a parameter of that group), the name, and an
+    unsigned 16-bit offset from itself to the next record (0: the last record). A group then
+    holds its description (a length byte, then the text); a parameter its type (-1
+    characters, 1 byte, 2 integer, 4 float), its number of dimensions (at most 7), the
+    dimensions, the values and its description. Every record must lie inside the section's
+    blocks and end before the next begins, and names must be printable ASCII.
 
     Raises
     ------
@@ -173,7 +173,10 @@ def check_parameter_section(path: Path, block: int, data_block: int, order: str)
         raise DataFileError(path, f"cannot read: {exc.strerror or exc}") from None
     start = (block - 1) * 512
     end = min(len(section), (data_block - block) * 512) if len(section) >= 4 else 0
-    pos = 3 + section[0] if len(section) >= 4 else 0
+    # the first record's block is 1 (bytes 0, 1: 1 and the key 0x50; Qualisys writes 0, 0,
+    # which ezc3d reads as 1, 0x50)
+    first = 1 if section[:2] == b"\x00\x00" else section[0] if len(section) >= 4 else 0
+    pos = 3 + first if len(section) >= 4 else 0
 
     def bad(at: int, what: str) -> DataFileError:
         return DataFileError(
@@ -192,7 +195,7 @@ def check_parameter_section(path: Path, block: int, data_block: int, order: str)
             raise bad(pos, "runs past the parameter section's end")
         if group_id in (0, -128) or not all(0x20 <= c < 0x7F for c in name):
             raise bad(pos, f"has group id {group_id} and name {bytes(name)!r}")
-        (offset,) = struct.unpack_from(order + "h", section, at)
+        (offset,) = struct.unpack_from(order + "H", section, at)  # unsigned, as ezc3d reads it
         limit = end if offset == 0 else at + offset
         if offset != 0 and not at + 2 <= limit <= end:
             raise bad(pos, f"points to its next record at {start + limit}, outside the section")
