@@ -197,3 +197,20 @@ def test_a_data_file_error_pickles_with_its_file_line_and_message() -> None:
     assert type(again) is DataFileError
     assert str(again) == str(error) == "./walk.bvh:12: frame 3 has 5 values"
     assert (again.path, again.line, again.message) == (Path("walk.bvh"), 12, error.message)
+
+
+def test_a_plugin_made_without_a_config_takes_its_defaults() -> None:
+    """`Knn()` is `Knn(Knn.Config())` (it was a TypeError: a missing argument), as a config
+    section holding only the kind means; a plugin whose config has required fields says which."""
+    from mdf_cmu import CmuSource
+    from mdf_knn import Knn
+    from mdf_lfm import LfmPulseDoppler
+
+    assert Knn().config == Knn.Config() and Knn().config.k == 5
+    radar = LfmPulseDoppler()
+    assert (radar.prf, radar.carrier_frequency) == (2400.0, 15e9)  # the paper's radar
+    with pytest.raises(TypeError) as info:
+        CmuSource()
+    assert str(info.value) == (
+        "CmuSource() needs a config: file has no default; give CmuSource(CmuSource.Config(...))"
+    )

@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, model_validator
+from pydantic import BaseModel, ConfigDict, ValidationError, model_validator
 
 from .physics.radar import distances
 from .pointcloud import PointCloud
@@ -193,7 +193,19 @@ class Plugin(ABC):
     #: The pydantic model of this plugin's config section (with ``kind: Literal[name]``).
     Config: ClassVar[type[PluginConfig]]
 
-    def __init__(self, config: PluginConfig) -> None:
+    def __init__(self, config: PluginConfig | None = None) -> None:
+        if config is None:  # the defaults, as a config section holding only the kind means
+            name = type(self).__name__
+            try:
+                config = type(self).Config.model_validate({})
+            except ValidationError as exc:
+                needed = sorted({str(e["loc"][0]) for e in exc.errors() if e["type"] == "missing"})
+                fields = ", ".join(needed) or "its fields"
+                verb = "has" if len(needed) == 1 else "have"
+                raise TypeError(
+                    f"{name}() needs a config: {fields} {verb} no default; give "
+                    f"{name}({name}.Config(...))"
+                ) from None
         if isinstance(config, Mapping):  # a config section as read, not validated
             name = type(self).__name__
             raise TypeError(

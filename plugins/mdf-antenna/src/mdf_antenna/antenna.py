@@ -182,7 +182,7 @@ class AntennaPattern(Effect):
     config: AntennaConfig
     stage = "scatterers"
 
-    def __init__(self, config: PluginConfig) -> None:
+    def __init__(self, config: PluginConfig | None = None) -> None:
         super().__init__(config)
         self._stats: dict[str, Any] = {}
         self._mean: FloatArray | None = None

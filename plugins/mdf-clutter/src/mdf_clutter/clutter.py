@@ -226,7 +226,7 @@ class GroundClutter(Effect):
     config: ClutterConfig
     stage = "received"
 
-    def __init__(self, config: PluginConfig) -> None:
+    def __init__(self, config: PluginConfig | None = None) -> None:
         super().__init__(config)
         self._stats: dict[str, Any] = {}
 

@@ -311,9 +311,9 @@ class FmcwRadar(RadarWaveform):
     Config = FmcwConfig
     config: FmcwConfig
 
-    def __init__(self, config: FmcwConfig) -> None:  # type: ignore[override]
+    def __init__(self, config: FmcwConfig | None = None) -> None:  # type: ignore[override]
         super().__init__(config)
-        self.sequence = config.sequence()
+        self.sequence = self.config.sequence()
         #: blocks hold whole frames
         self.block_multiple = self.sequence.chirps_per_frame
         #: ``c / (2 B)`` [m] over the sampled part of the ramp (``B`` = slope x n_samples /

@@ -131,7 +131,7 @@ class Shadowing(Effect):
     config: ShadowingConfig
     stage = "scatterers"
 
-    def __init__(self, config: PluginConfig) -> None:
+    def __init__(self, config: PluginConfig | None = None) -> None:
         super().__init__(config)
         self.start_record()
 

@@ -112,7 +112,7 @@ class GroundMultipath(Effect):
     config: MultipathConfig
     stage = "scatterers"
 
-    def __init__(self, config: PluginConfig) -> None:
+    def __init__(self, config: PluginConfig | None = None) -> None:
         super().__init__(config)
         self._stats: dict[str, Any] = {}
 

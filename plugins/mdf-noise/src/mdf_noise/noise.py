@@ -139,7 +139,7 @@ class ReceiverNoise(Effect):
     config: NoiseConfig
     stage = "received"
 
-    def __init__(self, config: PluginConfig) -> None:
+    def __init__(self, config: PluginConfig | None = None) -> None:
         super().__init__(config)
         self._power: float | None = None
 

@@ -99,9 +99,9 @@ class IsotropicPoints(ScattererModel):
     Config = IsotropicPointsConfig
     config: IsotropicPointsConfig
 
-    def __init__(self, config: IsotropicPointsConfig) -> None:
+    def __init__(self, config: IsotropicPointsConfig | None = None) -> None:
         super().__init__(config)
-        self.needs_canonical = config.body
+        self.needs_canonical = self.config.body
 
     def scatterers(
         self, motion: Motion, skeleton: Skeleton, radar_position: np.ndarray, wavelength: float
