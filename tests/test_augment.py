@@ -349,3 +349,16 @@ def test_a_sped_up_record_stays_within_its_sources_span(speed: float, warp: list
     with pytest.raises(SceneError, match=r"leaves 0\.750 s of the source's span"):
         _augmented(motion, {"speed": 2.0}, late[0], 1.0, late)
     _augmented(motion, {"speed": 1.2}, late[0], 1.0, late)  # 1.25 s: it fits
+
+
+def test_height_scaling_keeps_a_raised_floor() -> None:
+    """A walker standing on a 0.25 m step (lowest joint at 0.25 m) scaled to 1.2 x: the
+    lowest joint stays at 0.25 m (scaled about the floor under it, not about z = 0), and the
+    head rises 1.2 x as far above that floor."""
+    s = walker()
+    raised = s.with_positions(s.positions + np.array([0.0, 0.0, 0.25]))
+    tall = scale_height(raised, 1.2)
+    assert tall.positions[..., 2].min() == pytest.approx(0.25, abs=1e-12)
+    np.testing.assert_allclose(
+        tall.joint("head")[:, 2] - 0.25, 1.2 * s.joint("head")[:, 2], atol=1e-12
+    )
