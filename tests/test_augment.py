@@ -362,3 +362,24 @@ def test_height_scaling_keeps_a_raised_floor() -> None:
     np.testing.assert_allclose(
         tall.joint("head")[:, 2] - 0.25, 1.2 * s.joint("head")[:, 2], atol=1e-12
     )
+
+
+def test_randomization_mirror_probability_warp_bounds_and_factor_clipping() -> None:
+    """mirror = 0.25 mirrors a quarter of the records (2000 draws: 0.22 .. 0.28); time_warp =
+    0.9 draws three coefficients each within +-0.3, so sum |c_k| < 0.9 < 1 and the warp stays
+    monotone; a normal speed draw far beyond its 4 standard deviations is clipped to the
+    factor's range (10 x)."""
+    rng = np.random.default_rng(0)
+    rz = Randomization(mirror=0.25, time_warp=0.9)
+    draws = [rz.sample(rng) for _ in range(2000)]
+    assert 0.22 < np.mean([d["mirror"] for d in draws]) < 0.28
+    coeffs = np.array([d["time_warp"] for d in draws])
+    assert np.abs(coeffs).max() <= 0.3 and np.abs(coeffs).max() > 0.29
+    assert np.abs(coeffs).sum(axis=1).max() < 0.9
+
+    class Wild:
+        def normal(self, mean: float, sd: float) -> float:
+            return mean + 50 * sd
+
+    fast = Randomization.model_validate({"speed": {"normal": [2.0, 0.25]}})
+    assert fast.sample(Wild())["speed"] == 10.0  # type: ignore[arg-type]
