@@ -725,3 +725,14 @@ def test_amc_of_an_unknown_subject_assumes_120_hz_and_says_so(tmp_path: Path) ->
             ]
             == "config"
         )
+
+
+def test_bvh_root_position_channels_replace_its_offset(tmp_path: Path) -> None:
+    """The root's Xposition/Yposition/Zposition give its position; its OFFSET (CMU's are 0) is
+    replaced by them, not added: a root OFFSET of (10, 20, 30) leaves every joint in place."""
+    lines = bvh_lines()
+    k = next(i for i, ln in enumerate(lines) if ln.strip().startswith("OFFSET"))
+    assert lines[k].split()[1:] == ["0.00000"] * 3
+    lines[k] = "\tOFFSET 10.0 20.0 30.0"
+    moved = load(write(tmp_path / "09_03.bvh", lines)).skeleton.positions
+    np.testing.assert_array_equal(moved, load(BVH / "09_03.bvh").skeleton.positions)
