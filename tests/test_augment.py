@@ -349,3 +349,37 @@ def test_a_sped_up_record_stays_within_its_sources_span(speed: float, warp: list
     with pytest.raises(SceneError, match=r"leaves 0\.750 s of the source's span"):
         _augmented(motion, {"speed": 2.0}, late[0], 1.0, late)
     _augmented(motion, {"speed": 1.2}, late[0], 1.0, late)  # 1.25 s: it fits
+
+
+def test_height_scaling_keeps_a_raised_floor() -> None:
+    """A walker standing on a 0.25 m step (lowest joint at 0.25 m) scaled to 1.2 x: the
+    lowest joint stays at 0.25 m (scaled about the floor under it, not about z = 0), and the
+    head rises 1.2 x as far above that floor."""
+    s = walker()
+    raised = s.with_positions(s.positions + np.array([0.0, 0.0, 0.25]))
+    tall = scale_height(raised, 1.2)
+    assert tall.positions[..., 2].min() == pytest.approx(0.25, abs=1e-12)
+    np.testing.assert_allclose(
+        tall.joint("head")[:, 2] - 0.25, 1.2 * s.joint("head")[:, 2], atol=1e-12
+    )
+
+
+def test_randomization_mirror_probability_warp_bounds_and_factor_clipping() -> None:
+    """mirror = 0.25 mirrors a quarter of the records (2000 draws: 0.22 .. 0.28); time_warp =
+    0.9 draws three coefficients each within +-0.3, so sum |c_k| < 0.9 < 1 and the warp stays
+    monotone; a normal speed draw far beyond its 4 standard deviations is clipped to the
+    factor's range (10 x)."""
+    rng = np.random.default_rng(0)
+    rz = Randomization(mirror=0.25, time_warp=0.9)
+    draws = [rz.sample(rng) for _ in range(2000)]
+    assert 0.22 < np.mean([d["mirror"] for d in draws]) < 0.28
+    coeffs = np.array([d["time_warp"] for d in draws])
+    assert np.abs(coeffs).max() <= 0.3 and np.abs(coeffs).max() > 0.29
+    assert np.abs(coeffs).sum(axis=1).max() < 0.9
+
+    class Wild:
+        def normal(self, mean: float, sd: float) -> float:
+            return mean + 50 * sd
+
+    fast = Randomization.model_validate({"speed": {"normal": [2.0, 0.25]}})
+    assert fast.sample(Wild())["speed"] == 10.0  # type: ignore[arg-type]

@@ -359,3 +359,21 @@ def test_a_parameter_of_more_than_32_kib_is_read(tmp_path: Path) -> None:
     got, ref = read_c3d(path), read_c3d(REAL)
     assert got.labels == ref.labels
     np.testing.assert_array_equal(got.positions, ref.positions)
+
+
+def test_event_times_count_the_minutes(tmp_path: Path) -> None:
+    """C3D EVENT:TIMES holds minutes in its first row and seconds in its second: an event at
+    1 min 5.5 s is 65.5 s into the recording (the shipped file's events all lie in its first
+    minute, so its minutes are all 0)."""
+    import ezc3d
+
+    path = tmp_path / "events.c3d"
+    write_c3d(path, {"A": np.tile([0.1, 0.2, 0.3], (5, 1))}, 100.0, "mm", 0.001)
+    c = ezc3d.c3d(str(path))
+    c.add_parameter("EVENT", "USED", [2])
+    c.add_parameter("EVENT", "LABELS", ["Foot Strike", "Foot Off"])
+    c.add_parameter("EVENT", "CONTEXTS", ["Left", "Right"])
+    c.add_parameter("EVENT", "TIMES", np.array([[1.0, 0.0], [5.5, 0.25]]))
+    c.write(str(path))
+    events = {label: (context, t) for label, context, t in read_c3d(path).events}
+    assert events == {"Foot Strike": ("Left", 65.5), "Foot Off": ("Right", 0.25)}

@@ -247,3 +247,40 @@ def test_a_classifier_that_fails_is_named_in_the_error(rng: np.random.Generator)
         "in predict() of the classifier plugin 'failing' (test_classify.Failing); check it with "
         "mdframework.testing.check_classifier"
     ]
+
+
+def test_a_large_constant_feature_is_only_centred() -> None:
+    """A feature constant at 7,770,000.3 (numpy's std of it is 9e-10, rounding, not spread):
+    treated as zero-variance, so a query 1 mm/s off it is 0.001 off in z, not 1e6."""
+    x = np.stack([np.arange(7.0), np.full(7, 7770000.3)], axis=1)
+    assert x[:, 1].std() > 1e-12  # the rounding the relative tolerance is there for
+    s = Standardizer.fit(x)
+    assert s.scale[1] == 1.0
+    z = s.transform(np.array([[3.0, 7770000.301]]))
+    assert z[0, 0] == pytest.approx(0.0, abs=1e-12)
+    assert z[0, 1] == pytest.approx(0.001, abs=1e-6)
+
+
+def test_wrapper_prefers_fewer_features_at_equal_score(rng: np.random.Generator) -> None:
+    """Feature 0 alone separates the classes perfectly, and so does any pair holding it: at the
+    same score the smaller subset wins, (0,) rather than (0, 1)."""
+    y = np.repeat(["a", "b"], 20)
+    x = rng.normal(size=(40, 3))
+    x[:, 0] += (y == "b") * 20.0
+    sel = wrapper_select(x, y, lambda: knn(k=1), sizes=(1, 2), folds=4)
+    assert sel.scores[(0,)] == sel.scores[(0, 1)] == 1.0
+    assert sel.subset == (0,)
+
+
+def test_grouped_wrapper_does_not_score_a_class_it_never_trained_on(
+    rng: np.random.Generator,
+) -> None:
+    """Class 'c' is recorded by subject 0 only: the fold holding subject 0 out cannot know 'c'
+    and leaves its records out of that fold's score, so perfectly separable classes score 1.0
+    (counted as wrong they would pull the score below 1)."""
+    y = np.array(["a"] * 20 + ["b"] * 20 + ["c"] * 4)
+    groups = np.concatenate([np.arange(40) % 4, [0, 0, 0, 0]])
+    x = rng.normal(size=(44, 2))
+    x[:, 0] += np.select([y == "b", y == "c"], [20.0, 40.0], 0.0)
+    sel = wrapper_select(x, y, lambda: knn(k=1), sizes=(1,), folds=4, groups=groups)
+    assert sel.subset == (0,) and sel.score == 1.0

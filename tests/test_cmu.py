@@ -152,15 +152,19 @@ def simple_amc_frames(path: Path, wanted: set[int]) -> dict[int, dict[str, list[
     return frames
 
 
-def oracle_asf_positions(asf: Path, amc: Path, frame_numbers: list[int]) -> dict[int, dict]:
-    """Per-frame forward kinematics with scipy rotations ('xyz' extrinsic = Rz Ry Rx)."""
+def oracle_asf_positions(
+    asf: Path, amc: Path, frame_numbers: list[int], root_orientation: tuple = (0, 0, 0)
+) -> dict[int, dict]:
+    """Per-frame forward kinematics with scipy rotations ('xyz' extrinsic = Rz Ry Rx); the
+    root's rotation is ``C M C^-1`` with ``C`` from ``root_orientation`` [deg]."""
     bones, parent, order = simple_asf(asf)
     frames = simple_amc_frames(amc, set(frame_numbers))
+    c_root = Rotation.from_euler("xyz", root_orientation, degrees=True)
     result = {}
     for fno in frame_numbers:
         vals = frames[fno]
         root = vals["root"]
-        rot = {"root": Rotation.from_euler("xyz", root[3:6], degrees=True)}
+        rot = {"root": c_root * Rotation.from_euler("xyz", root[3:6], degrees=True) * c_root.inv()}
         pos = {"root": np.array(root[:3])}
         for name in order:
             b = bones[name]
@@ -574,6 +578,35 @@ def test_asf_angles_in_radians(tmp_path: Path) -> None:
     assert np.max(np.abs(deg.positions - full.positions[:20])) > 0.05
 
 
+def test_root_orientation_length_unit_and_radian_amc_match_the_oracle(tmp_path: Path) -> None:
+    """An ASF with a root ``orientation`` (10, 20, 30) deg and ``length 1`` (one unit = 1 inch =
+    0.0254 m) and its AMC in ``:RADIANS`` (root translations stay in length units): the joints
+    are the independent oracle's with ``C_root M C_root^-1`` at the root, in 0.0254 m units."""
+    lines = (AMC / "02.asf").read_text().split("\n")
+    lines = ["   orientation 10 20 30" if ln.split()[:1] == ["orientation"] else ln for ln in lines]
+    lines = ["  length 1.0" if ln.strip() == "length 0.45" else ln for ln in lines]
+    write(tmp_path / "02.asf", lines)
+    deg = write(tmp_path / "deg.amc", amc_sample(10))
+    rad = []
+    for ln in amc_sample(10):
+        toks = ln.split()
+        if toks == [":DEGREES"]:
+            ln = ":RADIANS"
+        elif toks and not toks[0].startswith((":", "#")) and not toks[0].isdigit():
+            vals = [float(t) for t in toks[1:]]
+            keep = 3 if toks[0] == "root" else 0  # TX TY TZ are lengths
+            vals = vals[:keep] + [math.radians(v) for v in vals[keep:]]
+            ln = " ".join([toks[0], *(repr(v) for v in vals)])
+        rad.append(ln)
+    assert ":RADIANS" in rad
+    sk = load(write(tmp_path / "02_01.amc", rad)).skeleton
+    ref = oracle_asf_positions(tmp_path / "02.asf", deg, list(range(1, 11)), (10, 20, 30))
+    for k in range(10):
+        for name, p in ref[k + 1].items():
+            want = cmu_to_project(p) / UNIT * 0.0254
+            np.testing.assert_allclose(sk.positions[k, sk.index(name)], want, atol=1e-9)
+
+
 def test_asf_unit_given_twice_or_bad_mass(tmp_path: Path) -> None:
     """A second ``length`` (or a second ``:units`` section repeating one) would silently change
     the body's size; a mass unit that is not a positive number breaks the input rules."""
@@ -692,3 +725,14 @@ def test_amc_of_an_unknown_subject_assumes_120_hz_and_says_so(tmp_path: Path) ->
             ]
             == "config"
         )
+
+
+def test_bvh_root_position_channels_replace_its_offset(tmp_path: Path) -> None:
+    """The root's Xposition/Yposition/Zposition give its position; its OFFSET (CMU's are 0) is
+    replaced by them, not added: a root OFFSET of (10, 20, 30) leaves every joint in place."""
+    lines = bvh_lines()
+    k = next(i for i, ln in enumerate(lines) if ln.strip().startswith("OFFSET"))
+    assert lines[k].split()[1:] == ["0.00000"] * 3
+    lines[k] = "\tOFFSET 10.0 20.0 30.0"
+    moved = load(write(tmp_path / "09_03.bvh", lines)).skeleton.positions
+    np.testing.assert_array_equal(moved, load(BVH / "09_03.bvh").skeleton.positions)

@@ -212,3 +212,83 @@ def test_smoothing_all_smooths_with_or_without_the_speed_limit() -> None:
     assert np.allclose(smoothed, limited, rtol=0, atol=1e-15)
     untouched, _ = conditioned(speed_limit=False, smoothing="none")
     assert np.array_equal(untouched, body.positions)
+
+
+def test_gap_duration_spans_the_valid_frames_around_it() -> None:
+    """A joint untracked in frames 10..19 at 100 Hz: the gap lasts from frame 9 to frame 20,
+    0.11 s (what max_gap_s is compared with); one at the record's start runs from frame 0."""
+    time = np.arange(50) / 100.0
+    valid = np.ones((50, 2), dtype=bool)
+    valid[10:20, 1] = False
+    valid[0:5, 0] = False
+    gaps = cond.find_gaps(time, valid)
+    assert [(j, s, e) for j, s, e, _ in gaps] == [(0, 0, 4), (1, 10, 19)]
+    assert gaps[0][3] == pytest.approx(0.05, abs=1e-12)
+    assert gaps[1][3] == pytest.approx(0.11, abs=1e-12)
+
+
+def test_bridging_holds_the_nearest_sample_outside_the_valid_span() -> None:
+    """Untracked first and last frames take the first / last valid sample (no spline
+    extrapolation); an inner gap of a straight line at constant speed is filled exactly."""
+    time = np.arange(20) / 10.0
+    pos = np.zeros((20, 1, 3))
+    pos[:, 0, 0] = 1.0 + 2.0 * time
+    pos[:, 0, 2] = (time - 1.0) ** 2  # curved: an extrapolated spline would leave 1.0 .. 0.25
+    valid = np.ones((20, 1), dtype=bool)
+    valid[:3] = valid[-3:] = valid[8:11] = False
+    out = cond.bridge_gaps(time, pos, valid)
+    np.testing.assert_allclose(out[:3, 0], np.repeat(pos[3:4, 0], 3, axis=0), atol=1e-12)
+    np.testing.assert_allclose(out[-3:, 0], np.repeat(pos[16:17, 0], 3, axis=0), atol=1e-12)
+    np.testing.assert_allclose(out[8:11, 0], pos[8:11, 0], atol=1e-12)
+
+
+def test_histogram_threshold_is_the_lower_edge_of_the_first_empty_bin() -> None:
+    """Deviations filling bins [0, 0.01) and [0.01, 0.02), jumps at 0.2: the threshold is
+    0.02 (minimum 0), or the minimum when that is higher."""
+    dev = np.concatenate([np.full(50, 0.005), np.full(30, 0.015), [0.2, 0.21]])
+    assert cond.histogram_threshold(dev, 0.01, 0.0) == pytest.approx(0.02, abs=1e-12)
+    assert cond.histogram_threshold(dev, 0.01, 0.05) == pytest.approx(0.05, abs=1e-12)
+
+
+def test_foot_outliers_are_judged_against_the_inliers_mean() -> None:
+    """70 frames of a 20 cm foot, 15 with the toe 7 cm up and 15 with it 50 cm up: against the
+    mean of all frames (pulled up 8.6 cm) only the 50 cm jumps stand out; against the inliers'
+    mean, as the outliers must not bias it, the 7 cm jumps are outliers too."""
+    n = 100
+    ankle = np.zeros((n, 3))
+    toe = np.tile([0.2, 0.0, 0.0], (n, 1))
+    toe[70:85, 2] = 0.07
+    toe[85:, 2] = 0.5
+    out, thr, dev = cond.foot_outliers(ankle, toe)
+    assert not out[:70].any() and out[70:].all()
+    assert thr == pytest.approx(0.05)
+    np.testing.assert_allclose(dev[:70], 0.07 * 15 / 85, atol=1e-12)
+
+
+def test_periodicity_of_a_sinusoid() -> None:
+    """A 1 s sinusoid sampled at 50 Hz for 3 s: period 1.0 s (lag 50 frames of 20 ms)."""
+    time = np.arange(151) / 50.0
+    found = cond.periodicity(time, np.sin(2 * np.pi * time))
+    assert found["period_s"] == pytest.approx(1.0, abs=1e-9)
+    assert found["strength"] > 0.5
+
+
+def test_a_missing_stretch_just_over_max_gap_s_is_refused() -> None:
+    """Frames missing for 0.3 s (the step between the frames around the hole) with
+    max_gap_s = 0.2 and long_gaps = "error": refused, naming the hole."""
+    time = np.concatenate([np.arange(20) / 100.0, 0.49 + np.arange(20) / 100.0])
+    pos = np.zeros((40, len(CANONICAL_JOINTS), 3)) + 1.0 + np.arange(len(CANONICAL_JOINTS))[:, None]
+    sk = Skeleton(time, pos, CANONICAL_JOINTS)
+    with pytest.raises(ValueError, match=r"no frame for 0\.300 s \(after frame 19 at 0\.190 s\)"):
+        cond.condition(sk, ConditioningConfig(enabled=True, max_gap_s=0.2, long_gaps="error"))
+    cond.condition(sk, ConditioningConfig(enabled=True, max_gap_s=0.35, long_gaps="error"))
+
+
+def test_skeleton_window_counts_from_the_first_frame_and_includes_both_ends() -> None:
+    """A recording whose clock starts at 10 s: window(start=0.2, duration=0.3) keeps the frames
+    0.2 .. 0.5 s after its first frame, both ends included (4 frames at 10 Hz)."""
+    time = 10.0 + np.arange(11) / 10.0
+    sk = Skeleton(time, np.zeros((11, 1, 3)) + time[:, None, None], ("a",))
+    w = sk.window(0.2, 0.3)
+    np.testing.assert_allclose(w.time, [10.2, 10.3, 10.4, 10.5], atol=1e-12)
+    assert sk.window(0.5).n_frames == 6

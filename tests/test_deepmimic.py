@@ -506,3 +506,21 @@ def test_bad_character_files(tmp_path: Path, change: dict[str, Any], message: st
     path = character_file(tmp_path / "c.txt", **change)
     with pytest.raises(DataFileError, match=re.escape(message)):
         load(WALK, character=path)
+
+
+def test_cycles_shift_only_horizontally() -> None:
+    """A clip whose root ends 3 cm lower than it starts (z up) is repeated with the horizontal
+    displacement only: every cycle keeps the clip's heights (no drift into or out of the
+    floor), and the seam's jump is that 3 cm."""
+    from mdf_deepmimic.kinematics import repeat_cycles
+
+    t = np.arange(5) * 0.1
+    p = np.zeros((5, 2, 3))
+    p[:, 0] = np.stack([0.3 * t, 0.1 * t, 0.9 - 0.075 * t], axis=1)  # root: 3 cm drop over 0.4 s
+    p[:, 1] = p[:, 0] + [0.0, 0.0, 0.5]
+    time, pos, closure = repeat_cycles(t, p, 3, 0)
+    assert time.shape == (13,) and np.allclose(np.diff(time), 0.1)
+    np.testing.assert_allclose(pos[4:8, :, 2], p[:4, :, 2], atol=1e-12)
+    np.testing.assert_allclose(pos[-1, :, 2], p[-1, :, 2], atol=1e-12)
+    np.testing.assert_allclose(pos[-1, 0, :2], 3 * p[-1, 0, :2], atol=1e-12)
+    assert closure == pytest.approx(0.03, abs=1e-12)

@@ -798,3 +798,18 @@ def test_summary_json_holds_what_repeats_the_experiment(
     assert repeated == written
     predictions = "within_kinect_predictions.csv"
     assert (tmp_path / "a" / predictions).read_text() == (tmp_path / "b" / predictions).read_text()
+
+
+def test_a_recording_split_never_holds_out_all_of_a_class() -> None:
+    """test_fraction = 0.9 of a class's 2 (or 3) recordings rounds to all of them: one (two)
+    is held out, so every split still trains on every class."""
+    from mdframework.experiment import recording_splits, recordings_held_out
+
+    assert recordings_held_out(2, 0.9) == 1 and recordings_held_out(3, 0.9) == 2
+    assert recordings_held_out(10, 0.4) == 4 and recordings_held_out(10, 0.01) == 1
+    labels = np.array(["a"] * 4 + ["b"] * 6)
+    recs = np.array(["a1", "a1", "a2", "a2", "b1", "b1", "b2", "b2", "b3", "b3"])
+    for train, test in recording_splits(labels, recs, 5, 0.9, seed=3):
+        assert set(labels[train]) == {"a", "b"} and set(labels[test]) == {"a", "b"}
+        assert not set(recs[train]) & set(recs[test])
+        assert len(set(recs[test])) == 3

@@ -984,3 +984,37 @@ def test_a_segment_whose_first_frames_are_untracked_says_where_time_0_is(tmp_pat
         "(what motion.start counts from) is that frame"
     ]
     assert m.metadata["segment"]["first_frame"] == 252
+
+
+def test_utkinect_walk_segment_frames_time_base_and_floor() -> None:
+    """The labelled walk (frames 252..390, both ends included) keeps exactly the file's frames
+    in that range, 390 among them; its time runs from 0 at frame 252 in frame numbers / 60 s;
+    and the floor puts the lowest foot joint on z = 0 (1st percentile): feet stand on it, they
+    do not sink through it (fewer than 5 % of frames more than 2 cm below)."""
+    rec = read_utkinect(UT)
+    inside = rec.frame_numbers[(rec.frame_numbers >= 252) & (rec.frame_numbers <= 390)]
+    assert inside[0] == 252 and inside[-1] == 390
+    m = KinectSource(KinectConfig(format="utkinect", file=UT, segment="walk")).load()
+    assert m.skeleton.n_frames == inside.size
+    np.testing.assert_allclose(m.skeleton.time, (inside - 252) / 60.0, rtol=0, atol=1e-12)
+    c = m.canonical()
+    lowest = np.nanmin(np.stack([c.joint("l_toe")[:, 2], c.joint("r_toe")[:, 2]]), axis=0)
+    assert np.mean(lowest < -0.02) < 0.05
+    assert np.nanmin(lowest) > -0.1
+
+
+def test_ntu_tracking_state_threshold(tmp_path: Path) -> None:
+    """NTU trackingState 0 (not tracked) is untracked, 1 (inferred) is kept by default
+    (min_tracking = 1) and dropped with min_tracking = 2, 2 (tracked) is always kept."""
+    rec = read_utkinect(UT)
+    lines = ntu_text(rec).split("\n")
+    # frame 1's joints follow "1" (frame count), "1" (bodies), body line, "25": lines 4..28
+    assert lines[3] == "25" and lines[4].endswith(" 2")
+    lines[4] = lines[4][:-1] + "1"  # SpineBase inferred
+    lines[5] = lines[5][:-1] + "0"  # SpineMid not tracked
+    path = tmp_path / "S001C001P001R001A001.skeleton"
+    path.write_text("\n".join(lines))
+    default = read_ntu(path).valid[0]
+    strict = read_ntu(path, min_tracking=2).valid[0]
+    assert default[0] and not default[1] and default[2:].all()
+    assert not strict[0] and not strict[1] and strict[2:].all()

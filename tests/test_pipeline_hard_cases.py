@@ -307,3 +307,65 @@ def test_placement_removes_the_drift_whatever_the_turn(mode: str) -> None:
     expected = speed * np.array([np.cos(1.4), np.sin(1.4)])
     np.testing.assert_allclose(linear_drift_rate(t, placed[:, :2]), expected, atol=1e-12)
     np.testing.assert_allclose(placed[0, :2], [5.0, 6.0], atol=1e-12)
+
+
+def _line_body(t0: float = 0.0) -> Any:
+    """A 3 s body at 10 Hz whose clock starts at ``t0``: joint 'head' at x = 1 m, 'base' at
+    x = 4 m (not the first joint), both 1 m up."""
+    from mdframework import Skeleton
+
+    time = t0 + np.arange(31) / 10.0
+    pos = np.zeros((31, 2, 3))
+    pos[:, 0] = [1.0, 0.0, 1.0]
+    pos[:, 1] = [4.0, 0.0, 1.0]
+    return Skeleton(time, pos, ("head", "base"))
+
+
+def test_record_window_counts_from_the_first_frame_and_refuses_what_is_outside() -> None:
+    """motion.start and motion.duration count from the recording's first frame (a clock that
+    starts at 5 s gives the record 6..8 s for start 1, duration 2); a start at the recording's
+    end, or a window ending 0.2 s after it, is refused naming the field."""
+    from mdframework.pipeline import record_window
+
+    assert record_window(_line_body(5.0), 1.0, 2.0) == pytest.approx((6.0, 8.0), abs=1e-12)
+    assert record_window(_line_body(5.0), 1.0, None) == pytest.approx((6.0, 8.0), abs=1e-12)
+    assert record_window(_line_body(), 2.0, 1.0) == pytest.approx((2.0, 3.0), abs=1e-12)
+    with pytest.raises(SceneError, match=r"motion\.duration: the window 2\.2\.\.3\.4 s"):
+        record_window(_line_body(), 2.2, 1.2)
+    with pytest.raises(SceneError, match=r"motion\.start: 3 s is not before the end"):
+        record_window(_line_body(), 3.0, None)
+
+
+def test_frames_inside_includes_both_ends() -> None:
+    """Frames at 0.0, 0.1, ... : the record 0.1..0.3 s holds frames 1, 2 and 3."""
+    from mdframework.pipeline import frames_inside
+
+    time = np.arange(10) / 10.0
+    assert frames_inside(time, 0.1, 0.3) == slice(1, 4)
+    assert frames_inside(time, 0.15, 0.25) == slice(2, 3)
+
+
+def test_gate_tracks_the_pelvis_wherever_it_is_listed_or_stays_fixed() -> None:
+    """gate = "track" follows the 'base' joint (4 m from a radar at the origin, not the first
+    joint's 1 m); a fixed gate is that range in every pulse."""
+    from mdframework.pipeline import gate_ranges
+
+    body = _line_body()
+    radar = np.zeros(3)
+    np.testing.assert_allclose(gate_ranges("track", body, radar), np.hypot(4.0, 1.0), rtol=1e-12)
+    np.testing.assert_allclose(gate_ranges(2.5, body, radar), 2.5, rtol=0)
+
+
+def test_a_joint_tracked_one_frame_late_is_refused() -> None:
+    """A joint first tracked 0.1 s into the record cannot be interpolated at its first pulse
+    (no extrapolation): refused, saying from when it is tracked."""
+    from mdframework import Skeleton
+    from mdframework.pipeline import refuse_untracked
+
+    body = _line_body()
+    valid = np.ones((31, 2), dtype=bool)
+    valid[0, 1] = False
+    late = Skeleton(body.time, body.positions, body.joint_names, valid)
+    with pytest.raises(SceneError, match=r"joint 'base' is tracked only from 0\.100 s"):
+        refuse_untracked(late, 0.0, 3.0, 0.0)
+    refuse_untracked(late, 0.1, 3.0, 0.0)

@@ -584,19 +584,26 @@ def test_the_shipped_recordings_are_upright_as_the_page_says() -> None:
         motions[EXAMPLES / name] = {"kind": kind, "file": str(EXAMPLES / name)}
     assert len(motions) >= 15
     rises, facing, legs = {}, {}, {}
+    checks: dict[str, list[str]] = {}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the recordings' own sanity warnings
         for file, section in motions.items():
             cfg = validate_run_config({"motion": section}, source="test", base_dir=EXAMPLES)
-            body = load_motion(build_stages(cfg).source).canonical()
+            motion = load_motion(build_stages(cfg).source)
+            body = motion.canonical()
             rises[file.name], facing[file.name] = head_rise(body), foot_facing_cosine(body)
             legs[file.name] = leg_length(body)
+            report = motion.metadata["sanity"]
+            checks[file.name] = [k for k in ("upright", "mirrored", "size") if not report[k]["ok"]]
     assert all(low <= r <= high for r in rises.values()), rises
     assert min(rises.values()) < low + 0.05 and max(rises.values()) > high - 0.05, rises
     # and none is mirrored: the feet point the way the left and right joints face them
     quoted = re.search(r"the shipped recordings give ([\d.]+)-1\.00, a mirrored", page)
     assert quoted is not None
     assert min(facing.values()) == pytest.approx(float(quoted.group(1)), abs=0.005), facing
+    # and the checks themselves pass every one of them (none flagged upside down, mirrored or
+    # of the wrong size)
+    assert not any(checks.values()), checks
     # and of human size: their legs' lengths, hip to knee to ankle
     quoted = re.search(r"the shipped recordings give ([\d.]+)-([\d.]+) m\) \|", page)
     assert quoted is not None
@@ -733,3 +740,35 @@ def test_a_plausible_range_given_upside_down_is_refused(name: str) -> None:
     }
     with pytest.raises(ConfigError, match=rf"motion\.sanity\.{name}: the lower bound .* above"):
         validate_run_config(cfg)
+
+
+def test_implied_acceleration_of_a_uniformly_accelerating_joint() -> None:
+    """x = a t^2 / 2 with a = 3 m/s^2 at uneven steps (10 and 20 ms): each inner frame lies
+    a dt1 dt2 / 2 off the line between its neighbours, and the implied acceleration is a."""
+    time = np.cumsum(np.r_[0.0, np.tile([0.01, 0.02], 10)])
+    pos = np.zeros((time.size, 1, 3))
+    pos[:, 0, 0] = 1.5 * time**2
+    e, acc = deviations(time, pos)
+    dt1, dt2 = np.diff(time)[:-1], np.diff(time)[1:]
+    np.testing.assert_allclose(e[1:-1, 0], 1.5 * dt1 * dt2, rtol=1e-9)
+    np.testing.assert_allclose(acc[1:-1, 0], 3.0, rtol=1e-9)
+    assert e[0, 0] == e[-1, 0] == acc[0, 0] == acc[-1, 0] == 0.0
+
+
+def test_repair_interpolates_from_valid_frames_only() -> None:
+    """A glitch at frame 5 of x = t, with frame 6 untracked and holding the (0, 0, 0) a Kinect
+    writes for a lost joint: the repair interpolates from frames 4 and 7, not from the zeros."""
+    time = np.arange(12) / 10.0
+    pos = np.zeros((12, 1, 3))
+    pos[:, 0, 0] = time
+    pos[5, 0, 0] = 3.0
+    pos[6, 0] = 0.0
+    valid = np.ones((12, 1), dtype=bool)
+    valid[6] = False
+    mask = np.zeros((12, 1), dtype=bool)
+    mask[5] = True
+    from mdframework.sanity import repair_glitches
+
+    out = repair_glitches(time, pos, mask, valid)
+    np.testing.assert_allclose(out[5, 0], [0.5, 0.0, 0.0], atol=1e-12)
+    np.testing.assert_array_equal(np.delete(out, 5, axis=0), np.delete(pos, 5, axis=0))

@@ -84,11 +84,15 @@ def _long_csv(path: Path, t: np.ndarray, tracks: dict[str, np.ndarray], scale: f
     path.write_text("\n".join(rows) + "\n")
 
 
-def test_long_csv_in_millimetres(tmp_path: Path) -> None:
+@pytest.mark.parametrize(
+    "units,scale", [("mm", 0.001), ("cm", 0.01), ("in", 0.0254), ("ft", 0.3048), ("m", 1.0)]
+)
+def test_long_csv_in_each_unit(tmp_path: Path, units: str, scale: float) -> None:
+    """The same tracks written in mm, cm, inches (25.4 mm), feet (304.8 mm) and m read back."""
     t, tracks = _tracks()
     path = tmp_path / "long.csv"
-    _long_csv(path, t, tracks, 0.001)
-    m = TableSource(TableConfig(file=path, units="mm")).load()
+    _long_csv(path, t, tracks, scale)
+    m = TableSource(TableConfig(file=path, units=units)).load()
     body = m.canonical()
     assert m.metadata["layout"] == "long" and m.metadata["joint_set"] == "canonical"
     assert m.metadata["frame_rate_hz"] == pytest.approx(50.0)
@@ -384,3 +388,18 @@ def test_time_unit_and_frame_rate_together_are_refused(tmp_path: Path) -> None:
     assert walk.skeleton.duration == pytest.approx(35.0)
     # no time column: frame_rate is the rows' rate and time_unit_s reads nothing
     TableConfig(file=ms, time_column="", time_unit_s=1e-3, frame_rate=60.0)
+
+
+def test_zero_is_missing_needs_all_three_coordinates_zero(tmp_path: Path) -> None:
+    """With zero_is_missing, a joint at (0, 0, 0) is untracked, but one with a single
+    coordinate exactly 0 (a joint on the y = 0 plane) is a real position and stays tracked."""
+    t, tracks = _tracks()
+    tracks["head"][3] = 0.0
+    tracks["head"][5, 1] = 0.0
+    path = tmp_path / "long.csv"
+    _long_csv(path, t, tracks, 1.0)
+    body = TableSource(TableConfig(file=path, zero_is_missing=True)).load().canonical()
+    h = CANONICAL_JOINTS.index("head")
+    assert not body.valid[3, h]
+    assert body.valid[5, h] and body.joint("head")[5, 1] == 0.0
+    assert body.valid[:, h].sum() == t.size - 1

@@ -395,3 +395,25 @@ def test_the_frames_beside_a_gap_are_not_glitches(tmp_path, lines) -> None:
     _, repaired = load(path, glitch_min_m=0.003, glitches="repair")
     changed = np.any(np.nan_to_num(repaired) != np.nan_to_num(raw), axis=2)
     assert np.argwhere(changed).tolist() == [[29, CANONICAL_JOINTS.index("l_elbow")]]
+
+
+@pytest.mark.parametrize("unit,per_mm", [("in", 1 / 25.4), ("cm", 0.1), ("m", 1e-3)])
+def test_the_real_walk_in_other_units_is_the_same_body(tmp_path: Path, unit: str, per_mm: float):
+    """The shipped walk (mm) rewritten in inches (25.4 mm each), cm and m: every joint where the
+    mm file puts it (to 1e-9 m), so each unit's metres per unit is right."""
+    lines = REAL.read_text().split("\n")
+    assert lines[2].split("\t")[4] == "mm"
+    head = lines[2].split("\t")
+    head[4] = unit
+    out = [*lines[:2], "\t".join(head), *lines[3:5]]
+    for ln in lines[5:]:
+        cells = ln.split("\t")
+        if len(cells) > 2:
+            cells = cells[:2] + [f"{float(c) * per_mm!r}" if c else c for c in cells[2:]]
+        out.append("\t".join(cells))
+    path = tmp_path / "walk.trc"
+    path.write_text("\n".join(out))
+    want = TrcSource(TrcConfig(file=REAL)).load().skeleton.positions
+    got = TrcSource(TrcConfig(file=path)).load().skeleton.positions
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-9)
+    assert np.nanmax(np.abs(want)) > 0.5
