@@ -606,6 +606,7 @@ def apply_overrides(data: dict[str, Any], overrides: Sequence[str]) -> dict[str,
     result: dict[str, Any] = copy.deepcopy(data)
     for item in overrides:
         parts, text = _override_key(item)
+        value = _override_value(text)
         node: Any = result
         for depth, part in enumerate(parts):
             last = depth == len(parts) - 1
@@ -619,12 +620,12 @@ def apply_overrides(data: dict[str, Any], overrides: Sequence[str]) -> dict[str,
                     )
                 index = int(part)
                 if last:
-                    node[index] = _override_value(text)
+                    node[index] = value
                 else:
                     node = node[index]
             elif isinstance(node, dict):
                 if last:
-                    node[part] = _override_value(text)
+                    node[part] = value
                 elif part not in node and parts[depth + 1].isdigit():
                     here = ".".join(parts[: depth + 1])
                     raise ConfigError(
@@ -651,12 +652,12 @@ def blaming_overrides(source: str, overrides: Sequence[str]) -> Iterator[None]:
             raise
         # the message's places, outermost first
         fields = [_dotted(place) for place in rest.split(": ")[:-1]]
+        said = re.sub(r"\([^)]*\)", "", rest)  # the message without its lists of names
         for item in reversed(overrides):  # the last override of a key is the one that counts
             key = ".".join(_override_key(item)[0])
             table, _, name = key.rpartition(".")
             # an error between two fields of a table names the other: processing.nfft: 1024 is
             # shorter than window_length 60000 (not in a list of names: "(allowed: ...)")
-            said = re.sub(r"\([^)]*\)", "", rest)
             named = bool(table) and re.search(rf"(?<![\w.]){re.escape(name)}(?![\w'])", said)
             for field in fields:
                 if (
