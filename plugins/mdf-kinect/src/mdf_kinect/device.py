@@ -457,22 +457,21 @@ def oni_info_isolated(path: Path, timeout_s: float = 2.0) -> dict[str, Any]:
     crashes the whole process (a segmentation fault) on some damaged recordings that pass
     :func:`scan_oni` (a damaged property name, for one), and a crash of the child is one
     :class:`~mdframework.DataFileError` here. Errors the child raises come back as raised."""
-    from concurrent.futures import ProcessPoolExecutor
     from concurrent.futures.process import BrokenProcessPool
-    from multiprocessing import get_context
 
-    from mdframework.workers import start_method
+    from mdframework.workers import worker_pool
 
     scan_oni(path)  # the structural checks here first: one line each, no process started
-    with ProcessPoolExecutor(1, mp_context=get_context(start_method())) as pool:
-        try:
-            return pool.submit(oni_info, path, timeout_s).result()
-        except BrokenProcessPool:
-            raise DataFileError(
-                path,
-                "OpenNI2 crashed while playing this recording (its structure is sound, so a "
-                "record's contents are damaged)",
-            ) from None
+    try:
+        with worker_pool(1) as pool:  # a worker that ends with this process, as a build's
+            info: dict[str, Any] = pool.submit(oni_info, path, timeout_s).result()
+            return info
+    except BrokenProcessPool:
+        raise DataFileError(
+            path,
+            "OpenNI2 crashed while playing this recording (its structure is sound, so a "
+            "record's contents are damaged)",
+        ) from None
 
 
 def oni_info(path: Path, timeout_s: float = 2.0) -> dict[str, Any]:
