@@ -237,6 +237,11 @@ def _write_failure(exc: OSError, args: argparse.Namespace) -> str:
     return line
 
 
+def _as_given(args: argparse.Namespace) -> str:
+    """The config file and its ``--set`` overrides, as a report names what it checked."""
+    return str(args.config) + "".join(f" --set {item}" for item in args.overrides)
+
+
 def _cmd_check(args: argparse.Namespace) -> int:
     with _progress(args).step("reading the config, the installed plugins and the motion"):
         from .check import format_plan, plan_run
@@ -248,8 +253,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(plan.as_dict(), indent=2))
     else:
-        sets = "".join(f" --set {item}" for item in args.overrides)
-        print(format_plan(plan, args.config + sets))
+        print(format_plan(plan, _as_given(args)))
     return 0
 
 
@@ -265,8 +269,7 @@ def _cmd_dataset_check(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(plan.as_dict(), indent=2))
     else:
-        sets = "".join(f" --set {item}" for item in args.overrides)
-        print(format_dataset_plan(plan, args.config + sets))
+        print(format_dataset_plan(plan, _as_given(args)))
     return 0
 
 

@@ -610,7 +610,7 @@ def apply_overrides(data: dict[str, Any], overrides: Sequence[str]) -> dict[str,
         node: Any = result
         for depth, part in enumerate(parts):
             last = depth == len(parts) - 1
-            where = ".".join(parts[:depth]) or "the top level"
+            where = ".".join(parts[:depth])  # (depth > 0: the top level is a table)
             if isinstance(node, list):
                 if not part.isdigit() or int(part) >= len(node):
                     has = f"a list of {len(node)}: index it with 0..{len(node) - 1}, or"
