@@ -208,14 +208,16 @@ def _write_failure(exc: OSError, args: argparse.Namespace) -> str:
     a file in a staging folder by its name in ``--out``; else ``--out`` itself), the cause, and,
     for a full disk or quota, what to do. A dataset build (an experiment's too) keeps the
     records it wrote."""
+    from .outdir import STAGING_PREFIX, WRITING_NOTE
+
     notes = [str(n) for n in getattr(exc, "__notes__", ())]
     writing = next(
-        (n[len("while writing ") :] for n in notes if n.startswith("while writing ")), None
+        (n.removeprefix(WRITING_NOTE) for n in notes if n.startswith(WRITING_NOTE)), None
     )
     out = getattr(args, "out", None)
     named = exc.filename if isinstance(exc.filename, (str, bytes, os.PathLike)) else None
     path = writing or (os.fsdecode(named) if named is not None else None)
-    if path is not None and out is not None and Path(path).parent.name.startswith(".mdf-staging-"):
+    if path is not None and out is not None and Path(path).parent.name.startswith(STAGING_PREFIX):
         path = str(Path(out) / Path(path).name)  # where the file was to go
     where = path if path is not None else (f"--out {out}" if out is not None else None)
     text = exc.strerror or str(exc)

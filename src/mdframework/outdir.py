@@ -52,6 +52,8 @@ from .errors import OutputError
 
 LOCK = ".mdf.lock"
 STAGING_PREFIX = ".mdf-staging-"
+#: the note a failed write's error gets, before the path it was writing
+WRITING_NOTE = "while writing "
 MARKER_PREFIX = ".mdf-"
 MARKER_SUFFIX = ".json"
 #: a marker being written (a command killed then leaves it; the next one removes it)
@@ -127,7 +129,7 @@ def _write_temporary(
             Path(tmp).unlink(missing_ok=True)
             raise
     except BaseException as exc:
-        exc.add_note(f"while writing {path}")
+        exc.add_note(f"{WRITING_NOTE}{path}")
         raise
     return fh, tmp
 
@@ -175,7 +177,7 @@ def _put_in_place(fh: Any, tmp: str, path: Path, mode: int) -> None:
         os.replace(tmp, path)
     except BaseException as exc:
         Path(tmp).unlink(missing_ok=True)
-        exc.add_note(f"while writing {path}")
+        exc.add_note(f"{WRITING_NOTE}{path}")
         raise
 
 
