@@ -73,6 +73,11 @@ def test_overrides_apply_in_order_and_a_whole_table_replaces_the_old() -> None:
             "effects.x=1",
             "--set effects.x=1: effects is a list of 1: index it with 0..0, or set the whole list",
         ),
+        (  # a digit that is not a decimal one indexes nothing (int() refused it: a traceback)
+            'effects."²"=1',
+            '--set effects."²"=1: effects is a list of 1: index it with 0..0, or set the '
+            "whole list",
+        ),
         (
             "scene.effects.0.x=1",
             "--set scene.effects.0.x=1: scene.effects is not in the config: set the whole list",

@@ -208,14 +208,16 @@ def _write_failure(exc: OSError, args: argparse.Namespace) -> str:
     a file in a staging folder by its name in ``--out``; else ``--out`` itself), the cause, and,
     for a full disk or quota, what to do. A dataset build (an experiment's too) keeps the
     records it wrote."""
+    from .outdir import STAGING_PREFIX, WRITING_NOTE
+
     notes = [str(n) for n in getattr(exc, "__notes__", ())]
     writing = next(
-        (n[len("while writing ") :] for n in notes if n.startswith("while writing ")), None
+        (n.removeprefix(WRITING_NOTE) for n in notes if n.startswith(WRITING_NOTE)), None
     )
     out = getattr(args, "out", None)
     named = exc.filename if isinstance(exc.filename, (str, bytes, os.PathLike)) else None
     path = writing or (os.fsdecode(named) if named is not None else None)
-    if path is not None and out is not None and Path(path).parent.name.startswith(".mdf-staging-"):
+    if path is not None and out is not None and Path(path).parent.name.startswith(STAGING_PREFIX):
         path = str(Path(out) / Path(path).name)  # where the file was to go
     where = path if path is not None else (f"--out {out}" if out is not None else None)
     text = exc.strerror or str(exc)
@@ -237,6 +239,11 @@ def _write_failure(exc: OSError, args: argparse.Namespace) -> str:
     return line
 
 
+def _as_given(args: argparse.Namespace) -> str:
+    """The config file and its ``--set`` overrides, as a report names what it checked."""
+    return str(args.config) + "".join(f" --set {item}" for item in args.overrides)
+
+
 def _cmd_check(args: argparse.Namespace) -> int:
     with _progress(args).step("reading the config, the installed plugins and the motion"):
         from .check import format_plan, plan_run
@@ -248,8 +255,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(plan.as_dict(), indent=2))
     else:
-        sets = "".join(f" --set {item}" for item in args.overrides)
-        print(format_plan(plan, args.config + sets))
+        print(format_plan(plan, _as_given(args)))
     return 0
 
 
@@ -265,8 +271,7 @@ def _cmd_dataset_check(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(plan.as_dict(), indent=2))
     else:
-        sets = "".join(f" --set {item}" for item in args.overrides)
-        print(format_dataset_plan(plan, args.config + sets))
+        print(format_dataset_plan(plan, _as_given(args)))
     return 0
 
 

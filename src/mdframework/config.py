@@ -610,9 +610,9 @@ def apply_overrides(data: dict[str, Any], overrides: Sequence[str]) -> dict[str,
         node: Any = result
         for depth, part in enumerate(parts):
             last = depth == len(parts) - 1
-            where = ".".join(parts[:depth]) or "the top level"
+            where = ".".join(parts[:depth])  # (depth > 0: the top level is a table)
             if isinstance(node, list):
-                if not part.isdigit() or int(part) >= len(node):
+                if not part.isdecimal() or int(part) >= len(node):
                     has = f"a list of {len(node)}: index it with 0..{len(node) - 1}, or"
                     raise ConfigError(
                         f"--set {item}: {where} is {has if node else 'an empty list:'} set the "
@@ -626,7 +626,7 @@ def apply_overrides(data: dict[str, Any], overrides: Sequence[str]) -> dict[str,
             elif isinstance(node, dict):
                 if last:
                     node[part] = value
-                elif part not in node and parts[depth + 1].isdigit():
+                elif part not in node and parts[depth + 1].isdecimal():
                     here = ".".join(parts[: depth + 1])
                     raise ConfigError(
                         f"--set {item}: {here} is not in the config: set the whole list"

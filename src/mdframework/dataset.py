@@ -401,9 +401,10 @@ def _load_motion(motion_json: str, base_dir: str) -> Motion:
     processes are forked after planning and inherit the motions the planner loaded (in
     parallel, :func:`_preload_motions`); local workers that are not forked (macOS,
     :func:`mdframework.workers.start_method`) and Dask workers are sent them when the build
-    starts (:func:`_receive_motions`), and load any other motion they meet once. The cache holds far
-    more recordings than a dataset config lists, so records scheduled in any order never evict
-    one. A motion loaded by another process shows its warnings here, when first asked for."""
+    starts (:func:`_receive_motions`), and load any other motion they meet once. The cache
+    holds far more recordings than a dataset config lists, so records scheduled in any order
+    never evict one. A motion loaded by another process shows its warnings here, when first
+    asked for."""
     key = (motion_json, base_dir)
     motion = _MOTIONS.get(key)
     if motion is None:
@@ -485,9 +486,8 @@ def _preload_motions(config: DatasetConfig, base_dir: Path, workers: int) -> Non
 
 def _receive_motions(motions: dict[tuple[str, str], Motion]) -> None:
     """Keep the motions the planner loaded (run on each Dask worker, and each local worker
-    that is not forked, as a build starts): they
-    replace any this worker kept from an earlier build, whose files may have changed since,
-    and so do the recordings it loads afresh."""
+    that is not forked, as a build starts): they replace any this worker kept from an earlier
+    build, whose files may have changed since, and so do the recordings it loads afresh."""
     _load_recordings.cache_clear()
     _MOTIONS.update(motions)
 

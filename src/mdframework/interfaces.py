@@ -194,8 +194,8 @@ class Plugin(ABC):
     Config: ClassVar[type[PluginConfig]]
 
     def __init__(self, config: PluginConfig | None = None) -> None:
+        name = type(self).__name__
         if config is None:  # the defaults, as a config section holding only the kind means
-            name = type(self).__name__
             try:
                 config = type(self).Config.model_validate({})
             except ValidationError as exc:
@@ -207,7 +207,6 @@ class Plugin(ABC):
                     f"{name}({name}.Config(...))"
                 ) from None
         if isinstance(config, Mapping):  # a config section as read, not validated
-            name = type(self).__name__
             raise TypeError(
                 f"{name} takes an instance of {name}.Config, e.g. {name}({name}.Config(...)) or, "
                 f"from a dict, {name}({name}.Config.model_validate(d)); got "

@@ -43,7 +43,7 @@ import threading
 import time
 import warnings
 from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -52,6 +52,8 @@ from .errors import OutputError
 
 LOCK = ".mdf.lock"
 STAGING_PREFIX = ".mdf-staging-"
+#: the note a failed write's error gets, before the path it was writing
+WRITING_NOTE = "while writing "
 MARKER_PREFIX = ".mdf-"
 MARKER_SUFFIX = ".json"
 #: a marker being written (a command killed then leaves it; the next one removes it)
@@ -113,25 +115,21 @@ def _write_temporary(
     otherwise names no file, or the temporary one)."""
     try:
         fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=suffix, dir=path.parent)
-    except BaseException as exc:
-        exc.add_note(f"while writing {path}")
-        raise
-    try:
-        fh = os.fdopen(fd, "wb")
-    except BaseException as exc:
-        os.close(fd)
-        Path(tmp).unlink(missing_ok=True)
-        exc.add_note(f"while writing {path}")
-        raise
-    try:
-        write(fh)
-    except BaseException as exc:
         try:
-            fh.close()  # a full disk can fail this too
-        except OSError:
-            pass
-        Path(tmp).unlink(missing_ok=True)
-        exc.add_note(f"while writing {path}")
+            fh = os.fdopen(fd, "wb")
+        except BaseException:
+            os.close(fd)
+            Path(tmp).unlink(missing_ok=True)
+            raise
+        try:
+            write(fh)
+        except BaseException:
+            with suppress(OSError):
+                fh.close()  # a full disk can fail this too
+            Path(tmp).unlink(missing_ok=True)
+            raise
+    except BaseException as exc:
+        exc.add_note(f"{WRITING_NOTE}{path}")
         raise
     return fh, tmp
 
@@ -179,7 +177,7 @@ def _put_in_place(fh: Any, tmp: str, path: Path, mode: int) -> None:
         os.replace(tmp, path)
     except BaseException as exc:
         Path(tmp).unlink(missing_ok=True)
-        exc.add_note(f"while writing {path}")
+        exc.add_note(f"{WRITING_NOTE}{path}")
         raise
 
 
@@ -304,6 +302,10 @@ def _read_holder(path: Path) -> dict[str, Any]:
     return {}
 
 
+#: what ``flock`` raises when another process holds the lock
+_BUSY = (errno.EAGAIN, errno.EACCES, errno.EWOULDBLOCK)
+
+
 def describe_holder(info: dict[str, Any]) -> str:
     """A lock holder as :func:`lock_holder` gives it, in words: ``process 4242 (mdf run,
     started ..., host ...)``, or ``another process`` when its details are unknown."""
@@ -327,17 +329,11 @@ def lock_holder(folder: Path) -> dict[str, Any] | None:
         return None  # no lock file: no command holds the folder
     try:
         fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
-    except OSError as exc:
-        if exc.errno in _BUSY:
-            return _read_holder(path)
-        return None  # a file system without locks: nothing to tell
+    except OSError as exc:  # held, or a file system without locks: nothing to tell
+        return _read_holder(path) if exc.errno in _BUSY else None
     finally:
         os.close(fd)  # (releases the lock taken, if any)
     return None
-
-
-#: what ``flock`` raises when another process holds the lock
-_BUSY = (errno.EAGAIN, errno.EACCES, errno.EWOULDBLOCK)
 
 
 class LockWarning(UserWarning):

@@ -89,9 +89,8 @@ def die_with_parent(parent_pid: int | None = None, *, ignore_interrupt: bool = T
         # SIGTERM ends a worker (the pool's way to stop one), not the handler of the command
         # it was forked from
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    if hasattr(signal, "pthread_sigmask"):
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
-    _parent_death_signal(getattr(signal, "SIGKILL", signal.SIGTERM))
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    _parent_death_signal(signal.SIGKILL)
     if (parent_pid is not None and parent != parent_pid) or os.getppid() != parent:
         os._exit(1)  # the parent died before the request above took effect
     creator = multiprocessing.parent_process()
@@ -107,9 +106,6 @@ def _interrupt_blocked() -> Iterator[None]:
     """Hold Ctrl-C (SIGINT) back from this thread while the block runs: a process started
     meanwhile starts with it blocked (and :func:`die_with_parent` drops it there); this thread
     gets it when the block ends."""
-    if not hasattr(signal, "pthread_sigmask"):
-        yield
-        return
     old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     try:
         yield
@@ -230,11 +226,7 @@ def _warning_state() -> tuple[Callable[..., None] | None, list[tuple[Any, ...]]]
     return (show if _picklable(show) else None), [f for f in warning_filters() if _picklable(f)]
 
 
-def _start_worker(
-    parent_pid: int | None,
-    n_workers: int,
-    fresh: tuple[Any, ...] | None = None,
-) -> None:
+def _start_worker(parent_pid: int | None, n_workers: int, fresh: tuple[Any, ...] | None) -> None:
     die_with_parent(parent_pid)
     if fresh is not None:  # not forked: take what a forked worker inherits
         show, filters, setup, setup_args = fresh

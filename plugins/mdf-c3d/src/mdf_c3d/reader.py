@@ -172,20 +172,22 @@ def check_parameter_section(path: Path, block: int, data_block: int, order: str)
     except OSError as exc:
         raise DataFileError(path, f"cannot read: {exc.strerror or exc}") from None
     start = (block - 1) * 512
-    end = min(len(section), (data_block - block) * 512) if len(section) >= 4 else 0
-    # the first record's block is 1 (bytes 0, 1: 1 and the key 0x50; Qualisys writes 0, 0,
-    # which ezc3d reads as 1, 0x50)
-    first = 1 if section[:2] == b"\x00\x00" else section[0] if len(section) >= 4 else 0
-    pos = 3 + first if len(section) >= 4 else 0
 
     def bad(at: int, what: str) -> DataFileError:
         return DataFileError(
             path, f"parameter section: the record at byte {start + at} {what}: the file is damaged"
         )
 
+    beyond = "starts beyond the parameter section, which ends at the data"
+    if len(section) < 4:
+        raise bad(0, beyond)
+    end = min(len(section), (data_block - block) * 512)
+    # the first record's block is 1 (bytes 0, 1: 1 and the key 0x50; Qualisys writes 0, 0,
+    # which ezc3d reads as 1, 0x50)
+    pos = 3 + (1 if section[:2] == b"\x00\x00" else section[0])
     while True:
         if pos + 2 > end:
-            raise bad(pos, "starts beyond the parameter section, which ends at the data")
+            raise bad(pos, beyond)
         n_chars, group_id = struct.unpack_from("bb", section, pos)
         if n_chars == 0:
             break
