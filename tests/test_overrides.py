@@ -44,6 +44,9 @@ def test_values_are_read_as_toml_and_other_text_as_a_string() -> None:
     assert got["effects"] == [{"kind": "noise", "snr_db": 10}]
     assert got["figures"] == {"enabled": False}
     assert got["motion"] == {"a.b": 1}  # a quoted part keeps its dot
+    # a value that TOML would read as more than one line of the file is text, not its first line
+    two = apply_overrides({}, ["radar.prf=4000\nradar.fc = 1", "scene.gate=[1.0,\n2.0]"])
+    assert two == {"radar": {"prf": "4000\nradar.fc = 1"}, "scene": {"gate": [1.0, 2.0]}}
     assert data == {"radar": {"kind": "lfm", "prf": 2400.0}, "effects": [{"kind": "noise"}]}
 
 

@@ -589,9 +589,10 @@ def _override_value(text: str) -> Any:
     """A ``--set`` value as TOML reads it (``4000``, ``7.7e10``, ``true``, ``"a b"``,
     ``[1, 2]``, ``{kind = "noise"}``); text that is not a TOML value is a string."""
     try:
-        return tomllib.loads(f"v = {text}")["v"]
+        doc = tomllib.loads(f"v = {text}")
     except tomllib.TOMLDecodeError:
         return text
+    return doc["v"] if len(doc) == 1 else text  # "4000\nradar.fc = 1" is no one value
 
 
 def apply_overrides(data: dict[str, Any], overrides: Sequence[str]) -> dict[str, Any]:
