@@ -47,6 +47,9 @@ def test_values_are_read_as_toml_and_other_text_as_a_string() -> None:
     # a value that TOML would read as more than one line of the file is text, not its first line
     two = apply_overrides({}, ["radar.prf=4000\nradar.fc = 1", "scene.gate=[1.0,\n2.0]"])
     assert two == {"radar": {"prf": "4000\nradar.fc = 1"}, "scene": {"gate": [1.0, 2.0]}}
+    # no config field is a date or a time: a label that TOML reads as one stays the text given
+    dates = apply_overrides({}, ["a=2024-01-01", "b=07:32:00", "c=1979-05-27T07:32:00Z"])
+    assert dates == {"a": "2024-01-01", "b": "07:32:00", "c": "1979-05-27T07:32:00Z"}
     assert data == {"radar": {"kind": "lfm", "prf": 2400.0}, "effects": [{"kind": "noise"}]}
 
 

@@ -12,6 +12,7 @@ Relative paths inside a config are relative to the config file's folder.
 from __future__ import annotations
 
 import copy
+import datetime
 import difflib
 import json
 import re
@@ -587,12 +588,15 @@ def _override_key(item: str) -> tuple[list[str], str]:
 
 def _override_value(text: str) -> Any:
     """A ``--set`` value as TOML reads it (``4000``, ``7.7e10``, ``true``, ``"a b"``,
-    ``[1, 2]``, ``{kind = "noise"}``); text that is not a TOML value is a string."""
+    ``[1, 2]``, ``{kind = "noise"}``); text that is not one TOML value, or is a date or a time
+    (no config field is), is a string."""
     try:
         doc = tomllib.loads(f"v = {text}")
     except tomllib.TOMLDecodeError:
         return text
-    return doc["v"] if len(doc) == 1 else text  # "4000\nradar.fc = 1" is no one value
+    if len(doc) != 1 or isinstance(doc["v"], datetime.date | datetime.time):
+        return text  # "4000\nradar.fc = 1" is no one value; no field is a date: 2024-01-01
+    return doc["v"]
 
 
 def apply_overrides(data: dict[str, Any], overrides: Sequence[str]) -> dict[str, Any]:
