@@ -100,7 +100,7 @@ def read_c3d_header(path: Path) -> C3dHeader:
             head = f.read(512)
             if len(head) == 512 and 1 <= head[0]:
                 f.seek((head[0] - 1) * 512)
-                param = f.read(4)
+                param = f.read(255 * 512)  # the parameter section: at most 255 blocks
             else:
                 param = b""
     except OSError as exc:
@@ -138,7 +138,7 @@ def read_c3d_header(path: Path) -> C3dHeader:
             f"samples from block {data_block} ({need:,} bytes), but the file holds {size:,} "
             "bytes: the file is truncated or its header is wrong",
         )
-    check_parameter_section(path, head[0], data_block, order)
+    check_parameter_section(path, param, head[0], data_block, order)
     return C3dHeader(n_points, n_analog, first, last, data_block, processor, floats)
 
 
@@ -146,11 +146,13 @@ def read_c3d_header(path: Path) -> C3dHeader:
 _PARAM_TYPES = {-1: 1, 1: 1, 2: 2, 4: 4}
 
 
-def check_parameter_section(path: Path, block: int, data_block: int, order: str) -> None:
-    """Walk the parameter section (the 512-byte blocks from ``block`` up to the first data
-    block ``data_block``; ``order`` ``"<"`` or ``">"``) as the C3D User Guide lays it out,
-    before ezc3d reads it: ezc3d trusts its sizes and offsets, and a damaged section can crash
-    the process instead of raising.
+def check_parameter_section(
+    path: Path, section: bytes, block: int, data_block: int, order: str
+) -> None:
+    """Walk the parameter section of ``path`` (``section``: the bytes from its 512-byte block
+    ``block``, as read, up to the first data block ``data_block``; ``order`` ``"<"`` or
+    ``">"``) as the C3D User Guide lays it out, before ezc3d reads it: ezc3d trusts its sizes
+    and offsets, and a damaged section can crash the process instead of raising.
 
     Each record: the name's length (a signed byte; 0 ends the section) and the group id (a
     signed byte: negative for a group, positive for a parameter of that group), the name, and an
@@ -165,12 +167,6 @@ def check_parameter_section(path: Path, block: int, data_block: int, order: str)
     mdframework.DataFileError
         Naming the byte offset of the first record that breaks these rules.
     """
-    try:
-        with path.open("rb") as f:
-            f.seek((block - 1) * 512)
-            section = f.read(255 * 512)
-    except OSError as exc:
-        raise DataFileError(path, f"cannot read: {exc.strerror or exc}") from None
     start = (block - 1) * 512
 
     def bad(at: int, what: str) -> DataFileError:
