@@ -314,6 +314,8 @@ class FmcwRadar(RadarWaveform):
     def __init__(self, config: FmcwConfig | None = None) -> None:  # type: ignore[override]
         super().__init__(config)
         self.sequence = self.config.sequence()
+        #: bytes of the record's kept range-Doppler maps (set by start_record)
+        self._maps_bytes = 0
         #: blocks hold whole frames
         self.block_multiple = self.sequence.chirps_per_frame
         #: ``c / (2 B)`` [m] over the sampled part of the ramp (``B`` = slope x n_samples /
@@ -431,8 +433,7 @@ class FmcwRadar(RadarWaveform):
     def working_memory(self) -> dict[str, int]:
         """The record's range-Doppler maps (``radar.save_range_doppler``), twice: the blocks'
         maps and their join into one array at the record's end."""
-        maps = getattr(self, "_maps_bytes", 0)
-        return {"range-Doppler maps": 2 * maps} if maps else {}
+        return {"range-Doppler maps": 2 * self._maps_bytes} if self._maps_bytes else {}
 
     def sensor_axes(self, radar_position: FloatArray) -> FloatArray:
         """Sensor axes (rows x right, y boresight, z up) in the scene frame."""
