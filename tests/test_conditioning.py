@@ -10,6 +10,7 @@ import pytest
 
 from mdframework import CANONICAL_JOINTS, Skeleton
 from mdframework import conditioning as cond
+from mdframework.sanity import _period_strength
 from mdframework.settings import ConditioningConfig
 
 DATA = Path(__file__).parents[1] / "examples" / "data" / "kinect"
@@ -266,11 +267,46 @@ def test_foot_outliers_are_judged_against_the_inliers_mean() -> None:
 
 
 def test_periodicity_of_a_sinusoid() -> None:
-    """A 1 s sinusoid sampled at 50 Hz for 3 s: period 1.0 s (lag 50 frames of 20 ms)."""
+    """A 1 s sinusoid sampled at 50 Hz for 3 s: period 1.0 s (lag 50 frames of 20 ms, to a
+    fiftieth of a frame); the autocorrelation there is the overlap, 2 s of 3."""
     time = np.arange(151) / 50.0
     found = cond.periodicity(time, np.sin(2 * np.pi * time))
-    assert found["period_s"] == pytest.approx(1.0, abs=1e-9)
-    assert found["strength"] > 0.5
+    assert found["period_s"] == pytest.approx(1.0, abs=0.02 / 50)
+    assert found["strength"] == pytest.approx(101 / 151, abs=0.01)
+
+
+@pytest.mark.parametrize("rate", [15.0, 30.0, 120.0])
+@pytest.mark.parametrize("duration", [2.0, 2.5, 3.0, 10.0])
+@pytest.mark.parametrize("period", [0.9, 1.1])
+def test_the_period_of_a_short_record_is_not_drawn_towards_lag_0(
+    rate: float, duration: float, period: float
+) -> None:
+    """A gait-like signal (a fundamental and its second harmonic) whose period is not a whole
+    number of frames, in records of two to eleven periods: the period to 0.5 %, from the
+    dominant period (conditioning) and from the first clear period (the sanity checks'
+    cadence), and the autocorrelation there near the overlap 1 - period / duration. The
+    autocorrelation divided by the whole record's energy falls with the overlap, which moved
+    its peak: a 1.1 s period in 3 s at 30 Hz came out at 1.067 s (a frame early), at 120 Hz
+    at 1.078 s."""
+    time = np.arange(0.0, duration, 1.0 / rate)
+    signal = np.sin(2 * np.pi * time / period) + 0.3 * np.sin(4 * np.pi * time / period + 1.0)
+    dominant = cond.periodicity(time, signal)
+    assert dominant["period_s"] == pytest.approx(period, rel=0.005)
+    assert dominant["strength"] == pytest.approx(1 - period / duration, abs=0.05)
+    first = _period_strength(time, signal)
+    assert first is not None
+    assert first[0] == pytest.approx(period, rel=0.005)
+    assert first[1] == pytest.approx(1 - period / duration, abs=0.05)
+
+
+def test_a_signal_without_a_zero_crossing_has_no_period() -> None:
+    """A constant has no autocorrelation and a slow swell of less than half a period never
+    correlates negatively with itself: no period."""
+    time = np.arange(0.0, 2.0, 1.0 / 15.0)
+    none = {"period_s": None, "strength": 0.0}
+    assert cond.periodicity(time, np.full_like(time, 3.0)) == none
+    assert cond.periodicity(time, np.sin(np.pi * time / 5.0)) == none
+    assert _period_strength(time, np.sin(np.pi * time / 5.0)) is None
 
 
 def test_a_missing_stretch_just_over_max_gap_s_is_refused() -> None:

@@ -64,6 +64,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .conditioning import correlation_peaks, lag_correlation
 from .errors import DataFileError
 from .interfaces import Motion
 from .settings import SanityConfig
@@ -334,53 +335,20 @@ def _period_strength(
     time: FloatArray, signal: FloatArray, min_strength: float = 0.3
 ) -> tuple[float, float] | None:
     """(period [s], autocorrelation there) of the signal's shortest clear period, or None:
-    the lag of the first local maximum of its autocorrelation (after the first zero crossing)
-    that reaches ``min_strength``. The signal is resampled linearly to its mean rate first, and
-    the lag refined to a fraction of a sample by a parabola through the peak and its neighbours
-    (at 15 frames per second a whole-sample lag is 10 % off).
+    the first peak of its biased autocorrelation (after the first zero crossing) that reaches
+    ``min_strength``, located on the normalised autocorrelation to a fraction of a sample
+    (:func:`~mdframework.conditioning.correlation_peaks`; at 15 frames per second a
+    whole-sample lag is 10 % off).
 
     The first such peak rather than the highest one: in a short clip the autocorrelation at a
     multiple of the period can be higher than at the period itself.
     """
-    t = np.asarray(time, dtype=np.float64)
-    n = t.shape[0]
-    if n < 8 or t[-1] <= t[0]:
+    found = lag_correlation(time, signal)
+    if found is None:
         return None
-    dt = (t[-1] - t[0]) / (n - 1)
-    x = np.interp(t[0] + dt * np.arange(n), t, signal)
-    x = x - x.mean()
-    denom = float(x @ x)
-    if denom <= 0:
-        return None
-    ac = _Autocorrelation(x, denom)
-    neg = next((lag for lag in range(n) if ac[lag] < 0), None)
-    if neg is None:
-        return None
-    for lag in range(neg + 1, n - 1):
-        if ac[lag] >= min_strength and ac[lag] >= ac[lag - 1] and ac[lag] >= ac[lag + 1]:
-            curve = ac[lag - 1] - 2 * ac[lag] + ac[lag + 1]
-            shift = 0.5 * (ac[lag - 1] - ac[lag + 1]) / curve if curve < 0 else 0.0
-            return float((lag + shift) * dt), float(ac[lag])
-    return None
-
-
-class _Autocorrelation:
-    """The autocorrelation of ``x`` (n,) at lags 0 .. n-1 divided by ``denom``, computed lag by
-    lag as far as it is read: the first clear period of a long recording lies within its
-    first few hundred lags, while the whole (``np.correlate``) costs n^2. Each lag is the dot
-    product of the overlapping parts, the value ``np.correlate(x, x, "full")`` gives there."""
-
-    def __init__(self, x: FloatArray, denom: float) -> None:
-        self.x = x
-        self.denom = denom
-        self.values: list[float] = []
-
-    def __getitem__(self, lag: int) -> float:
-        x, n, values = self.x, self.x.shape[0], self.values
-        while len(values) <= lag:
-            k = len(values)
-            values.append(float(x[k:] @ x[: n - k]) / self.denom)
-        return values[lag]
+    peaks = correlation_peaks(found[0], found[1])
+    lag, value = next((p for p in peaks if p[1] >= min_strength), (None, 0.0))
+    return None if lag is None else (lag * found[2], value)
 
 
 def cadence_estimate(
