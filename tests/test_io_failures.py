@@ -421,3 +421,33 @@ def test_a_folder_in_place_of_a_record_is_one_line_and_kept(
         "and run the build again"
     )
     assert (record / "mine.txt").read_text() == "x"
+
+
+@pytest.mark.parametrize("code", [errno.EIO, errno.ESTALE])
+def test_a_record_the_disk_fails_to_give_is_kept_when_a_build_resumes(
+    built: tuple[Path, Path],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    code: int,
+) -> None:
+    """A resumed build reads every record it finds; one that the disk fails to give (an I/O
+    error, a stale NFS handle) stops the build with one line naming it, and the record stays
+    (it was deleted as if corrupt, and recomputed, or lost if the disk then failed again)."""
+    import numpy as np
+
+    data = _copy(built, tmp_path)
+    before = {p.name: p.read_bytes() for p in (data / "records").iterdir()}
+    failing_record = sorted((data / "records").iterdir())[1]
+    real_load = np.load
+
+    def load(file: object, *args: object, **kwargs: object) -> object:
+        if Path(str(file)) == failing_record:
+            raise OSError(code, os.strerror(code), str(file))
+        return real_load(file, *args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(np, "load", load)
+    argv = ["dataset", "build", str(built[0]), "--out", str(data), "--workers", "1"]
+    line = _one_error(argv, capsys)
+    assert line == f"mdf: error: {failing_record}: {os.strerror(code)}"
+    assert {p.name: p.read_bytes() for p in (data / "records").iterdir()} == before

@@ -28,16 +28,18 @@ dataset seed and the record's index), so the result is identical whatever the nu
 or the scheduler. A record's id is its index and a digest of what makes its arrays, the
 contents of the motion or recording it is cut from included (:func:`motion_fingerprint`); its
 label, group, subject and dataset are not in it and are rewritten into a kept record when the
-config changes them. A killed build, run again, keeps every complete record, removes temp files and
-redoes records whose file is missing or unreadable. It resumes only into a folder built from the
-same config (the marker ``.mdf-dataset.json`` holds it; a different config is an error naming
-the difference, or with ``force`` a rebuild that keeps the old dataset whole until the new index
-is written). The folder rules are those of :mod:`mdframework.outdir`.
+config changes them. A killed build, run again, keeps every complete record, removes temp
+files and redoes records whose file is missing, cut short or corrupt. It resumes only into a
+folder built from the same config (the marker ``.mdf-dataset.json`` holds it; a different
+config is an error naming the difference, or with ``force`` a rebuild that keeps the old
+dataset whole until the new index is written). The folder rules are those of
+:mod:`mdframework.outdir`.
 """
 
 from __future__ import annotations
 
 import csv
+import errno
 import hashlib
 import io
 import itertools
@@ -1575,9 +1577,10 @@ def _complete(
     record whose label, group, subject, recording or dataset differ from ``spec``'s (the
     config changed only those) is kept and rewritten with the new ones (atomically; its arrays
     are not recomputed), and so is its row. A record that cannot be read for want of
-    permission is an error (it is not removed). A record computed by other software versions
-    than this process's is kept, its id, its versions (``None``: a record written before
-    records named theirs) and this process's added to ``other_versions``."""
+    permission, or because the disk fails to give it (an ``OSError`` with an errno, such as
+    EIO or NFS's ESTALE), is an error (it is not removed). A record computed by other
+    software versions than this process's is kept, its id, its versions (``None``: a record
+    written before records named theirs) and this process's added to ``other_versions``."""
     import zipfile
 
     if path.is_dir() and not path.is_symlink():  # not ours to delete
@@ -1601,7 +1604,12 @@ def _complete(
         row = _row(meta, arrays["features"])  # (a field missing: a corrupt record)
     except PermissionError as exc:
         raise _not_yours(path, exc) from None
-    except (OSError, EOFError, ValueError, KeyError, TypeError, zipfile.BadZipFile):
+    except OSError as exc:
+        if exc.errno not in (None, errno.ENOENT):  # the disk failed (EIO, NFS's ESTALE), not
+            raise  # the record: keep it, and the command says what failed
+        path.unlink(missing_ok=True)
+        return None
+    except (EOFError, ValueError, KeyError, TypeError, zipfile.BadZipFile):
         path.unlink(missing_ok=True)
         return None
     if renamed:  # a failure to write (a full disk) stops the build; the record stays as it was
