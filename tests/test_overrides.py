@@ -282,3 +282,15 @@ def test_an_error_between_two_fields_names_the_override_of_the_other(
     code, _, err = mdf(["check", str(config), "--set", "radar.prf=3000"], capsys)
     assert err.startswith(f"mdf: error: {config}: radar.foo: unknown field 'foo' (allowed: "), err
     assert "prf" in err
+
+
+def test_a_files_field_wrong_for_the_kind_an_override_chose_names_that_override(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """The point target's LFM radar fields are unknown to the FMCW radar that --set chose:
+    the file's field is at fault, and the message says which override made it wrong."""
+    item = "radar.kind=fmcw"
+    code, _, err = mdf(["check", str(POINT), "--set", item], capsys)
+    assert code == 2
+    assert err.startswith(f"mdf: error: {POINT}: radar.carrier_frequency: unknown field"), err
+    assert err.endswith(f" (for the kind of --set {item})\n"), err

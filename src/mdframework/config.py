@@ -648,7 +648,9 @@ def blaming_overrides(source: str, overrides: Sequence[str]) -> Iterator[None]:
     """A :class:`ConfigError` about a field that an override set (``source: field: ...`` or
     ``source: sources[0] record 3: field: ...``, a field above or below it, or a field of the
     same table whose message names the override's field) names the override instead of the
-    file ``source``."""
+    file ``source``. One about a file's field of a table whose ``kind`` an override chose
+    (``--set radar.kind=fmcw`` with the LFM radar's fields in the file) names that override
+    after the message."""
     try:
         yield
     except ConfigError as exc:
@@ -672,6 +674,11 @@ def blaming_overrides(source: str, overrides: Sequence[str]) -> Iterator[None]:
                     or (named and field.rpartition(".")[0] == table)
                 ):
                     raise ConfigError(f"--set {item.strip()}: {rest}") from None
+        for item in reversed(overrides):  # the file's field, wrong for a kind an override chose
+            key = ".".join(_override_key(item)[0])
+            table, _, name = key.rpartition(".")
+            if name == "kind" and table and any(f.startswith(f"{table}.") for f in fields):
+                raise ConfigError(f"{exc} (for the kind of --set {item.strip()})") from None
         raise
 
 
