@@ -775,3 +775,34 @@ def test_ctrl_c_during_start_up_is_one_line(tmp_path: Path, delay: float) -> Non
     assert proc.returncode == 130, err
     assert err.strip() == "mdf: interrupted"
     assert not (out / LOCK).exists()
+
+
+def test_a_runs_metadata_holds_a_fingerprint_of_what_it_read(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """metadata.json's motion.fingerprint is a digest of the loaded motion: the same for a copy
+    of the files at another path, another for a file with one value changed (the recorded
+    path alone cannot tell a researcher whether a rerun read the same data)."""
+    copy = tmp_path / "copy"
+    copy.mkdir()
+    for name in ("02_01.amc", "02.asf"):
+        (copy / name).write_bytes((CMU / "asf-amc" / name).read_bytes())
+
+    def fingerprint(name: str, *overrides: str) -> str:
+        out = tmp_path / name
+        args = ["run", str(EXAMPLES / "cmu_walk.toml"), "--out", str(out), "--no-figures"]
+        assert cli.main([*args, *overrides]) == 0, capsys.readouterr().err
+        return str(json.loads((out / "metadata.json").read_text())["motion"]["fingerprint"])
+
+    shipped = fingerprint("shipped")
+    copied = fingerprint("copied", "--set", f"motion.file={copy / '02_01.amc'}")
+    lines = (copy / "02_01.amc").read_text().splitlines(keepends=True)
+    at = next(j for j, line in enumerate(lines) if line.startswith("root "))
+    parts = lines[at].split()
+    parts[1] = repr(float(parts[1]) + 0.1)  # the first frame's root x position
+    lines[at] = " ".join(parts) + "\n"
+    (copy / "02_01.amc").write_text("".join(lines))
+    changed = fingerprint("changed", "--set", f"motion.file={copy / '02_01.amc'}")
+    assert len(shipped) == 40
+    assert copied == shipped
+    assert changed != shipped

@@ -69,6 +69,7 @@ from .config import (
 )
 from .errors import ConfigError, DataFileError, MdfError, OutputError, SceneError, SettingError
 from .features import FEATURE_NAMES, band_edge_frames, envelopes, features_from_envelopes
+from .fingerprint import motion_fingerprint, recording_fingerprint
 from .interfaces import Motion, Recording, RecordingSource
 from .outdir import (
     OutputFolder,
@@ -510,40 +511,6 @@ def _forget_loaded() -> None:
     _MOTIONS.clear()
     _PENDING.clear()
     _load_recordings.cache_clear()
-
-
-def _hash_arrays(digest: Any, *arrays: Any) -> None:
-    """Feed arrays into ``digest``: dtype, shape and bytes of each (None as a marker)."""
-    for a in arrays:
-        if a is None:
-            digest.update(b"none;")
-            continue
-        arr = np.ascontiguousarray(a)
-        digest.update(f"{arr.dtype.str}{arr.shape};".encode())
-        digest.update(arr.tobytes())
-
-
-def motion_fingerprint(motion: Motion) -> str:
-    """A digest (40 hex digits) of everything a loaded motion gives the simulation: its time
-    stamps, joint positions and validity, joint names, canonical map, point RCS and whether its
-    tracks are linear. It covers what was read from every file behind the motion (an ``.asf``
-    beside its ``.amc`` included), whatever their paths, times or copies."""
-    sk = motion.skeleton
-    digest = hashlib.sha1()
-    _hash_arrays(digest, sk.time, sk.positions, sk.valid, motion.point_rcs)
-    cmap = None if motion.canonical_map is None else sorted(motion.canonical_map.items())
-    digest.update(json.dumps([list(sk.joint_names), cmap, bool(motion.linear_tracks)]).encode())
-    return digest.hexdigest()
-
-
-def recording_fingerprint(recording: Recording) -> str:
-    """A digest (40 hex digits) of a real radar's recording: its name, frame period, frame
-    count and every point (frame, position, velocity, intensity)."""
-    cloud = recording.cloud
-    digest = hashlib.sha1()
-    digest.update(json.dumps([recording.name, cloud.frame_period, cloud.n_frames]).encode())
-    _hash_arrays(digest, cloud.frame, cloud.positions, cloud.velocity, cloud.intensity)
-    return digest.hexdigest()
 
 
 def _record_seed(seed: int, index: int) -> int:

@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 
 from . import conditioning, emptiness, limits, sanity
 from .errors import DataFileError, SceneError
+from .fingerprint import motion_fingerprint
 from .interfaces import (
     Effect,
     Motion,
@@ -283,13 +284,17 @@ def simulate(
     config: RunConfigBase, registry: Registry | None = None, progress: Progress = QUIET
 ) -> RunResult:
     """Run one config end to end; ``progress`` reports the steps that take more than a second
-    (:class:`~mdframework.progress.Progress`; silent by default)."""
+    (:class:`~mdframework.progress.Progress`; silent by default). The metadata's
+    ``motion.fingerprint`` is the loaded motion's digest
+    (:func:`~mdframework.fingerprint.motion_fingerprint`)."""
     stages = build_stages(config, registry)
     t0 = time.perf_counter()
     with progress.step(f"loading the motion ({stages.source.name})"):
         motion = load_motion(stages.source)
     timings = {"load": time.perf_counter() - t0}
-    return simulate_motion(config, stages, motion, timings, progress)
+    result = simulate_motion(config, stages, motion, timings, progress)
+    result.metadata["motion"]["fingerprint"] = motion_fingerprint(motion)
+    return result
 
 
 def load_motion(source: MotionSource) -> Motion:
