@@ -299,6 +299,18 @@ def test_the_period_of_a_short_record_is_not_drawn_towards_lag_0(
     assert first[1] == pytest.approx(1 - period / duration, abs=0.05)
 
 
+def test_the_dominant_period_of_a_long_noisy_record_is_not_a_multiple() -> None:
+    """Ten minutes at 120 Hz of a 1.1 s sinusoid in white noise of its own amplitude: the
+    autocorrelation is about 0.33 at every multiple of the period, within its noise (about
+    1/sqrt(n) = 0.004) of each other; the highest was at 2.2 s. The first peak within 0.9 of
+    the highest is the period (to 5 %: the noise moves the peak by a few lags)."""
+    time = np.arange(72000) / 120.0
+    noise = np.random.default_rng(0).normal(0.0, 1.0, time.size)
+    found = cond.periodicity(time, np.sin(2 * np.pi * time / 1.1) + noise)
+    assert found["period_s"] == pytest.approx(1.1, rel=0.05)
+    assert found["strength"] == pytest.approx(1 / 3, abs=0.02)
+
+
 def test_a_signal_without_a_zero_crossing_has_no_period() -> None:
     """A constant has no autocorrelation and a slow swell of less than half a period never
     correlates negatively with itself: no period."""

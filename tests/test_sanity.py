@@ -489,7 +489,7 @@ def _direct_period(t: np.ndarray, signal: np.ndarray) -> tuple[float, float] | N
         if top < 0.3:
             continue
         j = k
-        while 1 < j < n - 2 and normalised[j + 1] > normalised[j]:
+        while j < n - 2 and normalised[j + 1] > normalised[j]:
             j += 1
         while j > 1 and normalised[j - 1] > normalised[j]:
             j -= 1

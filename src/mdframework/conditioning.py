@@ -324,8 +324,8 @@ def lag_correlation(
 
 def correlation_peaks(biased: FloatArray, normalised: FloatArray) -> list[tuple[float, float]]:
     """The peaks of :func:`lag_correlation`'s biased values after their first negative one,
-    in lag order: (lag [samples], biased value there [1], the top of a parabola through the
-    peak and its neighbours, since a period between two lags lowers both).
+    in lag order: (lag [samples]; the biased value there [1], as the top of a parabola through
+    the peak and its neighbours, since a period between two lags lowers both).
 
     Each lag is the peak of the normalised values reached by climbing them from the biased
     peak, refined to a fraction by a parabola through it and its neighbours (so it is not
@@ -336,15 +336,15 @@ def correlation_peaks(biased: FloatArray, normalised: FloatArray) -> list[tuple[
     negative = np.flatnonzero(biased < 0)
     if negative.size == 0:
         return []
+    k = np.arange(max(int(negative[0]), 1), n - 1)
+    at_peak = (biased[k] >= biased[k - 1]) & (biased[k] >= biased[k + 1])
     peaks = []
-    for k in range(max(int(negative[0]), 1), n - 1):
-        if not (biased[k] >= biased[k - 1] and biased[k] >= biased[k + 1]):
-            continue
-        curve = biased[k - 1] - 2 * biased[k] + biased[k + 1]
-        shift = 0.5 * (biased[k - 1] - biased[k + 1]) / curve if curve < 0 else 0.0
-        top = float(biased[k] - 0.25 * (biased[k - 1] - biased[k + 1]) * shift)
-        j = k  # climb the normalised values from the biased peak to their own peak
-        while 1 < j < n - 2 and normalised[j + 1] > normalised[j]:
+    for k0 in k[at_peak].tolist():
+        curve = biased[k0 - 1] - 2 * biased[k0] + biased[k0 + 1]
+        shift = 0.5 * (biased[k0 - 1] - biased[k0 + 1]) / curve if curve < 0 else 0.0
+        top = float(biased[k0] - 0.25 * (biased[k0 - 1] - biased[k0 + 1]) * shift)
+        j = k0  # climb the normalised values from the biased peak to their own peak
+        while j < n - 2 and normalised[j + 1] > normalised[j]:
             j += 1
         while j > 1 and normalised[j - 1] > normalised[j]:
             j -= 1
@@ -352,15 +352,16 @@ def correlation_peaks(biased: FloatArray, normalised: FloatArray) -> list[tuple[
         if normalised[j] >= max(normalised[j - 1], normalised[j + 1]) and curve < 0:
             peaks.append((j + 0.5 * (normalised[j - 1] - normalised[j + 1]) / curve, top))
         else:
-            peaks.append((k + shift, top))
+            peaks.append((k0 + shift, top))
     return peaks
 
 
 def periodicity(time: FloatArray, signal: FloatArray) -> dict[str, float | None]:
     """Dominant period of a signal sampled at (possibly uneven) times.
 
-    The highest peak of the signal's biased autocorrelation after its first zero crossing,
-    located on the normalised one (:func:`lag_correlation`, :func:`correlation_peaks`).
+    The first peak of the signal's biased autocorrelation after its first zero crossing that
+    reaches 0.9 of the highest (on a long record every multiple of the period is about as
+    high), located on the normalised one (:func:`lag_correlation`, :func:`correlation_peaks`).
     Returns ``period_s`` [s] (None if there is no positive peak) and ``strength`` (the biased
     autocorrelation there, which falls with the overlap: at most ``1 - period / duration``).
     """
@@ -368,9 +369,10 @@ def periodicity(time: FloatArray, signal: FloatArray) -> dict[str, float | None]
     peaks = correlation_peaks(found[0], found[1]) if found is not None else []
     if found is None or not peaks:
         return {"period_s": None, "strength": 0.0}
-    lag, value = max(peaks, key=lambda p: p[1])
-    if value <= 0:
-        return {"period_s": None, "strength": value}
+    highest = max(p[1] for p in peaks)
+    if highest <= 0:
+        return {"period_s": None, "strength": highest}
+    lag, value = next(p for p in peaks if p[1] >= 0.9 * highest)
     return {"period_s": float(lag * found[2]), "strength": value}
 
 
