@@ -2,12 +2,17 @@
 whatever the inputs (drawn by Hypothesis, derandomized, a few dozen small examples each).
 
 - time reversal of a motion reverses the slow-time signal and mirrors the spectrogram in
-  Doppler (LFM, CW); reversing a constant velocity mirrors the Doppler in every radar (FMCW too);
+  Doppler (LFM, CW; points, and a body moving in place through the ellipsoid model and the
+  scatterer effects); reversing a constant velocity mirrors the Doppler in every radar (FMCW);
 - an approaching point has positive Doppler and a receding one negative, in every radar;
 - moving a radial scene along its line of sight by ``d`` multiplies the return by
   ``exp(-j 4 pi f_c d / c)`` and, with the range equation, by ``(R / (R + d))^2`` (LFM, CW);
-- turning scene and radar together about any axis leaves the return unchanged (LFM, CW), and
-  seeing a body from another bearing at the same aspect leaves it unchanged too;
+- turning scene and radar together about any axis leaves the return unchanged (LFM, CW; FMCW
+  about the vertical through the origin, at which it looks), and seeing a body from another
+  bearing at the same aspect leaves it unchanged too;
+- a record cut at ``motion.start = s`` equals the motion started where it is at ``s`` (every
+  radar and effect: the physics has no clock);
+- the dB map does not depend on the transmit power (every radar; noise and clutter by SNR, CSR);
 - scaling the carrier scales the Doppler of a constant velocity by the same factor;
 - any ``processing.block_pulses`` gives the run of one block, for every radar and effect;
 - a record resampled from its window equals resampling the whole recording (1e-9 m);
@@ -87,6 +92,30 @@ def run_config(
             "scene": {"radar_position": [0.0, 0.0, 0.0], **(scene or {})},
             "processing": {"precision": "float64", **(processing or {})},
         }
+    )
+
+
+def body_config(
+    radar: dict[str, Any],
+    scatterers: dict[str, Any],
+    effects: list[dict[str, Any]] | None = None,
+    *,
+    aspect_deg: float = 20.0,
+    radar_position: list[float] | None = None,
+    block_pulses: int = 4096,
+) -> Any:
+    """A run config of a body (the motion given to :func:`simulate_tracks`) placed at the
+    origin at ``aspect_deg`` to the radar (default at (6, 1, 1.5) m), a tracking gate."""
+    return run_config(
+        radar,
+        scatterers=scatterers,
+        effects=effects,
+        scene={
+            "radar_position": radar_position or [6.0, 1.0, 1.5],
+            "person": {"position": [0.0, 0.0], "aspect_deg": aspect_deg},
+            "gate": "track",
+        },
+        processing={"window_length": 64, "hop": 32, "block_pulses": block_pulses},
     )
 
 
@@ -495,16 +524,8 @@ def test_a_body_seen_from_another_bearing_at_the_same_aspect_gives_the_same_retu
     def run(bearing: float) -> RunResult:
         b = np.deg2rad(bearing)
         radar_pos = [distance * np.cos(b), distance * np.sin(b), height]
-        cfg = run_config(
-            LFM,
-            scatterers={"kind": "ellipsoid", "placement": placement, "scattering_phase": phase},
-            scene={
-                "radar_position": radar_pos,
-                "person": {"position": [0.0, 0.0], "aspect_deg": aspect_deg},
-                "gate": "track",
-            },
-            processing={"window_length": 64, "hop": 32},
-        )
+        model = {"kind": "ellipsoid", "placement": placement, "scattering_phase": phase}
+        cfg = body_config(LFM, model, aspect_deg=aspect_deg, radar_position=radar_pos)
         return simulate_tracks(cfg, t, motion)
 
     y, y_turned = run(0.0).received.signal, run(bearing_deg).received.signal
@@ -599,17 +620,7 @@ def test_any_block_size_gives_the_run_of_one_block(
         effects = [e for e in effects if e["kind"] != "noise"]
 
     def run(block_pulses: int) -> RunResult:
-        cfg = run_config(
-            radar,
-            scatterers=scatterers,
-            effects=effects,
-            scene={
-                "radar_position": [6.0, 1.0, 1.5],
-                "person": {"position": [0.0, 0.0], "aspect_deg": 20.0},
-                "gate": "track",
-            },
-            processing={"window_length": 64, "hop": 32, "block_pulses": block_pulses},
-        )
+        cfg = body_config(radar, scatterers, effects, block_pulses=block_pulses)
         return simulate_tracks(cfg, t, motion)
 
     one, cut = run(1_000_000), run(block)
@@ -617,6 +628,141 @@ def test_any_block_size_gives_the_run_of_one_block(
     assert np.max(np.abs(y)) > 0
     assert np.max(np.abs(y_cut - y)) <= 1e-12 * np.max(np.abs(y))
     assert np.array_equal(one.gate_range, cut.gate_range)
+
+
+# --------------------------------------------------------------------------- reversal, clock, power
+
+
+def scatterer_effects() -> st.SearchStrategy[list[dict[str, Any]]]:
+    """Any subset of the effects on the scatterers (multipath, antenna, attenuation)."""
+    return effect_lists().map(
+        lambda effects: [e for e in effects if e["kind"] not in ("noise", "clutter")]
+    )
+
+
+@settings(SETTINGS, max_examples=15)
+@given(
+    st.floats(0.5, 2.0),
+    st.floats(5.0, 40.0),
+    st.fixed_dictionaries(
+        {
+            "kind": st.just("ellipsoid"),
+            "placement": st.sampled_from(["joints17", "chen16"]),
+            "head": st.sampled_from(["sphere", "spheroid"]),
+            "scattering_phase": st.sampled_from(["centre", "specular"]),
+        }
+    ),
+    scatterer_effects(),
+    st.sampled_from([LFM, {**LFM, "gate_response": "sinc"}, CW]),
+    st.floats(-180.0, 180.0),
+)
+def test_a_body_moving_in_place_played_backwards_gives_the_signal_backwards(
+    cadence: float,
+    swing: float,
+    model: dict[str, Any],
+    effects: list[dict[str, Any]],
+    radar: dict[str, Any],
+    aspect: float,
+) -> None:
+    """A body swinging its limbs in place (placed as the forward motion is: its hips face the
+    same way, its hip centre starts at the same point), played backwards: every part's
+    position and orientation run backwards, so do its RCS, specular point, ground image,
+    antenna gain and attenuation, and the slow-time signal runs backwards. (A body that travels
+    is placed by its direction of travel and start point, which reversal changes.)"""
+    t = np.arange(31) / 60.0
+    pos = walking_positions(t, speed=0.0, swing_deg=swing, cadence_hz=cadence)
+    cfg = body_config(radar, model, effects, aspect_deg=aspect)
+    forward = simulate_tracks(cfg, t, pos)
+    backward = simulate_tracks(cfg, t, pos[::-1].copy())
+    y = forward.received.signal
+    assert np.max(np.abs(y)) > 0
+    assert np.max(np.abs(backward.received.signal - y[::-1])) < 1e-9 * np.max(np.abs(y))
+
+
+@settings(SETTINGS, max_examples=20)
+@given(
+    st.tuples(*[st.floats(-1.5, 1.5)] * 3),
+    st.integers(1, 60),
+    st.one_of(any_radar(), st.just({**FMCW, "receiver_noise": True})),
+    effect_lists(),
+)
+def test_a_record_cut_later_from_a_motion_equals_the_motion_started_there(
+    velocity: tuple[float, ...],
+    frames: int,
+    radar: dict[str, Any],
+    effects: list[dict[str, Any]],
+) -> None:
+    """The physics does not depend on the clock: a 0.5 s record cut at ``motion.start = s``
+    from points moving at constant velocity is the record of the same points placed where they
+    are at ``s`` and started there, to rounding, for every radar and effect (the random ones
+    seeded per record, the FMCW receiver's noise per frame of the record). The start is a
+    frame of the motion (100 Hz): a fixed antenna aims at the mean of the record's frames,
+    which another frame grid samples a little differently."""
+    start = frames / 100.0
+    if radar.get("receiver_noise"):
+        effects = [e for e in effects if e["kind"] != "noise"]
+    p0 = np.array([7.0, 1.5, 0.8])
+    v = np.array(velocity)
+    scene = {"radar_position": [0.0, 0.0, 1.0], "gate": "track"}
+    later = run_config(
+        radar,
+        effects=effects,
+        targets=[{"position": list(p0), "velocity": list(v)}],
+        scene=scene,
+        length=start + 0.5,
+    )
+    later = later.model_copy(
+        update={"motion": later.motion.model_copy(update={"start": start, "duration": 0.5})}
+    )
+    moved = run_config(
+        radar,
+        effects=effects,
+        targets=[{"position": list(p0 + start * v), "velocity": list(v)}],
+        scene=scene,
+        length=0.5,
+    )
+    y_later, y_moved = (
+        simulate_points(later).received.signal,
+        simulate_points(moved).received.signal,
+    )
+    assert y_later.shape == y_moved.shape
+    assert np.max(np.abs(y_later - y_moved)) < 1e-9 * np.max(np.abs(y_moved))
+
+
+@settings(SETTINGS, max_examples=20)
+@given(
+    moving_points(),
+    st.sampled_from([LFM, {**LFM, "path": "raw"}, CW, FMCW]),
+    effect_lists(),
+    st.integers(-6, 6),
+)
+def test_the_db_map_does_not_depend_on_the_transmit_power(
+    point: tuple[list[float], list[float], float],
+    radar: dict[str, Any],
+    effects: list[dict[str, Any]],
+    k: int,
+) -> None:
+    """Every echo scales with ``sqrt(P_t)``; the noise and clutter set by an SNR and a CSR
+    scale with the signal: the spectrogram in dB re its peak is the same at any transmit power
+    (``4^k`` W here: the amplitudes scale by ``2^k``, exactly in floating point)."""
+    position, velocity, _ = point
+
+    def run(power: float) -> RunResult:
+        cfg = run_config(
+            {**radar, "transmit_power": power},
+            effects=effects,
+            targets=[{"position": list(np.add(position, up)), "velocity": velocity}],
+            scene={"radar_position": up, "gate": "track"},
+            processing={"window_length": 64, "hop": 32},
+        )
+        return simulate_points(cfg)
+
+    up = [0.0, 0.0, 1.0]  # the radar above the ground (multipath)
+    one, scaled = run(1.0), run(4.0**k)
+    assert np.max(np.abs(scaled.received.signal - 2.0**k * one.received.signal)) <= 1e-12 * (
+        2.0**k * np.max(np.abs(one.received.signal))
+    )
+    assert np.max(np.abs(scaled.spectrogram_db - one.spectrogram_db)) < 1e-4
 
 
 # --------------------------------------------------------------------------- windows
