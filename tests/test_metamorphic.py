@@ -28,7 +28,7 @@ import warnings
 from typing import Any
 
 import numpy as np
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 from scenes import effect_sections, load_project_modules
 
@@ -614,21 +614,48 @@ def test_scaling_the_carrier_scales_the_doppler_of_a_constant_velocity(
 @given(
     st.one_of(any_radar(), st.just({**FMCW, "receiver_noise": True})),
     effect_lists(),
+    st.one_of(
+        st.none(),
+        st.builds(
+            lambda count, seed: {"kind": "static_scene", "count": count, "seed": seed},
+            st.integers(1, 5),
+            st.integers(0, 100),
+        ),
+    ),
+    st.one_of(
+        st.none(),
+        st.builds(
+            lambda d, bodies: {"kind": "shadowing", "decimation": d, "bodies": bodies},
+            st.integers(1, 60),
+            st.sampled_from(["auto", "capsules"]),
+        ),
+    ),
     st.sampled_from(["points", "ellipsoid"]),
     st.integers(16, 700),
 )
+# the last of the 721 pulses alone in a block, between two rays of every 7th pulse
+@example(LFM, [], None, {"kind": "shadowing", "decimation": 7}, "ellipsoid", 16)
 def test_any_block_size_gives_the_run_of_one_block(
-    radar: dict[str, Any], effects: list[dict[str, Any]], model: str, block: int
+    radar: dict[str, Any],
+    effects: list[dict[str, Any]],
+    room: dict[str, Any] | None,
+    shadowing: dict[str, Any] | None,
+    model: str,
+    block: int,
 ) -> None:
     """docs/concepts.md: the slow-time signal stays within 1e-12 of its peak whatever
     ``processing.block_pulses``, for every radar (the FMCW receiver's noise included: seeded
     per frame), scatterer model and effect (an FMCW block holds whole frames: the pipeline
-    rounds it up to one)."""
+    rounds it up to one). Self-shadowing casts its rays on every d-th pulse of the record and
+    holds them: a block may hold no such pulse."""
     t = np.arange(19) / 60.0  # 0.3 s
     motion = walking_positions(t, speed=1.5)
     scatterers = {"kind": model} if model == "ellipsoid" else {"kind": "points", "body": True}
     if radar.get("receiver_noise"):  # the FMCW receiver's own noise (per frame) replaces it
         effects = [e for e in effects if e["kind"] != "noise"]
+    # the body's self-shadowing (rays every d-th pulse of the record) first, then the room
+    # (before the effects on every scatterer)
+    effects = [e for e in (shadowing, room) if e is not None] + effects
 
     def run(block_pulses: int) -> RunResult:
         cfg = body_config(radar, scatterers, effects, block_pulses=block_pulses)
