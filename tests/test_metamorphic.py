@@ -630,11 +630,13 @@ def test_scaling_the_carrier_scales_the_doppler_of_a_constant_velocity(
             st.sampled_from(["auto", "capsules"]),
         ),
     ),
-    st.sampled_from(["points", "ellipsoid"]),
+    st.sampled_from(["points", "ellipsoid", "mujoco_body"]),
     st.integers(16, 700),
 )
 # the last of the 721 pulses alone in a block, between two rays of every 7th pulse
 @example(LFM, [], None, {"kind": "shadowing", "decimation": 7}, "ellipsoid", 16)
+# the MuJoCo body's scatterers (their own class) given ground images and a room
+@example(CW, [{"kind": "multipath"}], {"kind": "static_scene", "count": 2}, None, "mujoco_body", 99)
 def test_any_block_size_gives_the_run_of_one_block(
     radar: dict[str, Any],
     effects: list[dict[str, Any]],
@@ -650,7 +652,7 @@ def test_any_block_size_gives_the_run_of_one_block(
     holds them: a block may hold no such pulse."""
     t = np.arange(19) / 60.0  # 0.3 s
     motion = walking_positions(t, speed=1.5)
-    scatterers = {"kind": model} if model == "ellipsoid" else {"kind": "points", "body": True}
+    scatterers = {"kind": model} if model != "points" else {"kind": "points", "body": True}
     if radar.get("receiver_noise"):  # the FMCW receiver's own noise (per frame) replaces it
         effects = [e for e in effects if e["kind"] != "noise"]
     # the body's self-shadowing (rays every d-th pulse of the record) first, then the room
