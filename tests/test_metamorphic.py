@@ -186,6 +186,30 @@ def scatterer_effects() -> st.SearchStrategy[list[dict[str, Any]]]:
     )
 
 
+def body_models() -> st.SearchStrategy[dict[str, Any]]:
+    """The ellipsoid body models: ``ellipsoid`` (any placement, head, phase) or ``mujoco_body``."""
+    return st.one_of(
+        st.fixed_dictionaries(
+            {
+                "kind": st.just("ellipsoid"),
+                "placement": st.sampled_from(["joints17", "chen16"]),
+                "head": st.sampled_from(["sphere", "spheroid"]),
+                "scattering_phase": st.sampled_from(["centre", "specular"]),
+            }
+        ),
+        st.fixed_dictionaries(
+            {"kind": st.just("mujoco_body"), "placement": st.sampled_from(["centres", "chen16"])}
+        ),
+    )
+
+
+def body_effects() -> st.SearchStrategy[list[dict[str, Any]]]:
+    """:func:`scatterer_effects`, after the body's self-shadowing or not."""
+    return st.tuples(st.booleans(), scatterer_effects()).map(
+        lambda s: [{"kind": "shadowing"}, *s[1]] if s[0] else s[1]
+    )
+
+
 # --------------------------------------------------------------------------- time reversal
 
 
@@ -522,30 +546,27 @@ def test_turning_the_fmcw_scene_about_the_vertical_leaves_its_return_and_maps_un
     st.floats(-180.0, 180.0),
     st.floats(4.0, 15.0),
     st.floats(0.5, 3.0),
-    st.sampled_from(["joints17", "chen16"]),
-    st.sampled_from(["centre", "specular"]),
-    scatterer_effects(),
+    body_models(),
+    body_effects(),
 )
 def test_a_body_seen_from_another_bearing_at_the_same_aspect_gives_the_same_return(
     bearing_deg: float,
     aspect_deg: float,
     distance: float,
     height: float,
-    placement: str,
-    phase: str,
+    model: dict[str, Any],
     effects: list[dict[str, Any]],
 ) -> None:
     """The scene turned about the vertical through the person: the radar at another bearing,
     the person placed at the same aspect to it. The ellipsoids' RCS depend on the line of
     sight in each part's frame only, the ground (multipath) is horizontal, the antenna aims at
-    the body: the return is the same."""
+    the body, the parts hide each other as before: the return is the same."""
     t = np.arange(31) / 60.0
     motion = walking_positions(t, speed=1.2)
 
     def run(bearing: float) -> RunResult:
         b = np.deg2rad(bearing)
         radar_pos = [distance * np.cos(b), distance * np.sin(b), height]
-        model = {"kind": "ellipsoid", "placement": placement, "scattering_phase": phase}
         cfg = body_config(LFM, model, effects, aspect_deg=aspect_deg, radar_position=radar_pos)
         return simulate_tracks(cfg, t, motion)
 
@@ -677,15 +698,8 @@ def test_any_block_size_gives_the_run_of_one_block(
 @given(
     st.floats(0.5, 2.0),
     st.floats(5.0, 40.0),
-    st.fixed_dictionaries(
-        {
-            "kind": st.just("ellipsoid"),
-            "placement": st.sampled_from(["joints17", "chen16"]),
-            "head": st.sampled_from(["sphere", "spheroid"]),
-            "scattering_phase": st.sampled_from(["centre", "specular"]),
-        }
-    ),
-    scatterer_effects(),
+    body_models(),
+    body_effects(),
     st.sampled_from([LFM, {**LFM, "gate_response": "sinc"}, CW]),
     st.floats(-180.0, 180.0),
 )
@@ -699,9 +713,10 @@ def test_a_body_moving_in_place_played_backwards_gives_the_signal_backwards(
 ) -> None:
     """A body swinging its limbs in place (placed as the forward motion is: its hips face the
     same way, its hip centre starts at the same point), played backwards: every part's
-    position and orientation run backwards, so do its RCS, specular point, ground image,
-    antenna gain and attenuation, and the slow-time signal runs backwards. (A body that travels
-    is placed by its direction of travel and start point, which reversal changes.)"""
+    position and orientation run backwards, so do its RCS, specular point, shadows, ground
+    image, antenna gain and attenuation, and the slow-time signal runs backwards. (A body
+    that travels is placed by its direction of travel and start point, which reversal
+    changes.)"""
     t = np.arange(31) / 60.0
     pos = walking_positions(t, speed=0.0, swing_deg=swing, cadence_hz=cadence)
     cfg = body_config(radar, model, effects, aspect_deg=aspect)
