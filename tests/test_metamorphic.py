@@ -12,7 +12,9 @@ whatever the inputs (drawn by Hypothesis, derandomized, a few dozen small exampl
   bearing at the same aspect leaves it unchanged too;
 - a record cut at ``motion.start = s`` equals the motion started where it is at ``s`` (every
   radar and effect: the physics has no clock);
-- the dB map does not depend on the transmit power (every radar; noise and clutter by SNR, CSR);
+- the dB map does not depend on the transmit power (every radar; noise and clutter by SNR, CSR),
+  thermal noise neither, while clutter set by an RCS follows it as an echo does;
+- a record cut from a recording is that part of the whole record's signal;
 - scaling the carrier scales the Doppler of a constant velocity by the same factor;
 - any ``processing.block_pulses`` gives the run of one block, for every radar and effect;
 - a record resampled from its window equals resampling the whole recording (1e-9 m);
@@ -811,6 +813,47 @@ def test_the_db_map_does_not_depend_on_the_transmit_power(
         2.0**k * np.max(np.abs(one.received.signal))
     )
     assert np.max(np.abs(scaled.spectrogram_db - one.spectrogram_db)) < 1e-4
+
+
+@settings(SETTINGS, max_examples=15)
+@given(
+    moving_points(),
+    st.sampled_from([LFM, CW]),
+    st.sampled_from(["thermal noise", "clutter of an RCS"]),
+    st.integers(-4, 4),
+)
+def test_thermal_noise_ignores_the_transmit_power_and_clutter_of_an_rcs_follows_it(
+    point: tuple[list[float], list[float], float], radar: dict[str, Any], kind: str, k: int
+) -> None:
+    """docs/effects.md: thermal noise is the receiver's ``k T F`` whatever is transmitted, while
+    clutter set by an RCS is an echo like the target's: at ``4^k`` times the transmit power what
+    the effect adds is the same noise, or ``2^k`` times the clutter."""
+    position, velocity, _ = point
+    if kind == "thermal noise":
+        effect: dict[str, Any] = {"kind": "noise", "mode": "thermal"}
+        if radar["kind"] == "cw":  # k T F per I/Q sample (no pulse of its own)
+            effect |= {"pulse_width": 1 / 2000, "bandwidth": 2000.0}
+    else:
+        effect = {"kind": "clutter", "power": "rcs", "rcs_m2": 0.5, "range_resolution": 1.0}
+
+    def added(power: float) -> np.ndarray:
+        def run(effects: list[dict[str, Any]]) -> np.ndarray:
+            cfg = run_config(
+                {**radar, "transmit_power": power},
+                effects=effects,
+                targets=[
+                    {"position": list(np.add(position, [0.0, 0.0, 1.0])), "velocity": velocity}
+                ],
+                scene={"radar_position": [0.0, 0.0, 1.0], "gate": "track"},
+            )
+            return simulate_points(cfg).received.signal
+
+        return run([effect]) - run([])
+
+    one, scaled = added(1.0), added(4.0**k)
+    factor = 1.0 if kind == "thermal noise" else 2.0**k
+    assert np.max(np.abs(one)) > 0
+    assert np.max(np.abs(scaled - factor * one)) < 1e-6 * factor * np.max(np.abs(one))
 
 
 # --------------------------------------------------------------------------- windows
