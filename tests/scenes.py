@@ -236,8 +236,9 @@ def effect_sections(draw: st.DrawFn) -> list[dict[str, Any]]:
     effects = [out[i] for i in order]
     kinds = [e["kind"] for e in effects]
     if {"antenna", "multipath"} <= set(kinds):  # antenna after multipath, else refused
-        i, j = sorted((kinds.index("antenna"), kinds.index("multipath")))
-        effects[i], effects[j] = effects[j], effects[i]
+        i, j = kinds.index("multipath"), kinds.index("antenna")
+        if j < i:
+            effects[i], effects[j] = effects[j], effects[i]
     return effects
 
 

@@ -182,9 +182,12 @@ def apply_effects(
 
 def _check_effect_output(out: Any, data: Scatterers | Received) -> None:
     """Refuse what an effect's ``apply`` returned for ``data`` when it breaks the contract:
-    another type, another number of pulses, or values that are not finite (RCS below 0)."""
-    if not isinstance(out, type(data)):
-        raise TypeError(f"apply() returned {type(out).__name__} instead of {type(data).__name__}")
+    another type, another number of pulses, or values that are not finite (RCS below 0). Any
+    ``Scatterers`` answers ``Scatterers``: an effect that adds scatterers (ground images, a
+    room) returns the base class for a model's own subclass of it."""
+    expected = Scatterers if isinstance(data, Scatterers) else type(data)
+    if not isinstance(out, expected):
+        raise TypeError(f"apply() returned {type(out).__name__} instead of {expected.__name__}")
     if isinstance(out, Scatterers) and isinstance(data, Scatterers):
         n = data.positions.shape[0]
         if out.positions.shape[0] != n:

@@ -237,7 +237,8 @@ class Shadowing(Effect):
         m, d = _build_model(types, sizes)
         geomid = np.empty(n_s, dtype=np.int32)
         dist = np.empty(n_s, dtype=np.float64)
-        cutoff = float(rng.max() + 1.0)
+        # a block may hold no ray pulse (shorter than the decimation): it holds the last rays
+        cutoff = float(rng.max() + 1.0) if rng.size else 0.0
         xmat = rot.reshape(len(idx), len(types), 9)
         blocked = np.zeros((len(idx), n_s), dtype=bool)
         cols = np.arange(n_s)
