@@ -57,14 +57,15 @@ def run(
     return simulate(validate_run_config(cfg))
 
 
-def test_a_clutter_patch_is_in_the_maps_at_its_range_bin_and_zero_doppler() -> None:
+@pytest.mark.parametrize("path", ["analytic", "raw"])
+def test_a_clutter_patch_is_in_the_maps_at_its_range_bin_and_zero_doppler(path: str) -> None:
     """A static clutter patch (power 'rcs', no wind) goes into the IF samples: its peak is in
     the range bin of its range, in the zero-Doppler row, at the power the range equation gives
     through the range window's response at its offset from the bin (to 0.1 %), summed over the
     12 virtual antennas; the CFAR turns it into points there at 0 m/s; the spectrogram's
     slow-time signal carries the same patch at its amplitude, constant over the frame's loops
-    (zero Doppler); clutter_removal removes it from the maps and the points."""
-    fields = {**RADAR, "clutter_removal": False}
+    (zero Doppler); clutter_removal removes it from the maps and the points. Both paths."""
+    fields = {**RADAR, "clutter_removal": False, "path": path}
     res = run(fields, [CLUTTER])
     clean = run(fields, [])
     [effect] = res.metadata["effects"]
@@ -130,6 +131,7 @@ def test_the_noise_effect_fills_the_map_cells_with_the_analytic_mean_noise() -> 
     wf = FmcwRadar(FmcwConfig(**RADAR))
     sigma2 = 1.380649e-23 * 290.0 * 10.0 * wf.config.sample_rate
     assert res.metadata["effects"][0]["noise_power_w"] == pytest.approx(sigma2, rel=1e-12)
+    assert res.metadata["effects"][0]["in_receiver"] is True
     expected = fmcw.map_noise_power(sigma2, 12, "hann", 240, "hann", 16)
     assert rd.shape[0] == 30
     assert float(np.mean(rd)) == pytest.approx(expected, rel=0.02)

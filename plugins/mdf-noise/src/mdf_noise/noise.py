@@ -154,6 +154,7 @@ class ReceiverNoise(Effect):
     def __init__(self, config: PluginConfig | None = None) -> None:
         super().__init__(config)
         self._power: float | None = None
+        self._in_receiver = False
 
     def check_radar(self, waveform: RadarWaveform) -> None:
         """Refuse a radar that adds receiver noise itself (``RadarWaveform.adds_receiver_noise``:
@@ -213,6 +214,7 @@ class ReceiverNoise(Effect):
             b_n = float(rate)
         power = BOLTZMANN * c.temperature * 10.0 ** (c.noise_figure_db / 10.0) * b_n
         self._power = power
+        self._in_receiver = True
         key = int(context.rng.integers(2**63))
         return ReceiverInput(self.name, noise_power=power, noise_key=key)
 
@@ -239,5 +241,6 @@ class ReceiverNoise(Effect):
 
     def describe(self) -> dict[str, Any]:
         """The config plus the noise power per compressed sample [W] (per raw sample for a
-        radar that simulates it in its raw samples)."""
-        return {**self.config.model_dump(), "noise_power_w": self._power}
+        radar that simulates it in its raw samples, then marked ``in_receiver``)."""
+        out = {**self.config.model_dump(), "noise_power_w": self._power}
+        return {**out, "in_receiver": True} if self._in_receiver else out
