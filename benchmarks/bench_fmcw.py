@@ -18,7 +18,8 @@ path), the analytic path with points, in fresh processes alternating this, other
 dataset's simulated room: the same walk, away from the sensor 1 m in front of the subject, with its
 12 static reflectors, antenna pattern and 1 W; many more points a frame). It prints both
 medians of the CPU ms per frame, the median ratio of the rounds, and whether the two gave the
-same slow-time signal and point clouds (their largest difference).
+same slow-time signal and point clouds (their largest difference); and the same for drawing one
+frame's receiver noise alone (the radar's ``_noise``, 300 frames a round, CPU ms a frame).
 
     .venv/bin/python benchmarks/bench_fmcw.py [--repeats 3] [--duration 2.0]
     .venv/bin/python benchmarks/bench_fmcw.py --against OTHER [--scene walk|room] [--rounds 5]
@@ -109,10 +110,21 @@ def scene(name: str, duration: float) -> dict[str, Any]:
     return {**base, **ROOM} if name == "room" else base
 
 
+#: frames of receiver noise drawn a round (``--against``)
+NOISE_FRAMES = 300
+
+
 def child(name: str, duration: float, repeats: int, out: str) -> None:
-    """In a fresh process: the median CPU ms per frame of the analytic path with points; the
-    signal and points saved to ``out``."""
-    seconds, res = run(scene(name, duration), repeats)
+    """In a fresh process: the median CPU ms per frame of the analytic path with points, and of
+    drawing one frame's receiver noise; the signal and points saved to ``out``."""
+    data = scene(name, duration)
+    seconds, res = run(data, repeats)
+    radar = build_stages(validate_run_config(data, base_dir=SCENE.parent)).radar
+    n_rx = radar.antennas.rx.shape[0]
+    t0 = time.process_time()
+    for frame in range(NOISE_FRAMES):
+        radar._noise(frame, n_rx)
+    noise_ms = (time.process_time() - t0) / NOISE_FRAMES * 1e3
     import mdf_fmcw
 
     import mdframework
@@ -124,7 +136,7 @@ def child(name: str, duration: float, repeats: int, out: str) -> None:
     print(
         json.dumps(
             {"ms": seconds / n_frames * 1e3, "frames": n_frames, "points": len(points)}
-            | {"modules": modules}
+            | {"noise_ms": noise_ms, "modules": modules}
         )
     )
 
@@ -137,6 +149,7 @@ def against(other: str, name: str, duration: float, repeats: int, rounds: int) -
     env_other = {**os.environ, "PYTHONPATH": paths, "PYTHONWARNINGS": "ignore"}
     env_this = {**os.environ, "PYTHONWARNINGS": "ignore"}
     times: dict[str, list[float]] = {"this": [], "other": []}
+    noise: dict[str, list[float]] = {"this": [], "other": []}
     with tempfile.TemporaryDirectory() as tmp:
         for k in range(rounds):
             for who, env in (("this", env_this), ("other", env_other)):
@@ -151,9 +164,11 @@ def against(other: str, name: str, duration: float, repeats: int, rounds: int) -
                 if (who == "other") != all(m.startswith(root) for m in got["modules"]):
                     sys.exit(f"{who} imported {got['modules']}")
                 times[who].append(got["ms"])
+                noise[who].append(got["noise_ms"])
             print(
                 f"round {k + 1}: this {times['this'][-1]:.2f}, other {times['other'][-1]:.2f} "
-                f"ms a frame ({got['frames']} frames, {got['points']} points)",
+                f"ms a frame ({got['frames']} frames, {got['points']} points); noise alone "
+                f"this {noise['this'][-1]:.3f}, other {noise['other'][-1]:.3f}",
                 flush=True,
             )
         a, b = np.load(f"{tmp}/this.npz"), np.load(f"{tmp}/other.npz")
@@ -166,6 +181,12 @@ def against(other: str, name: str, duration: float, repeats: int, rounds: int) -
         f"of {repeats}): this {statistics.median(times['this']):.2f}, other "
         f"{statistics.median(times['other']):.2f}, median ratio {statistics.median(ratios):.3f} "
         f"({min(ratios):.3f} to {max(ratios):.3f})"
+    )
+    ratios = [t / o for t, o in zip(noise["this"], noise["other"], strict=True)]
+    print(
+        f"drawing one frame's receiver noise, CPU ms, median of {rounds} rounds: this "
+        f"{statistics.median(noise['this']):.3f}, other {statistics.median(noise['other']):.3f}, "
+        f"median ratio {statistics.median(ratios):.3f} ({min(ratios):.3f} to {max(ratios):.3f})"
     )
     print(
         f"slow-time signal bitwise equal: {same_signal}; points: "

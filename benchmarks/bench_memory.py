@@ -9,11 +9,12 @@ time of the simulation, the peak RSS [MiB] and the time exponent between the sho
 longest record (``log(t_long / t_short) / log(len_long / len_short)``), of the wall time and of
 the CPU time (the one to read on a shared machine, where other jobs stretch wall times).
 
-``--effects`` adds ground clutter, multipath, a static scene of 10 reflectors and (on the LFM
-paths; the FMCW preset adds its own receiver noise) noise; ``--motion walk`` replaces the
-treadmill by the Boulic walker walking straight away from the radar (10 m at the start, 0.88 m/s),
-so the range span the tracking gate covers, and with it the clutter's patch count, grows with
-the record.
+``--effects`` adds ground clutter (on the FMCW path static clutter of 0.1 m^2 a range cell in
+its IF samples: its maps and points take no other), multipath, a static scene of 10 reflectors
+and (on the LFM paths; the FMCW preset adds its own receiver noise) noise; ``--motion walk``
+replaces the treadmill by the Boulic walker walking straight away from the radar (10 m at the
+start, 0.88 m/s), so the range span the tracking gate covers, and with it the clutter's patch
+count, grows with the record.
 
     .venv/bin/python benchmarks/bench_memory.py [--lengths 6 600] [--paths analytic raw fmcw]
         [--effects] [--motion treadmill|walk]
@@ -58,6 +59,8 @@ if effects:
     spec["effects"] = [
         {{"kind": "clutter"}}, {{"kind": "multipath"}}, {{"kind": "static_scene", "count": 10}}
     ] + ([] if path == "fmcw" else [{{"kind": "noise"}}])
+    if path == "fmcw":  # static clutter of a given RCS, in the IF samples (maps and points)
+        spec["effects"][0] = {{"kind": "clutter", "power": "rcs", "wind_fraction": 0.0}}
 cfg = validate_run_config(spec)
 stages = build_stages(cfg)
 motion = load_motion(stages.source) if walk == "walk" else walking_motion(duration=length + 0.5)

@@ -749,7 +749,8 @@ def test_without_receiver_noise_points_stand_over_the_receivers_mean_noise() -> 
     ahead approaching at 0.86 m/s used to give 36 points a frame over 0.98-4.78 m, the window
     sidelobes over training cells of 0 W, at up to 2905 dB. CFAR now works on the map plus the
     receiver's mean noise, so the noise-free cloud is the noisy run's: the same cells (range
-    and Doppler bin) in every frame but one at the threshold's edge, all within 0.4 m of the
+    and Doppler bin) in every frame but two at the threshold's edge (of the seeded noise's
+    draws), all within 0.4 m of the
     target, the intensities alike (to 2 dB over 30 dB: the noisy smallest-of estimate
     fluctuates), the strongest at most the on-bin 1 + SNR of the range equation (k T0 F fs
     through both FFTs, docs/fmcw.md)."""
@@ -770,7 +771,7 @@ def test_without_receiver_noise_points_stand_over_the_receivers_mean_noise() -> 
             key = (int(f), int(k), float(v))
             best[key] = max(best.get(key, -np.inf), float(db))
         cells.append(best)
-    assert len(cells[0]) >= 20 and len(cells[0].keys() ^ cells[1].keys()) <= 1
+    assert len(cells[0]) >= 20 and len(cells[0].keys() ^ cells[1].keys()) <= 2
     both = cells[0].keys() & cells[1].keys()
     for k in both:
         assert abs(cells[0][k] - cells[1][k]) < (2.0 if cells[1][k] > 30.0 else 3.0)
@@ -857,7 +858,8 @@ def test_the_noise_effect_is_refused_beside_the_radars_own_receiver_noise() -> N
     }
     with pytest.raises(SceneError, match=r"^effects.noise: the 'fmcw' radar adds receiver noise"):
         simulate(validate_run_config(cfg))
-    cfg["radar"] = {**radar_, "receiver_noise": False, "points": False}
+    # without maps and points (else the noise goes into the IF samples: mode 'thermal')
+    cfg["radar"] = {**radar_, "receiver_noise": False, "points": False, "save_range_doppler": False}
     quiet = {**cfg, "effects": []}
     noisy = simulate(validate_run_config(cfg)).received.signal
     clean = simulate(validate_run_config(quiet)).received.signal

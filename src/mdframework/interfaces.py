@@ -440,6 +440,26 @@ class Received:
     range_time_pulses: NDArray[np.int64] | None = None
 
 
+@dataclass(frozen=True)
+class ReceiverInput:
+    """What a received-stage effect puts into the raw samples of a radar that simulates it
+    there (:attr:`RadarWaveform.takes_receiver_inputs`, e.g. the FMCW radar making range-Doppler
+    maps and points), so that it reaches every product of the radar alike
+    (:meth:`Effect.receiver_input`).
+
+    ``noise_power`` [W]: circular complex white Gaussian noise of this power per complex raw
+    (ADC) sample, drawn per frame from ``noise_key`` and the frame's index (the same whatever
+    the blocks). ``static_ranges`` (P,) [m] and ``static_rcs`` (P,) [m^2]: point scatterers that
+    do not move, at these ranges along the radar's boresight (zero Doppler).
+    """
+
+    effect: str
+    noise_power: float = 0.0
+    noise_key: int = 0
+    static_ranges: FloatArray = field(default_factory=lambda: np.zeros(0))
+    static_rcs: FloatArray = field(default_factory=lambda: np.zeros(0))
+
+
 class RadarWaveform(Plugin):
     """A radar: its carrier, pulse timing, range equation and receive chain."""
 
@@ -471,6 +491,19 @@ class RadarWaveform(Plugin):
         ``receiver_noise``); the ``noise`` effect is then refused, since it would count that
         noise twice. Default: False."""
         return False
+
+    @property
+    def takes_receiver_inputs(self) -> bool:
+        """Whether this radar simulates the received-stage effects that describe themselves as
+        a :class:`ReceiverInput` (:meth:`Effect.receiver_input`: noise, static clutter) in its
+        raw samples, so that they reach all its products (the FMCW radar's maps and points)
+        rather than the slow-time signal alone. Default: False."""
+        return False
+
+    def set_receiver_inputs(self, inputs: Sequence[ReceiverInput]) -> None:
+        """The record's :class:`ReceiverInput` s (maybe none), before its blocks, when
+        :attr:`takes_receiver_inputs`; a block with ``receiver_noise`` False leaves them out
+        (the scatterers' response alone). Default: nothing."""
 
     @property
     def range_resolution(self) -> float | None:
@@ -767,6 +800,14 @@ class Effect(Plugin):
         :class:`~mdframework.errors.SceneError` (naming the config field) when this effect
         cannot work with that radar, so that the run is refused before any pulse is simulated.
         Default: nothing."""
+
+    def receiver_input(self, context: SceneContext) -> ReceiverInput | None:
+        """A received-stage effect that a radar can simulate in its raw samples returns what it
+        puts there, when the radar takes it (:attr:`RadarWaveform.takes_receiver_inputs`);
+        :meth:`apply` is then not called. Called once per record before its blocks, with the
+        record's ``pulse_times`` and ``gate_range`` and the effect's own generator. Default
+        None: the effect acts on the slow-time signal (:meth:`apply`)."""
+        return None
 
     def check_effects(self, effects: Sequence[Effect]) -> None:
         """Called when a run's plugins are built, after :meth:`check_radar`, with every effect

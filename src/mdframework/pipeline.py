@@ -159,12 +159,14 @@ def apply_effects(
     data: Any,
     context: SceneContext,
     generators: Sequence[np.random.Generator],
+    skip: frozenset[int] = frozenset(),
 ) -> Any:
     """``data`` (a block's ``Scatterers`` or the record's ``Received``) through the effects of
     ``stage`` (``"scatterers"`` or ``"received"``) in the listed order, each with its own
-    generator (:func:`effect_generators`); an effect's exception is named as its plugin's bug."""
-    for effect, rng in zip(stages.effects, generators, strict=True):
-        if effect.stage == stage:
+    generator (:func:`effect_generators`), but those of index in ``skip`` (the radar simulated
+    them: :func:`hand_to_radar`); an effect's exception is named as its plugin's bug."""
+    for i, (effect, rng) in enumerate(zip(stages.effects, generators, strict=True)):
+        if effect.stage == stage and i not in skip:
             try:
                 out = effect.apply(data, replace(context, rng=rng))
                 _check_effect_output(out, data)
@@ -178,6 +180,28 @@ def apply_effects(
                 raise
             data = out
     return data
+
+
+def hand_to_radar(
+    stages: Stages, context: SceneContext, generators: Sequence[np.random.Generator]
+) -> frozenset[int]:
+    """Before a record's blocks: give a radar that simulates received-stage effects in its raw
+    samples (:attr:`RadarWaveform.takes_receiver_inputs`) what each of them puts there
+    (:meth:`Effect.receiver_input`, with the effect's own generator), so that they reach all
+    its products; the indices of those effects, which then do not act on the slow-time signal
+    again."""
+    wf, inputs, handed = stages.radar, [], set()
+    for i, (effect, rng) in enumerate(zip(stages.effects, generators, strict=True)):
+        if effect.stage != "received":
+            continue
+        with blame(effect, "receiver_input"):
+            got = effect.receiver_input(replace(context, rng=rng))
+        if got is not None:
+            inputs.append(got)
+            handed.add(i)
+    with blame(wf, "set_receiver_inputs"):
+        wf.set_receiver_inputs(inputs)
+    return frozenset(handed)
 
 
 def _check_effect_output(out: Any, data: Scatterers | Received) -> None:
@@ -433,6 +457,11 @@ def _simulate_motion(
     losses = emptiness.Losses()
     blocks = _blocks(n, proc.block_pulses, wf.block_multiple)
     early_effects = any(e.stage == "scatterers" for e in stages.effects)
+    handed: frozenset[int] = frozenset()
+    if wf.takes_receiver_inputs:  # the record's gate from the body's frames around it
+        span = np.interp(t, near.time, gate_ranges(sc.gate, near, radar_pos))
+        context = SceneContext(radar_pos, wf.prf, wf.carrier_frequency, t, span, None, wf, rng)
+        handed = hand_to_radar(stages, context, generators)
     for lo, hi in progress.counted(blocks, n, "simulating the pulses", "pulse"):
         clock = time.perf_counter()
         tb = t[lo:hi]
@@ -475,7 +504,7 @@ def _simulate_motion(
         received = replace(received, products={**received.products, **wf.product_axes()})
     echo = received.signal.copy()  # the target's echo, before noise and clutter
     context = SceneContext(radar_pos, wf.prf, wf.carrier_frequency, t, stream.gate, None, wf, rng)
-    received = apply_effects(stages, "received", received, context, generators)
+    received = apply_effects(stages, "received", received, context, generators, handed)
     _check_empty(echo, losses, proc, fixed_gate=sc.gate != "track")
     effects_ran = _describe(stages, "scatterers") + _describe(stages, "received")
     timings["received_effects"] = time.perf_counter() - clock

@@ -411,7 +411,9 @@ def if_samples(delays: FloatArray, amplitudes: FloatArray, seq: ChirpSequence) -
     return np.ascontiguousarray(out[:, :n_samples])
 
 
-def range_profile(samples: ComplexArray, name: WindowName, n_fft: int) -> ComplexArray:
+def range_profile(
+    samples: ComplexArray | NDArray[np.complex64], name: WindowName, n_fft: int
+) -> ComplexArray:
     """Windowed range FFT of IF samples (..., n_samples) -> (..., n_fft), normalised so that a
     lone on-bin target of amplitude ``a`` peaks at ``|X| = a`` (the range FFT of the module
     docstring; bin ``k`` is range ``k c fs / (2 S n_fft)``)."""
@@ -1002,7 +1004,7 @@ def chirp_profiles(
     path: Literal["raw", "analytic"],
     margin: int = 8,
     extra_ranges: FloatArray | None = None,
-    noise: ComplexArray | None = None,
+    noise: ComplexArray | NDArray[np.complex64] | None = None,
 ) -> ComplexArray:
     """Range profiles of every chirp and receive antenna, (n_chirps, n_rx, n_fft) complex128.
 
@@ -1016,7 +1018,8 @@ def chirp_profiles(
     ``(2 R - (p_tx + p_rx_mean) . u) / c``, times the far-field phase of each RX's offset from
     that centre ``exp(+j 2 pi f_c (p_rx - p_rx_mean) . u / c)``; other bins are 0 (the dropped
     window sidelobes).
-    ``noise`` (n_chirps, n_rx, n_samples): IF noise added before the range FFT (both paths).
+    ``noise`` (n_chirps, n_rx, n_samples) complex128 or complex64: IF noise added before the
+    range FFT (both paths).
     """
     n = positions.shape[0]
     n_rx = antennas.rx.shape[0]

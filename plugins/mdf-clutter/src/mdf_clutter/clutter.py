@@ -38,6 +38,9 @@ Power: the summed clutter ``c(n)`` is scaled so that its mean power over the rec
   and ``P_c = sum_k sigma_k mean_n |g_k(n)|^2`` through the waveform's range equation.
 
 The clutter is added to ``Received.signal``; a range-time map, if any, is passed on unchanged.
+A radar that simulates the clutter in its raw samples (``RadarWaveform.takes_receiver_inputs``:
+the FMCW radar making maps or points) gets the stationary patches as static point scatterers
+instead (:meth:`GroundClutter.receiver_input`; ``power = "rcs"`` and no wind only).
 """
 
 from __future__ import annotations
@@ -56,6 +59,7 @@ from mdframework import (
     PluginConfig,
     RadarWaveform,
     Received,
+    ReceiverInput,
     SceneContext,
     SceneError,
     point_responses,
@@ -232,8 +236,26 @@ class GroundClutter(Effect):
 
     def check_radar(self, waveform: RadarWaveform) -> None:
         """A radar without a range resolution (CW: ``RadarWaveform.range_resolution`` None) needs
-        ``range_resolution``: refused when the run is built, before any pulse."""
+        ``range_resolution``: refused when the run is built, before any pulse. A radar that
+        simulates the clutter in its raw samples (the FMCW radar making maps or points) takes
+        static patches of given RCS only: ``power = "csr"`` (set from the record's mean echo,
+        known only after the maps) and wind-blown clutter are refused."""
         self._resolution(waveform)
+        if not waveform.takes_receiver_inputs:
+            return
+        why = f"the {waveform.name!r} radar makes its maps and points from IF samples, which "
+        if self.config.power == "csr":
+            raise SceneError(
+                f"effects.clutter.power: {why}must carry the clutter before the record's mean "
+                "echo that 'csr' refers to is known: use power = 'rcs' with rcs_m2, or "
+                "radar.points = false and radar.save_range_doppler = false for a spectrogram alone"
+            )
+        if self.config.wind_fraction > 0.0:
+            raise SceneError(
+                f"effects.clutter.wind_fraction: {why}take the clutter as static patches at "
+                "zero Doppler: set wind_fraction = 0, or radar.points = false and "
+                "radar.save_range_doppler = false for wind-blown clutter in a spectrogram alone"
+            )
 
     def resolution(self, context: SceneContext) -> float:
         """Range resolution c/(2B) [m]."""
@@ -288,6 +310,29 @@ class GroundClutter(Effect):
         makes them a group of patches at a time)."""
         ranges = self.patch_ranges(context)
         return ranges, self.responses(context, ranges)
+
+    def receiver_input(self, context: SceneContext) -> ReceiverInput | None:
+        """For a radar that simulates the clutter in its raw samples (:meth:`check_radar`:
+        ``power = "rcs"``, no wind): the stationary patches as static point scatterers at
+        :meth:`patch_ranges`, patch ``k`` of RCS ``rcs_m2 (spacing / resolution) |alpha_k|^2``
+        (``alpha_k`` complex Gaussian of unit mean power: a Rayleigh amplitude; the carrier
+        phase follows from the patch's random range)."""
+        c = self.config
+        res = self.resolution(context)
+        spacing = c.patch_spacing_m if c.patch_spacing_m is not None else res / 2.0
+        ranges = self.patch_ranges(context)
+        rng = context.rng
+        alpha = (
+            rng.standard_normal(ranges.size) + 1j * rng.standard_normal(ranges.size)
+        ) / np.sqrt(2)
+        rcs = c.rcs_m2 * spacing / res * np.abs(alpha) ** 2
+        self._stats = {
+            "n_patches": int(ranges.size),
+            "patch_range_m": [float(ranges.min()), float(ranges.max())],
+            "clutter_rcs_m2": float(np.sum(rcs)),
+            "in_receiver": True,
+        }
+        return ReceiverInput(self.name, static_ranges=ranges, static_rcs=rcs)
 
     def apply(self, data: Received, context: SceneContext) -> Received:
         """The received data plus clutter. The patches' responses and wind-blown processes are

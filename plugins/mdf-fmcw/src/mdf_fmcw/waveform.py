@@ -47,7 +47,9 @@ from mdframework.settings import (
 from .presets import PRESETS
 
 if TYPE_CHECKING:
-    from mdframework.interfaces import PulseBlock
+    from collections.abc import Sequence
+
+    from mdframework.interfaces import PulseBlock, ReceiverInput
     from mdframework.physics.spectrogram import Spectrogram, SpectrogramGeometry
     from mdframework.settings import ProcessingConfig
 
@@ -316,6 +318,10 @@ class FmcwRadar(RadarWaveform):
         self.sequence = self.config.sequence()
         #: bytes of the record's kept range-Doppler maps (set by start_record)
         self._maps_bytes = 0
+        #: the record's received-stage effects simulated in the IF (set_receiver_inputs)
+        self._inputs: list[ReceiverInput] = []
+        #: the static scatterers' range profiles of one frame, by radar position
+        self._static: tuple[tuple[float, ...], NDArray[np.complex128] | None] | None = None
         #: blocks hold whole frames
         self.block_multiple = self.sequence.chirps_per_frame
         #: ``c / (2 B)`` [m] over the sampled part of the ramp (``B`` = slope x n_samples /
@@ -537,6 +543,9 @@ class FmcwRadar(RadarWaveform):
                 extra_ranges=extra,
                 noise=self._noise(index, antennas.rx.shape[0]) if block.receiver_noise else None,
             )
+            static = self._static_profiles(radar_position, sensor) if block.receiver_noise else None
+            if static is not None:
+                profiles += static
             signal[sl] = fmcw.gate_signal(
                 profiles, raxis, gate, c.gate_width, c.range_window, c.n_samples
             )
@@ -633,8 +642,63 @@ class FmcwRadar(RadarWaveform):
             max_range=c.detect_max_range or self.sequence.max_range,
             multi_peak=c.multi_object_threshold,
             tdm_compensation=c.tdm_compensation,
-            noise_floor=0.0 if c.receiver_noise else self.map_noise_power(),
+            noise_floor=0.0 if self._if_noise() else self.map_noise_power(),
         )
+
+    @property
+    def takes_receiver_inputs(self) -> bool:
+        """True when the radar makes range-Doppler maps or points (``points``,
+        ``save_range_doppler``): the received-stage effects that can (noise, static clutter)
+        then go into its IF samples, so that the maps, the points and the spectrogram all
+        carry them; without either, they act on the slow-time signal as with every radar."""
+        return self.config.points or self.config.save_range_doppler
+
+    def set_receiver_inputs(self, inputs: Sequence[ReceiverInput]) -> None:
+        """The record's effects in the IF samples: white noise per frame seeded by (the
+        input's ``noise_key``, frame index), static scatterers along the boresight."""
+        self._inputs = list(inputs)
+        self._static = None
+
+    def _if_noise(self) -> bool:
+        """Whether the IF samples carry noise (``receiver_noise`` or a noise effect)."""
+        return self.config.receiver_noise or any(i.noise_power > 0 for i in self._inputs)
+
+    def _static_profiles(
+        self, radar_position: FloatArray, sensor: FloatArray
+    ) -> NDArray[np.complex128] | None:
+        """The range profiles (chirps_per_frame, n_rx, n_range) of the static scatterers of the
+        receiver inputs (e.g. clutter patches), at their ranges along the boresight, the same
+        in every frame (they do not move: zero Doppler); None without any. Those at or beyond
+        the maximum range are left out, unless ``beyond_max_range = "alias"``. Made once per
+        record and radar position."""
+        key = tuple(float(v) for v in radar_position)
+        if self._static is not None and self._static[0] == key:
+            return self._static[1]
+        seq, c = self.sequence, self.config
+        ranges = np.concatenate([np.zeros(0), *(i.static_ranges for i in self._inputs)])
+        rcs = np.concatenate([np.zeros(0), *(i.static_rcs for i in self._inputs)])
+        if c.beyond_max_range != "alias":
+            keep = ranges < seq.max_range
+            ranges, rcs = ranges[keep], rcs[keep]
+        out = None
+        if ranges.size:
+            n = seq.n_tx  # one loop: every TDM slot once
+            positions = radar_position + ranges[:, None] * sensor[1]  # (P, 3) [m]
+            profiles = fmcw.chirp_profiles(
+                np.broadcast_to(positions, (n, *positions.shape)),
+                np.broadcast_to(c.amplitudes(rcs, ranges, seq.wavelength), (n, ranges.size)),
+                radar_position,
+                sensor,
+                seq,
+                self.antennas,
+                window_name=c.range_window,
+                n_fft=self.n_range,
+                path=c.path,
+                margin=c.analytic_margin,
+            )
+            out = np.tile(profiles, (seq.n_loops, 1, 1))
+        self._static = (key, out)
+        return out
 
     def thermal_noise_power(self) -> float:
         """The receiver's noise power per complex ADC sample, ``k T0 F fs`` [W], whether it is
@@ -667,18 +731,19 @@ class FmcwRadar(RadarWaveform):
             c.n_loops,
         )
 
-    def _noise(self, frame: int, n_rx: int) -> NDArray[np.complex128] | None:
-        """Complex white noise of one frame, (chirps_per_frame, n_rx, n_samples), seeded by
-        (noise_seed, frame index): the same whatever the blocks."""
-        power = self.noise_power()
-        if power == 0.0:
-            return None
-        rng = np.random.default_rng([self.config.noise_seed, frame])
+    def _noise(self, frame: int, n_rx: int) -> NDArray[np.complex64] | None:
+        """Complex white noise of one frame, (chirps_per_frame, n_rx, n_samples) complex64:
+        the receiver's (``receiver_noise``), seeded by (noise_seed, frame index), plus each
+        noise effect's in the IF, seeded by (its key, frame index): the same whatever the
+        blocks."""
         shape = (self.sequence.chirps_per_frame, n_rx, self.config.n_samples)
-        scale = np.sqrt(power / 2.0)
-        noise = np.empty(shape, dtype=np.complex128)  # real part drawn first, then imaginary
-        noise.real = rng.normal(0.0, scale, shape)
-        noise.imag = rng.normal(0.0, scale, shape)
+        draws = [(i.noise_power, i.noise_key) for i in self._inputs if i.noise_power > 0]
+        if self.config.receiver_noise:
+            draws.insert(0, (self.thermal_noise_power(), self.config.noise_seed))
+        noise: NDArray[np.complex64] | None = None
+        for power, key in draws:
+            one = complex_noise(np.random.default_rng([key, frame]), shape, power)
+            noise = one if noise is None else noise + one
         return noise
 
     def _check_ranges(self, ranges: FloatArray) -> None:
@@ -694,3 +759,15 @@ class FmcwRadar(RadarWaveform):
                 f"(maximum range {seq.max_range:.2f} m): raise sample_rate, lower slope, or "
                 "set beyond_max_range = 'alias'"
             )
+
+
+def complex_noise(
+    rng: np.random.Generator, shape: tuple[int, ...], power: float
+) -> NDArray[np.complex64]:
+    """Circular complex white Gaussian noise of ``power`` [W] per sample, complex64: float32
+    draws (real and imaginary parts of each sample in turn) straight into the complex64 buffer:
+    about 0.8 times the time of float64 draws into complex128 (docs/fmcw.md, Costs)."""
+    n = int(np.prod(shape))
+    out = rng.standard_normal(2 * n, dtype=np.float32).view(np.complex64).reshape(shape)
+    out *= np.float32(np.sqrt(power / 2.0))
+    return out

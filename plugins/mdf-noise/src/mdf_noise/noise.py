@@ -36,7 +36,11 @@ neighbouring cells' noise is in fact correlated over ``1/B``, which this does no
 
 A radar that adds its own receiver noise (the FMCW radar's ``receiver_noise``, which its
 presets turn on) refuses this effect: the noise would be counted twice, and ``snr_db`` would
-not be the SNR of the result.
+not be the SNR of the result. A radar that simulates the noise in its raw samples
+(``RadarWaveform.takes_receiver_inputs``: the FMCW radar making maps or points) gets it there
+(:meth:`ReceiverNoise.receiver_input`): ``k_B T F B_n`` per complex sample, ``B_n`` default its
+``sample_rate``; mode ``snr`` is then refused (its level follows from the record's mean echo,
+known only after the maps).
 """
 
 from __future__ import annotations
@@ -48,7 +52,15 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field, model_validator
 
-from mdframework import Effect, PluginConfig, RadarWaveform, Received, SceneContext, SceneError
+from mdframework import (
+    Effect,
+    PluginConfig,
+    RadarWaveform,
+    Received,
+    ReceiverInput,
+    SceneContext,
+    SceneError,
+)
 from mdframework.constants import BOLTZMANN
 from mdframework.settings import Bandwidth, Decibels, LossDb
 
@@ -142,6 +154,7 @@ class ReceiverNoise(Effect):
     def __init__(self, config: PluginConfig | None = None) -> None:
         super().__init__(config)
         self._power: float | None = None
+        self._in_receiver = False
 
     def check_radar(self, waveform: RadarWaveform) -> None:
         """Refuse a radar that adds receiver noise itself (``RadarWaveform.adds_receiver_noise``:
@@ -154,6 +167,14 @@ class ReceiverNoise(Effect):
                 "points and spectrogram: remove the noise effect (or set "
                 "radar.receiver_noise = false to have the effect's noise, which reaches the "
                 "spectrogram only)"
+            )
+        if waveform.takes_receiver_inputs and self.config.mode == "snr":
+            raise SceneError(
+                f"effects.noise.mode: 'snr' sets the noise from the record's mean echo, known "
+                f"only after the {waveform.name!r} radar has made its maps and points from IF "
+                "samples that must carry the noise: use mode 'thermal' (k T F B_n per IF "
+                "sample, in the maps, points and spectrogram), or radar.points = false and "
+                "radar.save_range_doppler = false for a spectrogram alone"
             )
         amplitude = getattr(getattr(waveform, "config", None), "amplitude", None)
         if self.config.mode == "thermal" and amplitude == "sqrt_rcs":
@@ -174,6 +195,28 @@ class ReceiverNoise(Effect):
                 "waveform does not give it, so set it in the effect"
             )
         return float(value)
+
+    def receiver_input(self, context: SceneContext) -> ReceiverInput | None:
+        """For a radar that simulates the noise in its raw samples (the FMCW radar making maps
+        or points; ``mode = "thermal"``, the only mode :meth:`check_radar` lets through):
+        ``k_B T F B_n`` per complex sample, ``B_n`` default the radar's ``sample_rate`` (the
+        complex ADC's noise bandwidth), drawn per frame from a key of this effect's stream."""
+        c = self.config
+        b_n = c.noise_bandwidth
+        if b_n is None:
+            rate = getattr(getattr(context.waveform, "config", None), "sample_rate", None)
+            if rate is None:
+                raise SceneError(
+                    "effects.noise: mode 'thermal' in the raw samples of the "
+                    f"{context.waveform.name!r} radar needs noise_bandwidth (it has no "
+                    "sample_rate): set it in the effect"
+                )
+            b_n = float(rate)
+        power = BOLTZMANN * c.temperature * 10.0 ** (c.noise_figure_db / 10.0) * b_n
+        self._power = power
+        self._in_receiver = True
+        key = int(context.rng.integers(2**63))
+        return ReceiverInput(self.name, noise_power=power, noise_key=key)
 
     def apply(self, data: Received, context: SceneContext) -> Received:
         """The received data plus noise of power :func:`noise_power`."""
@@ -197,5 +240,7 @@ class ReceiverNoise(Effect):
         return dataclasses.replace(data, signal=signal, range_time=range_time)
 
     def describe(self) -> dict[str, Any]:
-        """The config plus the noise power per compressed sample [W]."""
-        return {**self.config.model_dump(), "noise_power_w": self._power}
+        """The config plus the noise power per compressed sample [W] (per raw sample for a
+        radar that simulates it in its raw samples, then marked ``in_receiver``)."""
+        out = {**self.config.model_dump(), "noise_power_w": self._power}
+        return {**out, "in_receiver": True} if self._in_receiver else out

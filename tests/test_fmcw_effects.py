@@ -1,0 +1,196 @@
+"""Scene effects on the FMCW radar's IF samples: the ``clutter`` and ``noise`` effects reach its
+range-Doppler maps, its points and its spectrogram alike (docs/fmcw.md, docs/effects.md)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+from mdf_fmcw.waveform import FmcwConfig, FmcwRadar
+
+from mdframework.config import validate_run_config
+from mdframework.constants import SPEED_OF_LIGHT as C
+from mdframework.errors import SceneError
+from mdframework.physics import fmcw, radar
+from mdframework.pipeline import simulate
+
+#: the IWR1443 preset along +x, without the receiver's own noise
+RADAR = {
+    "kind": "fmcw",
+    "preset": "iwr1443_short_range_3d",
+    "boresight_azimuth_deg": 0.0,
+    "receiver_noise": False,
+}
+#: a target too faint to matter (1e-12 m^2), 3 m away, approaching at 1 m/s
+FAINT = [{"position": [3.0, 0.0, 0.0], "velocity": [-1.0, 0.0, 0.0], "rcs": 1e-12}]
+#: one clutter patch of 0.2 m^2 per range cell (before its Rayleigh draw), somewhere in
+#: 5.0-5.5 m: the gate fixed at 5 m, no margin, patches 0.5 m apart
+CLUTTER = {
+    "kind": "clutter",
+    "power": "rcs",
+    "rcs_m2": 0.2,
+    "wind_fraction": 0.0,
+    "patch_spacing_m": 0.5,
+    "margin_m": 0.0,
+}
+
+
+def run(
+    radar_: dict[str, Any],
+    effects: list[dict[str, Any]],
+    *,
+    length: float = 0.2,
+    seed: int = 0,
+    processing: dict[str, Any] | None = None,
+) -> Any:
+    """A faint point target seen by ``radar_`` at the origin, the gate fixed at 5 m."""
+    cfg = {
+        "motion": {"kind": "point_targets", "length": length, "targets": FAINT},
+        "scatterers": {"kind": "points"},
+        "radar": radar_,
+        "scene": {"radar_position": [0.0, 0.0, 0.0], "gate": 5.0},
+        "effects": effects,
+        "processing": processing or {},
+        "seed": seed,
+    }
+    return simulate(validate_run_config(cfg))
+
+
+@pytest.mark.parametrize("path", ["analytic", "raw"])
+def test_a_clutter_patch_is_in_the_maps_at_its_range_bin_and_zero_doppler(path: str) -> None:
+    """A static clutter patch (power 'rcs', no wind) goes into the IF samples: its peak is in
+    the range bin of its range, in the zero-Doppler row, at the power the range equation gives
+    through the range window's response at its offset from the bin (to 0.1 %), summed over the
+    12 virtual antennas; the CFAR turns it into points there at 0 m/s; the spectrogram's
+    slow-time signal carries the same patch at its amplitude, constant over the frame's loops
+    (zero Doppler); clutter_removal removes it from the maps and the points. Both paths."""
+    fields = {**RADAR, "clutter_removal": False, "path": path}
+    res = run(fields, [CLUTTER])
+    clean = run(fields, [])
+    [effect] = res.metadata["effects"]
+    lo, hi = effect["patch_range_m"]
+    assert effect["n_patches"] == 1 and lo == hi and 5.0 <= lo < 5.5
+    r, rcs = lo, effect["clutter_rcs_m2"]
+    wf = FmcwRadar(FmcwConfig(**fields))
+    seq = wf.sequence
+    amp = float(wf.config.amplitudes(np.array([rcs]), np.array([r]), seq.wavelength)[0])
+    rd = res.received.products["range_doppler"]  # (n_frames, 16, 240) [W]
+    n_dop, n_rng = rd.shape[1:]
+    zero = (n_dop - 1) // 2
+    assert res.received.products["range_doppler_velocity_mps"][zero] == 0.0
+    k = round(2 * seq.slope * r / C / seq.sample_rate * n_rng)
+    for frame in rd:
+        peak = np.unravel_index(np.argmax(frame), frame.shape)
+        assert peak == (zero, k)
+    # the range window's response at the patch's offset from bin k (stop-and-hop delay 2 r / c)
+    w = fmcw.window("hann", seq.n_samples)
+    nu = k / n_rng - 2 * seq.slope * r / C / seq.sample_rate
+    gain = abs(np.sum(w * np.exp(2j * np.pi * nu * np.arange(seq.n_samples)))) / np.sum(w)
+    expected = 12 * amp**2 * gain**2
+    assert rd[:, zero, k] == pytest.approx(expected, rel=1e-3)
+    assert amp**2 == pytest.approx(
+        radar.scatterer_amplitudes(
+            np.array([rcs]),
+            np.array([r]),
+            model="range_equation",
+            wavelength=seq.wavelength,
+            transmit_power=wf.config.transmit_power,
+        )[0]
+        ** 2
+    )
+    # points at the patch's range at 0 m/s (clutter removal off, as the preset has it)
+    pts = res.received.products["points"]
+    near = np.abs(np.linalg.norm(pts[:, 2:5], axis=1) - r) < 2 * seq.range_resolution
+    assert near.any() and np.all(pts[near, 5] == 0.0)
+    assert not (
+        np.abs(np.linalg.norm(clean.received.products["points"][:, 2:5], axis=1) - r) < 0.1
+    ).any()
+    # the spectrogram's signal: the patch at its amplitude (gate 5 m, 2 m wide), the same in
+    # every loop of a TDM slot
+    diff = res.received.signal - clean.received.signal
+    slot0 = diff[:: seq.n_tx]
+    assert np.abs(slot0) == pytest.approx(amp, rel=1e-2)
+    assert np.ptp(slot0.real) < 1e-6 * amp and np.ptp(slot0.imag) < 1e-6 * amp
+    # clutter removal: the static patch is gone from the maps and the points
+    removed = run({**fields, "clutter_removal": True}, [CLUTTER])
+    assert removed.received.products["range_doppler"][:, :, k].max() < 1e-9 * expected
+    pts = removed.received.products["points"]
+    assert not (np.abs(np.linalg.norm(pts[:, 2:5], axis=1) - r) < 2 * seq.range_resolution).any()
+
+
+def test_the_noise_effect_fills_the_map_cells_with_the_analytic_mean_noise() -> None:
+    """The noise effect (mode 'thermal') goes into the IF samples: k T F fs per complex sample
+    (10 dB, 290 K), so each map cell holds on average 12 x that x the range and Doppler window
+    gains (sum w^2 / (sum w)^2), to 2 % over 30 frames; the slow-time signal carries noise of
+    the same draws (it differs from the noise-free run's); a record cut in small blocks gives
+    the same maps, points and signal; the seed sets the draws."""
+    noise = {"kind": "noise", "mode": "thermal", "noise_figure_db": 10.0}
+    res = run(RADAR, [noise], length=1.0)
+    rd = res.received.products["range_doppler"]
+    wf = FmcwRadar(FmcwConfig(**RADAR))
+    sigma2 = 1.380649e-23 * 290.0 * 10.0 * wf.config.sample_rate
+    assert res.metadata["effects"][0]["noise_power_w"] == pytest.approx(sigma2, rel=1e-12)
+    assert res.metadata["effects"][0]["in_receiver"] is True
+    expected = fmcw.map_noise_power(sigma2, 12, "hann", 240, "hann", 16)
+    assert rd.shape[0] == 30
+    assert float(np.mean(rd)) == pytest.approx(expected, rel=0.02)
+    clean = run(RADAR, [], length=1.0)
+    gated = np.mean(np.abs(res.received.signal - clean.received.signal) ** 2)
+    assert gated > 0.1 * sigma2
+    blocks = run(RADAR, [noise], length=1.0, processing={"block_pulses": 48})
+    assert np.array_equal(blocks.received.products["range_doppler"], rd)
+    assert np.array_equal(blocks.received.products["points"], res.received.products["points"])
+    assert np.array_equal(blocks.received.signal, res.received.signal)
+    other = run(RADAR, [noise], length=1.0, seed=1)
+    assert not np.array_equal(other.received.products["range_doppler"], rd)
+
+
+def test_cfar_false_points_on_noise_alone_match_the_threshold() -> None:
+    """Noise alone (the noise effect in the IF, rectangular range window so that range cells
+    are independent): the power summed over 12 virtual antennas is Gamma(12)-distributed, so a
+    cell-averaging CFAR over N = 16 training cells at threshold t (2 dB) passes a cell with
+    probability P(X > t S / N), X ~ Gamma(12), S ~ Gamma(12 N): the Beta(12, 12 N) tail at
+    c / (1 + c), c = t / N (4.09 %). The points on the range bins with all their training
+    cells, over 30 frames, come to that rate within 5 %."""
+    from scipy.stats import beta
+
+    fields = {
+        **RADAR,
+        "range_window": "rect",
+        "peak_grouping": [],
+        "multi_object_threshold": None,
+        "cfar_range": {"mode": "ca", "train": 8, "guard": 2, "threshold_db": 2.0},
+    }
+    noise = {"kind": "noise", "mode": "thermal", "noise_figure_db": 10.0}
+    res = run(fields, [noise], length=1.0)
+    pts = res.received.products["points"]
+    n_frames, n_dop, n_rng = res.received.products["range_doppler"].shape
+    bins = np.rint(
+        np.linalg.norm(pts[:, 2:5], axis=1)
+        / FmcwRadar(FmcwConfig(**fields)).sequence.range_resolution
+    )
+    interior = (bins >= 10) & (bins < n_rng - 10)
+    c = 10**0.2 / 16
+    p_fa = beta.sf(c / (1 + c), 12, 12 * 16)
+    assert p_fa == pytest.approx(0.0409, abs=5e-4)
+    rate = interior.sum() / (n_frames * n_dop * (n_rng - 20))
+    assert rate == pytest.approx(p_fa, rel=0.05)
+
+
+@pytest.mark.parametrize(
+    ("effect", "field"),
+    [
+        ({"kind": "noise", "snr_db": 20.0}, "effects.noise.mode"),
+        ({**CLUTTER, "power": "csr"}, "effects.clutter.power"),
+        ({**CLUTTER, "wind_fraction": 0.3}, "effects.clutter.wind_fraction"),
+    ],
+)
+def test_effects_that_cannot_reach_the_maps_are_refused(effect: dict[str, Any], field: str) -> None:
+    """A noise level or a clutter power set from the record's mean echo, and wind-blown clutter,
+    cannot go into the IF samples the maps are made from: one error naming the field. Without
+    maps and points the effect acts on the spectrogram's signal as with every radar."""
+    with pytest.raises(SceneError, match=rf"^{field}: "):
+        run(RADAR, [effect])
+    alone = {**RADAR, "points": False, "save_range_doppler": False}
+    assert not np.array_equal(run(alone, [effect]).received.signal, run(alone, []).received.signal)
