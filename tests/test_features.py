@@ -22,13 +22,16 @@ def tone_signal(velocity_of_t: list[tuple[np.ndarray, float]], t: np.ndarray) ->
     return y
 
 
-def synthetic_walk(window: int) -> tuple[np.ndarray, np.ndarray, float]:
-    """physics.md 4.2: torso 1.1 + 0.15 sin(2 pi 1.8 t), limb 1.1 + 2.6 sin(2 pi 0.9 t) at 0.3."""
-    t = np.arange(int(6 * PRF)) / PRF
+def synthetic_walk(
+    window: int, hop: int = 32, nfft: int = 4096, length: float = 6.0, limb_amplitude: float = 0.3
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """physics.md 4.2: torso 1.1 + 0.15 sin(2 pi 1.8 t), limb 1.1 + 2.6 sin(2 pi 0.9 t) at 0.3,
+    ``length`` seconds at 15 GHz and PRF 2400 Hz."""
+    t = np.arange(int(length * PRF)) / PRF
     torso = 1.1 + 0.15 * np.sin(2 * np.pi * 1.8 * t)
     limb = 1.1 + 2.6 * np.sin(2 * np.pi * 0.9 * t)
-    y = tone_signal([(torso, 1.0), (limb, 0.3)], t)
-    s = spectrogram(y, PRF, window_length=window, hop=32, nfft=4096)
+    y = tone_signal([(torso, 1.0), (limb, limb_amplitude)], t)
+    s = spectrogram(y, PRF, window_length=window, hop=hop, nfft=nfft)
     vel = radar.doppler_to_velocity(s.doppler, FC)
     resolution = LAMBDA / 2 / (window / PRF)  # velocity resolution of the window [m/s]
     return s.power, vel, resolution
@@ -64,7 +67,8 @@ def test_percentile_method_on_the_synthetic_walk() -> None:
 
 def test_the_datasets_page_quotes_the_synthetic_walk() -> None:
     """docs/datasets.md gives features 1-4 of this walk for both envelope methods (it once
-    gave numbers of an older spectrogram for the threshold method)."""
+    gave numbers of an older spectrogram for the threshold method), with every setting a
+    reader needs to get them (it once left out the FFT size, whose default gives others)."""
     import re
 
     from conftest import ROOT
@@ -76,7 +80,18 @@ def test_the_datasets_page_quotes_the_synthetic_walk() -> None:
         page,
     )
     assert quoted is not None
-    power, vel, _ = synthetic_walk(256)
+    setup = re.search(
+        r"On a synthetic walk \((\d+) s of a torso at 1\.1 \+ 0\.15 sin\(2 pi 1\.8 t\) m/s and a "
+        r"limb at 1\.1 \+ 2\.6 sin\(2 pi 0\.9 t\) m/s of amplitude ([\d.]+), -([\d.]+) dB, at "
+        r"15 GHz; Hann window of (\d+) pulses at 2400 Hz, hop (\d+), a (\d+)-point FFT",
+        page,
+    )
+    assert setup is not None
+    length, amplitude, below_db, window, hop, nfft = setup.groups()
+    assert float(below_db) == pytest.approx(-20 * np.log10(float(amplitude)), abs=0.05)
+    power, vel, _ = synthetic_walk(
+        int(window), int(hop), int(nfft), float(length), float(amplitude)
+    )
     for text, options in zip(
         quoted.groups(), [{}, {"method": "percentile", "floor_db": -60.0}], strict=True
     ):
