@@ -165,8 +165,7 @@ class ReceiverNoise(Effect):
                 f"effects.noise: the {waveform.name!r} radar adds receiver noise itself "
                 "(for fmcw: radar.receiver_noise = true, as its presets set it), in its maps, "
                 "points and spectrogram: remove the noise effect (or set "
-                "radar.receiver_noise = false to have the effect's noise, which reaches the "
-                "spectrogram only)"
+                "radar.receiver_noise = false to have the effect's noise instead)"
             )
         if waveform.takes_receiver_inputs and self.config.mode == "snr":
             raise SceneError(
