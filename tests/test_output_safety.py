@@ -5,6 +5,7 @@ reproduction: the files named there used to be deleted, or left half swapped."""
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 import textwrap
@@ -262,3 +263,27 @@ def test_a_build_stopped_between_its_index_files_is_refused_until_finished(
     monkeypatch.setattr(dataset, "atomic_write_text", real)
     assert mdf(args, capsys)[0] == 0
     assert len(dataset.load_dataset(out).labels) == 1
+
+
+@pytest.mark.parametrize("kind", ["link", "fifo"])
+def test_a_lock_file_that_is_a_link_or_a_pipe_is_refused_untouched(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], kind: str
+) -> None:
+    """A received folder whose ``.mdf.lock`` is a link to a file elsewhere (or a pipe): the
+    command refuses it with one line, and the linked file is not truncated or written (the
+    lock's holder details were written through the link, even when the folder was then
+    refused)."""
+    precious = tmp_path / "precious.txt"
+    precious.write_text("the user's data\n")
+    out = tmp_path / "received"
+    out.mkdir()
+    if kind == "link":
+        (out / outdir.LOCK).symlink_to(Path("..") / "precious.txt")
+    else:
+        os.mkfifo(out / outdir.LOCK)
+    code, err = mdf(["run", str(POINT), "--out", str(out)], capsys)
+    assert code == 2
+    (line,) = err.strip().splitlines()
+    assert line.startswith(f"mdf: error: --out {out}: holds {outdir.LOCK} as a link"), line
+    assert precious.read_text() == "the user's data\n"
+    assert sorted(p.name for p in out.iterdir()) == [outdir.LOCK]

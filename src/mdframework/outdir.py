@@ -324,9 +324,9 @@ def lock_holder(folder: Path) -> dict[str, Any] | None:
     for an instant (shared), not kept."""
     path = folder / LOCK
     try:
-        fd = os.open(path, os.O_RDONLY)
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)  # (a pipe: no wait)
     except OSError:
-        return None  # no lock file: no command holds the folder
+        return None  # no lock file (or a link, which no command holds): no command holds it
     try:
         fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
     except OSError as exc:  # held, or a file system without locks: nothing to tell
@@ -370,13 +370,18 @@ def acquire_lock(folder: Path, command: str) -> int:
     over (the kernel released its ``flock`` when it died)."""
     path = folder / LOCK
     for _ in range(10):
-        try:
-            fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+        try:  # never through a link (a received folder's lock must not name a file elsewhere)
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_NONBLOCK, 0o666)
         except OSError as exc:
+            if exc.errno == errno.ELOOP or os.path.islink(path):
+                raise _not_a_lock(folder) from None
             raise OutputError(
                 f"--out {folder}: cannot write into the folder ({exc.strerror}); choose a "
                 "folder you can write to"
             ) from None
+        if not stat.S_ISREG(os.fstat(fd).st_mode):  # a pipe or a device, never written
+            os.close(fd)
+            raise _not_a_lock(folder)
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as exc:
@@ -398,6 +403,13 @@ def acquire_lock(folder: Path, command: str) -> int:
             continue
         return _write_holder(fd, command)
     raise OutputError(f"--out {folder}: could not take the lock {path}; try again")
+
+
+def _not_a_lock(folder: Path) -> OutputError:
+    return OutputError(
+        f"--out {folder}: holds {LOCK} as a link or a special file, not the lock file mdf "
+        "writes (a folder from elsewhere?); remove it, or choose another folder"
+    )
 
 
 def release_lock(folder: Path, fd: int) -> None:
