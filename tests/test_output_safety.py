@@ -287,3 +287,25 @@ def test_a_lock_file_that_is_a_link_or_a_pipe_is_refused_untouched(
     assert line.startswith(f"mdf: error: --out {out}: holds {outdir.LOCK} as a link"), line
     assert precious.read_text() == "the user's data\n"
     assert sorted(p.name for p in out.iterdir()) == [outdir.LOCK]
+
+
+def test_a_dataset_whose_records_folder_is_a_link_is_refused_untouched(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A received dataset folder whose ``records`` links to a folder elsewhere: a build (with
+    --force too) refuses it with one line, before writing a record there or removing one of
+    the record-named files it holds (an earlier config's records are removed on a rebuild)."""
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    (elsewhere / "00099-aaaaaaaaaa.npz").write_bytes(b"a record of another dataset")
+    before = tree(elsewhere)
+    out = tmp_path / "received"
+    out.mkdir()
+    (out / "records").symlink_to(Path("..") / "elsewhere")
+    for force in ([], ["--force"]):
+        code, err = mdf([*one_record_dataset(tmp_path, out), *force], capsys)
+        assert code == 2
+        (line,) = err.strip().splitlines()
+        assert line.startswith(f"mdf: error: --out {out}: "), line
+        assert "its 'records' is a link" in line or not force, line
+        assert tree(elsewhere) == before

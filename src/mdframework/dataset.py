@@ -2067,9 +2067,15 @@ _PARTIAL_NAME = re.compile(r"\.tmp-\w+\.(part|npz)")  # .npz: earlier versions
 
 def _refuse_names_in_the_way(out: Path) -> None:
     """:class:`OutputError` for a name the build writes that holds the other kind of entry: a
-    file (anything but a folder) named ``records``, a folder named as one of the index files.
+    file (anything but a folder) named ``records``, a folder named as one of the index files;
+    and for ``records`` that is a link (to a folder outside ``out``).
     Checked before anything is written, with ``--force`` too (which replaces files of the
     dataset's names, never a folder, and needs ``records`` to be one)."""
+    if (out / RECORDS).is_symlink():  # its records would be written, and removed, elsewhere
+        raise OutputError(
+            f"--out {out}: its {RECORDS!r} is a link to another folder, where `mdf dataset` "
+            "would write and remove records; replace it with a folder or choose another folder"
+        )
     for name in DATASET_FILES:
         path = out / name
         if not os.path.lexists(path) or path.is_dir() == (name == RECORDS):
