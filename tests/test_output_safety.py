@@ -309,3 +309,31 @@ def test_a_dataset_whose_records_folder_is_a_link_is_refused_untouched(
         assert line.startswith(f"mdf: error: --out {out}: "), line
         assert "its 'records' is a link" in line or not force, line
         assert tree(elsewhere) == before
+
+
+@pytest.mark.parametrize("linked", ["aside", "stage"])
+def test_a_received_marker_cannot_move_files_from_elsewhere_into_out(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], linked: str
+) -> None:
+    """A received folder whose marker records a swap killed half done, with the staging folder
+    (or the folder of replaced files in it) a link to a folder of the user's: undoing the swap
+    moved the user's files out of that folder into --out. Nothing outside --out moves now."""
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "id_rsa").write_text("secret\n")
+    before = tree(mine)
+    out = tmp_path / "received"
+    stage = out / ".mdf-staging-run-x"
+    if linked == "aside":
+        stage.mkdir(parents=True)
+        (stage / ".mdf-aside").symlink_to(Path("..") / ".." / "mine")
+    else:
+        out.mkdir()
+        (mine / ".mdf-aside").mkdir()
+        (mine / ".mdf-aside" / "notes.txt").write_text("mine too\n")
+        before = tree(mine)
+        stage.symlink_to(mine)
+    swap = {"stage": str(stage), "new": [], "previous_marker": None}
+    (out / ".mdf-run.json").write_text(json.dumps({"command": "run", "swap": swap}))
+    mdf(["run", str(POINT), "--out", str(out)], capsys)
+    assert tree(mine) == before

@@ -628,21 +628,33 @@ def _undo_swap(folder: Path, command: str) -> None:
     stage = Path(str(swap.get("stage", "")))
     new = swap.get("new")
     before = swap.get("previous_marker")
-    if not stage.name.startswith(STAGING_PREFIX) or not stage.is_dir() or not isinstance(new, list):
-        # the staging folder is gone (another command swept its --staging-dir): what moved
-        # in stays, as files the earlier output did not write
+    aside = stage / _ASIDE
+    if (
+        not stage.name.startswith(STAGING_PREFIX)
+        or not _real_folder(stage)
+        or (os.path.lexists(aside) and not _real_folder(aside))
+        or not isinstance(new, list)
+    ):
+        # the staging folder is gone (another command swept its --staging-dir), or is not
+        # one a command made (a link): what moved in stays, as files the earlier output did
+        # not write
         _restore_marker(path, before if isinstance(before, str) else None)
         return
     for name in new:
         if isinstance(name, str) and "/" not in name and not (stage / name).exists():
             (folder / name).unlink(missing_ok=True)  # moved in: the new output's
-    aside = stage / _ASIDE
     if aside.is_dir():
         for old in aside.iterdir():
             os.replace(old, folder / old.name)
     _restore_marker(path, before if isinstance(before, str) else None)
     shutil.rmtree(stage, ignore_errors=True)
     _fsync_dir(folder)
+
+
+def _real_folder(path: Path) -> bool:
+    """A folder, not a link to one (a received folder's marker may name any path: a swap is
+    undone only between real staging folders, never moving files from where a link points)."""
+    return path.is_dir() and not path.is_symlink()
 
 
 def _sweep_stale_stages(where: Path) -> None:
