@@ -195,6 +195,24 @@ def test_nesting_is_limited_at_the_documented_depth(tmp_path: Path, fmt: str) ->
         read_config_file(deeper)
 
 
+def test_yaml_aliases_that_expand_exponentially_are_refused_at_once(tmp_path: Path) -> None:
+    """A "billion laughs" YAML config (aliases of aliases: 10 ** 10 values in 400 bytes) is
+    refused in seconds naming the file (the nesting check walked every expanded value, and
+    hung); aliases that a config may reasonably use still read."""
+    lines = ["a0: &a0 [" + ", ".join(["1"] * 10) + "]"]
+    lines += [f"a{i}: &a{i} [" + ", ".join([f"*a{i - 1}"] * 10) + "]" for i in range(1, 10)]
+    laughs = tmp_path / "laughs.yaml"
+    laughs.write_text("\n".join(lines) + "\nseed: *a9\n")
+    t0 = time.perf_counter()
+    with pytest.raises(ConfigError, match="YAML aliases") as exc:
+        read_config_file(laughs)
+    assert time.perf_counter() - t0 < 30
+    assert str(exc.value).startswith(f"{laughs}: more than {limits.MAX_CONFIG_BYTES:,} values")
+    few = tmp_path / "few.yaml"
+    few.write_text("\n".join(lines[:3]) + "\nseed: *a2\n")  # 1,000 values
+    assert len(read_config_file(few)["seed"]) == 10
+
+
 def test_config_size_is_limited(tmp_path: Path) -> None:
     big = tmp_path / "big.toml"
     big.write_text(GOOD + "# " + "x" * limits.MAX_CONFIG_BYTES + "\n")
