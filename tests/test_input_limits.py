@@ -379,6 +379,29 @@ def test_plugin_configs_inherit_the_finite_rule() -> None:
         Strict(x=math.nan)
 
 
+def test_a_spectrogram_beyond_the_limit_is_refused_before_any_pulse(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A config asking for a spectrogram of trillions of values (1 MHz PRF, a hop of 1 pulse,
+    2**20 Doppler bins): `mdf check` called it valid and `mdf run` simulated every pulse, then
+    failed with an internal MemoryError (or, short of that, filled the memory). Both refuse it
+    with one line naming processing.hop; the largest allowed one passes."""
+    from mdframework import cli
+
+    walk = str(EXAMPLES / "cmu_walk.toml")
+    huge = ["radar.prf=1000000", "radar.pulse_width=1e-7", "processing.nfft=1048576",
+            "processing.window_length=65536", "processing.hop=1"]  # fmt: skip
+    sets = [a for kv in huge for a in ("--set", kv)]
+    out = tmp_path / "out"
+    for argv in (["check", walk, *sets], ["run", walk, "--out", str(out), *sets]):
+        assert cli.main(argv) == 2
+        (line,) = capsys.readouterr().err.strip().splitlines()
+        assert f"{walk}: processing.hop: the spectrogram of 1048576 Doppler bins x " in line
+        assert f"the limit is {limits.MAX_SPECTROGRAM_CELLS:,}" in line
+    assert not out.exists()
+    limits.check_spectrogram_cells(2**20, 2**10, 4)  # at the limit
+
+
 def test_the_documented_limits_are_the_code_s() -> None:
     import re
 

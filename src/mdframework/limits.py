@@ -81,6 +81,10 @@ MAX_FRAME_CELLS = 2**24
 #: FMCW radar's range-Doppler map of every frame).
 MAX_PRODUCT_BYTES = 2**30
 
+#: Most values (Doppler bins x frames) in one record's spectrogram: 2**30, 4 GiB of float32
+#: power (a record of MAX_PULSES pulses with a hop of 8 and 1024 Doppler bins holds 6.4e8).
+MAX_SPECTROGRAM_CELLS = 2**30
+
 #: Bytes the streaming pipeline holds per pulse of a record (time, gate range, the complex
 #: slow-time signal and its float32 STFT input): with :data:`SCATTERER_PULSE_BYTES` per
 #: scatterer when the result keeps every scatterer (``processing.keep_scatterers``), the basis
@@ -148,6 +152,20 @@ def check_frame_cells(shape: tuple[int, ...], what: str, field: str) -> None:
             f"{field}: one frame's {what} ({' x '.join(map(str, shape))}) is {n:,} complex "
             f"values (about {_size(16.0 * n)}); the limit is {MAX_FRAME_CELLS:,}: use fewer "
             "loops, samples or antennas, or smaller FFT sizes"
+        )
+
+
+def check_spectrogram_cells(nfft: int, n_frames: int, item_bytes: int) -> None:
+    """Refuse a spectrogram of ``nfft`` Doppler bins x ``n_frames`` frames of more than
+    :data:`MAX_SPECTROGRAM_CELLS` values (``item_bytes`` per value, for the memory it would
+    take), before any pulse is computed. Raises :class:`SceneError`."""
+    n = float(nfft) * float(n_frames)
+    if n > MAX_SPECTROGRAM_CELLS:
+        raise SceneError(
+            f"processing.hop: the spectrogram of {nfft} Doppler bins x {n_frames} frames is "
+            f"{n:.4g} values (about {_size(item_bytes * n)} of memory); the limit is "
+            f"{MAX_SPECTROGRAM_CELLS:,}: raise processing.hop, lower processing.nfft or shorten "
+            "the record"
         )
 
 
