@@ -1512,8 +1512,17 @@ def _row(meta: dict[str, Any], feats: NDArray[np.float64]) -> dict[str, Any]:
 
 
 def read_record(path: Path) -> tuple[dict[str, NDArray[Any]], dict[str, Any]]:
-    """Arrays and metadata of one record file; raises if it is incomplete or corrupt."""
+    """Arrays and metadata of one record file; raises if it is incomplete or corrupt.
+
+    A build stores a record's arrays uncompressed, so the file holds every byte they take: a
+    compressed member (a few megabytes of a crafted file could expand into gigabytes) is a
+    corrupt record (``ValueError``), refused before anything is read from it."""
+    import zipfile
+
     with np.load(path) as data:
+        packed = [i.filename for i in data.zip.infolist() if i.compress_type != zipfile.ZIP_STORED]
+        if packed:
+            raise ValueError(f"{path}: {packed[0]} is compressed")
         arrays = {k: data[k] for k in ("spectrogram_db", "velocity_mps", "time_s", "features")}
         if "histograms" in data.files:
             arrays["histograms"] = data["histograms"]
