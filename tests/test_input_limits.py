@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import socket
 import time
 import tracemalloc
@@ -400,6 +401,29 @@ def test_a_spectrogram_beyond_the_limit_is_refused_before_any_pulse(
         assert f"the limit is {limits.MAX_SPECTROGRAM_CELLS:,}" in line
     assert not out.exists()
     limits.check_spectrogram_cells(2**20, 2**10, 4)  # at the limit
+
+
+@pytest.mark.parametrize(("kind", "name"), [("cmu", "walk.bvh"), ("table", "walk.csv")])
+@pytest.mark.parametrize("special", ["fifo", "dev-zero"])
+def test_a_motion_file_that_is_a_pipe_or_a_device_is_refused_unread(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], kind: str, name: str, special: str
+) -> None:
+    """A received folder's motion file that is a named pipe, or a link to ``/dev/zero``: the
+    run waited forever on the pipe, or read zeros until the memory ran out (an internal
+    MemoryError). It is one line naming the file, exit 2, before the file is opened."""
+    from mdframework import cli
+
+    path = tmp_path / name
+    if special == "fifo":
+        os.mkfifo(path)
+    else:
+        path.symlink_to("/dev/zero")
+    out = tmp_path / "out"
+    argv = ["run", str(EXAMPLES / "cmu_walk.toml"), "--out", str(out)]
+    assert cli.main([*argv, "--set", f"motion.kind={kind}", "--set", f"motion.file={path}"]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert line == f"mdf: error: {path}: cannot read: not a regular file (a pipe or a device?)"
+    assert not out.exists()
 
 
 def test_the_documented_limits_are_the_code_s() -> None:

@@ -179,6 +179,23 @@ def check_product_bytes(n_bytes: float, what: str, field: str) -> None:
         )
 
 
+def read_file_bytes(path: str | Path) -> bytes:
+    """The bytes of a regular file (or a link to one). A pipe or a device (a received folder's
+    motion file may be a link to ``/dev/zero``, or a named pipe) is refused before it is
+    opened: reading it would never end, or fill the memory. Raises
+    :class:`~mdframework.errors.DataFileError` naming the file."""
+    import stat
+
+    p = Path(path)
+    try:
+        if not stat.S_ISREG(p.stat().st_mode):
+            what = "a folder" if p.is_dir() else "not a regular file (a pipe or a device?)"
+            raise DataFileError(p, f"cannot read: {what}")
+        return p.read_bytes()
+    except OSError as exc:
+        raise DataFileError(p, f"cannot read: {exc.strerror or exc}") from None
+
+
 def read_text_file(
     path: str | Path, what: str, max_bytes: int | None = None, latin1: bool = False
 ) -> str:
@@ -197,9 +214,9 @@ def read_text_file(
             raise DataFileError(
                 p, f"{size:,} bytes is beyond the limit of {max_bytes:,} bytes for {what}"
             )
-        raw = p.read_bytes()
     except OSError as exc:
         raise DataFileError(p, f"cannot read: {exc.strerror or exc}") from None
+    raw = read_file_bytes(p)
     if b"\0" in raw:
         line = raw[: raw.index(b"\0")].count(b"\n") + 1
         raise DataFileError(p, f"binary data (a NUL byte): not {what}", line)
