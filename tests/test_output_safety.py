@@ -337,3 +337,23 @@ def test_a_received_marker_cannot_move_files_from_elsewhere_into_out(
     (out / ".mdf-run.json").write_text(json.dumps({"command": "run", "swap": swap}))
     mdf(["run", str(POINT), "--out", str(out)], capsys)
     assert tree(mine) == before
+
+
+@pytest.mark.parametrize("special", ["fifo", "devzero"])
+def test_a_marker_that_is_a_pipe_or_a_device_is_not_read(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], special: str
+) -> None:
+    """A received folder whose run marker is a named pipe or a link to ``/dev/zero``: reading
+    it waited forever, or filled the memory (an internal MemoryError). It is an unreadable
+    marker now: the run writes its files and a marker of its own in its place."""
+    out = tmp_path / "received"
+    out.mkdir()
+    marker = out / ".mdf-run.json"
+    if special == "fifo":
+        os.mkfifo(marker)
+    else:
+        marker.symlink_to("/dev/zero")
+    code, err = mdf(["run", str(POINT), "--out", str(out)], capsys)
+    assert code == 0, err
+    assert marker.is_file() and not marker.is_symlink()
+    assert json.loads(marker.read_text())["command"] == "run"

@@ -79,6 +79,7 @@ from .outdir import (
     lock_holder,
     marker_name,
     output_folder,
+    read_marker_text,
     safe_name,
     wait_for_files,
 )
@@ -2110,7 +2111,7 @@ INDEX_WRITING = "writing"
 def _index_half_written(root: Path) -> bool:
     """Whether the build of the dataset at ``root`` stopped while it wrote its index files."""
     try:
-        marker = json.loads((root / marker_name("dataset")).read_text(encoding="utf-8"))
+        marker = json.loads(read_marker_text(root / marker_name("dataset")))
     except (OSError, ValueError):
         return False
     return isinstance(marker, dict) and marker.get("index") == INDEX_WRITING

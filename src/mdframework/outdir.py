@@ -62,6 +62,26 @@ MARKER_TMP = ".mdf-tmp-"
 _INTERNAL = re.compile(r"^\.mdf(\.lock|-.+\.json|-staging-.*|-tmp-.*)$")
 
 
+#: the most bytes :func:`read_marker_text` reads (a dataset's marker holds up to a few configs)
+MAX_MARKER_BYTES = 64 * 1024 * 1024
+
+
+def read_marker_text(path: Path) -> str:
+    """The text of a small file a command wrote (a marker, a lock's details), never through a
+    link nor from a pipe or a device, and at most :data:`MAX_MARKER_BYTES`: a received folder's
+    marker that links to ``/dev/zero`` would otherwise be read until the memory runs out. Raises
+    ``OSError`` or ``ValueError`` (``UnicodeDecodeError``) for anything else, as a damaged
+    marker does."""
+    fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    with os.fdopen(fd, "rb") as fh:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise OSError(errno.EINVAL, "not a regular file", str(path))
+        raw = fh.read(MAX_MARKER_BYTES + 1)
+    if len(raw) > MAX_MARKER_BYTES:
+        raise ValueError(f"{path}: more than {MAX_MARKER_BYTES} bytes")
+    return raw.decode("utf-8")
+
+
 def marker_name(command: str) -> str:
     """The marker file of ``command``'s outputs, e.g. ``.mdf-run.json``."""
     return f"{MARKER_PREFIX}{command}{MARKER_SUFFIX}"
@@ -293,7 +313,7 @@ def _process_start(pid: int) -> str:
 def _read_holder(path: Path) -> dict[str, Any]:
     for _ in range(20):  # the holder writes its details right after taking the lock
         try:
-            info = json.loads(path.read_text(encoding="utf-8"))
+            info = json.loads(read_marker_text(path))
             if isinstance(info, dict) and "pid" in info:
                 return info
         except (OSError, ValueError):
@@ -524,8 +544,8 @@ class OutputFolder:
         aside.mkdir()
         marker_path = self.path / marker_name(self.command)
         try:
-            before: str | None = marker_path.read_text(encoding="utf-8")
-        except OSError:
+            before: str | None = read_marker_text(marker_path)
+        except (OSError, ValueError):
             before = None
         journal = {"stage": str(stage), "new": names, "previous_marker": before}
         with _signals_held():
@@ -619,7 +639,7 @@ def _undo_swap(folder: Path, command: str) -> None:
     Called with the folder's lock held, before staging folders are swept."""
     path = folder / marker_name(command)
     try:
-        marker = json.loads(path.read_text(encoding="utf-8"))
+        marker = json.loads(read_marker_text(path))
     except (OSError, ValueError):
         return
     swap = marker.get("swap") if isinstance(marker, dict) else None
@@ -714,7 +734,7 @@ def _inspect(out: Path, command: str, patterns: tuple[str, ...], force: bool) ->
     mine = marker_name(command)
     if mine in markers:
         try:
-            marker = json.loads((out / mine).read_text(encoding="utf-8"))
+            marker = json.loads(read_marker_text(out / mine))
         except (OSError, ValueError):
             marker = {}
         folder.marker = marker if isinstance(marker, dict) else {}
