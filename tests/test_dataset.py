@@ -139,6 +139,14 @@ def test_a_missing_or_corrupt_record_names_its_file_when_loaded(
     files[0].write_text("damaged\n")
     with pytest.raises(DataFileError, match=rf"^{re.escape(str(files[0]))}: .*mdf dataset build"):
         load_dataset(out, spectrograms=False, histograms=True)
+    # a compressed record (a received one could expand megabytes into gigabytes) is refused
+    # before anything is read from it: a build never compresses one
+    arrays, meta = read_record(files[2])
+    for damaged in files[:2]:
+        damaged.write_bytes(files[2].read_bytes())
+    np.savez_compressed(files[2], **arrays, meta=np.array(json.dumps(meta)))
+    with pytest.raises(DataFileError, match=rf"^{re.escape(str(files[2]))}: not a complete"):
+        load_dataset(out)
 
 
 def test_same_result_with_one_and_two_workers_and_dask(

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import socket
 import time
 import tracemalloc
@@ -195,6 +196,24 @@ def test_nesting_is_limited_at_the_documented_depth(tmp_path: Path, fmt: str) ->
         read_config_file(deeper)
 
 
+def test_yaml_aliases_that_expand_exponentially_are_refused_at_once(tmp_path: Path) -> None:
+    """A "billion laughs" YAML config (aliases of aliases: 10 ** 10 values in 400 bytes) is
+    refused in seconds naming the file (the nesting check walked every expanded value, and
+    hung); aliases that a config may reasonably use still read."""
+    lines = ["a0: &a0 [" + ", ".join(["1"] * 10) + "]"]
+    lines += [f"a{i}: &a{i} [" + ", ".join([f"*a{i - 1}"] * 10) + "]" for i in range(1, 10)]
+    laughs = tmp_path / "laughs.yaml"
+    laughs.write_text("\n".join(lines) + "\nseed: *a9\n")
+    t0 = time.perf_counter()
+    with pytest.raises(ConfigError, match="YAML aliases") as exc:
+        read_config_file(laughs)
+    assert time.perf_counter() - t0 < 30
+    assert str(exc.value).startswith(f"{laughs}: more than {limits.MAX_CONFIG_BYTES:,} values")
+    few = tmp_path / "few.yaml"
+    few.write_text("\n".join(lines[:3]) + "\nseed: *a2\n")  # 1,000 values
+    assert len(read_config_file(few)["seed"]) == 10
+
+
 def test_config_size_is_limited(tmp_path: Path) -> None:
     big = tmp_path / "big.toml"
     big.write_text(GOOD + "# " + "x" * limits.MAX_CONFIG_BYTES + "\n")
@@ -359,6 +378,52 @@ def test_plugin_configs_inherit_the_finite_rule() -> None:
 
     with pytest.raises(ValueError, match="finite"):
         Strict(x=math.nan)
+
+
+def test_a_spectrogram_beyond_the_limit_is_refused_before_any_pulse(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A config asking for a spectrogram of trillions of values (1 MHz PRF, a hop of 1 pulse,
+    2**20 Doppler bins): `mdf check` called it valid and `mdf run` simulated every pulse, then
+    failed with an internal MemoryError (or, short of that, filled the memory). Both refuse it
+    with one line naming processing.hop; the largest allowed one passes."""
+    from mdframework import cli
+
+    walk = str(EXAMPLES / "cmu_walk.toml")
+    huge = ["radar.prf=1000000", "radar.pulse_width=1e-7", "processing.nfft=1048576",
+            "processing.window_length=65536", "processing.hop=1"]  # fmt: skip
+    sets = [a for kv in huge for a in ("--set", kv)]
+    out = tmp_path / "out"
+    for argv in (["check", walk, *sets], ["run", walk, "--out", str(out), *sets]):
+        assert cli.main(argv) == 2
+        (line,) = capsys.readouterr().err.strip().splitlines()
+        assert f"{walk}: processing.hop: the spectrogram of 1048576 Doppler bins x " in line
+        assert f"the limit is {limits.MAX_SPECTROGRAM_CELLS:,}" in line
+    assert not out.exists()
+    limits.check_spectrogram_cells(2**20, 2**10, 4)  # at the limit
+
+
+@pytest.mark.parametrize(("kind", "name"), [("cmu", "walk.bvh"), ("table", "walk.csv")])
+@pytest.mark.parametrize("special", ["fifo", "dev-zero"])
+def test_a_motion_file_that_is_a_pipe_or_a_device_is_refused_unread(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], kind: str, name: str, special: str
+) -> None:
+    """A received folder's motion file that is a named pipe, or a link to ``/dev/zero``: the
+    run waited forever on the pipe, or read zeros until the memory ran out (an internal
+    MemoryError). It is one line naming the file, exit 2, before the file is opened."""
+    from mdframework import cli
+
+    path = tmp_path / name
+    if special == "fifo":
+        os.mkfifo(path)
+    else:
+        path.symlink_to("/dev/zero")
+    out = tmp_path / "out"
+    argv = ["run", str(EXAMPLES / "cmu_walk.toml"), "--out", str(out)]
+    assert cli.main([*argv, "--set", f"motion.kind={kind}", "--set", f"motion.file={path}"]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert line == f"mdf: error: {path}: cannot read: not a regular file (a pipe or a device?)"
+    assert not out.exists()
 
 
 def test_the_documented_limits_are_the_code_s() -> None:

@@ -5,6 +5,7 @@ reproduction: the files named there used to be deleted, or left half swapped."""
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 import textwrap
@@ -262,3 +263,97 @@ def test_a_build_stopped_between_its_index_files_is_refused_until_finished(
     monkeypatch.setattr(dataset, "atomic_write_text", real)
     assert mdf(args, capsys)[0] == 0
     assert len(dataset.load_dataset(out).labels) == 1
+
+
+@pytest.mark.parametrize("kind", ["link", "fifo"])
+def test_a_lock_file_that_is_a_link_or_a_pipe_is_refused_untouched(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], kind: str
+) -> None:
+    """A received folder whose ``.mdf.lock`` is a link to a file elsewhere (or a pipe): the
+    command refuses it with one line, and the linked file is not truncated or written (the
+    lock's holder details were written through the link, even when the folder was then
+    refused)."""
+    precious = tmp_path / "precious.txt"
+    precious.write_text("the user's data\n")
+    out = tmp_path / "received"
+    out.mkdir()
+    if kind == "link":
+        (out / outdir.LOCK).symlink_to(Path("..") / "precious.txt")
+    else:
+        os.mkfifo(out / outdir.LOCK)
+    code, err = mdf(["run", str(POINT), "--out", str(out)], capsys)
+    assert code == 2
+    (line,) = err.strip().splitlines()
+    assert line.startswith(f"mdf: error: --out {out}: holds {outdir.LOCK} as a link"), line
+    assert precious.read_text() == "the user's data\n"
+    assert sorted(p.name for p in out.iterdir()) == [outdir.LOCK]
+
+
+def test_a_dataset_whose_records_folder_is_a_link_is_refused_untouched(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A received dataset folder whose ``records`` links to a folder elsewhere: a build (with
+    --force too) refuses it with one line, before writing a record there or removing one of
+    the record-named files it holds (an earlier config's records are removed on a rebuild)."""
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    (elsewhere / "00099-aaaaaaaaaa.npz").write_bytes(b"a record of another dataset")
+    before = tree(elsewhere)
+    out = tmp_path / "received"
+    out.mkdir()
+    (out / "records").symlink_to(Path("..") / "elsewhere")
+    for force in ([], ["--force"]):
+        code, err = mdf([*one_record_dataset(tmp_path, out), *force], capsys)
+        assert code == 2
+        (line,) = err.strip().splitlines()
+        assert line.startswith(f"mdf: error: --out {out}: "), line
+        assert "its 'records' is a link" in line or not force, line
+        assert tree(elsewhere) == before
+
+
+@pytest.mark.parametrize("linked", ["aside", "stage"])
+def test_a_received_marker_cannot_move_files_from_elsewhere_into_out(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], linked: str
+) -> None:
+    """A received folder whose marker records a swap killed half done, with the staging folder
+    (or the folder of replaced files in it) a link to a folder of the user's: undoing the swap
+    moved the user's files out of that folder into --out. Nothing outside --out moves now."""
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "id_rsa").write_text("secret\n")
+    before = tree(mine)
+    out = tmp_path / "received"
+    stage = out / ".mdf-staging-run-x"
+    if linked == "aside":
+        stage.mkdir(parents=True)
+        (stage / ".mdf-aside").symlink_to(Path("..") / ".." / "mine")
+    else:
+        out.mkdir()
+        (mine / ".mdf-aside").mkdir()
+        (mine / ".mdf-aside" / "notes.txt").write_text("mine too\n")
+        before = tree(mine)
+        stage.symlink_to(mine)
+    swap = {"stage": str(stage), "new": [], "previous_marker": None}
+    (out / ".mdf-run.json").write_text(json.dumps({"command": "run", "swap": swap}))
+    mdf(["run", str(POINT), "--out", str(out)], capsys)
+    assert tree(mine) == before
+
+
+@pytest.mark.parametrize("special", ["fifo", "devzero"])
+def test_a_marker_that_is_a_pipe_or_a_device_is_not_read(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], special: str
+) -> None:
+    """A received folder whose run marker is a named pipe or a link to ``/dev/zero``: reading
+    it waited forever, or filled the memory (an internal MemoryError). It is an unreadable
+    marker now: the run writes its files and a marker of its own in its place."""
+    out = tmp_path / "received"
+    out.mkdir()
+    marker = out / ".mdf-run.json"
+    if special == "fifo":
+        os.mkfifo(marker)
+    else:
+        marker.symlink_to("/dev/zero")
+    code, err = mdf(["run", str(POINT), "--out", str(out)], capsys)
+    assert code == 0, err
+    assert marker.is_file() and not marker.is_symlink()
+    assert json.loads(marker.read_text())["command"] == "run"

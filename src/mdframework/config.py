@@ -209,10 +209,18 @@ def _json_object(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
 
 def _check_depth(p: Path, data: Any) -> None:
     """Refuse tables and lists nested deeper than ``limits.MAX_CONFIG_DEPTH`` (iteratively, so
-    that the check itself cannot overflow the stack)."""
+    that the check itself cannot overflow the stack), and data of more values than a config
+    file has bytes (YAML aliases of aliases, which would otherwise expand exponentially)."""
     stack: list[tuple[Any, int]] = [(data, 1)]
+    count = 0
     while stack:
         node, depth = stack.pop()
+        count += 1
+        if count > limits.MAX_CONFIG_BYTES:  # more values than bytes: YAML aliases repeated
+            raise ConfigError(
+                f"{p}: more than {limits.MAX_CONFIG_BYTES:,} values once its YAML aliases "
+                "(*name) are expanded; write the values out instead of nesting aliases"
+            )
         if depth > limits.MAX_CONFIG_DEPTH:
             raise ConfigError(
                 f"{p}: tables and lists are nested more than {limits.MAX_CONFIG_DEPTH} deep"

@@ -79,6 +79,7 @@ from .outdir import (
     lock_holder,
     marker_name,
     output_folder,
+    read_marker_text,
     safe_name,
     wait_for_files,
 )
@@ -1512,8 +1513,17 @@ def _row(meta: dict[str, Any], feats: NDArray[np.float64]) -> dict[str, Any]:
 
 
 def read_record(path: Path) -> tuple[dict[str, NDArray[Any]], dict[str, Any]]:
-    """Arrays and metadata of one record file; raises if it is incomplete or corrupt."""
+    """Arrays and metadata of one record file; raises if it is incomplete or corrupt.
+
+    A build stores a record's arrays uncompressed, so the file holds every byte they take: a
+    compressed member (a few megabytes of a crafted file could expand into gigabytes) is a
+    corrupt record (``ValueError``), refused before anything is read from it."""
+    import zipfile
+
     with np.load(path) as data:
+        packed = [i.filename for i in data.zip.infolist() if i.compress_type != zipfile.ZIP_STORED]
+        if packed:
+            raise ValueError(f"{path}: {packed[0]} is compressed")
         arrays = {k: data[k] for k in ("spectrogram_db", "velocity_mps", "time_s", "features")}
         if "histograms" in data.files:
             arrays["histograms"] = data["histograms"]
@@ -2067,9 +2077,15 @@ _PARTIAL_NAME = re.compile(r"\.tmp-\w+\.(part|npz)")  # .npz: earlier versions
 
 def _refuse_names_in_the_way(out: Path) -> None:
     """:class:`OutputError` for a name the build writes that holds the other kind of entry: a
-    file (anything but a folder) named ``records``, a folder named as one of the index files.
+    file (anything but a folder) named ``records``, a folder named as one of the index files;
+    and for ``records`` that is a link (to a folder outside ``out``).
     Checked before anything is written, with ``--force`` too (which replaces files of the
     dataset's names, never a folder, and needs ``records`` to be one)."""
+    if (out / RECORDS).is_symlink():  # its records would be written, and removed, elsewhere
+        raise OutputError(
+            f"--out {out}: its {RECORDS!r} is a link to another folder, where `mdf dataset` "
+            "would write and remove records; replace it with a folder or choose another folder"
+        )
     for name in DATASET_FILES:
         path = out / name
         if not os.path.lexists(path) or path.is_dir() == (name == RECORDS):
@@ -2095,7 +2111,7 @@ INDEX_WRITING = "writing"
 def _index_half_written(root: Path) -> bool:
     """Whether the build of the dataset at ``root`` stopped while it wrote its index files."""
     try:
-        marker = json.loads((root / marker_name("dataset")).read_text(encoding="utf-8"))
+        marker = json.loads(read_marker_text(root / marker_name("dataset")))
     except (OSError, ValueError):
         return False
     return isinstance(marker, dict) and marker.get("index") == INDEX_WRITING

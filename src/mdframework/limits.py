@@ -81,6 +81,10 @@ MAX_FRAME_CELLS = 2**24
 #: FMCW radar's range-Doppler map of every frame).
 MAX_PRODUCT_BYTES = 2**30
 
+#: Most values (Doppler bins x frames) in one record's spectrogram: 2**30, 4 GiB of float32
+#: power (a record of MAX_PULSES pulses with a hop of 8 and 1024 Doppler bins holds 6.4e8).
+MAX_SPECTROGRAM_CELLS = 2**30
+
 #: Bytes the streaming pipeline holds per pulse of a record (time, gate range, the complex
 #: slow-time signal and its float32 STFT input): with :data:`SCATTERER_PULSE_BYTES` per
 #: scatterer when the result keeps every scatterer (``processing.keep_scatterers``), the basis
@@ -151,6 +155,20 @@ def check_frame_cells(shape: tuple[int, ...], what: str, field: str) -> None:
         )
 
 
+def check_spectrogram_cells(nfft: int, n_frames: int, item_bytes: int) -> None:
+    """Refuse a spectrogram of ``nfft`` Doppler bins x ``n_frames`` frames of more than
+    :data:`MAX_SPECTROGRAM_CELLS` values (``item_bytes`` per value, for the memory it would
+    take), before any pulse is computed. Raises :class:`SceneError`."""
+    n = float(nfft) * float(n_frames)
+    if n > MAX_SPECTROGRAM_CELLS:
+        raise SceneError(
+            f"processing.hop: the spectrogram of {nfft} Doppler bins x {n_frames} frames is "
+            f"{n:.4g} values (about {_size(item_bytes * n)} of memory); the limit is "
+            f"{MAX_SPECTROGRAM_CELLS:,}: raise processing.hop, lower processing.nfft or shorten "
+            "the record"
+        )
+
+
 def check_product_bytes(n_bytes: float, what: str, field: str) -> None:
     """Refuse a record whose kept radar products (``what``) would take more than
     :data:`MAX_PRODUCT_BYTES`; ``field`` is what to change. Raises :class:`SceneError`."""
@@ -159,6 +177,23 @@ def check_product_bytes(n_bytes: float, what: str, field: str) -> None:
             f"{field}: {what} would take about {_size(n_bytes)} of memory; the limit is "
             f"{_size(MAX_PRODUCT_BYTES)}: shorten the record or set {field} = false"
         )
+
+
+def read_file_bytes(path: str | Path) -> bytes:
+    """The bytes of a regular file (or a link to one). A pipe or a device (a received folder's
+    motion file may be a link to ``/dev/zero``, or a named pipe) is refused before it is
+    opened: reading it would never end, or fill the memory. Raises
+    :class:`~mdframework.errors.DataFileError` naming the file."""
+    import stat
+
+    p = Path(path)
+    try:
+        if not stat.S_ISREG(p.stat().st_mode):
+            what = "a folder" if p.is_dir() else "not a regular file (a pipe or a device?)"
+            raise DataFileError(p, f"cannot read: {what}")
+        return p.read_bytes()
+    except OSError as exc:
+        raise DataFileError(p, f"cannot read: {exc.strerror or exc}") from None
 
 
 def read_text_file(
@@ -179,9 +214,9 @@ def read_text_file(
             raise DataFileError(
                 p, f"{size:,} bytes is beyond the limit of {max_bytes:,} bytes for {what}"
             )
-        raw = p.read_bytes()
     except OSError as exc:
         raise DataFileError(p, f"cannot read: {exc.strerror or exc}") from None
+    raw = read_file_bytes(p)
     if b"\0" in raw:
         line = raw[: raw.index(b"\0")].count(b"\n") + 1
         raise DataFileError(p, f"binary data (a NUL byte): not {what}", line)

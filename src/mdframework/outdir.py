@@ -62,6 +62,26 @@ MARKER_TMP = ".mdf-tmp-"
 _INTERNAL = re.compile(r"^\.mdf(\.lock|-.+\.json|-staging-.*|-tmp-.*)$")
 
 
+#: the most bytes :func:`read_marker_text` reads (a dataset's marker holds up to a few configs)
+MAX_MARKER_BYTES = 64 * 1024 * 1024
+
+
+def read_marker_text(path: Path) -> str:
+    """The text of a small file a command wrote (a marker, a lock's details), never through a
+    link nor from a pipe or a device, and at most :data:`MAX_MARKER_BYTES`: a received folder's
+    marker that links to ``/dev/zero`` would otherwise be read until the memory runs out. Raises
+    ``OSError`` or ``ValueError`` (``UnicodeDecodeError``) for anything else, as a damaged
+    marker does."""
+    fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    with os.fdopen(fd, "rb") as fh:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise OSError(errno.EINVAL, "not a regular file", str(path))
+        raw = fh.read(MAX_MARKER_BYTES + 1)
+    if len(raw) > MAX_MARKER_BYTES:
+        raise ValueError(f"{path}: more than {MAX_MARKER_BYTES} bytes")
+    return raw.decode("utf-8")
+
+
 def marker_name(command: str) -> str:
     """The marker file of ``command``'s outputs, e.g. ``.mdf-run.json``."""
     return f"{MARKER_PREFIX}{command}{MARKER_SUFFIX}"
@@ -293,7 +313,7 @@ def _process_start(pid: int) -> str:
 def _read_holder(path: Path) -> dict[str, Any]:
     for _ in range(20):  # the holder writes its details right after taking the lock
         try:
-            info = json.loads(path.read_text(encoding="utf-8"))
+            info = json.loads(read_marker_text(path))
             if isinstance(info, dict) and "pid" in info:
                 return info
         except (OSError, ValueError):
@@ -324,9 +344,9 @@ def lock_holder(folder: Path) -> dict[str, Any] | None:
     for an instant (shared), not kept."""
     path = folder / LOCK
     try:
-        fd = os.open(path, os.O_RDONLY)
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)  # (a pipe: no wait)
     except OSError:
-        return None  # no lock file: no command holds the folder
+        return None  # no lock file (or a link, which no command holds): no command holds it
     try:
         fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
     except OSError as exc:  # held, or a file system without locks: nothing to tell
@@ -370,13 +390,18 @@ def acquire_lock(folder: Path, command: str) -> int:
     over (the kernel released its ``flock`` when it died)."""
     path = folder / LOCK
     for _ in range(10):
-        try:
-            fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+        try:  # never through a link (a received folder's lock must not name a file elsewhere)
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_NONBLOCK, 0o666)
         except OSError as exc:
+            if exc.errno == errno.ELOOP or os.path.islink(path):
+                raise _not_a_lock(folder) from None
             raise OutputError(
                 f"--out {folder}: cannot write into the folder ({exc.strerror}); choose a "
                 "folder you can write to"
             ) from None
+        if not stat.S_ISREG(os.fstat(fd).st_mode):  # a pipe or a device, never written
+            os.close(fd)
+            raise _not_a_lock(folder)
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as exc:
@@ -398,6 +423,13 @@ def acquire_lock(folder: Path, command: str) -> int:
             continue
         return _write_holder(fd, command)
     raise OutputError(f"--out {folder}: could not take the lock {path}; try again")
+
+
+def _not_a_lock(folder: Path) -> OutputError:
+    return OutputError(
+        f"--out {folder}: holds {LOCK} as a link or a special file, not the lock file mdf "
+        "writes (a folder from elsewhere?); remove it, or choose another folder"
+    )
 
 
 def release_lock(folder: Path, fd: int) -> None:
@@ -512,8 +544,8 @@ class OutputFolder:
         aside.mkdir()
         marker_path = self.path / marker_name(self.command)
         try:
-            before: str | None = marker_path.read_text(encoding="utf-8")
-        except OSError:
+            before: str | None = read_marker_text(marker_path)
+        except (OSError, ValueError):
             before = None
         journal = {"stage": str(stage), "new": names, "previous_marker": before}
         with _signals_held():
@@ -607,7 +639,7 @@ def _undo_swap(folder: Path, command: str) -> None:
     Called with the folder's lock held, before staging folders are swept."""
     path = folder / marker_name(command)
     try:
-        marker = json.loads(path.read_text(encoding="utf-8"))
+        marker = json.loads(read_marker_text(path))
     except (OSError, ValueError):
         return
     swap = marker.get("swap") if isinstance(marker, dict) else None
@@ -616,21 +648,33 @@ def _undo_swap(folder: Path, command: str) -> None:
     stage = Path(str(swap.get("stage", "")))
     new = swap.get("new")
     before = swap.get("previous_marker")
-    if not stage.name.startswith(STAGING_PREFIX) or not stage.is_dir() or not isinstance(new, list):
-        # the staging folder is gone (another command swept its --staging-dir): what moved
-        # in stays, as files the earlier output did not write
+    aside = stage / _ASIDE
+    if (
+        not stage.name.startswith(STAGING_PREFIX)
+        or not _real_folder(stage)
+        or (os.path.lexists(aside) and not _real_folder(aside))
+        or not isinstance(new, list)
+    ):
+        # the staging folder is gone (another command swept its --staging-dir), or is not
+        # one a command made (a link): what moved in stays, as files the earlier output did
+        # not write
         _restore_marker(path, before if isinstance(before, str) else None)
         return
     for name in new:
         if isinstance(name, str) and "/" not in name and not (stage / name).exists():
             (folder / name).unlink(missing_ok=True)  # moved in: the new output's
-    aside = stage / _ASIDE
     if aside.is_dir():
         for old in aside.iterdir():
             os.replace(old, folder / old.name)
     _restore_marker(path, before if isinstance(before, str) else None)
     shutil.rmtree(stage, ignore_errors=True)
     _fsync_dir(folder)
+
+
+def _real_folder(path: Path) -> bool:
+    """A folder, not a link to one (a received folder's marker may name any path: a swap is
+    undone only between real staging folders, never moving files from where a link points)."""
+    return path.is_dir() and not path.is_symlink()
 
 
 def _sweep_stale_stages(where: Path) -> None:
@@ -690,7 +734,7 @@ def _inspect(out: Path, command: str, patterns: tuple[str, ...], force: bool) ->
     mine = marker_name(command)
     if mine in markers:
         try:
-            marker = json.loads((out / mine).read_text(encoding="utf-8"))
+            marker = json.loads(read_marker_text(out / mine))
         except (OSError, ValueError):
             marker = {}
         folder.marker = marker if isinstance(marker, dict) else {}

@@ -341,12 +341,17 @@ def spectrogram_geometry(
 ) -> SpectrogramGeometry:
     """The geometry of the spectrogram the radar ``wf`` makes of ``n_pulses`` pulses
     (:meth:`RadarWaveform.spectrogram_geometry`); a record too short for it is a
-    :class:`SceneError` naming ``processing.window_length``. ``mdf check`` reports it."""
+    :class:`SceneError` naming ``processing.window_length``, and one of more than
+    ``limits.MAX_SPECTROGRAM_CELLS`` values one naming ``processing.hop``. ``mdf check``
+    reports both."""
     try:
         with blame(wf, "spectrogram_geometry"):
-            return wf.spectrogram_geometry(n_pulses, proc)
+            geometry = wf.spectrogram_geometry(n_pulses, proc)
     except RecordTooShortError as exc:
         raise SceneError(f"processing.window_length: {exc}") from None
+    item_bytes = 4 if proc.precision == "float32" else 8
+    limits.check_spectrogram_cells(geometry.nfft, geometry.n_frames, item_bytes)
+    return geometry
 
 
 def processing_stft(

@@ -101,10 +101,7 @@ def read_lines(path: Path) -> list[str]:
 
     Raises :class:`DataFileError` if the file cannot be read.
     """
-    try:
-        raw = Path(path).read_bytes()
-    except OSError as exc:
-        raise DataFileError(path, f"cannot read: {exc.strerror or exc}") from None
+    raw = limits.read_file_bytes(path)
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError:
