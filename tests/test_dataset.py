@@ -149,6 +149,23 @@ def test_a_missing_or_corrupt_record_names_its_file_when_loaded(
         load_dataset(out)
 
 
+@pytest.mark.parametrize("name", ["index.csv", "dataset.json", "record"])
+def test_a_dataset_file_that_is_a_pipe_is_refused_unread(tmp_path: Path, name: str) -> None:
+    """A received dataset whose index, manifest or record file is a named pipe: loading it
+    (``mdf experiment``) waited forever on the pipe. It is one error naming the file, before
+    the file is opened."""
+    out = tmp_path / "ds"
+    (out / RECORDS).mkdir(parents=True)
+    header = ",".join(["id", "label", "group", *FEATURE_NAMES])
+    (out / "index.csv").write_text(f"{header}\nr0,walk,g0,{','.join(['1.0'] * 7)}\n")
+    (out / "dataset.json").write_text("{}")
+    path = out / RECORDS / "r0.npz" if name == "record" else out / name
+    path.unlink(missing_ok=True)
+    os.mkfifo(path)
+    with pytest.raises(DataFileError, match=rf"^{re.escape(str(path))}: "):
+        load_dataset(out)
+
+
 def test_same_result_with_one_and_two_workers_and_dask(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

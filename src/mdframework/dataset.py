@@ -1517,9 +1517,13 @@ def read_record(path: Path) -> tuple[dict[str, NDArray[Any]], dict[str, Any]]:
 
     A build stores a record's arrays uncompressed, so the file holds every byte they take: a
     compressed member (a few megabytes of a crafted file could expand into gigabytes) is a
-    corrupt record (``ValueError``), refused before anything is read from it."""
+    corrupt record (``ValueError``), refused before anything is read from it, and so is a
+    file that is not a regular one (a pipe, a device)."""
+    import stat
     import zipfile
 
+    if not stat.S_ISREG(os.stat(path).st_mode):  # a pipe would never end, a device fill memory
+        raise ValueError(f"{path}: not a regular file")
     with np.load(path) as data:
         packed = [i.filename for i in data.zip.infolist() if i.compress_type != zipfile.ZIP_STORED]
         if packed:
@@ -2204,12 +2208,12 @@ def _verified_index(root: Path) -> str:
     records."""
     index = root / INDEX
     rebuild = "run the same `mdf dataset build` again to rewrite it from the records"
-    data = index.read_bytes()
+    data = limits.read_file_bytes(index)  # (a received pipe or device: refused unread)
     manifest_path = root / MANIFEST
+    if not manifest_path.exists():
+        raise DataFileError(manifest_path, f"missing, though {INDEX} is there; {rebuild}")
     try:
-        manifest = json.loads(manifest_path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise DataFileError(manifest_path, f"missing, though {INDEX} is there; {rebuild}") from None
+        manifest = json.loads(limits.read_file_bytes(manifest_path).decode("utf-8"))
     except (ValueError, UnicodeDecodeError) as exc:
         raise DataFileError(
             manifest_path, f"not valid JSON ({' '.join(str(exc).split())}); {rebuild}"
