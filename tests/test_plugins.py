@@ -450,6 +450,62 @@ def test_an_effect_returning_none_is_named_in_one_line(
     ]
 
 
+def test_a_receiver_input_that_breaks_the_contract_names_the_effect() -> None:
+    """What an effect's ``receiver_input`` returns for a radar that takes it (the FMCW radar
+    making maps or points) is checked before the radar gets it: another type, a noise power
+    that is not finite, static ranges and RCS of other shapes or values are the effect's bug,
+    named so (the radar's receive() failed on them, and the radar was named); a valid one
+    reaches the radar."""
+    from types import SimpleNamespace
+    from typing import Literal
+
+    from mdframework import Effect, PluginConfig, ReceiverInput, SceneContext
+    from mdframework.pipeline import hand_to_radar
+
+    class LeakyConfig(PluginConfig):
+        """Nothing to configure."""
+
+        kind: Literal["leaky"] = "leaky"
+
+    class Leaky(Effect):
+        """Returns ``given`` from receiver_input."""
+
+        name = "leaky"
+        Config = LeakyConfig
+        stage = "received"
+        given: Any = None
+
+        def apply(self, data: Any, context: Any) -> Any:
+            return data
+
+        def receiver_input(self, context: SceneContext) -> Any:
+            return self.given
+
+    got: list[Any] = []
+    radar = SimpleNamespace(set_receiver_inputs=got.extend)
+    effect = Leaky()
+    stages: Any = SimpleNamespace(radar=radar, effects=(effect,))
+    rngs = [np.random.default_rng(0)]
+    times = np.arange(4) / 1e3
+    context = SceneContext(np.zeros(3), 1e3, 24e9, times, np.ones(4), None, radar, rngs[0])
+    ones = np.ones(3)
+    cases: list[tuple[Any, type[Exception], str]] = [
+        ({"noise_power": 1.0}, TypeError, "returned dict instead of ReceiverInput or None"),
+        (ReceiverInput("leaky", noise_power=np.nan), ValueError, "noise power of nan W"),
+        (ReceiverInput("leaky", static_ranges=ones), ValueError, r"\(3,\) and RCS of shape"),
+        (ReceiverInput("leaky", static_ranges=ones, static_rcs=-ones), ValueError, "finite"),
+    ]
+    for given, error, text in cases:
+        effect.given = given
+        with pytest.raises(error, match=text) as exc:
+            hand_to_radar(stages, context, rngs)
+        assert "in receiver_input() of the effects plugin 'leaky'" in exc.value.__notes__[0]
+    assert got == []
+    effect.given = ReceiverInput("leaky", static_ranges=ones, static_rcs=ones)
+    assert hand_to_radar(stages, context, rngs) == frozenset({0})
+    assert got == [effect.given]
+
+
 def test_an_interrupt_python_could_not_raise_ends_the_command_as_interrupted(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -32,6 +32,7 @@ from .interfaces import (
     PulseBlock,
     RadarWaveform,
     Received,
+    ReceiverInput,
     ScattererModel,
     Scatterers,
     SceneContext,
@@ -196,12 +197,35 @@ def hand_to_radar(
             continue
         with blame(effect, "receiver_input"):
             got = effect.receiver_input(replace(context, rng=rng))
+            if got is not None:
+                _check_receiver_input(got)
         if got is not None:
             inputs.append(got)
             handed.add(i)
     with blame(wf, "set_receiver_inputs"):
         wf.set_receiver_inputs(inputs)
     return frozenset(handed)
+
+
+def _check_receiver_input(got: Any) -> None:
+    """Refuse what an effect's ``receiver_input`` returned when it breaks the contract (the
+    radar would fail with it, named as the culprit): another type than :class:`ReceiverInput`,
+    a noise power that is not finite and >= 0, static ranges and RCS that are not two (P,)
+    arrays of finite values (RCS >= 0)."""
+    if not isinstance(got, ReceiverInput):
+        raise TypeError(
+            f"receiver_input() returned {type(got).__name__} instead of ReceiverInput or None"
+        )
+    if not (np.isfinite(got.noise_power) and got.noise_power >= 0):
+        raise ValueError(f"receiver_input() gave a noise power of {got.noise_power} W")
+    ranges, rcs = np.asarray(got.static_ranges), np.asarray(got.static_rcs)
+    if ranges.ndim != 1 or rcs.shape != ranges.shape:
+        raise ValueError(
+            f"receiver_input() gave static ranges of shape {ranges.shape} and RCS of shape "
+            f"{rcs.shape}, not (P,) each"
+        )
+    if not (np.all(np.isfinite(ranges)) and np.all(np.isfinite(rcs)) and np.all(rcs >= 0)):
+        raise ValueError("receiver_input() gave static ranges or RCS not finite (RCS >= 0)")
 
 
 def _check_effect_output(out: Any, data: Scatterers | Received) -> None:
