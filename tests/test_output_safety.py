@@ -311,6 +311,25 @@ def test_a_dataset_whose_records_folder_is_a_link_is_refused_untouched(
         assert tree(elsewhere) == before
 
 
+@pytest.mark.parametrize("target", ["a-file", "nothing"])
+def test_a_records_link_to_a_file_or_nothing_is_named_as_a_file_in_the_way(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], target: str
+) -> None:
+    """A dataset folder whose ``records`` is a link to a file, or to nothing: the build with
+    --force is refused naming the file in the way (the message said a link to another
+    folder)."""
+    out = tmp_path / "received"
+    out.mkdir()
+    if target == "a-file":
+        (tmp_path / target).write_text("a file of the user's\n")
+    (out / "records").symlink_to(tmp_path / target)
+    code, err = mdf([*one_record_dataset(tmp_path, out), "--force"], capsys)
+    assert code == 2
+    (line,) = err.strip().splitlines()
+    assert line.startswith(f"mdf: error: --out {out}: holds the file 'records', "), line
+    assert target == "nothing" or (tmp_path / target).read_text() == "a file of the user's\n"
+
+
 @pytest.mark.parametrize("linked", ["aside", "stage"])
 def test_a_received_marker_cannot_move_files_from_elsewhere_into_out(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], linked: str

@@ -2082,10 +2082,12 @@ _PARTIAL_NAME = re.compile(r"\.tmp-\w+\.(part|npz)")  # .npz: earlier versions
 def _refuse_names_in_the_way(out: Path) -> None:
     """:class:`OutputError` for a name the build writes that holds the other kind of entry: a
     file (anything but a folder) named ``records``, a folder named as one of the index files;
-    and for ``records`` that is a link (to a folder outside ``out``).
+    and for ``records`` that is a link to a folder (outside ``out``; one to a file, or to
+    nothing, is a file in the way).
     Checked before anything is written, with ``--force`` too (which replaces files of the
     dataset's names, never a folder, and needs ``records`` to be one)."""
-    if (out / RECORDS).is_symlink():  # its records would be written, and removed, elsewhere
+    records = out / RECORDS  # a link to a folder: records written, and removed, elsewhere
+    if records.is_symlink() and records.is_dir():
         raise OutputError(
             f"--out {out}: its {RECORDS!r} is a link to another folder, where `mdf dataset` "
             "would write and remove records; replace it with a folder or choose another folder"
