@@ -272,12 +272,17 @@ class GroundClutter(Effect):
             )
         return float(resolution)
 
+    def _spacing(self, resolution: float) -> float:
+        """Patch spacing [m]: ``patch_spacing_m``, default half the range resolution [m]."""
+        spacing = self.config.patch_spacing_m
+        return float(spacing) if spacing is not None else resolution / 2.0
+
     def patch_ranges(self, context: SceneContext) -> FloatArray:
         """Patch ranges (n_patches,) [m], a random position inside each spacing (drawn from
         ``context.rng``)."""
         c = self.config
         res = self.resolution(context)
-        spacing = c.patch_spacing_m if c.patch_spacing_m is not None else res / 2.0
+        spacing = self._spacing(res)
         margin = c.margin_m if c.margin_m is not None else 4.0 * res
         gate = np.asarray(context.gate_range, dtype=np.float64)
         lo = max(float(gate.min()) - margin, spacing)
@@ -319,7 +324,7 @@ class GroundClutter(Effect):
         phase follows from the patch's random range)."""
         c = self.config
         res = self.resolution(context)
-        spacing = c.patch_spacing_m if c.patch_spacing_m is not None else res / 2.0
+        spacing = self._spacing(res)
         ranges = self.patch_ranges(context)
         rng = context.rng
         alpha = (
@@ -340,7 +345,7 @@ class GroundClutter(Effect):
         grows with the pulses, not with the pulses times the patches."""
         c = self.config
         res = self.resolution(context)
-        spacing = c.patch_spacing_m if c.patch_spacing_m is not None else res / 2.0
+        spacing = self._spacing(res)
         ranges = self.patch_ranges(context)
         n_patch = ranges.size
         sigma_k = c.rcs_m2 * spacing / res
