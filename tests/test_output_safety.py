@@ -330,6 +330,21 @@ def test_a_records_link_to_a_file_or_nothing_is_named_as_a_file_in_the_way(
     assert target == "nothing" or (tmp_path / target).read_text() == "a file of the user's\n"
 
 
+def test_a_received_dataset_json_that_is_a_pipe_is_not_read(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A received dataset folder whose marker names no config and whose ``dataset.json`` (where
+    a build before markers kept its config) is a named pipe: the build waited forever on the
+    pipe. The pipe counts as a damaged manifest (no earlier config), and the build replaces it."""
+    out = tmp_path / "received"
+    out.mkdir()
+    (out / ".mdf-dataset.json").write_text("{}")
+    os.mkfifo(out / "dataset.json")
+    code, err = mdf(one_record_dataset(tmp_path, out), capsys)
+    assert code == 0, err
+    assert json.loads((out / "dataset.json").read_text())["n_records"] == 1
+
+
 @pytest.mark.parametrize("linked", ["aside", "stage"])
 def test_a_received_marker_cannot_move_files_from_elsewhere_into_out(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], linked: str

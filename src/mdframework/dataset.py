@@ -1863,7 +1863,7 @@ def _built_from(folder: OutputFolder) -> dict[str, Any] | None:
     built = folder.marker.get("config")
     if built is None and (folder.path / MANIFEST).exists():  # built before markers existed
         try:
-            built = json.loads((folder.path / MANIFEST).read_text(encoding="utf-8")).get("config")
+            built = json.loads(read_marker_text(folder.path / MANIFEST)).get("config")
         except (OSError, ValueError, AttributeError):
             built = None
     if not isinstance(built, dict):

@@ -67,9 +67,10 @@ MAX_MARKER_BYTES = 64 * 1024 * 1024
 
 
 def read_marker_text(path: Path) -> str:
-    """The text of a small file a command wrote (a marker, a lock's details), never through a
-    link nor from a pipe or a device, and at most :data:`MAX_MARKER_BYTES`: a received folder's
-    marker that links to ``/dev/zero`` would otherwise be read until the memory runs out. Raises
+    """The text of a small file a command wrote (a marker, a lock's details, a dataset's
+    manifest), never through a link nor from a pipe or a device, and at most
+    :data:`MAX_MARKER_BYTES`: a received folder's marker that links to ``/dev/zero`` would
+    otherwise be read until the memory runs out, one that is a pipe waited on forever. Raises
     ``OSError`` or ``ValueError`` (``UnicodeDecodeError``) for anything else, as a damaged
     marker does."""
     fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
