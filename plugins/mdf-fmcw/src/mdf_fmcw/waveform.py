@@ -712,8 +712,9 @@ class FmcwRadar(RadarWaveform):
         return self.config.receiver_noise
 
     def noise_power(self) -> float:
-        """Receiver noise power added per complex ADC sample, ``k T0 F fs`` [W] (0 without
-        ``receiver_noise``)."""
+        """The radar's own receiver noise power added per complex ADC sample, ``k T0 F fs``
+        [W] (0 without ``receiver_noise``); a noise effect's in the IF samples is not counted
+        (its :class:`~mdframework.ReceiverInput`'s ``noise_power``)."""
         return self.thermal_noise_power() if self.config.receiver_noise else 0.0
 
     def map_noise_power(self) -> float:
