@@ -531,7 +531,9 @@ def _simulate_motion(
     received = stream.received()
     if received.products:
         received = replace(received, products={**received.products, **wf.product_axes()})
-    echo = received.signal.copy()  # the target's echo, before noise and clutter
+    # the target's echo before the received-stage effects (with the noise and clutter of a
+    # radar that puts them in its raw samples: its own receiver noise, those handed to it)
+    echo = received.signal.copy()
     context = SceneContext(radar_pos, wf.prf, wf.carrier_frequency, t, stream.gate, None, wf, rng)
     received = apply_effects(stages, "received", received, context, generators, handed)
     _check_empty(echo, losses, proc, fixed_gate=sc.gate != "track")
