@@ -403,14 +403,18 @@ def test_a_spectrogram_beyond_the_limit_is_refused_before_any_pulse(
     limits.check_spectrogram_cells(2**20, 2**10, 4)  # at the limit
 
 
-@pytest.mark.parametrize(("kind", "name"), [("cmu", "walk.bvh"), ("table", "walk.csv")])
+@pytest.mark.parametrize(
+    ("kind", "name"),
+    [("cmu", "walk.bvh"), ("table", "walk.csv"), ("table", "walk.npz"), ("c3d", "walk.c3d")],
+)
 @pytest.mark.parametrize("special", ["fifo", "dev-zero"])
 def test_a_motion_file_that_is_a_pipe_or_a_device_is_refused_unread(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], kind: str, name: str, special: str
 ) -> None:
     """A received folder's motion file that is a named pipe, or a link to ``/dev/zero``: the
     run waited forever on the pipe, or read zeros until the memory ran out (an internal
-    MemoryError). It is one line naming the file, exit 2, before the file is opened."""
+    MemoryError); a binary one (table .npz, C3D) waited on the pipe too. It is one line naming
+    the file, exit 2, before the file is opened."""
     from mdframework import cli
 
     path = tmp_path / name
@@ -458,3 +462,19 @@ def test_a_numerical_warning_in_our_code_stops_the_command(
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "overflow encountered" in err[0], err
     assert "Traceback" not in err[0]
+
+
+@pytest.mark.parametrize("name", ["points.txt", "points.txt.gz", "points.npz"])
+def test_a_radar_recording_that_is_a_pipe_is_refused_unread(tmp_path: Path, name: str) -> None:
+    """A real radar's recording (RadHAR text, gzip text, compact NPZ) that is a named pipe:
+    reading it waited forever; it is refused naming the file before it is opened."""
+    from mdf_radhar.source import npz_recordings, read_rostopic_text
+
+    from mdframework.errors import DataFileError
+
+    path = tmp_path / name
+    os.mkfifo(path)
+    reader = npz_recordings if name.endswith(".npz") else read_rostopic_text
+    with pytest.raises(DataFileError, match="not a regular file") as caught:
+        reader(path)
+    assert str(path) in str(caught.value)

@@ -179,21 +179,32 @@ def check_product_bytes(n_bytes: float, what: str, field: str) -> None:
         )
 
 
-def read_file_bytes(path: str | Path) -> bytes:
-    """The bytes of a regular file (or a link to one). A pipe or a device (a received folder's
-    motion file may be a link to ``/dev/zero``, or a named pipe) is refused before it is
-    opened: reading it would never end, or fill the memory. Raises
-    :class:`~mdframework.errors.DataFileError` naming the file."""
+def check_regular_file(path: str | Path) -> None:
+    """Refuse a file that is not a regular file (or a link to one) before it is opened: a
+    received folder's motion file may be a named pipe, or a link to ``/dev/zero``, and
+    reading it would never end, or fill the memory. Raises
+    :class:`~mdframework.errors.DataFileError` naming the file (also when it cannot be
+    examined)."""
     import stat
 
     p = Path(path)
     try:
-        if not stat.S_ISREG(p.stat().st_mode):
-            what = "a folder" if p.is_dir() else "not a regular file (a pipe or a device?)"
-            raise DataFileError(p, f"cannot read: {what}")
-        return p.read_bytes()
+        mode = p.stat().st_mode
     except OSError as exc:
         raise DataFileError(p, f"cannot read: {exc.strerror or exc}") from None
+    if not stat.S_ISREG(mode):
+        what = "a folder" if stat.S_ISDIR(mode) else "not a regular file (a pipe or a device?)"
+        raise DataFileError(p, f"cannot read: {what}")
+
+
+def read_file_bytes(path: str | Path) -> bytes:
+    """The bytes of a regular file (or a link to one), checked by :func:`check_regular_file`
+    before it is opened. Raises :class:`~mdframework.errors.DataFileError` naming the file."""
+    check_regular_file(path)
+    try:
+        return Path(path).read_bytes()
+    except OSError as exc:
+        raise DataFileError(Path(path), f"cannot read: {exc.strerror or exc}") from None
 
 
 def read_text_file(

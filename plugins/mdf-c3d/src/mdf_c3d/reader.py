@@ -94,6 +94,7 @@ def read_c3d_header(path: Path) -> C3dHeader:
         ``limits.MAX_FRAMES`` or last frame before the first, or declared frames that do not
         fit in the file (truncated).
     """
+    limits.check_regular_file(path)
     try:
         size = path.stat().st_size
         with path.open("rb") as f:

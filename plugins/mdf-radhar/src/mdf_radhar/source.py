@@ -134,6 +134,7 @@ def read_rostopic_text(path: str | Path) -> dict[str, NDArray[np.float64]]:
     go back, fewer than two frames or two distinct time stamps, binary data.
     """
     p = Path(path)
+    limits.check_regular_file(p)
     columns: dict[str, list[float]] = {k: [] for k in (*TEXT_KEYS, "stamp", "line")}
     current: dict[str, float] = {}
     at: dict[str, int] = {}  # the line of each value of the current message
@@ -303,6 +304,7 @@ def text_recording(path: str | Path, frame_period: float = FRAME_PERIOD_S) -> Po
 def _npz_members(path: Path) -> None:
     """Check every array's declared shape and type against the bytes the NPZ holds, before
     :func:`numpy.load` allocates anything (a damaged or crafted file can declare any size)."""
+    limits.check_regular_file(path)
     try:
         with zipfile.ZipFile(path) as archive:
             infos = {i.filename: i for i in archive.infolist()}

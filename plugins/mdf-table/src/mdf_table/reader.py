@@ -449,6 +449,7 @@ def _npz_shapes(path: Path) -> dict[str, tuple[tuple[int, ...], np.dtype[Any]]]:
     """Each member's shape and dtype from its .npy header, without reading its data."""
     import zipfile
 
+    limits.check_regular_file(path)
     out: dict[str, tuple[tuple[int, ...], np.dtype[Any]]] = {}
     try:
         with zipfile.ZipFile(path) as z:
