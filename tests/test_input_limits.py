@@ -478,3 +478,17 @@ def test_a_radar_recording_that_is_a_pipe_is_refused_unread(tmp_path: Path, name
     with pytest.raises(DataFileError, match="not a regular file") as caught:
         reader(path)
     assert str(path) in str(caught.value)
+
+
+def test_an_oni_recording_that_is_a_pipe_is_refused_unread(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`mdf kinect info` on an .oni "recording" that is a named pipe waited forever in the
+    structure scan; one line naming it, exit 2."""
+    from mdframework import cli
+
+    path = tmp_path / "take.oni"
+    os.mkfifo(path)
+    assert cli.main(["kinect", "info", str(path)]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert line == f"mdf: error: {path}: cannot read: not a regular file (a pipe or a device?)"

@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from mdframework import DataFileError, MdfError
+from mdframework import DataFileError, MdfError, limits
 
 #: Where Debian installs libOpenNI2.so.
 DEBIAN_OPENNI2 = "/usr/lib/x86_64-linux-gnu"
@@ -114,10 +114,7 @@ def scan_oni(path: Path) -> OniScan:
     OpenNI2's player reads them). After the end record only node-removed records and seek tables
     may follow (OpenNI2 plays nothing after it).
     """
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise DataFileError(path, f"cannot read: {exc.strerror or exc}") from None
+    data = limits.read_file_bytes(path)  # a named pipe or a device: refused unread
     if len(data) < FILE_HEADER.size:
         raise DataFileError(path, f"{len(data)} bytes: too short for the 24-byte .oni header")
     magic = data[:4]
