@@ -391,3 +391,23 @@ def test_a_marker_that_is_a_pipe_or_a_device_is_not_read(
     assert code == 0, err
     assert marker.is_file() and not marker.is_symlink()
     assert json.loads(marker.read_text())["command"] == "run"
+
+
+def test_a_received_marker_whose_swap_names_a_folder_leaves_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A received marker recording a half-done swap whose new files include the name of a
+    folder in --out: undoing the swap was an internal IsADirectoryError. A command writes
+    files only, so the folder is not one it moved in: it is left, and the run goes on to its
+    usual judgement of the folder (which holds files the run did not write: refused)."""
+    out = tmp_path / "received"
+    stage = out / ".mdf-staging-run-x"
+    stage.mkdir(parents=True)
+    (out / "data").mkdir()
+    (out / "data" / "keep.txt").write_text("mine\n")
+    swap = {"stage": str(stage), "new": ["data"], "previous_marker": None}
+    (out / ".mdf-run.json").write_text(json.dumps({"command": "run", "swap": swap}))
+    code, err = mdf(["run", str(POINT), "--out", str(out)], capsys)
+    assert code == 2, err
+    assert "internal error" not in err
+    assert (out / "data" / "keep.txt").read_text() == "mine\n"

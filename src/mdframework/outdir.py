@@ -662,7 +662,12 @@ def _undo_swap(folder: Path, command: str) -> None:
         _restore_marker(path, before if isinstance(before, str) else None)
         return
     for name in new:
-        if isinstance(name, str) and "/" not in name and not (stage / name).exists():
+        if (
+            isinstance(name, str)
+            and "/" not in name
+            and not (stage / name).exists()
+            and not _real_folder(folder / name)  # a command moves in files only
+        ):
             (folder / name).unlink(missing_ok=True)  # moved in: the new output's
     if aside.is_dir():
         for old in aside.iterdir():
