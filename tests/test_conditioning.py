@@ -340,3 +340,26 @@ def test_skeleton_window_counts_from_the_first_frame_and_includes_both_ends() ->
     w = sk.window(0.2, 0.3)
     np.testing.assert_allclose(w.time, [10.2, 10.3, 10.4, 10.5], atol=1e-12)
     assert sk.window(0.5).n_frames == 6
+
+
+def test_the_motion_formats_page_quotes_the_bias_it_removed() -> None:
+    """docs/motion-formats.md: a 1.1 s period in 3 s at 30 frames per second "read a frame
+    early, 3 % short" from the biased autocorrelation's highest whole lag, and the estimator
+    now reads it to 0.5 %."""
+    from conftest import ROOT
+
+    time = np.arange(0.0, 3.0, 1.0 / 30.0)
+    signal = np.sin(2 * np.pi * time / 1.1) + 0.3 * np.sin(4 * np.pi * time / 1.1 + 1.0)
+    found = cond.lag_correlation(time, signal)
+    assert found is not None
+    biased = found[0]
+    start = int(np.flatnonzero(biased < 0)[0])
+    old_lag = start + int(np.argmax(biased[start:]))  # the estimator before
+    assert old_lag == 32 and round(1.1 * 30) - old_lag == 1  # a frame early
+    short = 100 * (1.1 - old_lag / 30) / 1.1
+    page = " ".join((ROOT / "docs" / "motion-formats.md").read_text().split())
+    assert (
+        f"a 1.1 s period in 3 s at 30 frames per second read a frame early, {short:.0f} % short"
+        in page
+    )
+    assert cond.periodicity(time, signal)["period_s"] == pytest.approx(1.1, rel=0.005)
