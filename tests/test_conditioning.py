@@ -319,6 +319,16 @@ def test_a_signal_without_a_zero_crossing_has_no_period() -> None:
     assert cond.periodicity(time, np.full_like(time, 3.0)) == none
     assert cond.periodicity(time, np.sin(np.pi * time / 5.0)) == none
     assert _period_strength(time, np.sin(np.pi * time / 5.0)) is None
+    assert _period_strength(time, np.full_like(time, 3.0)) is None
+
+
+def test_a_peak_of_exactly_min_strength_is_a_clear_period() -> None:
+    """The first peak counts when its autocorrelation equals ``min_strength``."""
+    time = np.arange(0.0, 3.0, 1.0 / 30.0)
+    signal = np.sin(2 * np.pi * time / 1.1)
+    found = _period_strength(time, signal)
+    assert found is not None
+    assert _period_strength(time, signal, min_strength=found[1]) == found
 
 
 def test_a_missing_stretch_just_over_max_gap_s_is_refused() -> None:
@@ -363,3 +373,56 @@ def test_the_motion_formats_page_quotes_the_bias_it_removed() -> None:
         in page
     )
     assert cond.periodicity(time, signal)["period_s"] == pytest.approx(1.1, rel=0.005)
+
+
+def test_lag_correlation_needs_eight_samples_over_a_rising_clock() -> None:
+    """Eight samples are enough, seven are not; a clock that runs backwards has no time span."""
+    time = np.arange(8) / 10.0
+    signal = np.sin(7.0 * time)
+    assert cond.lag_correlation(time, signal) is not None
+    assert cond.lag_correlation(time[:7], signal[:7]) is None
+    assert cond.lag_correlation(time[::-1], signal) is None
+
+
+def test_correlation_peaks_fall_back_on_the_biased_parabola() -> None:
+    """Hand-made correlations. Where the normalised values rise to the last lag or fall all the
+    way from lag 0 (no peak to climb to), the lag is the top of the biased peak's parabola:
+    3 + 0.5 (b2 - b4) / (b2 - 2 b3 + b4), also for a peak at the last inner lag n - 2."""
+    biased = np.array([1.0, -0.5, 0.0, 0.2, 0.1])
+    rising = np.array([1.0, -0.5, 0.0, 0.6, 0.9])
+    top = 0.2 - 0.25 * (0.0 - 0.1) * (0.5 * (0.0 - 0.1) / -0.3)
+    assert cond.correlation_peaks(biased, rising) == [pytest.approx((3 + 1 / 6, top))]
+    biased = np.array([1.0, -0.2, 0.1, 0.3, 0.2, -0.1, 0.0])
+    falling = np.linspace(1.0, 0.4, 7)
+    assert cond.correlation_peaks(biased, falling) == [pytest.approx((3 + 1 / 6, 0.30417), 1e-4)]
+
+
+def test_correlation_peaks_climb_down_to_an_earlier_normalised_peak() -> None:
+    """The normalised peak one lag before the biased one (lag 3, parabola to 3.3): the climb
+    goes down to it."""
+    biased = np.array([1.0, -0.2, 0.1, 0.2, 0.3, 0.1, 0.0])
+    normalised = np.array([1.0, -0.2, 0.5, 0.9, 0.8, 0.4, 0.0])
+    assert cond.correlation_peaks(biased, normalised)[0][0] == pytest.approx(3.3)
+
+
+def test_correlation_peaks_of_a_flat_top_are_finite() -> None:
+    """Three equal values at lags 2..4, in both correlations: no parabola (no division by its
+    zero curvature); every peak found lies on the plateau."""
+    biased = np.array([1.0, -0.2, 0.3, 0.3, 0.3, 0.1, 0.0])
+    normalised = np.array([1.0, -0.2, 0.5, 0.5, 0.5, 0.4, 0.0])
+    lags = [lag for lag, _ in cond.correlation_peaks(biased, normalised)]
+    assert lags and all(2.0 <= lag <= 4.0 for lag in lags)
+
+
+def test_the_dominant_period_is_not_a_strong_harmonic_and_its_strength_is_its_own() -> None:
+    """20 s at 30 Hz. A 1 s sinusoid plus a stronger 0.25 s one (power 1.5): the
+    autocorrelation peaks at 0.25 s at 0.6 of the 1 s peak, short of 0.9: period 1 s. A 1 s
+    sinusoid plus a 2 s one of amplitude 0.2: the 2 s peak is the highest (0.9 = the
+    overlap), the 1 s one reaches (1 - 0.04) / 1.04 x 0.95 = 0.877 and is the period, and
+    its strength is its own value, not the highest."""
+    time = np.arange(0.0, 20.0, 1 / 30.0)
+    harmonic = np.sin(2 * np.pi * time) + np.sqrt(1.5) * np.sin(8 * np.pi * time)
+    assert cond.periodicity(time, harmonic)["period_s"] == pytest.approx(1.0, abs=0.005)
+    found = cond.periodicity(time, np.sin(2 * np.pi * time) + 0.2 * np.sin(np.pi * time))
+    assert found["period_s"] == pytest.approx(1.0, abs=0.005)
+    assert found["strength"] == pytest.approx(0.96 / 1.04 * 0.95, abs=0.005)

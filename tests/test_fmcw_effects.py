@@ -88,7 +88,7 @@ def test_a_clutter_patch_is_in_the_maps_at_its_range_bin_and_zero_doppler(path: 
     nu = k / n_rng - 2 * seq.slope * r / C / seq.sample_rate
     gain = abs(np.sum(w * np.exp(2j * np.pi * nu * np.arange(seq.n_samples)))) / np.sum(w)
     expected = 12 * amp**2 * gain**2
-    assert rd[:, zero, k] == pytest.approx(expected, rel=1e-3)
+    assert rd[:, zero, k] == pytest.approx(expected, rel=1e-3, abs=0)
     assert amp**2 == pytest.approx(
         radar.scatterer_amplitudes(
             np.array([rcs]),
@@ -97,12 +97,17 @@ def test_a_clutter_patch_is_in_the_maps_at_its_range_bin_and_zero_doppler(path: 
             wavelength=seq.wavelength,
             transmit_power=wf.config.transmit_power,
         )[0]
-        ** 2
+        ** 2,
+        abs=0,
     )
     # points at the patch's range at 0 m/s (clutter removal off, as the preset has it)
     pts = res.received.products["points"]
     near = np.abs(np.linalg.norm(pts[:, 2:5], axis=1) - r) < 2 * seq.range_resolution
     assert near.any() and np.all(pts[near, 5] == 0.0)
+    # and nothing else: without noise in the IF the CFAR floor is the receiver's mean noise,
+    # above the patch's window sidelobes
+    assert near.all()
+    assert np.all(pts[near, 3] > 0.95 * r)  # on the boresight (sensor y), as the patch is
     assert not (
         np.abs(np.linalg.norm(clean.received.products["points"][:, 2:5], axis=1) - r) < 0.1
     ).any()
@@ -110,7 +115,7 @@ def test_a_clutter_patch_is_in_the_maps_at_its_range_bin_and_zero_doppler(path: 
     # every loop of a TDM slot
     diff = res.received.signal - clean.received.signal
     slot0 = diff[:: seq.n_tx]
-    assert np.abs(slot0) == pytest.approx(amp, rel=1e-2)
+    assert np.abs(slot0) == pytest.approx(amp, rel=1e-2, abs=0)
     assert np.ptp(slot0.real) < 1e-6 * amp and np.ptp(slot0.imag) < 1e-6 * amp
     # clutter removal: the static patch is gone from the maps and the points
     removed = run({**fields, "clutter_removal": True}, [CLUTTER])
@@ -130,11 +135,11 @@ def test_the_noise_effect_fills_the_map_cells_with_the_analytic_mean_noise() -> 
     rd = res.received.products["range_doppler"]
     wf = FmcwRadar(FmcwConfig(**RADAR))
     sigma2 = 1.380649e-23 * 290.0 * 10.0 * wf.config.sample_rate
-    assert res.metadata["effects"][0]["noise_power_w"] == pytest.approx(sigma2, rel=1e-12)
+    assert res.metadata["effects"][0]["noise_power_w"] == pytest.approx(sigma2, rel=1e-12, abs=0)
     assert res.metadata["effects"][0]["in_receiver"] is True
     expected = fmcw.map_noise_power(sigma2, 12, "hann", 240, "hann", 16)
     assert rd.shape[0] == 30
-    assert float(np.mean(rd)) == pytest.approx(expected, rel=0.02)
+    assert float(np.mean(rd)) == pytest.approx(expected, rel=0.02, abs=0)
     clean = run(RADAR, [], length=1.0)
     gated = np.mean(np.abs(res.received.signal - clean.received.signal) ** 2)
     assert gated > 0.1 * sigma2
@@ -210,3 +215,52 @@ def test_the_fmcw_page_quotes_these_tests() -> None:
     assert "(measured to 2 % over 30 frames)" in page
     assert "that rate within 5 %" in page
     assert "to 0.1 %), gives points there at 0 m/s" in page
+
+
+def test_two_noise_effects_add_up_in_the_maps() -> None:
+    """Two noise effects (10 and 13 dB) are independent draws added in the IF samples: the
+    map cells hold on average the sum of their powers (to 3 % over 15 frames), not the last
+    one's."""
+    effects = [{"kind": "noise", "mode": "thermal", "noise_figure_db": nf} for nf in (10, 13)]
+    res = run(RADAR, effects, length=0.5)
+    both = sum(e["noise_power_w"] for e in res.metadata["effects"])
+    expected = fmcw.map_noise_power(both, 12, "hann", 240, "hann", 16)
+    rd = res.received.products["range_doppler"]
+    assert float(np.mean(rd)) == pytest.approx(expected, rel=0.03, abs=0)
+
+
+def test_the_clutter_patches_rcs_have_a_rayleigh_amplitude_of_unit_mean_power() -> None:
+    """The static patches the clutter effect hands the radar: RCS rcs_m2 (spacing /
+    resolution) |alpha|^2, |alpha|^2 exponential of mean 1: over 4000 patches 0.1 m apart
+    (resolution 0.2 m, rcs_m2 = 2) the mean RCS is 1 m^2 to 5 %, and 1 - 1/e of them lie
+    below it (to 0.03)."""
+    from types import SimpleNamespace
+
+    from mdf_clutter.clutter import GroundClutter
+
+    config = {**CLUTTER, "rcs_m2": 2.0, "patch_spacing_m": 0.1, "range_resolution": 0.2}
+    effect = GroundClutter(GroundClutter.Config(**{**config, "margin_m": 200.0}))
+    context: Any = SimpleNamespace(
+        gate_range=np.array([300.0]), rng=np.random.default_rng(0), waveform=None
+    )
+    got = effect.receiver_input(context)
+    assert got is not None and got.static_rcs.size == 4000
+    assert float(np.mean(got.static_rcs)) == pytest.approx(1.0, rel=0.05)
+    assert float(np.mean(got.static_rcs < 1.0)) == pytest.approx(1 - np.exp(-1), abs=0.03)
+
+
+def test_static_scatterers_beyond_the_maximum_range_are_left_out_unless_aliased() -> None:
+    """A receiver input's static scatterer 1 m beyond the maximum range adds nothing to the
+    range profiles (as a moving one there is refused), unless beyond_max_range = "alias",
+    when it folds back into them."""
+    from mdframework import ReceiverInput
+
+    profiles = {}
+    for mode in ("error", "alias"):
+        wf = FmcwRadar(FmcwConfig(**RADAR, beyond_max_range=mode))
+        far = np.array([wf.sequence.max_range + 1.0])
+        wf.set_receiver_inputs([ReceiverInput("far", static_ranges=far, static_rcs=np.ones(1))])
+        origin = np.zeros(3)
+        profiles[mode] = wf._static_profiles(origin, wf.sensor_axes(origin))
+    assert profiles["error"] is None
+    assert profiles["alias"] is not None and np.abs(profiles["alias"]).max() > 0

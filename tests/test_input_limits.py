@@ -401,6 +401,20 @@ def test_a_spectrogram_beyond_the_limit_is_refused_before_any_pulse(
         assert f"the limit is {limits.MAX_SPECTROGRAM_CELLS:,}" in line
     assert not out.exists()
     limits.check_spectrogram_cells(2**20, 2**10, 4)  # at the limit
+    with pytest.raises(SceneError, match=r"1\.075e\+09 values \(about 4 GiB of memory\)"):
+        limits.check_spectrogram_cells(2**20, 2**10 + 1, 4)  # a frame over it
+
+
+def test_check_regular_file_follows_links_and_names_a_folder(tmp_path: Path) -> None:
+    """A link to a regular file is read as that file; a folder and a missing file are
+    refused naming the path and what is wrong."""
+    (tmp_path / "walk.bvh").write_text("HIERARCHY\n")
+    (tmp_path / "link.bvh").symlink_to(tmp_path / "walk.bvh")
+    limits.check_regular_file(tmp_path / "link.bvh")
+    with pytest.raises(DataFileError, match="cannot read: a folder"):
+        limits.check_regular_file(tmp_path)
+    with pytest.raises(DataFileError, match="cannot read: No such file"):
+        limits.check_regular_file(tmp_path / "gone.bvh")
 
 
 @pytest.mark.parametrize(

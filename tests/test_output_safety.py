@@ -345,13 +345,14 @@ def test_a_received_dataset_json_that_is_a_pipe_is_not_read(
     assert json.loads((out / "dataset.json").read_text())["n_records"] == 1
 
 
-@pytest.mark.parametrize("linked", ["aside", "stage"])
+@pytest.mark.parametrize("linked", ["aside", "stage", "foreign"])
 def test_a_received_marker_cannot_move_files_from_elsewhere_into_out(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], linked: str
 ) -> None:
     """A received folder whose marker records a swap killed half done, with the staging folder
     (or the folder of replaced files in it) a link to a folder of the user's: undoing the swap
-    moved the user's files out of that folder into --out. Nothing outside --out moves now."""
+    moved the user's files out of that folder into --out. Nothing outside --out moves now, nor
+    from a real folder of the user's that the marker names as the staging folder."""
     mine = tmp_path / "mine"
     mine.mkdir()
     (mine / "id_rsa").write_text("secret\n")
@@ -361,6 +362,12 @@ def test_a_received_marker_cannot_move_files_from_elsewhere_into_out(
     if linked == "aside":
         stage.mkdir(parents=True)
         (stage / ".mdf-aside").symlink_to(Path("..") / ".." / "mine")
+    elif linked == "foreign":
+        out.mkdir()
+        (mine / ".mdf-aside").mkdir()
+        (mine / ".mdf-aside" / "notes.txt").write_text("mine too\n")
+        before = tree(mine)
+        stage = mine
     else:
         out.mkdir()
         (mine / ".mdf-aside").mkdir()
@@ -371,6 +378,32 @@ def test_a_received_marker_cannot_move_files_from_elsewhere_into_out(
     (out / ".mdf-run.json").write_text(json.dumps({"command": "run", "swap": swap}))
     mdf(["run", str(POINT), "--out", str(out)], capsys)
     assert tree(mine) == before
+
+
+@pytest.mark.parametrize("new", [None, 5, {"a": 1}])
+def test_a_received_marker_whose_swap_lists_no_names_is_left(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], new: object
+) -> None:
+    """A received marker recording a swap whose new files are not a list of names: the run
+    goes ahead (nothing to undo), with a marker of its own."""
+    out = tmp_path / "received"
+    stage = out / ".mdf-staging-run-x"
+    stage.mkdir(parents=True)
+    swap = {"stage": str(stage), "new": new, "previous_marker": None}
+    (out / ".mdf-run.json").write_text(json.dumps({"command": "run", "swap": swap}))
+    code, err = mdf(["run", str(POINT), "--out", str(out)], capsys)
+    assert code == 0, err
+    assert json.loads((out / ".mdf-run.json").read_text())["command"] == "run"
+
+
+def test_read_marker_text_reads_at_most_max_marker_bytes(tmp_path: Path) -> None:
+    """A marker of MAX_MARKER_BYTES is read whole; one byte more is refused."""
+    path = tmp_path / "marker.json"
+    path.write_text("x" * outdir.MAX_MARKER_BYTES)
+    assert len(outdir.read_marker_text(path)) == outdir.MAX_MARKER_BYTES
+    path.write_text("x" * (outdir.MAX_MARKER_BYTES + 1))
+    with pytest.raises(ValueError, match="more than"):
+        outdir.read_marker_text(path)
 
 
 @pytest.mark.parametrize("special", ["fifo", "devzero"])

@@ -479,6 +479,7 @@ def test_a_receiver_input_that_breaks_the_contract_names_the_effect() -> None:
             return data
 
         def receiver_input(self, context: SceneContext) -> Any:
+            self.seen = context.rng
             return self.given
 
     got: list[Any] = []
@@ -487,11 +488,18 @@ def test_a_receiver_input_that_breaks_the_contract_names_the_effect() -> None:
     stages: Any = SimpleNamespace(radar=radar, effects=(effect,))
     rngs = [np.random.default_rng(0)]
     times = np.arange(4) / 1e3
-    context = SceneContext(np.zeros(3), 1e3, 24e9, times, np.ones(4), None, radar, rngs[0])
+    own = np.random.default_rng(1)
+    context = SceneContext(np.zeros(3), 1e3, 24e9, times, np.ones(4), None, radar, own)
     ones = np.ones(3)
     cases: list[tuple[Any, type[Exception], str]] = [
         ({"noise_power": 1.0}, TypeError, "returned dict instead of ReceiverInput or None"),
         (ReceiverInput("leaky", noise_power=np.nan), ValueError, "noise power of nan W"),
+        (ReceiverInput("leaky", noise_power=np.inf), ValueError, "noise power of inf W"),
+        (
+            ReceiverInput("leaky", static_ranges=ones[None], static_rcs=ones[None]),
+            ValueError,
+            r"\(1, 3\) and RCS of shape \(1, 3\), not \(P,\)",
+        ),
         (ReceiverInput("leaky", static_ranges=ones), ValueError, r"\(3,\) and RCS of shape"),
         (ReceiverInput("leaky", static_ranges=ones, static_rcs=-ones), ValueError, "finite"),
     ]
@@ -501,9 +509,14 @@ def test_a_receiver_input_that_breaks_the_contract_names_the_effect() -> None:
             hand_to_radar(stages, context, rngs)
         assert "in receiver_input() of the effects plugin 'leaky'" in exc.value.__notes__[0]
     assert got == []
-    effect.given = ReceiverInput("leaky", static_ranges=ones, static_rcs=ones)
+    valid = effect.given = ReceiverInput("leaky", static_ranges=ones, static_rcs=ones)
     assert hand_to_radar(stages, context, rngs) == frozenset({0})
-    assert got == [effect.given]
+    assert got == [valid]
+    assert effect.seen is rngs[0]  # the effect's own stream, not the record's
+    effect.stage = "scatterers"  # only received-stage effects are asked
+    effect.given = {"not": "asked"}
+    assert hand_to_radar(stages, context, rngs) == frozenset()
+    assert got == [valid]
 
 
 def test_an_interrupt_python_could_not_raise_ends_the_command_as_interrupted(
