@@ -77,7 +77,7 @@ def test_noise_power_matches_requested_snr(snr_db: float) -> None:
     rho = np.abs(np.mean(noise[1:] * np.conj(noise[:-1]))) / np.mean(np.abs(noise) ** 2)
     assert rho < 0.06
     assert noisy.metadata["effects"][0]["noise_power_w"] == pytest.approx(
-        p_sig * 10 ** (-snr_db / 10), rel=1e-12
+        p_sig * 10 ** (-snr_db / 10), rel=1e-12, abs=0
     )
 
 
@@ -89,11 +89,13 @@ def test_thermal_noise_is_kTF_over_tau_after_compression() -> None:
     noisy = run(APPROACHING, [eff], radar_cfg=rcfg)
     expected = BOLTZMANN * temp * 10 ** (nf_db / 10) / tau  # k T F B / (tau B)
     noise = noisy.received.signal - clean.received.signal
-    assert np.mean(np.abs(noise) ** 2) == pytest.approx(expected, rel=0.06)
+    assert np.mean(np.abs(noise) ** 2) == pytest.approx(expected, rel=0.06, abs=0)
     # thermal noise does not depend on the signal (unlike mode 'snr')
     strong = [{**APPROACHING[0], "rcs": 100.0}]
     noisy_strong = run(strong, [eff], radar_cfg=rcfg)
-    assert noisy_strong.metadata["effects"][0]["noise_power_w"] == pytest.approx(expected)
+    assert noisy_strong.metadata["effects"][0]["noise_power_w"] == pytest.approx(
+        expected, rel=1e-12, abs=0
+    )
 
 
 def test_thermal_noise_is_refused_without_the_range_equation() -> None:
@@ -124,7 +126,7 @@ def test_thermal_noise_with_a_cw_radar_takes_the_pages_pulse_width_and_bandwidth
     given = {**thermal, "pulse_width": 1 / fs, "bandwidth": fs}
     res = run(APPROACHING, [given], radar_cfg=cw, duration=0.2)
     kt_f = BOLTZMANN * 290.0 * 10 ** (3.0 / 10)  # the effect's default T and F
-    assert res.metadata["effects"][0]["noise_power_w"] == pytest.approx(kt_f * fs, rel=1e-12)
+    assert res.metadata["effects"][0]["noise_power_w"] == pytest.approx(kt_f * fs, rel=1e-12, abs=0)
 
 
 def test_noise_floor_in_spectrogram_is_sigma2_sum_w2() -> None:
@@ -174,7 +176,7 @@ def test_noise_on_raw_path_reaches_range_time_map() -> None:
     assert clean.received.range_time is not None and noisy.received.range_time is not None
     diff = noisy.received.range_time - clean.received.range_time
     sigma2 = noisy.metadata["effects"][0]["noise_power_w"]
-    assert np.mean(np.abs(diff) ** 2) == pytest.approx(sigma2, rel=0.05)
+    assert np.mean(np.abs(diff) ** 2) == pytest.approx(sigma2, rel=0.05, abs=0)
 
 
 # --------------------------------------------------------------------------- clutter
@@ -678,7 +680,7 @@ def test_antenna_before_multipath_or_static_scene_is_refused() -> None:
     # the room's reflector 45 deg off a 20 deg beam aimed at the target: -61 dB one way
     weighed = run(APPROACHING, [room, {"kind": "antenna"}], duration=0.2)
     g = np.exp(-4 * np.log(2) * (45.0 / 20.0) ** 2)
-    assert weighed.scatterers.rcs[0, 1] == pytest.approx(g**2, rel=1e-9)
+    assert weighed.scatterers.rcs[0, 1] == pytest.approx(g**2, rel=1e-9, abs=0)
 
 
 # --------------------------------------------------------------------------- attenuation

@@ -564,9 +564,9 @@ def test_map_noise_power_is_the_mean_noise_of_the_detection_map(
         rd = fmcw.range_doppler(fmcw.virtual_cube(prof, SEQ, 3), doppler_window, 16)  # type: ignore[arg-type]
         total += float(np.mean(fmcw.detection_map(rd)))
     expected = fmcw.map_noise_power(p, 12, range_window, 240, doppler_window, 16)  # type: ignore[arg-type]
-    assert total / n_frames == pytest.approx(expected, rel=0.02)
+    assert total / n_frames == pytest.approx(expected, rel=0.02, abs=0)
     if range_window == "hann":  # the coherent gains 2 n / 3 of the docs
-        assert expected == pytest.approx(12 * p / (2 * 240 / 3) / (2 * 16 / 3), rel=1e-12)
+        assert expected == pytest.approx(12 * p / (2 * 240 / 3) / (2 * 16 / 3), rel=1e-12, abs=0)
 
 
 def _detect_points_reference(
