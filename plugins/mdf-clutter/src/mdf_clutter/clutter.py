@@ -316,21 +316,24 @@ class GroundClutter(Effect):
         ranges = self.patch_ranges(context)
         return ranges, self.responses(context, ranges)
 
+    def _patches(self, context: SceneContext) -> tuple[FloatArray, float, ComplexArray]:
+        """The record's patches, drawn from ``context.rng``: their ranges (n_patches,) [m]
+        (:meth:`patch_ranges`), each patch's mean RCS ``rcs_m2 spacing / resolution`` [m^2]
+        and their complex Gaussian amplitudes of unit mean power (n_patches,) (Rayleigh)."""
+        res = self.resolution(context)
+        ranges = self.patch_ranges(context)
+        n = ranges.size
+        alpha = (context.rng.standard_normal(n) + 1j * context.rng.standard_normal(n)) / np.sqrt(2)
+        return ranges, float(self.config.rcs_m2 * self._spacing(res) / res), alpha
+
     def receiver_input(self, context: SceneContext) -> ReceiverInput | None:
         """For a radar that simulates the clutter in its raw samples (:meth:`check_radar`:
         ``power = "rcs"``, no wind): the stationary patches as static point scatterers at
         :meth:`patch_ranges`, patch ``k`` of RCS ``rcs_m2 (spacing / resolution) |alpha_k|^2``
         (``alpha_k`` complex Gaussian of unit mean power: a Rayleigh amplitude; the carrier
         phase follows from the patch's random range)."""
-        c = self.config
-        res = self.resolution(context)
-        spacing = self._spacing(res)
-        ranges = self.patch_ranges(context)
-        rng = context.rng
-        alpha = (
-            rng.standard_normal(ranges.size) + 1j * rng.standard_normal(ranges.size)
-        ) / np.sqrt(2)
-        rcs = c.rcs_m2 * spacing / res * np.abs(alpha) ** 2
+        ranges, sigma_k, alpha = self._patches(context)
+        rcs = sigma_k * np.abs(alpha) ** 2
         self._stats = {
             "n_patches": int(ranges.size),
             "patch_range_m": [float(ranges.min()), float(ranges.max())],
@@ -344,13 +347,9 @@ class GroundClutter(Effect):
         made a group of patches at a time (:func:`wind_process_groups`) and summed, so memory
         grows with the pulses, not with the pulses times the patches."""
         c = self.config
-        res = self.resolution(context)
-        spacing = self._spacing(res)
-        ranges = self.patch_ranges(context)
+        ranges, sigma_k, alpha = self._patches(context)
         n_patch = ranges.size
-        sigma_k = c.rcs_m2 * spacing / res
         rng = context.rng
-        alpha = (rng.standard_normal(n_patch) + 1j * rng.standard_normal(n_patch)) / np.sqrt(2)
         lam = radar.wavelength(context.carrier_frequency)
         spread_hz = 2.0 * c.spread_mps / lam
         n_p = np.shape(context.gate_range)[0]
