@@ -197,11 +197,11 @@ def hand_to_radar(
             continue
         with blame(effect, "receiver_input"):
             got = effect.receiver_input(replace(context, rng=rng))
-            if got is not None:
-                _check_receiver_input(got)
-        if got is not None:
-            inputs.append(got)
-            handed.add(i)
+            if got is None:
+                continue
+            _check_receiver_input(got)
+        inputs.append(got)
+        handed.add(i)
     with blame(wf, "set_receiver_inputs"):
         wf.set_receiver_inputs(inputs)
     return frozenset(handed)
