@@ -340,8 +340,8 @@ def test_receive_is_block_invariant() -> None:
 
 
 def test_spectrogram_follows_the_frame_timing() -> None:
-    """With frame gaps, one Doppler spectrum per frame at its middle loop, over +-v_max; without
-    gaps, the STFT at the loop rate."""
+    """With frame gaps, one Doppler spectrum per frame at its window's centre, over +-v_max;
+    without gaps, the STFT at the loop rate."""
     v = 1.0
     res = fmcw_run([{"position": [3.0, 0.0, 0.0], "velocity": [-v, 0.0, 0.0]}], **QUIET)
     wf = FmcwRadar(IWR1443)
@@ -349,7 +349,7 @@ def test_spectrogram_follows_the_frame_timing() -> None:
     spec = res.spectrogram
     assert spec.time.shape == (15,)
     np.testing.assert_allclose(np.diff(spec.time), seq.frame_period, rtol=1e-9)
-    assert spec.time[0] == pytest.approx(7.5 * seq.loop_period, rel=1e-9)
+    assert spec.time[0] == pytest.approx(8 * seq.loop_period, rel=1e-9)  # Hann centre, 16 / 2
     vel = radar.doppler_to_velocity(spec.doppler, wf.carrier_frequency)
     assert vel[0] == pytest.approx(-seq.max_velocity, rel=1e-9)
     peaks = vel[np.argmax(spec.power, axis=0)]
