@@ -501,6 +501,24 @@ def test_outputs_hold_maps_points_and_their_figures(tmp_path: Any) -> None:
     assert len(lines) - 1 == len(pts) > 0
 
 
+def test_points_csv_keeps_the_frame_times_of_a_long_record(tmp_path: Any) -> None:
+    """``points.csv`` keeps each point's time to a microsecond however far into the record:
+    frames 33.333 ms apart, 1234.6 s and 3470.0 s in (a record of at most ``MAX_PULSES``
+    chirps reaches an hour), read back at their times and in their order. Six significant
+    digits rounded every time past 1000 s to 10 ms (1234.59 for 1234.5877 s), up to 15 % of a
+    frame."""
+    from mdframework.output import write_points_csv
+
+    period = 33.333e-3
+    frames = np.array([37038, 37039, 104101])
+    pts = np.zeros((frames.size, 7))
+    pts[:, 0], pts[:, 1], pts[:, 3] = frames, frames * period, 3.0
+    write_points_csv(tmp_path / "points.csv", pts)
+    table = np.loadtxt(tmp_path / "points.csv", delimiter=",", skiprows=1, ndmin=2)
+    np.testing.assert_allclose(table[:, 1], pts[:, 1], rtol=0, atol=1e-6)
+    np.testing.assert_array_equal(table[:, 0], frames)
+
+
 def test_a_radar_section_without_kind_is_still_the_lfm_radar() -> None:
     """With several radars installed, a ``[radar]`` section that names no kind keeps meaning
     the default radar (as it did when ``lfm`` was the only one)."""
