@@ -832,6 +832,37 @@ def test_the_ambiguous_doppler_bin_as_documented() -> None:
         assert strongest[5] == pytest.approx(want, rel=1e-9)
 
 
+def test_zero_padded_range_doppler_maps_peak_on_their_axes() -> None:
+    """The map's axes with FFTs longer than the data (``range_fft_size`` 480 for 240 samples,
+    an odd ``doppler_fft_size`` of 33 for 16 loops): a point approaching on boresight at
+    Doppler bin +2 of the 33 (0.596 m/s, zero Doppler on row 16) from 3.5 m, between two
+    bins of the 2.2 cm grid, peaks in every frame on row 18 (``range_doppler_velocity_mps``
+    exactly +v) and on the range bin nearest to its range at the frame's middle chirp
+    (``range_doppler_range_m``, within half a bin)."""
+    radar_ = FmcwRadar(
+        FmcwConfig(preset="iwr1443_short_range_3d", range_fft_size=480, doppler_fft_size=33)
+    )
+    seq, axes = radar_.sequence, radar_.axes()
+    ranges, velocity = axes["range_m"], axes["velocity_mps"]
+    assert velocity[16] == 0.0
+    v, r0 = float(velocity[18]), 3.5
+    res = fmcw_run(
+        [{"position": [r0, 0.0, 0.0], "velocity": [-v, 0.0, 0.0]}],
+        duration=0.2,
+        range_fft_size=480,
+        doppler_fft_size=33,
+        **QUIET,
+    )
+    maps = res.received.products["range_doppler"]
+    np.testing.assert_array_equal(res.received.products["range_doppler_range_m"], ranges)
+    assert maps.shape == (6, 33, 480)
+    for f, frame in enumerate(maps):
+        row, col = np.unravel_index(np.argmax(frame), frame.shape)
+        middle = f * seq.frame_period + seq.idle_time + seq.frame_active_time / 2
+        assert row == 18
+        assert abs(ranges[col] - (r0 - v * middle)) <= (ranges[1] - ranges[0]) / 2
+
+
 def test_the_aliasing_advice_names_the_fields_that_set_the_slow_time_rate() -> None:
     """The default FMCW radar (3 TX, 70 us chirps: loop rate 4762 Hz, v_max 4.58 m/s) and a
     point approaching at 5.5 m/s: the error names the chirp timing and the TDM order (fmcw has
