@@ -561,7 +561,7 @@ def _simulate_motion(
         "max_unambiguous_velocity_mps": stream.v_max,
         "max_radial_speed_mps": stream.speed,
         "radar_position_m": list(sc.radar_position),
-        "record_start_s": t_start,
+        "record_start_s": t_start - float(body.time[0]),  # as motion.start counts
         "effects": effects_ran,
         "seed": config.seed,
         "timings_s": timings,
