@@ -667,6 +667,26 @@ def test_check_refuses_a_body_nearer_the_radar_than_min_range(
     assert code == 2 and "scatterer 'base' comes within 0.0657 m of the radar" in err, err
 
 
+def test_a_target_too_near_is_refused_at_its_time_in_the_recording(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A point reaching the radar 3.374 s into its recording, in a record cut at
+    ``motion.start = 2``: the refusal names both times, 1.374 s into the record and 3.374 s
+    into the recording (the time ``motion.start`` counts), in the run and in ``mdf check``
+    (its joint frames 10 ms apart: 3.370 s). It named the record's time alone, where the
+    recording shows nothing."""
+    cfg = tmp_path / "near.toml"
+    cfg.write_text(
+        '[motion]\nkind = "point_targets"\nlength = 5.0\nstart = 2.0\n'
+        "targets = [{ position = [10.123, 0.0, 0.0], velocity = [-3.0, 0.0, 0.0] }]\n"
+        '[scatterers]\nkind = "points"\n[scene]\nradar_position = [0.0, 0.0, 0.0]\n'
+    )
+    code, _, err = run_cli(["run", str(cfg), "--out", str(tmp_path / "o")], capsys)
+    assert code == 2 and "t = 1.374 s into the record, 3.374 s into the recording" in err, err
+    code, _, err = run_cli(["check", str(cfg)], capsys)
+    assert code == 2 and "t = 1.370 s into the record, 3.370 s into the recording" in err, err
+
+
 def test_progress_notes_only_on_a_terminal(monkeypatch: pytest.MonkeyPatch) -> None:
     """Notes of slow steps reach an interactive user; a pipe keeps one line per error."""
     import io

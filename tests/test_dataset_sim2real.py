@@ -261,6 +261,35 @@ min_range = 0.25
     assert meta["units"]["histograms"] == "points (or weights) per bin and frame"
 
 
+def test_a_simulated_cloud_holds_every_frame_of_its_record() -> None:
+    """A 1.02 s record of 50 ms frames (6.7 ms of chirps each) holds 21 frames, the last from
+    1.00 s: its cloud has 21 frames, frame times 0 to 1 s, also when the last frame has no
+    point (it had 20 then, floor(1.02 / 0.05): a record's histograms and times lost their
+    last frame whenever it held no point)."""
+    from types import SimpleNamespace
+
+    from mdf_fmcw.waveform import FmcwConfig
+
+    from mdframework.dataset import _simulated_cloud
+    from mdframework.physics import fmcw
+
+    seq = FmcwConfig().sequence()
+    t = fmcw.chirp_times(seq, 0.0, 1.02)
+    assert t.size == 21 * seq.chirps_per_frame
+    points = np.zeros((20, 7))
+    points[:, 0] = np.arange(20)  # one point in each frame but the last
+    points[:, 1] = points[:, 0] * seq.frame_period
+    result = SimpleNamespace(
+        received=SimpleNamespace(products={"points": points}), pulse_times=t - t[0]
+    )
+    config = SimpleNamespace(
+        radar=SimpleNamespace(frame_period=seq.frame_period),
+        motion=SimpleNamespace(duration=1.02),
+    )
+    cloud = _simulated_cloud(result, config, "r")
+    assert cloud.n_frames == 21 and cloud.frame_period == 0.05
+
+
 def test_the_sim_to_real_dataset_plan() -> None:
     """docs/sim-to-real.md: 45 simulated records of 2 s (16 boxing, 15 jump, 14 walk) beside
     360 real ones (120 per activity), every simulated one with its own draws."""

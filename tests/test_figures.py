@@ -65,6 +65,26 @@ def test_auto_span_of_a_receding_point_target() -> None:
         plt.close(fig)
 
 
+def test_spectrogram_cells_are_centred_on_their_times_and_velocities() -> None:
+    """The image's cells are centred on the frame times and the velocity bins: the extent runs
+    half a hop before the first frame's time to half a hop after the last, half a bin below
+    the first velocity to half a bin above the last. A record of one frame (a single FMCW
+    frame, stamped 1.5 ms in) spans its window, 0 to 3 ms; it was drawn one second wide, from
+    -0.5 s."""
+    velocity = np.linspace(-2.0, 2.0, 9)
+    time = 0.05 + np.arange(4) * 0.02
+    with style() as plt:
+        fig, ax = plt.subplots()
+        image = draw_spectrogram(ax, np.zeros((9, 4)), time, velocity, velocity_span="full")
+        assert image.get_extent() == pytest.approx([0.04, 0.12, -2.25, 2.25])
+        assert ax.get_xlim() == pytest.approx((0.04, 0.12))
+        ax.clear()
+        image = draw_spectrogram(ax, np.zeros((9, 1)), np.array([1.5e-3]), velocity)
+        assert image.get_extent()[:2] == pytest.approx([0.0, 3e-3])
+        assert ax.get_xlim() == pytest.approx((0.0, 3e-3))
+        plt.close(fig)
+
+
 def test_caption_names_source_radar_geometry_and_effects(tmp_path: Path) -> None:
     config = load_run_config(EXAMPLES / "cmu_walk.toml")
     data = json.loads(config.model_dump_json())

@@ -728,3 +728,25 @@ def test_clutter_removal_removes_the_static_target_and_keeps_the_moving_one() ->
     np.testing.assert_allclose(np.abs(rd[:, row, 40]), a, rtol=1e-9)
     kept = fmcw.range_doppler(cube, "hann", n_loops)  # without removal the still target stays
     np.testing.assert_allclose(np.abs(kept[:, (n_loops - 1) // 2, 20]), 1.5, rtol=1e-9)
+
+
+@pytest.mark.parametrize("window", ["hann", "boxcar"])
+def test_a_frame_spectrum_is_stamped_at_its_windows_centre(window: str) -> None:
+    """One Doppler spectrum per frame (frames with gaps): a point 40 % of the way to v_max
+    turns from approaching to receding at the time frame 2's spectrum is stamped with: its
+    power splits evenly between the positive and the negative Doppler half, to 1e-6 (an odd
+    FFT size: the halves have the same bins). That time is the centre of the window over the
+    frame's loops, n_loops / 2 loop periods after its first chirp with the periodic Hann
+    window (n_loops = 16 here), (n_loops - 1) / 2 with the boxcar. Stamping every window at
+    its middle loop, (n_loops - 1) / 2, stamped a Hann frame half a loop early: a turn at that
+    stamp leaves 42 % of the power in the positive half."""
+    n_frames, f = 4, 2
+    frame = np.arange(n_frames)[:, None] * SEQ.frame_period
+    t = (frame + np.arange(SEQ.chirps_per_frame)[None, :] * SEQ.chirp_period).ravel()
+    _, _, time = fmcw.frame_spectrogram(np.ones(t.size, complex), SEQ, window, 129, "float64")
+    t_rev = time[f]  # from the first chirp, as the chirp times t
+    f0 = 0.4 / (2 * SEQ.loop_period)
+    signal = np.exp(2j * np.pi * f0 * (t_rev - np.abs(t - t_rev)))
+    power, doppler, _ = fmcw.frame_spectrogram(signal, SEQ, window, 129, "float64")
+    up, down = power[doppler > 0, f].sum(), power[doppler < 0, f].sum()
+    assert up / (up + down) == pytest.approx(0.5, abs=1e-6)

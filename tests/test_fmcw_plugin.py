@@ -340,8 +340,8 @@ def test_receive_is_block_invariant() -> None:
 
 
 def test_spectrogram_follows_the_frame_timing() -> None:
-    """With frame gaps, one Doppler spectrum per frame at its middle loop, over +-v_max; without
-    gaps, the STFT at the loop rate."""
+    """With frame gaps, one Doppler spectrum per frame at its window's centre, over +-v_max;
+    without gaps, the STFT at the loop rate."""
     v = 1.0
     res = fmcw_run([{"position": [3.0, 0.0, 0.0], "velocity": [-v, 0.0, 0.0]}], **QUIET)
     wf = FmcwRadar(IWR1443)
@@ -349,7 +349,7 @@ def test_spectrogram_follows_the_frame_timing() -> None:
     spec = res.spectrogram
     assert spec.time.shape == (15,)
     np.testing.assert_allclose(np.diff(spec.time), seq.frame_period, rtol=1e-9)
-    assert spec.time[0] == pytest.approx(7.5 * seq.loop_period, rel=1e-9)
+    assert spec.time[0] == pytest.approx(8 * seq.loop_period, rel=1e-9)  # Hann centre, 16 / 2
     vel = radar.doppler_to_velocity(spec.doppler, wf.carrier_frequency)
     assert vel[0] == pytest.approx(-seq.max_velocity, rel=1e-9)
     peaks = vel[np.argmax(spec.power, axis=0)]
@@ -499,6 +499,24 @@ def test_outputs_hold_maps_points_and_their_figures(tmp_path: Any) -> None:
     table = np.loadtxt(tmp_path / "run" / "points.csv", delimiter=",", skiprows=1, ndmin=2)
     np.testing.assert_allclose(table, pts, rtol=1e-5, atol=1e-6)
     assert len(lines) - 1 == len(pts) > 0
+
+
+def test_points_csv_keeps_the_frame_times_of_a_long_record(tmp_path: Any) -> None:
+    """``points.csv`` keeps each point's time to a microsecond however far into the record:
+    frames 33.333 ms apart, 1234.6 s and 3470.0 s in (a record of at most ``MAX_PULSES``
+    chirps reaches an hour), read back at their times and in their order. Six significant
+    digits rounded every time past 1000 s to 10 ms (1234.59 for 1234.5877 s), up to 15 % of a
+    frame."""
+    from mdframework.output import write_points_csv
+
+    period = 33.333e-3
+    frames = np.array([37038, 37039, 104101])
+    pts = np.zeros((frames.size, 7))
+    pts[:, 0], pts[:, 1], pts[:, 3] = frames, frames * period, 3.0
+    write_points_csv(tmp_path / "points.csv", pts)
+    table = np.loadtxt(tmp_path / "points.csv", delimiter=",", skiprows=1, ndmin=2)
+    np.testing.assert_allclose(table[:, 1], pts[:, 1], rtol=0, atol=1e-6)
+    np.testing.assert_array_equal(table[:, 0], frames)
 
 
 def test_a_radar_section_without_kind_is_still_the_lfm_radar() -> None:
@@ -812,6 +830,37 @@ def test_the_ambiguous_doppler_bin_as_documented() -> None:
         pts = res.received.products["points"]
         strongest = pts[np.argmax(pts[:, 6])]
         assert strongest[5] == pytest.approx(want, rel=1e-9)
+
+
+def test_zero_padded_range_doppler_maps_peak_on_their_axes() -> None:
+    """The map's axes with FFTs longer than the data (``range_fft_size`` 480 for 240 samples,
+    an odd ``doppler_fft_size`` of 33 for 16 loops): a point approaching on boresight at
+    Doppler bin +2 of the 33 (0.596 m/s, zero Doppler on row 16) from 3.5 m, between two
+    bins of the 2.2 cm grid, peaks in every frame on row 18 (``range_doppler_velocity_mps``
+    exactly +v) and on the range bin nearest to its range at the frame's middle chirp
+    (``range_doppler_range_m``, within half a bin)."""
+    radar_ = FmcwRadar(
+        FmcwConfig(preset="iwr1443_short_range_3d", range_fft_size=480, doppler_fft_size=33)
+    )
+    seq, axes = radar_.sequence, radar_.axes()
+    ranges, velocity = axes["range_m"], axes["velocity_mps"]
+    assert velocity[16] == 0.0
+    v, r0 = float(velocity[18]), 3.5
+    res = fmcw_run(
+        [{"position": [r0, 0.0, 0.0], "velocity": [-v, 0.0, 0.0]}],
+        duration=0.2,
+        range_fft_size=480,
+        doppler_fft_size=33,
+        **QUIET,
+    )
+    maps = res.received.products["range_doppler"]
+    np.testing.assert_array_equal(res.received.products["range_doppler_range_m"], ranges)
+    assert maps.shape == (6, 33, 480)
+    for f, frame in enumerate(maps):
+        row, col = np.unravel_index(np.argmax(frame), frame.shape)
+        middle = f * seq.frame_period + seq.idle_time + seq.frame_active_time / 2
+        assert row == 18
+        assert abs(ranges[col] - (r0 - v * middle)) <= (ranges[1] - ranges[0]) / 2
 
 
 def test_the_aliasing_advice_names_the_fields_that_set_the_slow_time_rate() -> None:

@@ -401,7 +401,7 @@ def test_6_10_sign_convention_and_axes_end_to_end() -> None:
     peak = res.spectrogram.doppler[np.argmax(res.spectrogram.power, axis=0)]
     assert np.all(peak == pytest.approx(93.75, abs=1e-9))  # approaching -> positive
     assert np.allclose(res.velocity, res.spectrogram.doppler * SPEED_OF_LIGHT / (2 * FC))
-    centres = (np.arange(res.spectrogram.time.size) * 64 + 127.5) / 2400.0
+    centres = (np.arange(res.spectrogram.time.size) * 64 + 128) / 2400.0  # Hann: L/2
     assert np.allclose(res.spectrogram.time, centres)
 
 

@@ -96,7 +96,7 @@ def test_spectrogram_axes_and_frame_centres() -> None:
     y = np.exp(2j * np.pi * 300.0 * np.arange(4800) / fs)
     s = spectrogram.spectrogram(y, fs, window_length=256, hop=64, nfft=512)
     assert s.doppler[0] == -fs / 2 and s.doppler[-1] == pytest.approx(fs / 2 - fs / 512)
-    assert s.time[0] == pytest.approx(127.5 / fs)
+    assert s.time[0] == pytest.approx(128 / fs)  # the periodic Hann window's centre, L/2
     assert np.allclose(np.diff(s.time), 64 / fs)
     assert s.doppler[np.argmax(s.power[:, 3])] == pytest.approx(300.0, abs=fs / 512 / 2)
     # Parseval per frame: sum over bins of |X|^2 / nfft = sum |w y|^2 (nfft >= window)
@@ -160,6 +160,46 @@ def test_other_windows_come_from_scipy_and_unknown_names_fail() -> None:
     assert np.array_equal(w, get_window("flattop", 128, fftbins=True))
     with pytest.raises(ValueError):
         spectrogram.stft_window("nosuchwindow", 8)
+
+
+def _reversal(t: np.ndarray, t_rev: float, f0: float) -> np.ndarray:
+    """A tone at +f0 [Hz] until ``t_rev`` [s], then at -f0, its phase continuous: the slow-time
+    return of a point that approaches, turns at ``t_rev`` and recedes at the same speed."""
+    return np.exp(2j * np.pi * f0 * (t_rev - np.abs(t - t_rev)))
+
+
+def _half_power_time(power: np.ndarray, doppler: np.ndarray, time: np.ndarray) -> float:
+    """The time [s] at which a spectrogram's power above 0 Hz falls to half of the power off
+    0 Hz, interpolated linearly between its columns."""
+    up = power[doppler > 0].sum(axis=0)
+    share = up / (up + power[doppler < 0].sum(axis=0))
+    i = int(np.flatnonzero((share[:-1] >= 0.5) & (share[1:] < 0.5))[0])
+    return float(time[i] + (share[i] - 0.5) / (share[i] - share[i + 1]) * (time[i + 1] - time[i]))
+
+
+@pytest.mark.parametrize(
+    ("window", "length", "nfft"),
+    [("hann", 256, 256), ("hann", 255, 511), ("blackman", 128, 128), ("boxcar", 64, 128)],
+)
+def test_a_frame_is_stamped_at_its_windows_centre(window: str, length: int, nfft: int) -> None:
+    """A return whose Doppler flips from +300 to -300 Hz at t_rev: the frame whose power splits
+    evenly between them is the one whose window is centred on t_rev, and its time says t_rev
+    to 0.02 samples (hop 1). The periodic windows (Hann, Blackman) are symmetric about their
+    L/2-th sample, the boxcar about (L - 1)/2: stamping every window at the middle sample
+    (L - 1)/2 put the flip half a sample (0.2 ms at 2400 Hz) after its true time."""
+    fs = 2400.0
+    t = np.arange(1200) / fs
+    t_rev = 600.3 / fs
+    s = spectrogram.spectrogram(
+        _reversal(t, t_rev, 300.0),
+        fs,
+        window=window,
+        window_length=length,
+        hop=1,
+        nfft=nfft,
+        precision="float64",
+    )
+    assert _half_power_time(s.power, s.doppler, s.time) == pytest.approx(t_rev, abs=0.02 / fs)
 
 
 @pytest.mark.parametrize("nfft", [255, 257])

@@ -76,6 +76,66 @@ def test_record_uses_only_its_window_of_a_long_recording() -> None:
     assert 110 <= res.body.n_frames <= 122  # 120 Hz for 1 s
 
 
+def test_a_record_cut_at_start_counts_its_times_from_its_first_pulse() -> None:
+    """docs/getting-started.md: a record cut at ``motion.start`` = 0.7 s of a point receding
+    from 10 m at 1 m/s counts every time from its own first pulse: pulse 0 is at 0 s and sees
+    the point at 10.7 m, pulse ``k`` at ``10.7 + pulse_time_s[k]`` (to 1e-9 m), and the
+    spectrogram's first frame is stamped at its Hann window's centre, 128 pulses in."""
+    res = pipeline.simulate(
+        validate_run_config(
+            {
+                "motion": {
+                    "kind": "point_targets",
+                    "length": 3.0,
+                    "start": 0.7,
+                    "duration": 1.0,
+                    "targets": [{"position": [10.0, 0.0, 0.0], "velocity": [1.0, 0.0, 0.0]}],
+                },
+                "scatterers": {"kind": "points"},
+                "scene": {"radar_position": [0.0, 0.0, 0.0]},
+                "processing": {"keep_scatterers": True, "window_length": 256},
+            }
+        )
+    )
+    arrays = result_arrays(res)
+    t = arrays["pulse_time_s"]
+    assert t[0] == 0.0 and t[-1] == pytest.approx(1.0)
+    np.testing.assert_allclose(arrays["scatterer_range_m"][:, 0], 10.7 + t, rtol=0, atol=1e-9)
+    assert arrays["time_s"][0] == pytest.approx(128 / 2400.0, rel=1e-12)
+    assert arrays["body_time_s"][0] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_the_records_start_in_the_metadata_counts_from_the_recordings_first_frame() -> None:
+    """``metadata.json``'s ``record_start_s`` is where the record starts as ``motion.start``
+    counts it (and ``mdf check`` prints it), from the recording's first frame, also for a
+    motion whose clock starts at 100 s: 0.5, not the clock's 100.5."""
+    from mdframework import Motion, Skeleton
+
+    t = 100.0 + np.arange(201) / 100.0
+    pos = np.zeros((t.size, 1, 3))
+    pos[:, 0, 0] = 10.0 + (t - 100.0)
+    motion = Motion(Skeleton(t, pos, ("p",)), {"source": "clock"}, None, np.ones(1), True)
+    cfg = validate_run_config(
+        {
+            "motion": {
+                "kind": "point_targets",
+                "length": 2.0,
+                "start": 0.5,
+                "duration": 1.0,
+                "targets": [{"position": [10.0, 0.0, 0.0]}],
+            },
+            "scatterers": {"kind": "points"},
+            "scene": {"radar_position": [0.0, 0.0, 0.0]},
+            "processing": {"keep_scatterers": True},
+        }
+    )
+    res = simulate_motion(cfg, build_stages(cfg), motion)
+    assert res.metadata["record_start_s"] == pytest.approx(0.5, abs=1e-12)
+    assert res.pulse_times[0] == 0.0
+    assert res.scatterers is not None
+    assert res.scatterers.ranges(np.zeros(3))[0, 0] == pytest.approx(10.5, abs=1e-9)
+
+
 def test_long_raw_records_keep_a_bounded_range_time_map() -> None:
     """Beyond MAX_KEPT_RANGE_TIME_ROWS pulses the map keeps evenly spaced rows with their
     indices, and the saved map at most MAX_SAVED_RANGE_TIME_ROWS of them with their times: every

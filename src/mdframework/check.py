@@ -224,7 +224,8 @@ def plan_run(
     seen = body.valid[inside]
     ranges = np.where(seen, radar.distances(body.positions[inside], radar_pos), np.inf)
     since = body.time[inside] - body.time[inside][:1]
-    refuse_near(ranges, body.joint_names, since, config.scene.min_range, "joint")
+    start = float(body.time[inside][0] - body.time[0]) if np.any(inside) else 0.0
+    refuse_near(ranges, body.joint_names, since, config.scene.min_range, "joint", start)
     speed = max_joint_radial_speed(
         body.time[inside], body.positions[inside], body.valid[inside], radar_pos
     )

@@ -1452,7 +1452,8 @@ def _simulated_cloud(result: Any, config: Any, record: str) -> PointCloud:
     """The point cloud a simulated radar produced: ``received.products["points"]``
     (n_points, 7) with columns frame (from 0 in the record), t [s], x, y, z [m, sensor frame],
     v [m/s, positive approaching], intensity [dB]; the frame period is the radar's
-    ``frame_period`` [s]."""
+    ``frame_period`` [s]. It holds every frame of the record, up to that of its last pulse, the
+    last frames too when they hold no point."""
     products = getattr(result.received, "products", None) or {}
     points = products.get("points")
     period = getattr(config.radar, "frame_period", None)
@@ -1463,8 +1464,9 @@ def _simulated_cloud(result: Any, config: Any, record: str) -> PointCloud:
         )
     pts = np.asarray(points, dtype=np.float64)
     frame = pts[:, 0].astype(np.int64)
-    whole = int(np.floor(float(config.motion.duration) / period + 1e-6))
-    n_frames = max(whole, int(frame.max()) + 1 if frame.size else 1)
+    times = np.asarray(result.pulse_times, dtype=np.float64)  # from the first pulse
+    last = int(np.floor(float(times[-1]) / float(period) + 1e-9)) if times.size else 0
+    n_frames = max(last + 1, int(frame.max()) + 1 if frame.size else 1)
     return PointCloud(frame, pts[:, 2:5], pts[:, 5], pts[:, 6], float(period), n_frames)
 
 

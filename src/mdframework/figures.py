@@ -210,12 +210,14 @@ def _power_image(
     up: NDArray[np.float64],
     dynamic_range_db: float,
     colormap: str,
+    lone_width: float = 1.0,
 ) -> Any:
     """Draw a dB map ``db`` (len(up), len(across)) into ``ax``, each cell centred on its
     coordinates (``across``, ``up``: evenly spaced, ascending), the top ``dynamic_range_db``
     in colour, max-pooled to :data:`MAX_IMAGE_CELLS` cells across (the rows stay: a velocity
-    span may show a few of them). Returns the image (for a colour bar)."""
-    da = float(across[1] - across[0]) if across.size > 1 else 1.0
+    span may show a few of them); a lone cell across is ``lone_width`` wide. Returns the image
+    (for a colour bar)."""
+    da = float(across[1] - across[0]) if across.size > 1 else lone_width
     du = float(up[1] - up[0]) if up.size > 1 else 1.0
     extent = (across[0] - da / 2, across[-1] + da / 2, up[0] - du / 2, up[-1] + du / 2)
     peak = float(np.max(db))
@@ -244,8 +246,11 @@ def draw_spectrogram(
     """Draw a spectrogram into ``ax``: time [s] across, radial velocity [m/s] up (positive =
     approaching), the top ``dynamic_range_db`` in colour. Returns the image (for a colour bar).
     ``spectrogram_db`` (n_doppler, n_frames) [dB re peak]; ``time`` (n_frames,) [s];
-    ``velocity`` (n_doppler,) ascending [m/s]."""
-    im = _power_image(ax, spectrogram_db, time, velocity, dynamic_range_db, colormap)
+    ``velocity`` (n_doppler,) ascending [m/s]. A lone frame spans its window, from the
+    record's start to twice its time (its window's centre)."""
+    t0 = float(time[0]) if time.size else 0.0
+    lone = 2.0 * t0 if t0 > 0 else 1.0
+    im = _power_image(ax, spectrogram_db, time, velocity, dynamic_range_db, colormap, lone)
     ax.set_ylim(*velocity_limits(spectrogram_db, velocity, velocity_span, dynamic_range_db))
     ax.set_xlabel("time [s]")
     ax.set_ylabel("radial velocity [m/s] (+ approaching)")

@@ -310,11 +310,13 @@ POINTS_HEADER = "frame,t,x,y,z,v,intensity"
 
 def write_points_csv(path: Path, points: np.ndarray) -> None:
     """``points`` (n_points, 7) as CSV with :data:`POINTS_HEADER`: frame index, t [s from the
-    first pulse], x, y, z [m, sensor frame], v [m/s, + approaching], intensity [dB]."""
+    first pulse], x, y, z [m, sensor frame], v [m/s, + approaching], intensity [dB]. Six
+    significant digits, but ten for ``t``: a microsecond in a record of a day."""
     with open(path, "w", encoding="utf-8") as f:
         f.write(POINTS_HEADER + "\n")
         for row in points:
-            f.write(f"{int(row[0])}," + ",".join(f"{v:.6g}" for v in row[1:]) + "\n")
+            rest = ",".join(f"{v:.6g}" for v in row[2:])
+            f.write(f"{int(row[0])},{row[1]:.10g},{rest}\n")
 
 
 def plot_point_products(

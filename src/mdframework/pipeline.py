@@ -482,7 +482,9 @@ def _simulate_motion(
     generators = effect_generators(config.seed, stages.effects)
     # the contexts' generator: apply_effects gives each effect its own in its place
     rng = generators[0] if generators else np.random.default_rng(config.seed)
-    stream = _Stream(n, proc.keep_scatterers, proc.aliasing, wf, sc.min_range, t)
+    stream = _Stream(
+        n, proc.keep_scatterers, proc.aliasing, wf, sc.min_range, t, float(t[0] - body.time[0])
+    )
     losses = emptiness.Losses()
     blocks = _blocks(n, proc.block_pulses, wf.block_multiple)
     early_effects = any(e.stage == "scatterers" for e in stages.effects)
@@ -559,7 +561,7 @@ def _simulate_motion(
         "max_unambiguous_velocity_mps": stream.v_max,
         "max_radial_speed_mps": stream.speed,
         "radar_position_m": list(sc.radar_position),
-        "record_start_s": t_start,
+        "record_start_s": t_start - float(body.time[0]),  # as motion.start counts
         "effects": effects_ran,
         "seed": config.seed,
         "timings_s": timings,
@@ -714,8 +716,10 @@ class _Stream:
         wf: RadarWaveform,
         min_range: float,
         t: FloatArray,
+        start: float = 0.0,
     ) -> None:
         self.n, self.keep, self.aliasing, self.min_range, self.t = n, keep, aliasing, min_range, t
+        self.start = start  # where the record starts in the recording [s]: named in refusals
         self.signal = np.empty(n, dtype=np.complex128)
         self.gate = np.empty(n, dtype=np.float64)
         self.v_max = wf.max_unambiguous_velocity
@@ -737,7 +741,7 @@ class _Stream:
             raise SceneError("a scatterer position is not finite")
         if nearest < self.min_range:
             t = self.t[lo : lo + ranges.shape[0]] - self.t[0]
-            refuse_near(ranges, scat.names, t, self.min_range, "scatterer")
+            refuse_near(ranges, scat.names, t, self.min_range, "scatterer", self.start)
 
     def check(self, lo: int, scat: Scatterers, ranges: FloatArray) -> None:
         """Finite ranges above ``scene.min_range``; the fastest radial speed so far."""
@@ -817,19 +821,29 @@ class _Stream:
 
 
 def refuse_near(
-    ranges: FloatArray, names: Sequence[str], time: FloatArray, min_range: float, what: str
+    ranges: FloatArray,
+    names: Sequence[str],
+    time: FloatArray,
+    min_range: float,
+    what: str,
+    start: float = 0.0,
 ) -> None:
     """A :class:`SceneError` naming the ``what`` (scatterer, joint) nearest the radar when it
     comes within ``min_range`` [m]: ``ranges`` (n, len(names)) [m] (inf where not seen) at
-    ``time`` (n,) [s from the record's start]."""
+    ``time`` (n,) [s from the record's start]; ``start`` [s]: where the record starts in the
+    recording (as ``motion.start`` counts), named too when the record does not start at its
+    first frame."""
     if ranges.size == 0:
         return
     k, j = (int(i) for i in np.unravel_index(int(np.argmin(ranges)), ranges.shape))
     if ranges[k, j] < min_range:
+        when = f"t = {time[k]:.3f} s"
+        if abs(start) > 5e-4:  # the record starts after the recording's first frame
+            when += f" into the record, {time[k] + start:.3f} s into the recording"
         raise SceneError(
-            f"{what} {names[j]!r} comes within {ranges[k, j]:.3g} m of the radar at t = "
-            f"{time[k]:.3f} s (scene.min_range = {min_range:g} m): the range equation and "
-            "far-field RCS do not hold there"
+            f"{what} {names[j]!r} comes within {ranges[k, j]:.3g} m of the radar at {when} "
+            f"(scene.min_range = {min_range:g} m): the range equation and far-field RCS do not "
+            "hold there"
         )
 
 

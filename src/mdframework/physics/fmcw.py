@@ -1175,15 +1175,18 @@ def frame_spectrogram(
     ``nfft`` >= n_loops points, in ``precision`` (as the STFT's ``processing.precision``:
     float32 is complex64 FFTs and float32 power). Returns power (nfft, n_frames) [|signal|^2]
     float32 or float64, Doppler (nfft,) [Hz] ascending, ``(k - nfft // 2) / (nfft T_loop)`` as
-    in every radar's spectrogram (not :func:`doppler_axis`), and the time of each frame's middle
-    loop (n_frames,) [s from the first chirp].
+    in every radar's spectrogram (not :func:`doppler_axis`), and the time of each frame's
+    window centre (n_frames,) [s from the first chirp]: ``f T_frame + c T_loop``, ``c`` the
+    :func:`~mdframework.physics.spectrogram.window_centre` of the window over the loops
+    (``n_loops / 2`` for the periodic Hann window: the middle of the frame's loops).
     """
     # the cosine windows without importing scipy.signal
-    from .spectrogram import precision_dtypes, stft_window
+    from .spectrogram import precision_dtypes, stft_window, window_centre
 
     real, cplx = precision_dtypes(precision)
     frames = np.asarray(signal).reshape(-1, seq.chirps_per_frame)[:, :: seq.n_tx]
-    w = stft_window(window_name, seq.n_loops).astype(real)
+    w64 = stft_window(window_name, seq.n_loops)
+    w = w64.astype(real)
     n_frames = frames.shape[0]
     power = np.empty((nfft, n_frames), dtype=real)
     for lo in range(0, n_frames, FRAMES_PER_BLOCK):  # memory set by the block, not the record
@@ -1191,7 +1194,7 @@ def frame_spectrogram(
         x = frames[lo:hi].astype(cplx) * w
         spec = np.fft.fftshift(np.fft.fft(x, n=nfft, axis=1), axes=1)
         power[:, lo:hi] = (spec.real**2 + spec.imag**2).T
-    time = np.arange(n_frames) * seq.frame_period + (seq.n_loops - 1) / 2 * seq.loop_period
+    time = np.arange(n_frames) * seq.frame_period + window_centre(w64) * seq.loop_period
     # the micro-Doppler axis of every radar's spectrogram (ambiguous bin first, as receding),
     # not the range-Doppler map's TI order: FMCW and pulse-Doppler spectrograms compare bin by bin
     doppler = np.arange(-(nfft // 2), nfft - nfft // 2) / (nfft * seq.loop_period)

@@ -54,6 +54,22 @@ def stft_window(name: str, length: int) -> FloatArray:
     return np.asarray(get_window(name, length, fftbins=True), dtype=np.float64)
 
 
+def window_centre(window: FloatArray) -> float:
+    """The time centre of a window ``w`` (L,), in samples from its first: the centroid of its
+    energy, ``sum_n n w(n)^2 / sum_n w(n)^2``. A spectrum taken through the window measures
+    the signal around that instant: a tone that changes at it puts half of the spectrum's
+    energy on either side. ``L / 2`` for the periodic (DFT-even) Hann and Blackman windows of
+    :func:`stft_window` (their first sample, 0, pairs with the missing ``L``-th: they are
+    symmetric about ``L / 2``, not about the middle sample ``(L - 1) / 2``), within 0.01 sample
+    of it for the periodic Hamming window, ``(L - 1) / 2`` for the boxcar. A window without
+    energy counts from its middle sample."""
+    w2 = np.square(np.asarray(window, dtype=np.float64))
+    total = float(np.sum(w2))
+    if not total > 0.0:
+        return float(w2.shape[0] - 1) / 2.0
+    return float(np.dot(np.arange(w2.shape[0], dtype=np.float64), w2) / total)
+
+
 class RecordTooShortError(ValueError):
     """The record has fewer samples than one STFT window."""
 
@@ -115,8 +131,8 @@ def stft_geometry(
 class Spectrogram:
     """``power`` (n_doppler, n_frames) float32 (float64 with ``precision = "float64"``)
     [W-like, |signal|^2 units];
-    ``doppler`` (n_doppler,) [Hz], ascending; ``time`` (n_frames,) [s], window centres relative
-    to the first sample."""
+    ``doppler`` (n_doppler,) [Hz], ascending; ``time`` (n_frames,) [s], window centres
+    (:func:`window_centre`) relative to the first sample."""
 
     power: NDArray[np.floating[Any]]
     doppler: FloatArray
@@ -137,7 +153,8 @@ def spectrogram(
 
     ``window`` is any scipy window name; ``window_length`` and ``hop`` in samples; ``nfft`` >=
     ``window_length`` (default: the window length). Frame ``m`` covers samples
-    ``mH .. mH + L - 1`` and its time is their midpoint ``(mH + (L - 1)/2) / fs``. A record shorter
+    ``mH .. mH + L - 1`` and its time is its window's centre ``(mH + c) / fs``, ``c`` the
+    :func:`window_centre` (``L / 2`` for the periodic Hann window). A record shorter
     than one window raises :class:`RecordTooShortError`; the resolution never changes silently
     (``ValueError`` for a signal of more than one dimension: one channel at a time).
     ``precision``: ``float32`` (complex64 FFTs, float32 power; the accuracy ladder in
@@ -171,9 +188,8 @@ def spectrogram(
         np.square(spec.real, out=power[lo:hi])
         power[lo:hi] += np.square(spec.imag)
     doppler = np.arange(-(nfft // 2), nfft - nfft // 2, dtype=np.float64) * sample_rate / nfft
-    time = np.asarray(
-        (np.arange(n_frames) * hop + (window_length - 1) / 2.0) / sample_rate, np.float64
-    )
+    centre = window_centre(w)  # of the window itself: the (-1)^n above leaves w^2 as it is
+    time = np.asarray((np.arange(n_frames) * hop + centre) / sample_rate, np.float64)
     return Spectrogram(power.T, doppler, time)
 
 

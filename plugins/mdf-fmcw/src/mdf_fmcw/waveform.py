@@ -613,7 +613,8 @@ class FmcwRadar(RadarWaveform):
         """Micro-Doppler spectrogram from the first TDM slot's chirps (one sample per loop):
         an STFT (``processing`` window, length, hop, FFT size) when the frames follow each other
         without gaps, else one Doppler spectrum per frame (window over the frame's loops, FFT
-        size ``max(processing.nfft, n_loops)``), at the frame's middle loop; the power in
+        size ``max(processing.nfft, n_loops)``), at its window's centre (``n_loops / 2`` loops
+        after the frame's first chirp with the Hann window); the power in
         ``processing.precision`` (float32 by default). :meth:`spectrogram_geometry` gives its
         geometry. ``times`` is not needed: the config fixes the chirp timing."""
         from mdframework.physics.spectrogram import Spectrogram
