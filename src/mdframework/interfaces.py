@@ -500,6 +500,14 @@ class RadarWaveform(Plugin):
         rather than the slow-time signal alone. Default: False."""
         return False
 
+    @property
+    def max_static_range(self) -> float | None:
+        """Range [m] at or beyond which the static scatterers of :class:`ReceiverInput` s
+        (``static_ranges``) are left out of the raw samples (the FMCW radar's maximum range,
+        unless it aliases them), so that an effect can report what was simulated; ``None``:
+        none left out. Default: ``None``."""
+        return None
+
     def set_receiver_inputs(self, inputs: Sequence[ReceiverInput]) -> None:
         """The record's :class:`ReceiverInput` s (maybe none), before its blocks, when
         :attr:`takes_receiver_inputs`; a block with ``receiver_noise`` False leaves them out

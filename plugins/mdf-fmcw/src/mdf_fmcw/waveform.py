@@ -653,6 +653,12 @@ class FmcwRadar(RadarWaveform):
         carry them; without either, they act on the slow-time signal as with every radar."""
         return self.config.points or self.config.save_range_doppler
 
+    @property
+    def max_static_range(self) -> float | None:
+        """The maximum range [m]: static scatterers at or beyond it are left out of the IF
+        samples; ``None`` with ``beyond_max_range = "alias"`` (they fold back in)."""
+        return None if self.config.beyond_max_range == "alias" else self.sequence.max_range
+
     def set_receiver_inputs(self, inputs: Sequence[ReceiverInput]) -> None:
         """The record's effects in the IF samples: white noise per frame seeded by (the
         input's ``noise_key``, frame index), static scatterers along the boresight."""
@@ -677,8 +683,9 @@ class FmcwRadar(RadarWaveform):
         seq, c = self.sequence, self.config
         ranges = np.concatenate([np.zeros(0), *(i.static_ranges for i in self._inputs)])
         rcs = np.concatenate([np.zeros(0), *(i.static_rcs for i in self._inputs)])
-        if c.beyond_max_range != "alias":
-            keep = ranges < seq.max_range
+        far = self.max_static_range
+        if far is not None:
+            keep = ranges < far
             ranges, rcs = ranges[keep], rcs[keep]
         out = None
         if ranges.size:
