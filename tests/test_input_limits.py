@@ -405,6 +405,34 @@ def test_a_spectrogram_beyond_the_limit_is_refused_before_any_pulse(
         limits.check_spectrogram_cells(2**20, 2**10 + 1, 4)  # a frame over it
 
 
+def test_an_fmcw_spectrogram_beyond_the_limit_names_the_fields_that_set_its_size(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An FMCW radar with gaps between its frames makes one spectrum per frame of
+    processing.nfft bins: processing.hop does not change its size, so the limit's message names
+    radar.frame_period (one column per frame) and processing.nfft instead (40 s of 33.3 ms
+    frames, 2**20 bins: 1.26e9 values)."""
+    from mdframework import cli
+
+    cfg = tmp_path / "fmcw.toml"
+    cfg.write_text(
+        '[motion]\nkind = "point_targets"\nlength = 40.0\n'
+        "targets = [{ position = [3.0, 0.0, 0.0], velocity = [0.0, 0.0, 0.0], rcs = 1.0 }]\n"
+        '[scatterers]\nkind = "points"\n'
+        '[radar]\nkind = "fmcw"\npreset = "iwr1443_short_range_3d"\n'
+        "[scene]\nradar_position = [0.0, 0.0, 0.0]\ngate = 3.0\n"
+        "[processing]\nnfft = 1048576\n"
+    )
+    assert cli.main(["check", str(cfg)]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert line.startswith(
+        f"mdf: error: {cfg}: radar.frame_period: the spectrogram of 1048576 Doppler bins x "
+        "1200 frames is 1.258e+09 values"
+    )
+    assert line.endswith("raise radar.frame_period, lower processing.nfft or shorten the record")
+    assert "hop" not in line
+
+
 def test_check_regular_file_follows_links_and_names_a_folder(tmp_path: Path) -> None:
     """A link to a regular file is read as that file; a folder and a missing file are
     refused naming the path and what is wrong."""

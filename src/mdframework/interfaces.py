@@ -545,6 +545,17 @@ class RadarWaveform(Plugin):
         fields (FMCW timing, CW's sample rate) overrides it."""
         return f"raise radar.prf to at least {np.ceil(rate):.0f} Hz"
 
+    def smaller_spectrogram(self, processing: ProcessingConfig) -> tuple[str, str]:
+        """What sets the size of this radar's spectrogram (:meth:`spectrogram_geometry`), for
+        the message refusing one of more than ``limits.MAX_SPECTROGRAM_CELLS`` values: the
+        config field to name first and a clause saying what to change. Default: the
+        pipeline's STFT's, ``limits.STFT_SIZE_FIELDS`` (``processing.hop``,
+        ``processing.nfft``, the record's length); a radar whose spectrogram is sized by other
+        fields (FMCW frames with gaps: one column per frame) overrides it."""
+        from .limits import STFT_SIZE_FIELDS
+
+        return STFT_SIZE_FIELDS
+
     @property
     def shortest_record(self) -> float:
         """Shortest record [s] that :meth:`pulse_times` gives any pulse in (e.g. the chirps of

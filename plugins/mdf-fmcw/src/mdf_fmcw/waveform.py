@@ -607,6 +607,17 @@ class FmcwRadar(RadarWaveform):
         hop = seq.frame_period * self.prf
         return SpectrogramGeometry(self.prf, seq.n_loops, hop, max(p.nfft, seq.n_loops), n_frames)
 
+    def smaller_spectrogram(self, processing: ProcessingConfig) -> tuple[str, str]:
+        """The STFT's fields when the frames follow each other without gaps; else one spectrum
+        per frame of ``max(processing.nfft, n_loops)`` bins: ``radar.frame_period`` and
+        ``processing.nfft`` (``n_loops`` bins per frame stay under the pulse limit)."""
+        if self._gapless():
+            return super().smaller_spectrogram(processing)
+        return (
+            "radar.frame_period",
+            "raise radar.frame_period, lower processing.nfft or shorten the record",
+        )
+
     def spectrogram(
         self, signal: NDArray[np.complex128], times: FloatArray, processing: ProcessingConfig
     ) -> Spectrogram:
