@@ -400,9 +400,10 @@ def test_a_spectrogram_beyond_the_limit_is_refused_before_any_pulse(
         assert f"{walk}: processing.hop: the spectrogram of 1048576 Doppler bins x " in line
         assert f"the limit is {limits.MAX_SPECTROGRAM_CELLS:,}" in line
     assert not out.exists()
-    limits.check_spectrogram_cells(2**20, 2**10, 4)  # at the limit
+    fields = ("processing.hop", "raise processing.hop")
+    limits.check_spectrogram_cells(2**20, 2**10, 4, fields)  # at the limit
     with pytest.raises(SceneError, match=r"1\.075e\+09 values \(about 4 GiB of memory\)"):
-        limits.check_spectrogram_cells(2**20, 2**10 + 1, 4)  # a frame over it
+        limits.check_spectrogram_cells(2**20, 2**10 + 1, 4, fields)  # a frame over it
 
 
 def test_an_fmcw_spectrogram_beyond_the_limit_names_the_fields_that_set_its_size(

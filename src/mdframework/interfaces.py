@@ -549,12 +549,13 @@ class RadarWaveform(Plugin):
         """What sets the size of this radar's spectrogram (:meth:`spectrogram_geometry`), for
         the message refusing one of more than ``limits.MAX_SPECTROGRAM_CELLS`` values: the
         config field to name first and a clause saying what to change. Default: the
-        pipeline's STFT's, ``limits.STFT_SIZE_FIELDS`` (``processing.hop``,
-        ``processing.nfft``, the record's length); a radar whose spectrogram is sized by other
-        fields (FMCW frames with gaps: one column per frame) overrides it."""
-        from .limits import STFT_SIZE_FIELDS
-
-        return STFT_SIZE_FIELDS
+        pipeline's STFT's (``processing.hop``, ``processing.nfft``, the record's length); a
+        radar whose spectrogram is sized by other fields (FMCW frames with gaps: one column per
+        frame) overrides it."""
+        return (
+            "processing.hop",
+            "raise processing.hop, lower processing.nfft or shorten the record",
+        )
 
     @property
     def shortest_record(self) -> float:

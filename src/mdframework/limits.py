@@ -155,21 +155,13 @@ def check_frame_cells(shape: tuple[int, ...], what: str, field: str) -> None:
         )
 
 
-#: What sets an STFT's size: the field its limit's message names, and what to change.
-STFT_SIZE_FIELDS = (
-    "processing.hop",
-    "raise processing.hop, lower processing.nfft or shorten the record",
-)
-
-
 def check_spectrogram_cells(
-    nfft: int, n_frames: int, item_bytes: int, fields: tuple[str, str] = STFT_SIZE_FIELDS
+    nfft: int, n_frames: int, item_bytes: int, fields: tuple[str, str]
 ) -> None:
     """Refuse a spectrogram of ``nfft`` Doppler bins x ``n_frames`` frames of more than
     :data:`MAX_SPECTROGRAM_CELLS` values (``item_bytes`` per value, for the memory it would
     take), before any pulse is computed. ``fields``: the config field the message names and a
-    clause saying what to change (default :data:`STFT_SIZE_FIELDS`, the pipeline's STFT; a
-    radar's own spectrogram may be sized by others:
+    clause saying what to change (the radar's
     :meth:`~mdframework.RadarWaveform.smaller_spectrogram`). Raises :class:`SceneError`."""
     n = float(nfft) * float(n_frames)
     if n > MAX_SPECTROGRAM_CELLS:

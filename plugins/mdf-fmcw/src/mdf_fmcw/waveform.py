@@ -608,9 +608,10 @@ class FmcwRadar(RadarWaveform):
         return SpectrogramGeometry(self.prf, seq.n_loops, hop, max(p.nfft, seq.n_loops), n_frames)
 
     def smaller_spectrogram(self, processing: ProcessingConfig) -> tuple[str, str]:
-        """The STFT's fields when the frames follow each other without gaps; else one spectrum
-        per frame of ``max(processing.nfft, n_loops)`` bins: ``radar.frame_period`` and
-        ``processing.nfft`` (``n_loops`` bins per frame stay under the pulse limit)."""
+        """The STFT's fields (the default's) when the frames follow each other without gaps;
+        else one spectrum per frame of ``max(processing.nfft, n_loops)`` bins:
+        ``radar.frame_period`` and ``processing.nfft`` (``n_loops`` bins per frame stay under
+        the pulse limit)."""
         if self._gapless():
             return super().smaller_spectrogram(processing)
         return (
