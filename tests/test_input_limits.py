@@ -386,7 +386,8 @@ def test_a_spectrogram_beyond_the_limit_is_refused_before_any_pulse(
     """A config asking for a spectrogram of trillions of values (1 MHz PRF, a hop of 1 pulse,
     2**20 Doppler bins): `mdf check` called it valid and `mdf run` simulated every pulse, then
     failed with an internal MemoryError (or, short of that, filled the memory). Both refuse it
-    with one line naming processing.hop; the largest allowed one passes."""
+    with one line naming processing.hop, and the --set that gave it; the largest allowed one
+    passes."""
     from mdframework import cli
 
     walk = str(EXAMPLES / "cmu_walk.toml")
@@ -397,7 +398,7 @@ def test_a_spectrogram_beyond_the_limit_is_refused_before_any_pulse(
     for argv in (["check", walk, *sets], ["run", walk, "--out", str(out), *sets]):
         assert cli.main(argv) == 2
         (line,) = capsys.readouterr().err.strip().splitlines()
-        assert f"{walk}: processing.hop: the spectrogram of 1048576 Doppler bins x " in line
+        assert "error: --set processing.hop=1: processing.hop: the spectrogram of 1048576 " in line
         assert f"the limit is {limits.MAX_SPECTROGRAM_CELLS:,}" in line
     assert not out.exists()
     fields = ("processing.hop", "raise processing.hop")
