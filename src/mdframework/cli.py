@@ -47,7 +47,7 @@ from .plugins import (
     reset_default_registry,
     suggest,
 )
-from .progress import Progress, printed, retract, safe_stderr, say
+from .progress import Progress, check_progress_setting, printed, retract, safe_stderr, say
 
 EXIT_USAGE = 2
 EXIT_INTERRUPTED = 130
@@ -879,6 +879,8 @@ def _main(argv: list[str], debug: bool) -> int:
         return EXIT_USAGE
     args.debug = debug or args.debug
     try:
+        if hasattr(args, "no_progress"):  # a command that reports progress: a bad setting
+            check_progress_setting()  # stops it before it starts
         return int(args.func(args))
     except BrokenPipeError:
         raise
