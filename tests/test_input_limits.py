@@ -536,3 +536,42 @@ def test_an_oni_recording_that_is_a_pipe_is_refused_unread(
     assert cli.main(["kinect", "info", str(path)]) == 2
     (line,) = capsys.readouterr().err.strip().splitlines()
     assert line == f"mdf: error: {path}: cannot read: not a regular file (a pipe or a device?)"
+
+
+@pytest.mark.parametrize(
+    ("name", "what"),
+    [("big.bvh", "a BVH file"), ("big.asf", "an ASF file"), ("big.amc", "an AMC file")],
+)
+def test_a_motion_capture_text_file_beyond_the_size_limit_is_refused_unread(
+    tmp_path: Path, name: str, what: str
+) -> None:
+    """A BVH, ASF or AMC file had no size limit: a huge one was read whole (about 13 times its
+    size in memory for an AMC) and ended in an internal MemoryError. One over
+    MAX_MOTION_TEXT_BYTES (a sparse file, holding nothing) is refused naming the file and the
+    limit, before it is read; the shipped files are far below it."""
+    from mdf_cmu.asfamc import read_amc, read_asf
+    from mdf_cmu.bvh import read_bvh
+
+    cmu = EXAMPLES / "data" / "cmu"
+    path = tmp_path / name
+    with path.open("wb") as fh:
+        fh.truncate(limits.MAX_MOTION_TEXT_BYTES + 1)
+    read = {
+        ".bvh": read_bvh,
+        ".asf": read_asf,
+        ".amc": lambda p: read_amc(p, read_asf(cmu / "asf-amc" / "02.asf")),
+    }[path.suffix]
+    tracemalloc.start()
+    try:
+        with pytest.raises(DataFileError) as exc:
+            read(path)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert str(exc.value) == (
+        f"{path}: {limits.MAX_MOTION_TEXT_BYTES + 1:,} bytes is beyond the limit of "
+        f"{limits.MAX_MOTION_TEXT_BYTES:,} bytes for {what}"
+    )
+    assert peak < 10 * 2**20
+    shipped = [*cmu.glob("*/*"), *(EXAMPLES / "data").glob("*/*.bvh")]
+    assert max(p.stat().st_size for p in shipped) < limits.MAX_MOTION_TEXT_BYTES / 50

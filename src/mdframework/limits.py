@@ -63,6 +63,9 @@ MAX_DB = 400.0
 #: Largest config file [bytes] and deepest nesting of tables and lists in it.
 MAX_CONFIG_BYTES = 4 * 1024 * 1024
 MAX_CONFIG_DEPTH = 32
+#: Largest motion-capture text file (BVH, ASF, AMC) [bytes]: 256 MiB, about 45 minutes of a
+#: CMU AMC at 120 Hz (reading an AMC takes about 13 times its size in memory at its peak).
+MAX_MOTION_TEXT_BYTES = 256 * 1024 * 1024
 #: Most records one dataset config may plan.
 MAX_RECORDS = 1_000_000
 #: Largest |value| of a random distribution's parameters in a dataset config (what is drawn
@@ -211,6 +214,21 @@ def read_file_bytes(path: str | Path) -> bytes:
         raise DataFileError(Path(path), f"cannot read: {exc.strerror or exc}") from None
 
 
+def check_file_size(path: str | Path, what: str, max_bytes: int) -> None:
+    """Refuse a file of more than ``max_bytes`` before it is read; ``what`` names what it
+    should be (``"a BVH file"``). Raises :class:`~mdframework.errors.DataFileError` naming the
+    file, its size and the limit (also when it cannot be examined)."""
+    p = Path(path)
+    try:
+        size = p.stat().st_size
+    except OSError as exc:
+        raise DataFileError(p, f"cannot read: {exc.strerror or exc}") from None
+    if size > max_bytes:
+        raise DataFileError(
+            p, f"{size:,} bytes is beyond the limit of {max_bytes:,} bytes for {what}"
+        )
+
+
 def read_text_file(
     path: str | Path, what: str, max_bytes: int | None = None, latin1: bool = False
 ) -> str:
@@ -224,13 +242,8 @@ def read_text_file(
     byte.
     """
     p = Path(path)
-    try:
-        if max_bytes is not None and (size := p.stat().st_size) > max_bytes:
-            raise DataFileError(
-                p, f"{size:,} bytes is beyond the limit of {max_bytes:,} bytes for {what}"
-            )
-    except OSError as exc:
-        raise DataFileError(p, f"cannot read: {exc.strerror or exc}") from None
+    if max_bytes is not None:
+        check_file_size(p, what, max_bytes)
     raw = read_file_bytes(p)
     if b"\0" in raw:
         line = raw[: raw.index(b"\0")].count(b"\n") + 1
