@@ -549,6 +549,7 @@ def test_a_motion_capture_text_file_beyond_the_size_limit_is_refused_unread(
     size in memory for an AMC) and ended in an internal MemoryError. One over
     MAX_MOTION_TEXT_BYTES (a sparse file, holding nothing) is refused naming the file and the
     limit, before it is read; the shipped files are far below it."""
+    from helpers import data_error_and_peak
     from mdf_cmu.asfamc import read_amc, read_asf
     from mdf_cmu.bvh import read_bvh
 
@@ -561,14 +562,8 @@ def test_a_motion_capture_text_file_beyond_the_size_limit_is_refused_unread(
         ".asf": read_asf,
         ".amc": lambda p: read_amc(p, read_asf(cmu / "asf-amc" / "02.asf")),
     }[path.suffix]
-    tracemalloc.start()
-    try:
-        with pytest.raises(DataFileError) as exc:
-            read(path)
-        peak = tracemalloc.get_traced_memory()[1]
-    finally:
-        tracemalloc.stop()
-    assert str(exc.value) == (
+    error, peak = data_error_and_peak(lambda: read(path))
+    assert str(error) == (
         f"{path}: {limits.MAX_MOTION_TEXT_BYTES + 1:,} bytes is beyond the limit of "
         f"{limits.MAX_MOTION_TEXT_BYTES:,} bytes for {what}"
     )

@@ -66,6 +66,10 @@ MAX_CONFIG_DEPTH = 32
 #: Largest motion-capture text file (BVH, ASF, AMC) [bytes]: 256 MiB, about 45 minutes of a
 #: CMU AMC at 120 Hz (reading an AMC takes about 13 times its size in memory at its peak).
 MAX_MOTION_TEXT_BYTES = 256 * 1024 * 1024
+#: Largest array of a binary motion file (a table's NPZ member), uncompressed [bytes]: 512 MiB,
+#: 6.7e7 float64 values (about 2 hours of 25 joints at 120 Hz); checked from the sizes the file
+#: declares, before anything is decompressed (a small compressed file can expand to gigabytes).
+MAX_MOTION_ARRAY_BYTES = 512 * 1024 * 1024
 #: Most records one dataset config may plan.
 MAX_RECORDS = 1_000_000
 #: Largest |value| of a random distribution's parameters in a dataset config (what is drawn
