@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from mdframework import DataFileError
 from mdframework.config import validate_run_config
 from mdframework.pipeline import RunResult, simulate
 
@@ -120,3 +122,20 @@ kind = "points"
 kind = "{radar}"
 """)
     return path
+
+
+def data_error_and_peak(call: Callable[[], object]) -> tuple[DataFileError, int]:
+    """The :class:`DataFileError` that ``call`` raises (pytest fails if none) and the peak of
+    the memory traced while it ran [bytes] (numpy's arrays included)."""
+    import tracemalloc
+
+    import pytest
+
+    tracemalloc.start()
+    try:
+        with pytest.raises(DataFileError) as exc:
+            call()
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    return exc.value, peak

@@ -15,6 +15,7 @@ from mdf_lfm import LfmPulseDoppler
 from mdf_noise import ReceiverNoise
 
 from mdframework import Received, SceneContext, Skeleton
+from mdframework.check import plan_run
 from mdframework.config import validate_run_config
 from mdframework.constants import BOLTZMANN, SPEED_OF_LIGHT
 from mdframework.physics import radar
@@ -121,12 +122,75 @@ def test_thermal_noise_with_a_cw_radar_takes_the_pages_pulse_width_and_bandwidth
     fs = 2400.0
     cw = {"kind": "cw", "sample_rate": fs}
     thermal = {"kind": "noise", "mode": "thermal"}
-    with pytest.raises(SceneError, match=r"^effects\.noise: mode 'thermal' needs pulse_width"):
+    refused = r"^effects\.noise\.pulse_width: mode 'thermal' needs pulse_width; the 'cw' "
+    with pytest.raises(SceneError, match=refused):
         run(APPROACHING, [thermal], radar_cfg=cw, duration=0.2)
+    cfg = {
+        "motion": {"kind": "point_targets", "length": 0.2, "targets": APPROACHING},
+        "scatterers": {"kind": "points"},
+        "radar": cw,
+        "effects": [thermal],
+    }
+    with pytest.raises(SceneError, match=refused):  # mdf check too, before any pulse
+        plan_run(validate_run_config(cfg))
     given = {**thermal, "pulse_width": 1 / fs, "bandwidth": fs}
     res = run(APPROACHING, [given], radar_cfg=cw, duration=0.2)
     kt_f = BOLTZMANN * 290.0 * 10 ** (3.0 / 10)  # the effect's default T and F
     assert res.metadata["effects"][0]["noise_power_w"] == pytest.approx(kt_f * fs, rel=1e-12, abs=0)
+
+
+def test_noise_in_raw_samples_without_a_noise_bandwidth_is_refused_by_mdf_check() -> None:
+    """A radar that takes the noise effect into its raw samples (``takes_receiver_inputs``)
+    but has no ``sample_rate`` to default the noise bandwidth to (a third-party radar: the
+    shipped FMCW radar has one) needs the effect's noise_bandwidth: refused when the run is
+    planned (``mdf check``) and built, before any pulse, with one line naming the field; given,
+    the run goes."""
+    from types import ModuleType
+    from typing import Literal
+
+    import synthetic
+    from mdf_lfm.waveform import LfmConfig
+
+    from mdframework import SceneError
+    from mdframework.plugins import build_registry
+
+    class RawConfig(LfmConfig):
+        """The LFM radar's fields (``sample_rate`` None by default)."""
+
+        kind: Literal["raw_lfm"] = "raw_lfm"
+
+    class RawLfm(LfmPulseDoppler):
+        """An LFM radar that takes the received-stage effects into its raw samples."""
+
+        name = "raw_lfm"
+        Config = RawConfig
+
+        @property
+        def takes_receiver_inputs(self) -> bool:
+            return True
+
+    module = ModuleType("raw_lfm_plugin")
+    module.mdframework_register_radar_waveforms = synthetic.hookimpl(  # type: ignore[attr-defined]
+        lambda: [RawLfm]
+    )
+    reg = build_registry([module])
+    thermal = {"kind": "noise", "mode": "thermal"}
+    cfg = {
+        "motion": {"kind": "point_targets", "length": 0.2, "targets": APPROACHING},
+        "scatterers": {"kind": "points"},
+        "radar": {"kind": "raw_lfm"},
+        "effects": [thermal],
+    }
+    line = (
+        "effects.noise.noise_bandwidth: mode 'thermal' in the raw samples of the 'raw_lfm' "
+        "radar needs noise_bandwidth (it has no sample_rate): set it in the effect"
+    )
+    for call in (plan_run, simulate):
+        with pytest.raises(SceneError) as exc:
+            call(validate_run_config(cfg, registry=reg), reg)
+        assert str(exc.value) == line
+    given = {**cfg, "effects": [{**thermal, "noise_bandwidth": 1e6}]}
+    plan_run(validate_run_config(given, registry=reg), reg)
 
 
 def test_noise_floor_in_spectrogram_is_sigma2_sum_w2() -> None:

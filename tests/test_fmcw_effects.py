@@ -241,7 +241,9 @@ def test_the_clutter_patches_rcs_have_a_rayleigh_amplitude_of_unit_mean_power() 
     config = {**CLUTTER, "rcs_m2": 2.0, "patch_spacing_m": 0.1, "range_resolution": 0.2}
     effect = GroundClutter(GroundClutter.Config(**{**config, "margin_m": 200.0}))
     context: Any = SimpleNamespace(
-        gate_range=np.array([300.0]), rng=np.random.default_rng(0), waveform=None
+        gate_range=np.array([300.0]),
+        rng=np.random.default_rng(0),
+        waveform=SimpleNamespace(max_static_range=None),
     )
     got = effect.receiver_input(context)
     assert got is not None and got.static_rcs.size == 4000
@@ -264,3 +266,29 @@ def test_static_scatterers_beyond_the_maximum_range_are_left_out_unless_aliased(
         profiles[mode] = wf._static_profiles(origin, wf.sensor_axes(origin))
     assert profiles["error"] is None
     assert profiles["alias"] is not None and np.abs(profiles["alias"]).max() > 0
+
+
+def test_the_clutter_metadata_counts_only_the_patches_within_the_maximum_range() -> None:
+    """Clutter patches at or beyond the maximum range are left out of the IF samples, so the
+    effect's metadata counts the patches simulated (``n_patches``, their ``patch_range_m`` and
+    ``clutter_rcs_m2`` all below the maximum range) and those left out apart
+    (``n_patches_beyond_max_range``); with beyond_max_range = "alias" every patch is simulated,
+    from the same draws (the run's seed), so the counts and RCS add up to its own."""
+    max_range = FmcwRadar(FmcwConfig(**RADAR)).sequence.max_range
+    far = {**CLUTTER, "margin_m": max_range}  # patches from 0.5 m to 5 m + max_range
+    effects = {}
+    for mode in ("error", "alias"):
+        res = run({**RADAR, "beyond_max_range": mode}, [far], length=0.05)
+        [effects[mode]] = res.metadata["effects"]
+    kept, every = effects["error"], effects["alias"]
+    assert every["n_patches_beyond_max_range"] == 0
+    n_all = every["n_patches"]  # 0.5 m apart from 0.5 m to 5 m + max_range
+    assert n_all == int(np.ceil((5.0 + max_range - 0.5) / 0.5))
+    assert every["patch_range_m"][1] > max_range
+    assert 0 < kept["n_patches_beyond_max_range"] < n_all
+    assert kept["n_patches"] + kept["n_patches_beyond_max_range"] == n_all
+    # patch k lies in [0.5 (k + 1), 0.5 (k + 2)) m: those below max_range are kept
+    assert int(np.ceil(max_range / 0.5)) - 2 <= kept["n_patches"] <= int(max_range / 0.5)
+    assert kept["patch_range_m"][0] == every["patch_range_m"][0]
+    assert kept["patch_range_m"][1] < max_range
+    assert 0 < kept["clutter_rcs_m2"] < every["clutter_rcs_m2"]

@@ -386,7 +386,8 @@ def test_a_spectrogram_beyond_the_limit_is_refused_before_any_pulse(
     """A config asking for a spectrogram of trillions of values (1 MHz PRF, a hop of 1 pulse,
     2**20 Doppler bins): `mdf check` called it valid and `mdf run` simulated every pulse, then
     failed with an internal MemoryError (or, short of that, filled the memory). Both refuse it
-    with one line naming processing.hop; the largest allowed one passes."""
+    with one line naming processing.hop, and the --set that gave it; the largest allowed one
+    passes."""
     from mdframework import cli
 
     walk = str(EXAMPLES / "cmu_walk.toml")
@@ -397,12 +398,41 @@ def test_a_spectrogram_beyond_the_limit_is_refused_before_any_pulse(
     for argv in (["check", walk, *sets], ["run", walk, "--out", str(out), *sets]):
         assert cli.main(argv) == 2
         (line,) = capsys.readouterr().err.strip().splitlines()
-        assert f"{walk}: processing.hop: the spectrogram of 1048576 Doppler bins x " in line
+        assert "error: --set processing.hop=1: processing.hop: the spectrogram of 1048576 " in line
         assert f"the limit is {limits.MAX_SPECTROGRAM_CELLS:,}" in line
     assert not out.exists()
-    limits.check_spectrogram_cells(2**20, 2**10, 4)  # at the limit
+    fields = ("processing.hop", "raise processing.hop")
+    limits.check_spectrogram_cells(2**20, 2**10, 4, fields)  # at the limit
     with pytest.raises(SceneError, match=r"1\.075e\+09 values \(about 4 GiB of memory\)"):
-        limits.check_spectrogram_cells(2**20, 2**10 + 1, 4)  # a frame over it
+        limits.check_spectrogram_cells(2**20, 2**10 + 1, 4, fields)  # a frame over it
+
+
+def test_an_fmcw_spectrogram_beyond_the_limit_names_the_fields_that_set_its_size(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An FMCW radar with gaps between its frames makes one spectrum per frame of
+    processing.nfft bins: processing.hop does not change its size, so the limit's message names
+    radar.frame_period (one column per frame) and processing.nfft instead (40 s of 33.3 ms
+    frames, 2**20 bins: 1.26e9 values)."""
+    from mdframework import cli
+
+    cfg = tmp_path / "fmcw.toml"
+    cfg.write_text(
+        '[motion]\nkind = "point_targets"\nlength = 40.0\n'
+        "targets = [{ position = [3.0, 0.0, 0.0], velocity = [0.0, 0.0, 0.0], rcs = 1.0 }]\n"
+        '[scatterers]\nkind = "points"\n'
+        '[radar]\nkind = "fmcw"\npreset = "iwr1443_short_range_3d"\n'
+        "[scene]\nradar_position = [0.0, 0.0, 0.0]\ngate = 3.0\n"
+        "[processing]\nnfft = 1048576\n"
+    )
+    assert cli.main(["check", str(cfg)]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert line.startswith(
+        f"mdf: error: {cfg}: radar.frame_period: the spectrogram of 1048576 Doppler bins x "
+        "1200 frames is 1.258e+09 values"
+    )
+    assert line.endswith("raise radar.frame_period, lower processing.nfft or shorten the record")
+    assert "hop" not in line
 
 
 def test_check_regular_file_follows_links_and_names_a_folder(tmp_path: Path) -> None:
@@ -506,3 +536,37 @@ def test_an_oni_recording_that_is_a_pipe_is_refused_unread(
     assert cli.main(["kinect", "info", str(path)]) == 2
     (line,) = capsys.readouterr().err.strip().splitlines()
     assert line == f"mdf: error: {path}: cannot read: not a regular file (a pipe or a device?)"
+
+
+@pytest.mark.parametrize(
+    ("name", "what"),
+    [("big.bvh", "a BVH file"), ("big.asf", "an ASF file"), ("big.amc", "an AMC file")],
+)
+def test_a_motion_capture_text_file_beyond_the_size_limit_is_refused_unread(
+    tmp_path: Path, name: str, what: str
+) -> None:
+    """A BVH, ASF or AMC file had no size limit: a huge one was read whole (about 13 times its
+    size in memory for an AMC) and ended in an internal MemoryError. One over
+    MAX_MOTION_TEXT_BYTES (a sparse file, holding nothing) is refused naming the file and the
+    limit, before it is read; the shipped files are far below it."""
+    from helpers import data_error_and_peak
+    from mdf_cmu.asfamc import read_amc, read_asf
+    from mdf_cmu.bvh import read_bvh
+
+    cmu = EXAMPLES / "data" / "cmu"
+    path = tmp_path / name
+    with path.open("wb") as fh:
+        fh.truncate(limits.MAX_MOTION_TEXT_BYTES + 1)
+    read = {
+        ".bvh": read_bvh,
+        ".asf": read_asf,
+        ".amc": lambda p: read_amc(p, read_asf(cmu / "asf-amc" / "02.asf")),
+    }[path.suffix]
+    error, peak = data_error_and_peak(lambda: read(path))
+    assert str(error) == (
+        f"{path}: {limits.MAX_MOTION_TEXT_BYTES + 1:,} bytes is beyond the limit of "
+        f"{limits.MAX_MOTION_TEXT_BYTES:,} bytes for {what}"
+    )
+    assert peak < 10 * 2**20
+    shipped = [*cmu.glob("*/*"), *(EXAMPLES / "data").glob("*/*.bvh")]
+    assert max(p.stat().st_size for p in shipped) < limits.MAX_MOTION_TEXT_BYTES / 50

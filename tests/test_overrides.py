@@ -294,3 +294,28 @@ def test_a_files_field_wrong_for_the_kind_an_override_chose_names_that_override(
     assert code == 2
     assert err.startswith(f"mdf: error: {POINT}: radar.carrier_frequency: unknown field"), err
     assert err.endswith(f" (for the kind of --set {item})\n"), err
+
+
+@pytest.mark.parametrize("command", ["check", "run"])
+def test_a_scene_error_about_an_overridden_field_names_the_override(
+    command: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A noise effect that --set added beside the FMCW radar's own receiver noise is refused
+    when the run is built: the message names the override, as a config error about it does,
+    not the file (which has no effects); from the file, it names the file."""
+    fmcw = EXAMPLES / "fmcw_walk.toml"
+    item = 'effects=[{kind="noise",mode="thermal"}]'
+    out = tmp_path / "out"
+    argv = [command, str(fmcw), "--set", item] + (["--out", str(out)] if command == "run" else [])
+    code, _, err = mdf(argv, capsys)
+    assert code == 2
+    (line,) = err.splitlines()
+    assert line.startswith(f"mdf: error: --set {item}: effects.noise: the 'fmcw' radar adds "), err
+    assert not out.exists()
+    config = tmp_path / "noisy.toml"
+    config.write_text(
+        fmcw.read_text().replace('file = "data/', f'file = "{EXAMPLES}/data/')
+        + '\n[[effects]]\nkind = "noise"\nmode = "thermal"\n'
+    )
+    code, _, err = mdf(["check", str(config), "--set", "radar.gain_dbi=3"], capsys)
+    assert err.startswith(f"mdf: error: {config}: effects.noise: the 'fmcw' radar adds "), err

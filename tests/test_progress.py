@@ -223,3 +223,20 @@ def test_progress_variable_reads_the_usual_words_for_on_and_off(
     choice to the terminal."""
     monkeypatch.setenv(progress.PROGRESS_ENV, value)
     assert progress._forced() is shown
+
+
+def test_an_unknown_progress_value_is_refused_naming_the_variable(
+    config: Path, tmp_path: Path
+) -> None:
+    """`MDF_PROGRESS=maybe` was ignored without a word: a command that reports progress refuses
+    it, as it refuses a bad MDF_START_METHOD, with one line naming the variable and the values
+    it takes, before it does anything; an empty value is unset."""
+    out = tmp_path / "o"
+    done = mdf(["run", str(config), "--out", str(out)], {progress.PROGRESS_ENV: "maybe"})
+    assert done.returncode == 2 and done.stdout == ""
+    assert done.stderr.splitlines() == [
+        "mdf: error: MDF_PROGRESS='maybe': not a progress setting; use 1, true, yes or on to "
+        "show progress, 0, false, no or off to hide it (any case), or leave it unset"
+    ]
+    assert not out.exists()
+    assert mdf(["check", str(config)], {progress.PROGRESS_ENV: " "}).returncode == 0

@@ -403,3 +403,72 @@ def test_zero_is_missing_needs_all_three_coordinates_zero(tmp_path: Path) -> Non
     assert not body.valid[3, h]
     assert body.valid[5, h] and body.joint("head")[5, 1] == 0.0
     assert body.valid[:, h].sum() == t.size - 1
+
+
+def _npz_of_zeros(path: Path, shape: tuple[int, ...]) -> None:
+    """A compressed NPZ whose ``positions`` (float64 zeros of ``shape``, written a MiB at a
+    time) deflates to a small file, with 25 joint names."""
+    import io
+    import zipfile
+
+    header = io.BytesIO()
+    np.lib.format.write_array_header_1_0(
+        header, {"descr": "<f8", "fortran_order": False, "shape": shape}
+    )
+    names = io.BytesIO()
+    np.save(names, np.array([f"j{i}" for i in range(shape[1])]))
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED, compresslevel=1) as z:
+        z.writestr("joints.npy", names.getvalue())
+        with z.open("positions.npy", "w", force_zip64=True) as f:
+            f.write(header.getvalue())
+            left, chunk = 8 * int(np.prod(shape)), bytes(1 << 20)
+            while left > 0:
+                f.write(chunk[: min(left, len(chunk))])
+                left -= len(chunk)
+
+
+def test_a_compressed_npz_member_beyond_the_size_limit_is_refused_before_it_expands(
+    tmp_path: Path,
+) -> None:
+    """A compressed NPZ may declare up to 3e9 values per array: a 2.3 MB file of zeros
+    expanded to 512 MiB (1.1 GiB of memory at its peak), and one of 24 GB ended in a
+    MemoryError. A member whose uncompressed size is over limits.MAX_MOTION_ARRAY_BYTES is
+    refused from the sizes the file declares (the archive's, or the shape in the member's
+    header), naming the file and the member, before anything is decompressed; a small one is
+    read."""
+    import io
+    import zipfile
+
+    from helpers import data_error_and_peak
+
+    from mdframework import limits
+
+    frames = limits.MAX_MOTION_ARRAY_BYTES // (25 * 3 * 8) + 1  # just over the limit
+    path = tmp_path / "zeros.npz"
+    _npz_of_zeros(path, (frames, 25, 3))
+    assert path.stat().st_size < 5e6
+    spec = TableLayout(time_column="", frame_rate=120.0)
+    error, peak = data_error_and_peak(lambda: read_table(path, spec))
+    assert str(error) == (
+        f"{path}: array 'positions' is {frames * 600 + 128:,} bytes uncompressed, beyond the "
+        f"limit of {limits.MAX_MOTION_ARRAY_BYTES:,} bytes for an array of a motion file"
+    )
+    assert peak < 10 * 2**20
+    # a member whose header declares more than it holds (the archive's size is its own)
+    header = io.BytesIO()
+    np.lib.format.write_array_header_1_0(
+        header, {"descr": "<f8", "fortran_order": False, "shape": (10**6, 25, 3)}
+    )
+    forged = tmp_path / "forged.npz"
+    with zipfile.ZipFile(forged, "w") as z:
+        z.writestr("positions.npy", header.getvalue())
+    with pytest.raises(DataFileError) as err:
+        read_table(forged, spec)
+    assert str(err.value) == (
+        f"{forged}: array 'positions' is 600,000,000 bytes (shape (1000000, 25, 3) of float64) "
+        f"uncompressed, beyond the limit of {limits.MAX_MOTION_ARRAY_BYTES:,} bytes for an "
+        "array of a motion file"
+    )
+    small = tmp_path / "small.npz"
+    _npz_of_zeros(small, (240, 25, 3))
+    assert read_table(small, spec).positions.shape == (240, 25, 3)

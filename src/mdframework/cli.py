@@ -47,7 +47,7 @@ from .plugins import (
     reset_default_registry,
     suggest,
 )
-from .progress import Progress, printed, retract, safe_stderr, say
+from .progress import Progress, check_progress_setting, printed, retract, safe_stderr, say
 
 EXIT_USAGE = 2
 EXIT_INTERRUPTED = 130
@@ -82,7 +82,7 @@ def _progress(args: argparse.Namespace) -> Progress:
 def _cmd_run(args: argparse.Namespace) -> int:
     progress = _progress(args)
     with progress.step("reading the config and the installed plugins"):
-        from .config import load_run_config
+        from .config import blaming_overrides, load_run_config
         from .output import run_folder, write_run
         from .pipeline import simulate
 
@@ -91,7 +91,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
         figures = config.figures.model_copy(update={"enabled": False})
         config = config.model_copy(update={"figures": figures})
     with run_folder(args.out, force=args.force, staging_dir=args.staging_dir) as folder:
-        with _naming(args.config):
+        with blaming_overrides(args.config, args.overrides), _naming(args.config):
             result = simulate(config, progress=progress)
         resolved = json.loads(config.model_dump_json())
         written = write_run(result, resolved, folder, progress=progress)
@@ -103,7 +103,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
 def _cmd_show(args: argparse.Namespace) -> int:
     progress = _progress(args)
     with progress.step("reading the config and the installed plugins"):
-        from .config import load_run_config
+        from .config import blaming_overrides, load_run_config
         from .output import run_folder, stage_run
         from .pipeline import simulate
         from .preview import check_frame_rate, check_instants, stage_preview
@@ -111,7 +111,7 @@ def _cmd_show(args: argparse.Namespace) -> int:
         check_frame_rate(args.format, args.fps)  # before anything is simulated or written
         config = load_run_config(args.config, overrides=args.overrides)
     with run_folder(args.out, force=args.force, staging_dir=args.staging_dir) as folder:
-        with _naming(args.config):
+        with blaming_overrides(args.config, args.overrides), _naming(args.config):
             result = simulate(config, progress=progress)
         if args.at is not None:
             check_instants(result.body, args.at)  # before anything is written
@@ -247,10 +247,10 @@ def _as_given(args: argparse.Namespace) -> str:
 def _cmd_check(args: argparse.Namespace) -> int:
     with _progress(args).step("reading the config, the installed plugins and the motion"):
         from .check import format_plan, plan_run
-        from .config import load_run_config
+        from .config import blaming_overrides, load_run_config
 
         config = load_run_config(args.config, overrides=args.overrides)
-        with _naming(args.config):
+        with blaming_overrides(args.config, args.overrides), _naming(args.config):
             plan = plan_run(config)
     if args.json:
         print(json.dumps(plan.as_dict(), indent=2))
@@ -879,6 +879,8 @@ def _main(argv: list[str], debug: bool) -> int:
         return EXIT_USAGE
     args.debug = debug or args.debug
     try:
+        if hasattr(args, "no_progress"):  # a command that reports progress: a bad setting
+            check_progress_setting()  # stops it before it starts
         return int(args.func(args))
     except BrokenPipeError:
         raise

@@ -653,15 +653,15 @@ def apply_overrides(data: dict[str, Any], overrides: Sequence[str]) -> dict[str,
 
 @contextmanager
 def blaming_overrides(source: str, overrides: Sequence[str]) -> Iterator[None]:
-    """A :class:`ConfigError` about a field that an override set (``source: field: ...`` or
-    ``source: sources[0] record 3: field: ...``, a field above or below it, or a field of the
-    same table whose message names the override's field) names the override instead of the
-    file ``source``. One about a file's field of a table whose ``kind`` an override chose
-    (``--set radar.kind=fmcw`` with the LFM radar's fields in the file) names that override
-    after the message."""
+    """A :class:`ConfigError` or :class:`SceneError` about a field that an override set
+    (``source: field: ...`` or ``source: sources[0] record 3: field: ...``, a field above or
+    below it, or a field of the same table whose message names the override's field) names the
+    override instead of the file ``source``. One about a file's field of a table whose ``kind``
+    an override chose (``--set radar.kind=fmcw`` with the LFM radar's fields in the file) names
+    that override after the message."""
     try:
         yield
-    except ConfigError as exc:
+    except (ConfigError, SceneError) as exc:
         rest = str(exc).removeprefix(f"{source}: ")
         if rest == str(exc):
             raise
@@ -681,12 +681,12 @@ def blaming_overrides(source: str, overrides: Sequence[str]) -> Iterator[None]:
                     or field.startswith(f"{key}.")
                     or (named and field.rpartition(".")[0] == table)
                 ):
-                    raise ConfigError(f"--set {item.strip()}: {rest}") from None
+                    raise type(exc)(f"--set {item.strip()}: {rest}") from None
         for item in reversed(overrides):  # the file's field, wrong for a kind an override chose
             key = ".".join(_override_key(item)[0])
             table, _, name = key.rpartition(".")
             if name == "kind" and table and any(f.startswith(f"{table}.") for f in fields):
-                raise ConfigError(f"{exc} (for the kind of --set {item.strip()})") from None
+                raise type(exc)(f"{exc} (for the kind of --set {item.strip()})") from None
         raise
 
 

@@ -500,6 +500,14 @@ class RadarWaveform(Plugin):
         rather than the slow-time signal alone. Default: False."""
         return False
 
+    @property
+    def max_static_range(self) -> float | None:
+        """Range [m] at or beyond which the static scatterers of :class:`ReceiverInput` s
+        (``static_ranges``) are left out of the raw samples (the FMCW radar's maximum range,
+        unless it aliases them), so that an effect can report what was simulated; ``None``:
+        none left out. Default: ``None``."""
+        return None
+
     def set_receiver_inputs(self, inputs: Sequence[ReceiverInput]) -> None:
         """The record's :class:`ReceiverInput` s (maybe none), before its blocks, when
         :attr:`takes_receiver_inputs`; a block with ``receiver_noise`` False leaves them out
@@ -536,6 +544,18 @@ class RadarWaveform(Plugin):
         config fields. Default: ``radar.prf``; a radar whose slow-time rate follows from other
         fields (FMCW timing, CW's sample rate) overrides it."""
         return f"raise radar.prf to at least {np.ceil(rate):.0f} Hz"
+
+    def smaller_spectrogram(self, processing: ProcessingConfig) -> tuple[str, str]:
+        """What sets the size of this radar's spectrogram (:meth:`spectrogram_geometry`), for
+        the message refusing one of more than ``limits.MAX_SPECTROGRAM_CELLS`` values: the
+        config field to name first and a clause saying what to change. Default: the
+        pipeline's STFT's (``processing.hop``, ``processing.nfft``, the record's length); a
+        radar whose spectrogram is sized by other fields (FMCW frames with gaps: one column per
+        frame) overrides it."""
+        return (
+            "processing.hop",
+            "raise processing.hop, lower processing.nfft or shorten the record",
+        )
 
     @property
     def shortest_record(self) -> float:

@@ -63,6 +63,13 @@ MAX_DB = 400.0
 #: Largest config file [bytes] and deepest nesting of tables and lists in it.
 MAX_CONFIG_BYTES = 4 * 1024 * 1024
 MAX_CONFIG_DEPTH = 32
+#: Largest motion-capture text file (BVH, ASF, AMC) [bytes]: 256 MiB, about 45 minutes of a
+#: CMU AMC at 120 Hz (reading an AMC takes about 13 times its size in memory at its peak).
+MAX_MOTION_TEXT_BYTES = 256 * 1024 * 1024
+#: Largest array of a binary motion file (a table's NPZ member), uncompressed [bytes]: 512 MiB,
+#: 6.7e7 float64 values (about 2 hours of 25 joints at 120 Hz); checked from the sizes the file
+#: declares, before anything is decompressed (a small compressed file can expand to gigabytes).
+MAX_MOTION_ARRAY_BYTES = 512 * 1024 * 1024
 #: Most records one dataset config may plan.
 MAX_RECORDS = 1_000_000
 #: Largest |value| of a random distribution's parameters in a dataset config (what is drawn
@@ -155,17 +162,21 @@ def check_frame_cells(shape: tuple[int, ...], what: str, field: str) -> None:
         )
 
 
-def check_spectrogram_cells(nfft: int, n_frames: int, item_bytes: int) -> None:
+def check_spectrogram_cells(
+    nfft: int, n_frames: int, item_bytes: int, fields: tuple[str, str]
+) -> None:
     """Refuse a spectrogram of ``nfft`` Doppler bins x ``n_frames`` frames of more than
     :data:`MAX_SPECTROGRAM_CELLS` values (``item_bytes`` per value, for the memory it would
-    take), before any pulse is computed. Raises :class:`SceneError`."""
+    take), before any pulse is computed. ``fields``: the config field the message names and a
+    clause saying what to change (the radar's
+    :meth:`~mdframework.RadarWaveform.smaller_spectrogram`). Raises :class:`SceneError`."""
     n = float(nfft) * float(n_frames)
     if n > MAX_SPECTROGRAM_CELLS:
+        field, advice = fields
         raise SceneError(
-            f"processing.hop: the spectrogram of {nfft} Doppler bins x {n_frames} frames is "
+            f"{field}: the spectrogram of {nfft} Doppler bins x {n_frames} frames is "
             f"{n:.4g} values (about {_size(item_bytes * n)} of memory); the limit is "
-            f"{MAX_SPECTROGRAM_CELLS:,}: raise processing.hop, lower processing.nfft or shorten "
-            "the record"
+            f"{MAX_SPECTROGRAM_CELLS:,}: {advice}"
         )
 
 
@@ -207,6 +218,21 @@ def read_file_bytes(path: str | Path) -> bytes:
         raise DataFileError(Path(path), f"cannot read: {exc.strerror or exc}") from None
 
 
+def check_file_size(path: str | Path, what: str, max_bytes: int) -> None:
+    """Refuse a file of more than ``max_bytes`` before it is read; ``what`` names what it
+    should be (``"a BVH file"``). Raises :class:`~mdframework.errors.DataFileError` naming the
+    file, its size and the limit (also when it cannot be examined)."""
+    p = Path(path)
+    try:
+        size = p.stat().st_size
+    except OSError as exc:
+        raise DataFileError(p, f"cannot read: {exc.strerror or exc}") from None
+    if size > max_bytes:
+        raise DataFileError(
+            p, f"{size:,} bytes is beyond the limit of {max_bytes:,} bytes for {what}"
+        )
+
+
 def read_text_file(
     path: str | Path, what: str, max_bytes: int | None = None, latin1: bool = False
 ) -> str:
@@ -220,13 +246,8 @@ def read_text_file(
     byte.
     """
     p = Path(path)
-    try:
-        if max_bytes is not None and (size := p.stat().st_size) > max_bytes:
-            raise DataFileError(
-                p, f"{size:,} bytes is beyond the limit of {max_bytes:,} bytes for {what}"
-            )
-    except OSError as exc:
-        raise DataFileError(p, f"cannot read: {exc.strerror or exc}") from None
+    if max_bytes is not None:
+        check_file_size(p, what, max_bytes)
     raw = read_file_bytes(p)
     if b"\0" in raw:
         line = raw[: raw.index(b"\0")].count(b"\n") + 1

@@ -366,7 +366,8 @@ def spectrogram_geometry(
     """The geometry of the spectrogram the radar ``wf`` makes of ``n_pulses`` pulses
     (:meth:`RadarWaveform.spectrogram_geometry`); a record too short for it is a
     :class:`SceneError` naming ``processing.window_length``, and one of more than
-    ``limits.MAX_SPECTROGRAM_CELLS`` values one naming ``processing.hop``. ``mdf check``
+    ``limits.MAX_SPECTROGRAM_CELLS`` values one naming the fields that set its size
+    (:meth:`RadarWaveform.smaller_spectrogram`: ``processing.hop`` for an STFT). ``mdf check``
     reports both."""
     try:
         with blame(wf, "spectrogram_geometry"):
@@ -374,7 +375,9 @@ def spectrogram_geometry(
     except RecordTooShortError as exc:
         raise SceneError(f"processing.window_length: {exc}") from None
     item_bytes = 4 if proc.precision == "float32" else 8
-    limits.check_spectrogram_cells(geometry.nfft, geometry.n_frames, item_bytes)
+    with blame(wf, "smaller_spectrogram"):
+        fields = wf.smaller_spectrogram(proc)
+    limits.check_spectrogram_cells(geometry.nfft, geometry.n_frames, item_bytes, fields)
     return geometry
 
 

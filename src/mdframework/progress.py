@@ -30,8 +30,12 @@ from contextlib import contextmanager
 from typing import Any
 
 #: Environment variable: ``1`` forces progress on (every step, no delay), ``0`` off (also
-#: ``true``/``yes``/``on`` and ``false``/``no``/``off``, in any case; anything else is ignored).
+#: ``true``/``yes``/``on`` and ``false``/``no``/``off``, in any case; empty is unset; anything
+#: else is refused by the ``mdf`` commands that report progress, :func:`check_progress_setting`,
+#: and left to the terminal by library calls).
 PROGRESS_ENV = "MDF_PROGRESS"
+_ON = ("1", "true", "yes", "on")
+_OFF = ("0", "false", "no", "off")
 #: A step or bar appears once it has lasted this long [s].
 DELAY_S = 1.0
 #: ANSI: cursor one line up, to its start, and clear that line.
@@ -46,11 +50,25 @@ class _State:
 
 def _forced() -> bool | None:
     value = os.environ.get(PROGRESS_ENV, "").strip().lower()
-    if value in ("1", "true", "yes", "on"):
+    if value in _ON:
         return True
-    if value in ("0", "false", "no", "off"):
+    if value in _OFF:
         return False
     return None
+
+
+def check_progress_setting() -> None:
+    """Refuse a :data:`PROGRESS_ENV` that is neither on, off nor empty: a
+    :class:`~mdframework.errors.SettingError` naming the variable and the values it takes."""
+    from .errors import SettingError
+
+    text = os.environ.get(PROGRESS_ENV, "")
+    if text.strip() and _forced() is None:
+        raise SettingError(
+            f"{PROGRESS_ENV}={text!r}: not a progress setting; use {', '.join(_ON[:-1])} or "
+            f"{_ON[-1]} to show progress, {', '.join(_OFF[:-1])} or {_OFF[-1]} to hide it "
+            "(any case), or leave it unset"
+        )
 
 
 def progress_enabled(wanted: bool = True) -> bool:

@@ -331,12 +331,21 @@ class GroundClutter(Effect):
         ``power = "rcs"``, no wind): the stationary patches as static point scatterers at
         :meth:`patch_ranges`, patch ``k`` of RCS ``rcs_m2 (spacing / resolution) |alpha_k|^2``
         (``alpha_k`` complex Gaussian of unit mean power: a Rayleigh amplitude; the carrier
-        phase follows from the patch's random range)."""
+        phase follows from the patch's random range). Patches at or beyond the radar's
+        :attr:`~mdframework.RadarWaveform.max_static_range` are left out (drawn all the same):
+        ``n_patches``, ``patch_range_m`` and ``clutter_rcs_m2`` of :meth:`describe` are those
+        of the patches simulated, ``n_patches_beyond_max_range`` counts the others."""
         ranges, sigma_k, alpha = self._patches(context)
         rcs = sigma_k * np.abs(alpha) ** 2
+        far = context.waveform.max_static_range
+        n_all = ranges.size
+        if far is not None:
+            keep = ranges < far
+            ranges, rcs = ranges[keep], rcs[keep]
         self._stats = {
             "n_patches": int(ranges.size),
-            "patch_range_m": [float(ranges.min()), float(ranges.max())],
+            "n_patches_beyond_max_range": int(n_all - ranges.size),
+            "patch_range_m": [float(ranges.min()), float(ranges.max())] if ranges.size else None,
             "clutter_rcs_m2": float(np.sum(rcs)),
             "in_receiver": True,
         }

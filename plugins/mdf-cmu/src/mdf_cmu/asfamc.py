@@ -219,7 +219,7 @@ def read_asf(path: str | Path) -> AsfSkeleton:
         unsupported ``dof``, truncated block; the message names the file and line.
     """
     p = Path(path)
-    lines = read_lines(p)
+    lines = read_lines(p, "an ASF file")
     section = ""
     length_scale = 1.0
     degrees = True
@@ -439,7 +439,7 @@ def read_amc(path: str | Path, asf: AsfSkeleton) -> AmcMotion:
         repeated in a frame, non-consecutive frame numbers, zero frames; names the file and line.
     """
     p = Path(path)
-    lines = read_lines(p)
+    lines = read_lines(p, "an AMC file")
     regular = _read_regular_amc(p, lines, asf)
     if regular is not None:
         return regular

@@ -95,12 +95,14 @@ class BvhData:
         return int(self.values.shape[0])
 
 
-def read_lines(path: Path) -> list[str]:
+def read_lines(path: Path, what: str = "a motion-capture text file") -> list[str]:
     """The lines of a text file without their line ends (LF, CRLF, CR or mixed) and without a
     UTF-8 byte-order mark.
 
-    Raises :class:`DataFileError` if the file cannot be read.
+    Raises :class:`DataFileError` if the file cannot be read or is longer than
+    ``limits.MAX_MOTION_TEXT_BYTES`` (``what`` names what it should be: ``"a BVH file"``).
     """
+    limits.check_file_size(path, what, limits.MAX_MOTION_TEXT_BYTES)
     raw = limits.read_file_bytes(path)
     try:
         text = raw.decode("utf-8-sig")
@@ -231,7 +233,7 @@ def read_bvh(path: str | Path) -> BvhData:
         truncated file, zero frames), naming the file and the 1-based line.
     """
     p = Path(path)
-    lines = read_lines(p)
+    lines = read_lines(p, "a BVH file")
     # The hierarchy ends at the line starting with MOTION.
     motion_at = next((i for i, ln in enumerate(lines) if ln.split()[:1] == ["MOTION"]), None)
     head = lines if motion_at is None else lines[:motion_at]

@@ -607,6 +607,18 @@ class FmcwRadar(RadarWaveform):
         hop = seq.frame_period * self.prf
         return SpectrogramGeometry(self.prf, seq.n_loops, hop, max(p.nfft, seq.n_loops), n_frames)
 
+    def smaller_spectrogram(self, processing: ProcessingConfig) -> tuple[str, str]:
+        """The STFT's fields (the default's) when the frames follow each other without gaps;
+        else one spectrum per frame of ``max(processing.nfft, n_loops)`` bins:
+        ``radar.frame_period`` and ``processing.nfft`` (``n_loops`` bins per frame stay under
+        the pulse limit)."""
+        if self._gapless():
+            return super().smaller_spectrogram(processing)
+        return (
+            "radar.frame_period",
+            "raise radar.frame_period, lower processing.nfft or shorten the record",
+        )
+
     def spectrogram(
         self, signal: NDArray[np.complex128], times: FloatArray, processing: ProcessingConfig
     ) -> Spectrogram:
@@ -654,6 +666,12 @@ class FmcwRadar(RadarWaveform):
         carry them; without either, they act on the slow-time signal as with every radar."""
         return self.config.points or self.config.save_range_doppler
 
+    @property
+    def max_static_range(self) -> float | None:
+        """The maximum range [m]: static scatterers at or beyond it are left out of the IF
+        samples; ``None`` with ``beyond_max_range = "alias"`` (they fold back in)."""
+        return None if self.config.beyond_max_range == "alias" else self.sequence.max_range
+
     def set_receiver_inputs(self, inputs: Sequence[ReceiverInput]) -> None:
         """The record's effects in the IF samples: white noise per frame seeded by (the
         input's ``noise_key``, frame index), static scatterers along the boresight."""
@@ -678,8 +696,9 @@ class FmcwRadar(RadarWaveform):
         seq, c = self.sequence, self.config
         ranges = np.concatenate([np.zeros(0), *(i.static_ranges for i in self._inputs)])
         rcs = np.concatenate([np.zeros(0), *(i.static_rcs for i in self._inputs)])
-        if c.beyond_max_range != "alias":
-            keep = ranges < seq.max_range
+        far = self.max_static_range
+        if far is not None:
+            keep = ranges < far
             ranges, rcs = ranges[keep], rcs[keep]
         out = None
         if ranges.size:

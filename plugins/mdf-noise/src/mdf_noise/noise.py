@@ -158,8 +158,11 @@ class ReceiverNoise(Effect):
 
     def check_radar(self, waveform: RadarWaveform) -> None:
         """Refuse a radar that adds receiver noise itself (``RadarWaveform.adds_receiver_noise``:
-        the FMCW radar's ``receiver_noise``), and mode ``thermal`` with a radar whose amplitudes
-        are ``sqrt(rcs)`` (``amplitude = "sqrt_rcs"``), not received powers."""
+        the FMCW radar's ``receiver_noise``), mode ``thermal`` with a radar whose amplitudes
+        are ``sqrt(rcs)`` (``amplitude = "sqrt_rcs"``), not received powers, and mode
+        ``thermal`` without the values it needs that neither the effect nor the radar's config
+        gives (``pulse_width`` and ``bandwidth``; ``noise_bandwidth`` or the radar's
+        ``sample_rate`` in raw samples), so that ``mdf check`` refuses them too."""
         if waveform.adds_receiver_noise:
             raise SceneError(
                 f"effects.noise: the {waveform.name!r} radar adds receiver noise itself "
@@ -182,18 +185,41 @@ class ReceiverNoise(Effect):
                 "radar.amplitude = 'sqrt_rcs' the signal is sqrt(rcs), not a received power: "
                 "use mode 'snr', or radar.amplitude = 'range_equation'"
             )
+        if self.config.mode != "thermal":
+            return
+        if waveform.takes_receiver_inputs:
+            self._noise_bandwidth(waveform)
+        else:
+            self._waveform_param(waveform, "pulse_width")
+            self._waveform_param(waveform, "bandwidth")
 
-    def _waveform_param(self, context: SceneContext, field: str) -> float:
+    def _waveform_param(self, waveform: RadarWaveform, field: str) -> float:
+        """The effect's ``field``, else the radar config's; a :class:`SceneError` naming the
+        effect's field when neither gives it."""
         given = getattr(self.config, field)
         if given is not None:
             return float(given)
-        value = getattr(getattr(context.waveform, "config", None), field, None)
+        value = getattr(getattr(waveform, "config", None), field, None)
         if value is None:
             raise SceneError(
-                f"effects.noise: mode 'thermal' needs {field}; the {context.waveform.name!r} "
+                f"effects.noise.{field}: mode 'thermal' needs {field}; the {waveform.name!r} "
                 "waveform does not give it, so set it in the effect"
             )
         return float(value)
+
+    def _noise_bandwidth(self, waveform: RadarWaveform) -> float:
+        """``noise_bandwidth`` [Hz] in the raw samples: the effect's, else the radar config's
+        ``sample_rate``; a :class:`SceneError` naming the field when neither gives it."""
+        if self.config.noise_bandwidth is not None:
+            return float(self.config.noise_bandwidth)
+        rate = getattr(getattr(waveform, "config", None), "sample_rate", None)
+        if rate is None:
+            raise SceneError(
+                "effects.noise.noise_bandwidth: mode 'thermal' in the raw samples of the "
+                f"{waveform.name!r} radar needs noise_bandwidth (it has no sample_rate): set "
+                "it in the effect"
+            )
+        return float(rate)
 
     def receiver_input(self, context: SceneContext) -> ReceiverInput | None:
         """For a radar that simulates the noise in its raw samples (the FMCW radar making maps
@@ -201,16 +227,7 @@ class ReceiverNoise(Effect):
         ``k_B T F B_n`` per complex sample, ``B_n`` default the radar's ``sample_rate`` (the
         complex ADC's noise bandwidth), drawn per frame from a key of this effect's stream."""
         c = self.config
-        b_n = c.noise_bandwidth
-        if b_n is None:
-            rate = getattr(getattr(context.waveform, "config", None), "sample_rate", None)
-            if rate is None:
-                raise SceneError(
-                    "effects.noise: mode 'thermal' in the raw samples of the "
-                    f"{context.waveform.name!r} radar needs noise_bandwidth (it has no "
-                    "sample_rate): set it in the effect"
-                )
-            b_n = float(rate)
+        b_n = self._noise_bandwidth(context.waveform)
         power = BOLTZMANN * c.temperature * 10.0 ** (c.noise_figure_db / 10.0) * b_n
         self._power = power
         self._in_receiver = True
@@ -228,8 +245,8 @@ class ReceiverNoise(Effect):
                 noise_figure_db=c.noise_figure_db,
                 temperature=c.temperature,
                 noise_bandwidth=c.noise_bandwidth,
-                pulse_width=self._waveform_param(context, "pulse_width"),
-                bandwidth=self._waveform_param(context, "bandwidth"),
+                pulse_width=self._waveform_param(context.waveform, "pulse_width"),
+                bandwidth=self._waveform_param(context.waveform, "bandwidth"),
             )
         self._power = power
         signal = data.signal + complex_noise(context.rng, data.signal.shape, power)

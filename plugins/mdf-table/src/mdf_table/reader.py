@@ -29,15 +29,16 @@ frames at ``frame_rate``. Frames out of order are sorted, frames repeating a tim
 (the first is kept; both counted in the metadata). A missing value (an empty field, ``nan``)
 marks that joint as not tracked in that frame.
 
-Checks before anything is allocated for the data: text is UTF-8 (a NUL byte means binary), an
-NPZ member's declared shape is read from its header and must stay within
-``limits.MAX_FRAMES`` frames and :data:`MAX_JOINTS` joints; then every number is finite (or
-missing) and within ``limits.MAX_FILE_COORDINATE``; every time, in seconds (after
-``time_unit_s`` or ``frame_rate``), within ``limits.MAX_CLOCK_TIME_S`` (clock times such as Unix
-epoch seconds pass: the motion counts from its first frame), and the times spanning at most
-``limits.MAX_DURATION_S``; and the frame rate (the inverse of the median step between frames)
-within ``limits.MIN_FRAME_RATE_HZ .. MAX_FRAME_RATE_HZ``, as for every recording (milliseconds
-read as seconds are not a 0.12 Hz recording).
+Checks before anything is allocated for the data: text is UTF-8 (a NUL byte means binary); an
+NPZ member's uncompressed size, as the archive declares it and as the shape in its header
+makes it, is at most ``limits.MAX_MOTION_ARRAY_BYTES`` (checked before it is decompressed),
+and its shape stays within ``limits.MAX_FRAMES`` frames and :data:`MAX_JOINTS` joints; then
+every number is finite (or missing) and within ``limits.MAX_FILE_COORDINATE``; every time, in
+seconds (after ``time_unit_s`` or ``frame_rate``), within ``limits.MAX_CLOCK_TIME_S`` (clock
+times such as Unix epoch seconds pass: the motion counts from its first frame), and the times
+spanning at most ``limits.MAX_DURATION_S``; and the frame rate (the inverse of the median step
+between frames) within ``limits.MIN_FRAME_RATE_HZ .. MAX_FRAME_RATE_HZ``, as for every
+recording (milliseconds read as seconds are not a 0.12 Hz recording).
 
 Arrays: :class:`Table` ``positions`` (n_frames, n_joints, 3) float64 in the file's unit, NaN
 where missing; ``time`` (n_frames,) float64 [s], strictly increasing.
@@ -446,16 +447,29 @@ def _wide_text(
 
 
 def _npz_shapes(path: Path) -> dict[str, tuple[tuple[int, ...], np.dtype[Any]]]:
-    """Each member's shape and dtype from its .npy header, without reading its data."""
+    """Each member's shape and dtype from its .npy header, without reading its data; a member
+    whose uncompressed size (as the archive declares it, or as its shape and dtype make it) is
+    over ``limits.MAX_MOTION_ARRAY_BYTES`` is refused before it is decompressed."""
     import zipfile
 
     limits.check_regular_file(path)
     out: dict[str, tuple[tuple[int, ...], np.dtype[Any]]] = {}
+    biggest = limits.MAX_MOTION_ARRAY_BYTES
+
+    def too_big(key: str, size: str) -> DataFileError:
+        return DataFileError(
+            path,
+            f"array {key!r} is {size} uncompressed, beyond the limit of {biggest:,} bytes for "
+            "an array of a motion file",
+        )
+
     try:
         with zipfile.ZipFile(path) as z:
             for info in z.infolist():
                 if not info.filename.endswith(".npy"):
                     continue
+                if info.file_size > biggest:
+                    raise too_big(info.filename[:-4], f"{info.file_size:,} bytes")
                 with z.open(info) as f:
                     version = np.lib.format.read_magic(f)
                     reader = (
@@ -464,6 +478,10 @@ def _npz_shapes(path: Path) -> dict[str, tuple[tuple[int, ...], np.dtype[Any]]]:
                         else np.lib.format.read_array_header_2_0
                     )
                     shape, _fortran, dtype = reader(f)
+                n = int(np.prod(shape, dtype=object)) if shape else 1
+                if n * dtype.itemsize > biggest:  # (the archive's size may be forged)
+                    size = f"{n * dtype.itemsize:,} bytes (shape {tuple(shape)} of {dtype})"
+                    raise too_big(info.filename[:-4], size)
                 out[info.filename[:-4]] = (tuple(shape), dtype)
     except (OSError, zipfile.BadZipFile, ValueError) as exc:
         raise DataFileError(path, f"not a readable .npz file ({exc})") from None
@@ -474,12 +492,9 @@ def _read_npz(
     path: Path, spec: TableLayout
 ) -> tuple[FloatArray, tuple[str, ...], FloatArray, str, int]:
     shapes = _npz_shapes(path)
-    for key, (shape, dtype) in shapes.items():
+    for key, (_shape, dtype) in shapes.items():
         if dtype.hasobject:
             raise DataFileError(path, f"array {key!r} holds Python objects: not read (pickles)")
-        n = int(np.prod(shape)) if shape else 1
-        if n > limits.MAX_FRAMES * 3 * 100:
-            raise DataFileError(path, f"array {key!r} of shape {shape} is beyond the limits")
     layout = spec.layout
     if layout == "auto":
         layout = "wide" if "positions" in shapes else "long"
