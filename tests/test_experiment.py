@@ -813,3 +813,44 @@ def test_a_recording_split_never_holds_out_all_of_a_class() -> None:
         assert set(labels[train]) == {"a", "b"} and set(labels[test]) == {"a", "b"}
         assert not set(recs[train]) & set(recs[test])
         assert len(set(recs[test])) == 3
+
+
+def test_a_class_of_one_side_only_is_named_in_the_train_test_report(
+    kinect_dataset: Path, tmp_path: Path
+) -> None:
+    """punch is recorded by s01 only. Trained on s02 and s03 and tested on s01, its 2 test
+    records cannot be scored (no training record of it); trained on s01 and s02 and tested on
+    s03, it is left out of training (so no s03 record can be called punch). Either way the
+    score is over jog and boxing only: the report, stderr and summary.json say which class was
+    left out and how many records, instead of scoring a subset of the records in silence."""
+    from mdframework.dataset import load_dataset
+
+    data = load_dataset(kinect_dataset, spectrograms=False)
+    n_punch = int(np.sum(data.labels == "punch"))
+    for train, test, words in (
+        (["s02", "s03"], "s01", f"{n_punch} test records not scored: no training record of it"),
+        (["s01", "s02"], "s03", f"{n_punch} training records left out of training"),
+    ):
+        cfg = exp.ExperimentConfig.model_validate(
+            {
+                "dataset": {"path": str(kinect_dataset)},
+                "selection": {"method": "none"},
+                "train_test": {"train": {"subject": train}, "test": {"subject": test}},
+            }
+        )
+        res = exp.train_test(cfg, exp.classifier_factory(cfg.classifier, "t"), data)
+        assert res["classes"] == ["boxing", "jog"]
+        assert list(res["left_out"]) == ["punch"] and res["left_out"]["punch"].startswith(words)
+    body = (
+        '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\n'
+        '[train_test]\ntrain = { subject = ["s02", "s03"] }\ntest = { subject = "s01" }\n'
+    )
+    e = _experiment(kinect_dataset, tmp_path, body)
+    with pytest.warns(exp.ExperimentWarning, match=r"train_test: class 'punch' left out"):
+        summary = exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+    report = (tmp_path / "o" / "report.md").read_text()
+    line = "Left out (on one side only; the score is over the classes both sides hold): punch"
+    assert f"{line} ({n_punch} test records not scored" in report
+    assert summary["train_test"]["left_out"] == {
+        "punch": f"{n_punch} test records not scored: no training record of it"
+    }

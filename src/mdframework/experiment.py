@@ -730,10 +730,21 @@ def _train_then_test(
     """Select features and fit on the ``train`` records (mask), predict the ``test`` records,
     over the classes both hold (``who`` names the two sides in the error when they share
     fewer than two). ``x`` (n_records, n_columns) named by ``names``; ``labels`` (n_records,);
-    ``units`` (n_records,): what the wrapper's folds hold out (:func:`held_out_units`), or None."""
+    ``units`` (n_records,): what the wrapper's folds hold out (:func:`held_out_units`), or None.
+    ``left_out``: each class of one side only, with its record count (its test records are not
+    scored; its training records are not trained on, so no test record can be called it)."""
     shared = sorted(set(labels[train].tolist()) & set(labels[test].tolist()))
     if len(shared) < 2:
         raise MdfError(f"{who} share fewer than two classes ({shared})")
+    left_out = {}
+    for c in sorted(set(labels[train | test].tolist()) - set(shared)):
+        n_train, n_test = int(np.sum(labels[train] == c)), int(np.sum(labels[test] == c))
+        left_out[c] = (
+            f"{n_test} test record{'s' if n_test != 1 else ''} not scored: no training record of it"
+            if n_test
+            else f"{n_train} training record{'s' if n_train != 1 else ''} left out of "
+            "training: no test record of it"
+        )
     train = train & np.isin(labels, shared)
     test = test & np.isin(labels, shared)
     sel = _select(
@@ -752,6 +763,7 @@ def _train_then_test(
         "subset": [names[i] for i in sel.subset],
         "train_counts": {c: int(np.sum(labels[train] == c)) for c in shared},
         "test_counts": {c: int(np.sum(labels[test] == c)) for c in shared},
+        "left_out": left_out,
         "test_index": np.flatnonzero(test),
         "true": labels[test],
         "predicted": pred,
@@ -1067,6 +1079,7 @@ def _report(
             f"Balanced accuracy {res['balanced_accuracy']:.3f}; inputs {res['subset']}; "
             f"training {res['train_counts']}, test {res['test_counts']}.",
             "",
+            *_left_out_markdown(res, "cross-source"),
             "Per-class rates (test records of each class classified correctly): "
             + ", ".join(f"{c} {res['confusion'][i, i]:.2f}" for i, c in enumerate(res["classes"]))
             + ".",
@@ -1100,6 +1113,7 @@ def _report(
             f"Balanced accuracy {res['balanced_accuracy']:.3f}; features {res['subset']}; "
             f"training {res['train_counts']}, test {res['test_counts']}.",
             "",
+            *_left_out_markdown(res, "train_test"),
             _markdown_matrix(res["classes"], res["confusion"], None),
             "",
             "![train/test](train_test_confusion.png)",
@@ -1199,6 +1213,25 @@ def _spread_words(res: dict[str, Any], splits: str) -> str:
         f"std {std:.3f} over the classes' recalls, as not every split scores every class; the "
         f"mean per-class recall of the matrix below, mean ± std over {splits}"
     )
+
+
+def _left_out_markdown(res: dict[str, Any], part: str) -> list[str]:
+    """Report lines naming the classes a train/test result leaves out (of one side only: the
+    score is over the shared classes), each also a warning on stderr naming ``part``."""
+    left = res["left_out"]
+    for c, why in left.items():
+        warnings.warn(
+            f"{part}: class {c!r} left out (not on both sides): {why}",
+            ExperimentWarning,
+            stacklevel=3,
+        )
+    if not left:
+        return []
+    words = "; ".join(f"{c} ({why})" for c, why in left.items())
+    return [
+        f"Left out (on one side only; the score is over the classes both sides hold): {words}.",
+        "",
+    ]
 
 
 def _held_out_markdown(res: dict[str, Any]) -> list[str]:
