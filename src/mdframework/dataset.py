@@ -1231,6 +1231,8 @@ def _build_recorded(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         "first_frame": run["first_frame"],
         "histogram": spec.histogram["histogram"],
         "recording": dict(rec.metadata),
+        "recording_name": spec.recording,  # index.csv's recording (``<file>:<name>`` where
+        # two files hold a recording of one name, see _distinct_recordings)
         "units": RECORD_UNITS,
     }
     return _write_record(out_dir, spec, meta, arrays)
@@ -1495,7 +1497,7 @@ def _row(meta: dict[str, Any], feats: NDArray[np.float64]) -> dict[str, Any]:
         "subject": meta.get("subject", ""),
         "recording": meta.get("recording", meta["file"])
         if isinstance(meta.get("recording", ""), str)
-        else meta["file"],
+        else meta.get("recording_name", meta["file"]),  # a recorded record's: its metadata
         "dataset": meta.get("dataset", meta["source"]),
         "start_s": meta["start_s"],
         "duration_s": meta["duration_s"],
@@ -1545,8 +1547,10 @@ def _planned_meta(spec: RecordSpec) -> dict[str, Any]:
         "subject": spec.subject,
         "dataset": spec.dataset,
     }
-    if "recording" not in spec.run_config:  # recorded records name their recording themselves
+    if "recording" not in spec.run_config:
         planned["recording"] = spec.recording
+    else:  # a recorded record's "recording" holds the recording's metadata
+        planned["recording_name"] = spec.recording
     return planned
 
 
