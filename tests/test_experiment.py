@@ -854,3 +854,35 @@ def test_a_class_of_one_side_only_is_named_in_the_train_test_report(
     assert summary["train_test"]["left_out"] == {
         "punch": f"{n_punch} test records not scored: no training record of it"
     }
+
+
+def test_recording_splits_are_distinct_and_all_made_when_fewer_exist() -> None:
+    """Three classes of two recordings allow 2 * 2 * 2 = 8 splits holding out one recording
+    per class. Ten random draws of them repeated some (seed 0: 6 distinct, one split drawn 4
+    times, so it weighed 40 % in the mean and the walk recording 02_01 was held out in 8 of 10):
+    now each of the 8 is made once, and the report says so. Where more splits exist than are
+    asked for, the splits are still distinct."""
+    files = {"boxing": ["13_18", "80_10"], "run": ["09_03", "09_06"], "walk": ["02_01", "16_21"]}
+    labels = np.array([c for c, names in files.items() for _ in names for _ in range(4)])
+    recordings = np.array([n for names in files.values() for n in names for _ in range(4)])
+    splits = exp.recording_splits(labels, recordings, 10, 0.4, 0)
+    held = [frozenset(recordings[te].tolist()) for _, te in splits]
+    assert len(held) == len(set(held)) == 8
+    assert exp.distinct_recording_splits(labels, recordings, 0.4) == 8
+    for train, test in splits:
+        assert not set(recordings[train]) & set(recordings[test])
+        assert set(labels[test]) == set(labels[train]) == set(files)
+    many = np.array([f"{c}{i // 2}" for c, i in zip(labels, range(24), strict=True)])  # 4 per class
+    drawn = [
+        frozenset(many[te].tolist()) for _, te in exp.recording_splits(labels, many, 50, 0.4, 1)
+    ]
+    assert len(drawn) == len(set(drawn)) == 50  # of 6 ** 3 = 216
+    x = np.zeros((24, 7))
+    x[:, 0] = np.repeat([0.0, 5.0, 10.0], 8)
+    cfg = _cfg({"split": "recording", "repeats": 10})
+    res = exp.within_source(cfg, exp.classifier_factory(cfg.classifier, "t"), x, labels, recordings)
+    assert res["n_splits"] == 8 and res["balanced_accuracy_mean"] == 1.0
+    assert exp._held_out_markdown(res)[0] == (
+        "Recordings held out in every split: boxing 1 of 2, run 1 of 2, walk 1 of 2. These allow "
+        "8 distinct splits only, and each is made once (not 10 splits, some of them repeated)."
+    )

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import csv
 import io
+import itertools
 import json
 import os
 import warnings
@@ -358,22 +359,55 @@ def recording_splits(
     labels: NDArray[Any], recordings: NDArray[Any], repeats: int, test_fraction: float, seed: int
 ) -> list[tuple[NDArray[np.intp], NDArray[np.intp]]]:
     """Train/test index splits that hold out whole recordings: for every class, a random
-    ``test_fraction`` of its recordings (at least one, and never all) goes to the test side."""
+    ``test_fraction`` of its recordings (at least one, and never all) goes to the test side.
+
+    The splits are distinct: a draw that repeats an earlier split is drawn again, so that no
+    split weighs twice in the mean. Where fewer than ``repeats`` distinct splits exist (3
+    classes of 2 recordings: 2 * 2 * 2 = 8), every one of them is made, once
+    (:func:`distinct_recording_splits` counts them)."""
     rng = np.random.default_rng(seed)
-    splits = []
-    for _ in range(repeats):
+    classes = sorted(set(labels.tolist()))
+    files = {c: sorted(set(recordings[labels == c].tolist())) for c in classes}
+    for label, held in files.items():
+        if len(held) < 2:
+            raise MdfError(
+                f"evaluation.split = 'recording': class {label!r} has only one recording"
+            )
+    splits: list[tuple[NDArray[np.intp], NDArray[np.intp]]] = []
+    if repeats >= distinct_recording_splits(labels, recordings, test_fraction):  # every one
+        choices = [
+            itertools.combinations(files[c], recordings_held_out(len(files[c]), test_fraction))
+            for c in classes
+        ]
+        for chosen in itertools.product(*choices):
+            test_mask = np.zeros(labels.shape[0], dtype=bool)
+            for label, names in zip(classes, chosen, strict=True):
+                test_mask |= (labels == label) & np.isin(recordings, list(names))
+            splits.append((np.flatnonzero(~test_mask), np.flatnonzero(test_mask)))
+        return splits
+    seen: set[tuple[int, ...]] = set()
+    while len(splits) < repeats:
         test_mask = np.zeros(labels.shape[0], dtype=bool)
-        for label in sorted(set(labels.tolist())):
-            files = sorted(set(recordings[labels == label].tolist()))
-            if len(files) < 2:
-                raise MdfError(
-                    f"evaluation.split = 'recording': class {label!r} has only one recording"
-                )
-            n_test = recordings_held_out(len(files), test_fraction)
-            held = set(rng.permutation(files)[:n_test].tolist())
-            test_mask |= (labels == label) & np.isin(recordings, list(held))
-        splits.append((np.flatnonzero(~test_mask), np.flatnonzero(test_mask)))
+        for label in classes:
+            n_test = recordings_held_out(len(files[label]), test_fraction)
+            held_out = set(rng.permutation(files[label])[:n_test].tolist())
+            test_mask |= (labels == label) & np.isin(recordings, list(held_out))
+        test = np.flatnonzero(test_mask)
+        if tuple(test.tolist()) not in seen:
+            seen.add(tuple(test.tolist()))
+            splits.append((np.flatnonzero(~test_mask), test))
     return splits
+
+
+def distinct_recording_splits(
+    labels: NDArray[Any], recordings: NDArray[Any], test_fraction: float
+) -> int:
+    """How many distinct splits :func:`recording_splits` can make: the product over the classes
+    of the ways to choose the held-out recordings among each class's recordings."""
+    from math import comb, prod
+
+    counts = [len(set(recordings[labels == c].tolist())) for c in sorted(set(labels.tolist()))]
+    return prod(comb(n, recordings_held_out(n, test_fraction)) for n in counts)
 
 
 def recordings_held_out(n_recordings: int, test_fraction: float) -> int:
@@ -688,6 +722,7 @@ def within_source(
         "class_counts": counts,
         "predictions": predictions,
         "recordings_held_out": {c: list(v) for c, v in held.items()},
+        "repeats": ev.repeats if ev.split != "groups" else len(splits),
     }
 
 
@@ -1241,7 +1276,14 @@ def _held_out_markdown(res: dict[str, Any]) -> list[str]:
     if not held:
         return []
     words = ", ".join(f"{c} {k} of {n}" for c, (k, n) in held.items())
-    return [f"Recordings held out in every split: {words}.", ""]
+    n, repeats = res["n_splits"], res.get("repeats", res["n_splits"])
+    every = (
+        f" These allow {n} distinct splits only, and each is made once (not {repeats} splits, "
+        "some of them repeated)."
+        if n < repeats
+        else ""
+    )
+    return [f"Recordings held out in every split: {words}.{every}", ""]
 
 
 def _not_evaluated_markdown(res: dict[str, Any], splits: str) -> list[str]:
