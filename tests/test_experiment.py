@@ -886,3 +886,34 @@ def test_recording_splits_are_distinct_and_all_made_when_fewer_exist() -> None:
         "Recordings held out in every split: boxing 1 of 2, run 1 of 2, walk 1 of 2. These allow "
         "8 distinct splits only, and each is made once (not 10 splits, some of them repeated)."
     )
+
+
+def test_generated_walkers_of_other_parameters_are_other_recordings(tmp_path: Path) -> None:
+    """Boulic walkers read from no file were all one recording, 'boulic': a class of five
+    walkers was 'not evaluated: it has one recording only' under split = 'recording', and
+    leave-recordings-out held all walkers of every class out together. Each walker is now the
+    recording of its parameters; two spans of one walker (start, duration) stay one."""
+    from mdframework.dataset import plan_records
+
+    p = tmp_path / "d.toml"
+    sources = [
+        ("walk", "rv = 0.7, n_cycles = 3"),
+        ("walk", "rv = 0.7, n_cycles = 3, start = 1.0"),
+        ("walk", "rv = 0.9, n_cycles = 3"),
+        ("brisk", "rv = 2.0, n_cycles = 3"),
+    ]
+    p.write_text(
+        "[record_lengths]\nwalk = 1.0\nbrisk = 1.0\n[base.radar]\nkind = 'lfm'\n"
+        + "".join(
+            f'[[sources]]\nlabel = "{label}"\nmax_records = 1\n'
+            f'motion = {{ kind = "boulic", {params} }}\n'
+            for label, params in sources
+        )
+    )
+    specs = plan_records(*load_dataset_config(p))
+    assert [s.recording for s in specs] == [
+        "boulic(n_cycles=3 rv=0.7)",
+        "boulic(n_cycles=3 rv=0.7)",
+        "boulic(n_cycles=3 rv=0.9)",
+        "boulic(n_cycles=3 rv=2.0)",
+    ]

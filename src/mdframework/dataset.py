@@ -631,6 +631,19 @@ def _plan_recordings(
     return specs, short
 
 
+def _generated_recording(motion: Mapping[str, Any]) -> str:
+    """The recording of a motion read from no file (a generator such as the Boulic walker): its
+    kind and parameters, ``boulic(n_cycles=7 rv=0.7)``, so that walkers of other parameters
+    are other recordings (they were all one, ``boulic``, which experiments holding out
+    recordings could not hold out) and sources of one walker (spans of it) are one."""
+    params = " ".join(
+        f"{k}={json.dumps(v, sort_keys=True, separators=(',', ':'))}"
+        for k, v in sorted(motion.items())
+        if k not in ("kind", "start", "duration")
+    )
+    return f"{motion['kind']}({params})" if params else str(motion["kind"])
+
+
 def _naming(
     entry: SourceEntry, md: Mapping[str, Any], recording: str, kind: str
 ) -> tuple[str, str, str]:
@@ -1011,7 +1024,9 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
             short.append(str(where))
             continue
         md = loaded.metadata
-        meta = _naming(entry, md, str(md.get("file") or where), motion["kind"])
+        meta = _naming(
+            entry, md, str(md.get("file") or _generated_recording(motion)), motion["kind"]
+        )
         hop = entry.hop or length
         rz = _randomize(config, entry)
         origins = _draw_origins(config, entry_no, entry)
