@@ -1024,9 +1024,8 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
             short.append(str(where))
             continue
         md = loaded.metadata
-        meta = _naming(
-            entry, md, str(md.get("file") or _generated_recording(motion)), motion["kind"]
-        )
+        named = md.get("file") or motion.get("file") or _generated_recording(motion)
+        meta = _naming(entry, md, str(named), motion["kind"])
         hop = entry.hop or length
         rz = _randomize(config, entry)
         origins = _draw_origins(config, entry_no, entry)
