@@ -126,7 +126,11 @@ class EvaluationConfig(StrictModel):
     holds out whole groups such as subjects (`groups`)."""
 
     repeats: int = Field(
-        10, ge=1, le=10_000, description="Number of random splits (split = 'record', 'recording')."
+        10,
+        ge=1,
+        le=10_000,
+        description="Number of random splits (split = 'record', 'recording'; with 'recording' "
+        "distinct splits, all of them, each once, where fewer exist).",
     )
     test_fraction: float = Field(
         0.4, gt=0, lt=1, description="Test share (the paper: 40 %; not used by split = 'groups')."
