@@ -284,3 +284,19 @@ def test_grouped_wrapper_does_not_score_a_class_it_never_trained_on(
     x[:, 0] += np.select([y == "b", y == "c"], [20.0, 40.0], 0.0)
     sel = wrapper_select(x, y, lambda: knn(k=1), sizes=(1,), folds=4, groups=groups)
     assert sel.subset == (0,) and sel.score == 1.0
+
+
+def test_a_knn_metric_that_cannot_be_computed_is_a_config_error() -> None:
+    """A misspelt metric, or one that needs parameters the plugin does not take (seuclidean's
+    variances, mahalanobis' covariance), used to pass validation and fail at the first
+    prediction as an internal error of the plugin; it is refused naming classifier.metric. A
+    metric it takes gives the distances it names."""
+    from mdframework.experiment import classifier_factory
+
+    for metric in ("euclidian", "seuclidean", "mahalanobis", "precomputed"):
+        with pytest.raises(ConfigError, match=rf"classifier\.metric: '{metric}' is not one of"):
+            classifier_factory({"kind": "knn", "metric": metric}, "e.toml")
+    make = classifier_factory({"kind": "knn", "k": 1, "metric": "manhattan"}, "e.toml")
+    x = np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 0.0]])  # std (0.816, 0.471)
+    dist, idx = make().fit(x, np.array(["a", "b", "c"])).neighbours(np.array([[1.0, 0.0]]))
+    assert idx[0, 0] == 0 and dist[0, 0] == pytest.approx(1 / np.sqrt(2 / 3), rel=1e-12)

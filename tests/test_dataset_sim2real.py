@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -463,6 +464,20 @@ recordings = ["20_boxing_3.txt"]
         "b/boxing.npz:20_boxing_3.txt",
     }
     assert recordings(["a/boxing.npz", "./a/boxing.npz"]) == {"20_boxing_3.txt"}
+    # and so does the built dataset's index.csv, which experiments split on (it gave both
+    # records the recording's own name, one recording to split = 'recording'), also when a
+    # dataset built before is resumed
+    recordings(["a/boxing.npz", "b/boxing.npz"])
+    cfg, base = load_dataset_config(tmp_path / "real.toml")
+    two = ["a/boxing.npz:20_boxing_3.txt", "b/boxing.npz:20_boxing_3.txt"]
+    build_dataset(cfg, base, tmp_path / "ds", progress=False)
+    assert list(load_dataset(tmp_path / "ds", spectrograms=False).table["recording"]) == two
+    for path in (tmp_path / "ds" / RECORDS).glob("*.npz"):  # records of a build before the fix
+        arrays, meta = read_record(path)
+        del meta["recording_name"]
+        np.savez(path, **arrays, meta=np.array(json.dumps(meta)))
+    build_dataset(cfg, base, tmp_path / "ds", progress=False)
+    assert list(load_dataset(tmp_path / "ds", spectrograms=False).table["recording"]) == two
     monkeypatch.setenv("HOME", str(tmp_path))
     assert recordings(["a/boxing.npz", "~/a/boxing.npz"]) == {"20_boxing_3.txt"}
 

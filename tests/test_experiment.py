@@ -813,3 +813,107 @@ def test_a_recording_split_never_holds_out_all_of_a_class() -> None:
         assert set(labels[train]) == {"a", "b"} and set(labels[test]) == {"a", "b"}
         assert not set(recs[train]) & set(recs[test])
         assert len(set(recs[test])) == 3
+
+
+def test_a_class_of_one_side_only_is_named_in_the_train_test_report(
+    kinect_dataset: Path, tmp_path: Path
+) -> None:
+    """punch is recorded by s01 only. Trained on s02 and s03 and tested on s01, its 2 test
+    records cannot be scored (no training record of it); trained on s01 and s02 and tested on
+    s03, it is left out of training (so no s03 record can be called punch). Either way the
+    score is over jog and boxing only: the report, stderr and summary.json say which class was
+    left out and how many records, instead of scoring a subset of the records in silence."""
+    from mdframework.dataset import load_dataset
+
+    data = load_dataset(kinect_dataset, spectrograms=False)
+    n_punch = int(np.sum(data.labels == "punch"))
+    for train, test, words in (
+        (["s02", "s03"], "s01", f"{n_punch} test records not scored: no training record of it"),
+        (["s01", "s02"], "s03", f"{n_punch} training records left out of training"),
+    ):
+        cfg = exp.ExperimentConfig.model_validate(
+            {
+                "dataset": {"path": str(kinect_dataset)},
+                "selection": {"method": "none"},
+                "train_test": {"train": {"subject": train}, "test": {"subject": test}},
+            }
+        )
+        res = exp.train_test(cfg, exp.classifier_factory(cfg.classifier, "t"), data)
+        assert res["classes"] == ["boxing", "jog"]
+        assert list(res["left_out"]) == ["punch"] and res["left_out"]["punch"].startswith(words)
+    body = (
+        '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\n'
+        '[train_test]\ntrain = { subject = ["s02", "s03"] }\ntest = { subject = "s01" }\n'
+    )
+    e = _experiment(kinect_dataset, tmp_path, body)
+    with pytest.warns(exp.ExperimentWarning, match=r"train_test: class 'punch' left out"):
+        summary = exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+    report = (tmp_path / "o" / "report.md").read_text()
+    line = "Left out (on one side only; the score is over the classes both sides hold): punch"
+    assert f"{line} ({n_punch} test records not scored" in report
+    assert summary["train_test"]["left_out"] == {
+        "punch": f"{n_punch} test records not scored: no training record of it"
+    }
+
+
+def test_recording_splits_are_distinct_and_all_made_when_fewer_exist() -> None:
+    """Three classes of two recordings allow 2 * 2 * 2 = 8 splits holding out one recording
+    per class. Ten random draws of them repeated some (seed 0: 6 distinct, one split drawn 4
+    times, so it weighed 40 % in the mean and the walk recording 02_01 was held out in 8 of 10):
+    now each of the 8 is made once, and the report says so. Where more splits exist than are
+    asked for, the splits are still distinct."""
+    files = {"boxing": ["13_18", "80_10"], "run": ["09_03", "09_06"], "walk": ["02_01", "16_21"]}
+    labels = np.array([c for c, names in files.items() for _ in names for _ in range(4)])
+    recordings = np.array([n for names in files.values() for n in names for _ in range(4)])
+    splits = exp.recording_splits(labels, recordings, 10, 0.4, 0)
+    held = [frozenset(recordings[te].tolist()) for _, te in splits]
+    assert len(held) == len(set(held)) == 8
+    assert exp.distinct_recording_splits(labels, recordings, 0.4) == 8
+    for train, test in splits:
+        assert not set(recordings[train]) & set(recordings[test])
+        assert set(labels[test]) == set(labels[train]) == set(files)
+    many = np.array([f"{c}{i // 2}" for c, i in zip(labels, range(24), strict=True)])  # 4 per class
+    drawn = [
+        frozenset(many[te].tolist()) for _, te in exp.recording_splits(labels, many, 50, 0.4, 1)
+    ]
+    assert len(drawn) == len(set(drawn)) == 50  # of 6 ** 3 = 216
+    x = np.zeros((24, 7))
+    x[:, 0] = np.repeat([0.0, 5.0, 10.0], 8)
+    cfg = _cfg({"split": "recording", "repeats": 10})
+    res = exp.within_source(cfg, exp.classifier_factory(cfg.classifier, "t"), x, labels, recordings)
+    assert res["n_splits"] == 8 and res["balanced_accuracy_mean"] == 1.0
+    assert exp._held_out_markdown(res)[0] == (
+        "Recordings held out in every split: boxing 1 of 2, run 1 of 2, walk 1 of 2. These allow "
+        "8 distinct splits only, and each is made once (not 10 splits, some of them repeated)."
+    )
+
+
+def test_generated_walkers_of_other_parameters_are_other_recordings(tmp_path: Path) -> None:
+    """Boulic walkers read from no file were all one recording, 'boulic': a class of five
+    walkers was 'not evaluated: it has one recording only' under split = 'recording', and
+    leave-recordings-out held all walkers of every class out together. Each walker is now the
+    recording of its parameters; two spans of one walker (start, duration) stay one."""
+    from mdframework.dataset import plan_records
+
+    p = tmp_path / "d.toml"
+    sources = [
+        ("walk", "rv = 0.7, n_cycles = 3"),
+        ("walk", "rv = 0.7, n_cycles = 3, start = 1.0"),
+        ("walk", "rv = 0.9, n_cycles = 3"),
+        ("brisk", "rv = 2.0, n_cycles = 3"),
+    ]
+    p.write_text(
+        "[record_lengths]\nwalk = 1.0\nbrisk = 1.0\n[base.radar]\nkind = 'lfm'\n"
+        + "".join(
+            f'[[sources]]\nlabel = "{label}"\nmax_records = 1\n'
+            f'motion = {{ kind = "boulic", {params} }}\n'
+            for label, params in sources
+        )
+    )
+    specs = plan_records(*load_dataset_config(p))
+    assert [s.recording for s in specs] == [
+        "boulic(n_cycles=3 rv=0.7)",
+        "boulic(n_cycles=3 rv=0.7)",
+        "boulic(n_cycles=3 rv=0.9)",
+        "boulic(n_cycles=3 rv=2.0)",
+    ]

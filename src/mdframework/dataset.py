@@ -631,6 +631,19 @@ def _plan_recordings(
     return specs, short
 
 
+def _generated_recording(motion: Mapping[str, Any]) -> str:
+    """The recording of a motion read from no file (a generator such as the Boulic walker): its
+    kind and parameters, ``boulic(n_cycles=7 rv=0.7)``, so that walkers of other parameters
+    are other recordings (they were all one, ``boulic``, which experiments holding out
+    recordings could not hold out) and sources of one walker (spans of it) are one."""
+    params = " ".join(
+        f"{k}={json.dumps(v, sort_keys=True, separators=(',', ':'))}"
+        for k, v in sorted(motion.items())
+        if k not in ("kind", "start", "duration")
+    )
+    return f"{motion['kind']}({params})" if params else str(motion["kind"])
+
+
 def _naming(
     entry: SourceEntry, md: Mapping[str, Any], recording: str, kind: str
 ) -> tuple[str, str, str]:
@@ -1011,7 +1024,8 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
             short.append(str(where))
             continue
         md = loaded.metadata
-        meta = _naming(entry, md, str(md.get("file") or where), motion["kind"])
+        named = md.get("file") or motion.get("file") or _generated_recording(motion)
+        meta = _naming(entry, md, str(named), motion["kind"])
         hop = entry.hop or length
         rz = _randomize(config, entry)
         origins = _draw_origins(config, entry_no, entry)
@@ -1231,6 +1245,8 @@ def _build_recorded(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         "first_frame": run["first_frame"],
         "histogram": spec.histogram["histogram"],
         "recording": dict(rec.metadata),
+        "recording_name": spec.recording,  # index.csv's recording (``<file>:<name>`` where
+        # two files hold a recording of one name, see _distinct_recordings)
         "units": RECORD_UNITS,
     }
     return _write_record(out_dir, spec, meta, arrays)
@@ -1497,7 +1513,7 @@ def _row(meta: dict[str, Any], feats: NDArray[np.float64]) -> dict[str, Any]:
         "subject": meta.get("subject", ""),
         "recording": meta.get("recording", meta["file"])
         if isinstance(meta.get("recording", ""), str)
-        else meta["file"],
+        else meta.get("recording_name", meta["file"]),  # a recorded record's: its metadata
         "dataset": meta.get("dataset", meta["source"]),
         "start_s": meta["start_s"],
         "duration_s": meta["duration_s"],
@@ -1547,8 +1563,10 @@ def _planned_meta(spec: RecordSpec) -> dict[str, Any]:
         "subject": spec.subject,
         "dataset": spec.dataset,
     }
-    if "recording" not in spec.run_config:  # recorded records name their recording themselves
+    if "recording" not in spec.run_config:
         planned["recording"] = spec.recording
+    else:  # a recorded record's "recording" holds the recording's metadata
+        planned["recording_name"] = spec.recording
     return planned
 
 

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import csv
 import io
+import itertools
 import json
 import os
 import warnings
@@ -125,7 +126,11 @@ class EvaluationConfig(StrictModel):
     holds out whole groups such as subjects (`groups`)."""
 
     repeats: int = Field(
-        10, ge=1, le=10_000, description="Number of random splits (split = 'record', 'recording')."
+        10,
+        ge=1,
+        le=10_000,
+        description="Number of random splits (split = 'record', 'recording'; with 'recording' "
+        "distinct splits, all of them, each once, where fewer exist).",
     )
     test_fraction: float = Field(
         0.4, gt=0, lt=1, description="Test share (the paper: 40 %; not used by split = 'groups')."
@@ -358,22 +363,55 @@ def recording_splits(
     labels: NDArray[Any], recordings: NDArray[Any], repeats: int, test_fraction: float, seed: int
 ) -> list[tuple[NDArray[np.intp], NDArray[np.intp]]]:
     """Train/test index splits that hold out whole recordings: for every class, a random
-    ``test_fraction`` of its recordings (at least one, and never all) goes to the test side."""
+    ``test_fraction`` of its recordings (at least one, and never all) goes to the test side.
+
+    The splits are distinct: a draw that repeats an earlier split is drawn again, so that no
+    split weighs twice in the mean. Where fewer than ``repeats`` distinct splits exist (3
+    classes of 2 recordings: 2 * 2 * 2 = 8), every one of them is made, once
+    (:func:`distinct_recording_splits` counts them)."""
     rng = np.random.default_rng(seed)
-    splits = []
-    for _ in range(repeats):
+    classes = sorted(set(labels.tolist()))
+    files = {c: sorted(set(recordings[labels == c].tolist())) for c in classes}
+    for label, held in files.items():
+        if len(held) < 2:
+            raise MdfError(
+                f"evaluation.split = 'recording': class {label!r} has only one recording"
+            )
+    splits: list[tuple[NDArray[np.intp], NDArray[np.intp]]] = []
+    if repeats >= distinct_recording_splits(labels, recordings, test_fraction):  # every one
+        choices = [
+            itertools.combinations(files[c], recordings_held_out(len(files[c]), test_fraction))
+            for c in classes
+        ]
+        for chosen in itertools.product(*choices):
+            test_mask = np.zeros(labels.shape[0], dtype=bool)
+            for label, names in zip(classes, chosen, strict=True):
+                test_mask |= (labels == label) & np.isin(recordings, list(names))
+            splits.append((np.flatnonzero(~test_mask), np.flatnonzero(test_mask)))
+        return splits
+    seen: set[tuple[int, ...]] = set()
+    while len(splits) < repeats:
         test_mask = np.zeros(labels.shape[0], dtype=bool)
-        for label in sorted(set(labels.tolist())):
-            files = sorted(set(recordings[labels == label].tolist()))
-            if len(files) < 2:
-                raise MdfError(
-                    f"evaluation.split = 'recording': class {label!r} has only one recording"
-                )
-            n_test = recordings_held_out(len(files), test_fraction)
-            held = set(rng.permutation(files)[:n_test].tolist())
-            test_mask |= (labels == label) & np.isin(recordings, list(held))
-        splits.append((np.flatnonzero(~test_mask), np.flatnonzero(test_mask)))
+        for label in classes:
+            n_test = recordings_held_out(len(files[label]), test_fraction)
+            held_out = set(rng.permutation(files[label])[:n_test].tolist())
+            test_mask |= (labels == label) & np.isin(recordings, list(held_out))
+        test = np.flatnonzero(test_mask)
+        if tuple(test.tolist()) not in seen:
+            seen.add(tuple(test.tolist()))
+            splits.append((np.flatnonzero(~test_mask), test))
     return splits
+
+
+def distinct_recording_splits(
+    labels: NDArray[Any], recordings: NDArray[Any], test_fraction: float
+) -> int:
+    """How many distinct splits :func:`recording_splits` can make: the product over the classes
+    of the ways to choose the held-out recordings among each class's recordings."""
+    from math import comb, prod
+
+    counts = [len(set(recordings[labels == c].tolist())) for c in sorted(set(labels.tolist()))]
+    return prod(comb(n, recordings_held_out(n, test_fraction)) for n in counts)
 
 
 def recordings_held_out(n_recordings: int, test_fraction: float) -> int:
@@ -688,6 +726,7 @@ def within_source(
         "class_counts": counts,
         "predictions": predictions,
         "recordings_held_out": {c: list(v) for c, v in held.items()},
+        "repeats": ev.repeats if ev.split != "groups" else len(splits),
     }
 
 
@@ -730,10 +769,21 @@ def _train_then_test(
     """Select features and fit on the ``train`` records (mask), predict the ``test`` records,
     over the classes both hold (``who`` names the two sides in the error when they share
     fewer than two). ``x`` (n_records, n_columns) named by ``names``; ``labels`` (n_records,);
-    ``units`` (n_records,): what the wrapper's folds hold out (:func:`held_out_units`), or None."""
+    ``units`` (n_records,): what the wrapper's folds hold out (:func:`held_out_units`), or None.
+    ``left_out``: each class of one side only, with its record count (its test records are not
+    scored; its training records are not trained on, so no test record can be called it)."""
     shared = sorted(set(labels[train].tolist()) & set(labels[test].tolist()))
     if len(shared) < 2:
         raise MdfError(f"{who} share fewer than two classes ({shared})")
+    left_out = {}
+    for c in sorted(set(labels[train | test].tolist()) - set(shared)):
+        n_train, n_test = int(np.sum(labels[train] == c)), int(np.sum(labels[test] == c))
+        left_out[c] = (
+            f"{n_test} test record{'s' if n_test != 1 else ''} not scored: no training record of it"
+            if n_test
+            else f"{n_train} training record{'s' if n_train != 1 else ''} left out of "
+            "training: no test record of it"
+        )
     train = train & np.isin(labels, shared)
     test = test & np.isin(labels, shared)
     sel = _select(
@@ -752,6 +802,7 @@ def _train_then_test(
         "subset": [names[i] for i in sel.subset],
         "train_counts": {c: int(np.sum(labels[train] == c)) for c in shared},
         "test_counts": {c: int(np.sum(labels[test] == c)) for c in shared},
+        "left_out": left_out,
         "test_index": np.flatnonzero(test),
         "true": labels[test],
         "predicted": pred,
@@ -1067,6 +1118,7 @@ def _report(
             f"Balanced accuracy {res['balanced_accuracy']:.3f}; inputs {res['subset']}; "
             f"training {res['train_counts']}, test {res['test_counts']}.",
             "",
+            *_left_out_markdown(res, "cross-source"),
             "Per-class rates (test records of each class classified correctly): "
             + ", ".join(f"{c} {res['confusion'][i, i]:.2f}" for i, c in enumerate(res["classes"]))
             + ".",
@@ -1100,6 +1152,7 @@ def _report(
             f"Balanced accuracy {res['balanced_accuracy']:.3f}; features {res['subset']}; "
             f"training {res['train_counts']}, test {res['test_counts']}.",
             "",
+            *_left_out_markdown(res, "train_test"),
             _markdown_matrix(res["classes"], res["confusion"], None),
             "",
             "![train/test](train_test_confusion.png)",
@@ -1201,6 +1254,25 @@ def _spread_words(res: dict[str, Any], splits: str) -> str:
     )
 
 
+def _left_out_markdown(res: dict[str, Any], part: str) -> list[str]:
+    """Report lines naming the classes a train/test result leaves out (of one side only: the
+    score is over the shared classes), each also a warning on stderr naming ``part``."""
+    left = res["left_out"]
+    for c, why in left.items():
+        warnings.warn(
+            f"{part}: class {c!r} left out (not on both sides): {why}",
+            ExperimentWarning,
+            stacklevel=3,
+        )
+    if not left:
+        return []
+    words = "; ".join(f"{c} ({why})" for c, why in left.items())
+    return [
+        f"Left out (on one side only; the score is over the classes both sides hold): {words}.",
+        "",
+    ]
+
+
 def _held_out_markdown(res: dict[str, Any]) -> list[str]:
     """The report line saying how many recordings of each class a split held out (the share
     ``test_fraction`` asks for, rounded, at least one and never all)."""
@@ -1208,7 +1280,14 @@ def _held_out_markdown(res: dict[str, Any]) -> list[str]:
     if not held:
         return []
     words = ", ".join(f"{c} {k} of {n}" for c, (k, n) in held.items())
-    return [f"Recordings held out in every split: {words}.", ""]
+    n, repeats = res["n_splits"], res.get("repeats", res["n_splits"])
+    every = (
+        f" These allow {n} distinct splits only, and each is made once (not {repeats} splits, "
+        "some of them repeated)."
+        if n < repeats
+        else ""
+    )
+    return [f"Recordings held out in every split: {words}.{every}", ""]
 
 
 def _not_evaluated_markdown(res: dict[str, Any], splits: str) -> list[str]:

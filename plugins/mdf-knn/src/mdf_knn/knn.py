@@ -20,7 +20,7 @@ from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import Field
+from pydantic import Field, field_validator
 
 from mdframework import Classifier, ConfigError, PluginConfig
 from mdframework.classify import Standardizer
@@ -46,11 +46,34 @@ class KnnConfig(PluginConfig):
 
     kind: Literal["knn"] = "knn"
     k: int = Field(5, ge=1, le=10_000, description="Number of neighbours.")
-    metric: str = Field("euclidean", description="Distance (any scikit-learn metric name).")
+    metric: str = Field(
+        "euclidean",
+        description="Distance: a scikit-learn metric name that needs no parameters (not "
+        "seuclidean, mahalanobis, precomputed or haversine).",
+    )
     tie_rule: Literal["nearest", "lowest"] = Field(
         "nearest",
         description="Vote ties: the tied class with the nearest member, or the first label.",
     )
+
+    @field_validator("metric")
+    @classmethod
+    def _known_metric(cls, value: str) -> str:
+        """A metric scikit-learn computes between queries and training samples without more
+        parameters, so that a misspelt name stops before any fit (not as an error of the
+        plugin at its first prediction)."""
+        if value == "euclidean":
+            return value
+        from sklearn.neighbors import VALID_METRICS
+
+        # seuclidean and mahalanobis need variances the plugin does not take, precomputed a
+        # distance matrix, haversine two columns of angles
+        usable = sorted(
+            set(VALID_METRICS["brute"]) - {"seuclidean", "mahalanobis", "precomputed", "haversine"}
+        )
+        if value not in usable:
+            raise ValueError(f"{value!r} is not one of the metrics {', '.join(usable)}")
+        return value
 
 
 class Knn(Classifier):
