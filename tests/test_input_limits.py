@@ -540,18 +540,28 @@ def test_an_oni_recording_that_is_a_pipe_is_refused_unread(
 
 @pytest.mark.parametrize(
     ("name", "what"),
-    [("big.bvh", "a BVH file"), ("big.asf", "an ASF file"), ("big.amc", "an AMC file")],
+    [
+        ("big.bvh", "a BVH file"),
+        ("big.asf", "an ASF file"),
+        ("big.amc", "an AMC file"),
+        ("big.trc", "a TRC text file"),
+        ("joints_s01_e01.txt", "a text skeleton file"),
+        ("big.csv", "a text table"),
+    ],
 )
 def test_a_motion_capture_text_file_beyond_the_size_limit_is_refused_unread(
     tmp_path: Path, name: str, what: str
 ) -> None:
-    """A BVH, ASF or AMC file had no size limit: a huge one was read whole (about 13 times its
-    size in memory for an AMC) and ended in an internal MemoryError. One over
-    MAX_MOTION_TEXT_BYTES (a sparse file, holding nothing) is refused naming the file and the
-    limit, before it is read; the shipped files are far below it."""
+    """A BVH, ASF, AMC, TRC, Kinect text or text table file had no size limit: a huge one was
+    read whole (about 13 times its size in memory for an AMC) and ended in an internal
+    MemoryError. One over MAX_MOTION_TEXT_BYTES (a sparse file, holding nothing) is refused
+    naming the file and the limit, before it is read; the shipped files are far below it."""
     from helpers import data_error_and_peak
+    from mdf_c3d.trc import read_trc
     from mdf_cmu.asfamc import read_amc, read_asf
     from mdf_cmu.bvh import read_bvh
+    from mdf_kinect.formats import read_utkinect
+    from mdf_table.reader import read_table
 
     cmu = EXAMPLES / "data" / "cmu"
     path = tmp_path / name
@@ -561,6 +571,9 @@ def test_a_motion_capture_text_file_beyond_the_size_limit_is_refused_unread(
         ".bvh": read_bvh,
         ".asf": read_asf,
         ".amc": lambda p: read_amc(p, read_asf(cmu / "asf-amc" / "02.asf")),
+        ".trc": read_trc,
+        ".txt": read_utkinect,
+        ".csv": read_table,
     }[path.suffix]
     error, peak = data_error_and_peak(lambda: read(path))
     assert str(error) == (
@@ -568,5 +581,6 @@ def test_a_motion_capture_text_file_beyond_the_size_limit_is_refused_unread(
         f"{limits.MAX_MOTION_TEXT_BYTES:,} bytes for {what}"
     )
     assert peak < 10 * 2**20
-    shipped = [*cmu.glob("*/*"), *(EXAMPLES / "data").glob("*/*.bvh")]
+    motion_text = {".bvh", ".asf", ".amc", ".trc", ".txt", ".csv"}
+    shipped = [p for p in (EXAMPLES / "data").rglob("*") if p.suffix in motion_text]
     assert max(p.stat().st_size for p in shipped) < limits.MAX_MOTION_TEXT_BYTES / 50

@@ -63,8 +63,9 @@ MAX_DB = 400.0
 #: Largest config file [bytes] and deepest nesting of tables and lists in it.
 MAX_CONFIG_BYTES = 4 * 1024 * 1024
 MAX_CONFIG_DEPTH = 32
-#: Largest motion-capture text file (BVH, ASF, AMC) [bytes]: 256 MiB, about 45 minutes of a
-#: CMU AMC at 120 Hz (reading an AMC takes about 13 times its size in memory at its peak).
+#: Largest motion-capture text file (BVH, ASF, AMC, TRC, Kinect text, text table) [bytes]:
+#: 256 MiB, about 45 minutes of a CMU AMC at 120 Hz (reading an AMC takes about 13 times its
+#: size in memory at its peak).
 MAX_MOTION_TEXT_BYTES = 256 * 1024 * 1024
 #: Largest array of a binary motion file (a table's NPZ member), uncompressed [bytes]: 512 MiB,
 #: 6.7e7 float64 values (about 2 hours of 25 joints at 120 Hz); checked from the sizes the file

@@ -175,7 +175,9 @@ def read_trc(
         rate, fewer than two frames.
     """
     # old writers put Windows paths in line 1: text that is not UTF-8 is read as Latin-1
-    lines = limits.read_text_file(path, "a TRC text file", latin1=True).splitlines()
+    lines = limits.read_text_file(
+        path, "a TRC text file", limits.MAX_MOTION_TEXT_BYTES, latin1=True
+    ).splitlines()
     header = _header(path, lines)
     rate = float(frame_rate) if frame_rate is not None else _rate(path, header)
     n_markers = _int(path, header, "NumMarkers", 1, MAX_MARKERS)

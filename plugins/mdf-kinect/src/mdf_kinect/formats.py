@@ -182,7 +182,7 @@ class Recording:
 
 def read_text(path: Path) -> list[str]:
     """The file's lines; clear errors for unreadable, empty or binary files."""
-    text = limits.read_text_file(path, "a text skeleton file")
+    text = limits.read_text_file(path, "a text skeleton file", limits.MAX_MOTION_TEXT_BYTES)
     if not text.strip():
         raise DataFileError(path, "the file is empty")
     return text.splitlines()

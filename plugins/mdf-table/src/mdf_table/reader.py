@@ -169,7 +169,7 @@ def read_table(path: Path, spec: TableLayout | None = None) -> Table:
 
 def _lines(path: Path) -> list[tuple[int, str]]:
     """Non-empty, non-comment lines with their 1-based numbers."""
-    text = limits.read_text_file(path, "a text table")
+    text = limits.read_text_file(path, "a text table", limits.MAX_MOTION_TEXT_BYTES)
     out = [(i, s) for i, s in enumerate(text.splitlines(), start=1) if s.strip()]
     out = [(i, s) for i, s in out if not s.lstrip().startswith("#")]
     if not out:
