@@ -11,7 +11,7 @@ For every variant, seed, classifier input (the seven features, the histogram vec
 classifier, a classifier is trained on ALL simulated records and tested on ALL real records:
 balanced accuracy and per-class rates, then mean and std over the seeds. The real-to-real
 reference uses the same input and classifier, trained on real recordings and tested on held-out
-real recordings (``--repeats`` random splits holding out 40 % of the recordings of every class).
+real recordings (``--repeats`` random splits holding out 5 of the 12 recordings of every class).
 
     .venv/bin/python benchmarks/bench_sim2real.py [--seeds 0 1 2] [--variants full,...]
         [--workers N] [--out out/bench_sim2real] [--docs]
@@ -51,6 +51,7 @@ from mdframework.experiment import (  # noqa: E402
     classifier_factory,
     classifier_inputs,
     recording_splits,
+    recordings_held_out,
 )
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -58,6 +59,9 @@ CONFIG = ROOT / "examples" / "datasets" / "sim2real.toml"
 DOCS_RESULTS = ROOT / "docs" / "data" / "sim2real_results.json"
 DOCS_FIGURE = ROOT / "docs" / "figures" / "sim2real_histograms.png"
 SIM, REAL = "sim", "radhar"
+#: The real-to-real splits' test fraction, and the real recordings of each activity the
+#: repository ships (a split holds ``recordings_held_out(12, 0.4)`` = 5 of them out).
+TEST_FRACTION, REAL_RECORDINGS = 0.4, 12
 CLASSIFIERS: dict[str, dict[str, Any]] = {
     "knn": {"kind": "knn", "k": 5},
     "forest": {
@@ -223,7 +227,7 @@ def real_to_real(path: Path, kind: str, clf: dict[str, Any], repeats: int) -> di
     classes = sorted(set(y.tolist()))
     factory = classifier_factory(clf, "bench")
     scores, rates = [], []
-    for train, test in recording_splits(y, files, repeats, 0.4, 0):
+    for train, test in recording_splits(y, files, repeats, TEST_FRACTION, 0):
         pred = factory().fit(x[train], y[train]).predict(x[test])
         scores.append(balanced_accuracy(y[test], pred))
         rates.append(_rates(y[test], pred, classes))
@@ -464,7 +468,8 @@ def markdown(results: dict[str, Any]) -> str:
     lines = [
         f"Balanced accuracy on the real recordings; simulated: mean ± std over dataset seeds "
         f"{', '.join(map(str, seeds))}; real-to-real: mean ± std over {results['repeats']} "
-        "splits holding out 40 % of the recordings of every class.",
+        f"splits holding out {recordings_held_out(REAL_RECORDINGS, TEST_FRACTION)} of the "
+        f"{REAL_RECORDINGS} recordings of every class.",
         "",
         *head,
         "| real (held-out recordings) | "

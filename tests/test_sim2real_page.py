@@ -119,3 +119,20 @@ def test_the_prose_figures_derived_from_the_results() -> None:
     ratios = [points["full"][a]["points"] / points["real"][a]["points"] for a in points["real"]]
     low, high = (float(t) for t in times.groups())
     assert low - 0.05 <= min(ratios) and max(ratios) <= high + 0.05, ratios
+
+
+def test_the_real_to_real_split_words_count_the_shipped_recordings() -> None:
+    """The page says a real-to-real split holds out 5 of each activity's 12 recordings (the
+    test fraction 0.4 rounded to whole recordings, as the splits do); the script's constant
+    must be the number of recordings the repository ships for each activity."""
+    import numpy as np
+
+    from mdframework.experiment import recordings_held_out
+
+    bench = _bench()
+    for npz in sorted((ROOT / "examples" / "data" / "radhar").glob("radhar_*_subset.npz")):
+        with np.load(npz) as data:
+            assert len(set(data["files"].tolist())) == bench.REAL_RECORDINGS, npz.name
+    held = recordings_held_out(bench.REAL_RECORDINGS, bench.TEST_FRACTION)
+    assert (held, bench.REAL_RECORDINGS) == (5, 12)
+    assert "holding out 5 of the 12 recordings of every class" in PAGE.read_text()
