@@ -20,21 +20,21 @@ ROOT = Path(__file__).resolve().parents[1]
 FIGURES = ROOT / "docs" / "figures"
 
 
-def main() -> None:
-    """Run the three examples and save the figures."""
+def main(figures: Path = FIGURES) -> None:
+    """Run the three examples and save the figures into ``figures`` (docs/figures by default)."""
     walk = result_arrays(simulate(load_run_config(ROOT / "examples" / "fmcw_walk.toml")))
     points = walk["points"]
     frame = int(np.argmax(np.bincount(points[:, 0].astype(np.int64))))
     title = f"CMU walk, IWR1443 preset, frame {frame}"
     plot_range_doppler(
-        FIGURES / "fmcw_walk_range_doppler.png",
+        figures / "fmcw_walk_range_doppler.png",
         walk["range_doppler"][frame],
         walk["range_doppler_range_m"],
         walk["range_doppler_velocity_mps"],
         title=title,
     )
     plot_point_cloud(
-        FIGURES / "fmcw_walk_point_cloud.png", points[points[:, 0] == frame], title=title
+        figures / "fmcw_walk_point_cloud.png", points[points[:, 0] == frame], title=title
     )
     panels = []
     for name, label in (("lfm", "LFM pulse-Doppler"), ("fmcw", "chirp-sequence FMCW")):
@@ -42,7 +42,7 @@ def main() -> None:
             simulate(load_run_config(ROOT / "examples" / f"walk_side_by_side_{name}.toml"))
         )
         panels.append((run["spectrogram_db"], run["time_s"], run["velocity_mps"], label))
-    plot_spectrogram_panels(FIGURES / "fmcw_lfm_side_by_side.png", panels)
+    plot_spectrogram_panels(figures / "fmcw_lfm_side_by_side.png", panels)
 
 
 if __name__ == "__main__":
