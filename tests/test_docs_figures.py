@@ -4,6 +4,7 @@ make them still run and draw figures of the shipped ones' size."""
 from __future__ import annotations
 
 import importlib.util
+import os
 import re
 import sys
 import types
@@ -24,7 +25,12 @@ def _script(path: Path) -> types.ModuleType:
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module  # dataclasses look their module up
-    spec.loader.exec_module(module)
+    environ = dict(os.environ)  # the benchmarks pin BLAS threads when imported
+    try:
+        spec.loader.exec_module(module)
+    finally:
+        os.environ.clear()
+        os.environ.update(environ)
     return module
 
 
@@ -108,3 +114,42 @@ def test_the_accuracy_figure_is_the_one_drawn_from_the_pages_results(tmp_path: P
     scenes = {r["scene"] for r in results["rows"] if r["map_err"] is None}
     assert scenes == {"boulic", "cmu_run_09_06", "kinect_walk"}
     assert shipped[0] == round(5.2 * len(scenes) * DPI)  # 5.2 in a panel
+
+
+def test_the_sim_to_real_figure_is_drawn_by_its_benchmark(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """bench_sim2real.py's histogram figure (the benchmark takes minutes: its dataset is replaced
+    by three classes' mean histograms) draws, at the shipped figure's size, one panel per class
+    with the real and the simulated bars, each class's shares where they were put."""
+    import numpy as np
+
+    module = _script(ROOT / "benchmarks" / "bench_sim2real.py")
+    velocity = (np.arange(17) - 8) * 0.61466867
+    shares = {
+        group: {c: np.eye(17)[k + (group == module.SIM)] for k, c in enumerate(("a", "b", "c"))}
+        for group in (module.REAL, module.SIM)
+    }
+    monkeypatch.setattr(module, "mean_histograms", lambda path, group: shares[group])
+    monkeypatch.setattr(
+        module, "load_dataset", lambda *a, **k: types.SimpleNamespace(velocity=velocity)
+    )
+    drawn: list[object] = []
+    import mdframework.figures as figures
+
+    original = figures.save
+
+    def keep(fig: object, path: Path, caption: str = "", **kw: object) -> None:
+        drawn.append(fig)
+        original(fig, path, caption, **kw)
+
+    monkeypatch.setattr(figures, "save", keep)
+    module.plot_histograms(tmp_path / "ds", tmp_path / "h.png")
+    assert _png_shape(tmp_path / "h.png") == _png_shape(module.DOCS_FIGURE)
+    [fig] = drawn
+    axes = fig.axes  # type: ignore[attr-defined]
+    assert [ax.get_title() for ax in axes] == ["a", "b", "c"]
+    for k, ax in enumerate(axes):
+        real, sim = ax.containers
+        assert np.argmax([b.get_height() for b in real]) == k
+        assert np.argmax([b.get_height() for b in sim]) == k + 1
