@@ -1,4 +1,4 @@
-"""Regenerate the figures of the core docs (concepts page) from the shipped examples.
+"""Regenerate the figures of the concepts and motion-formats pages from the shipped examples.
 
 .venv/bin/python docs/make_figures.py
 """
