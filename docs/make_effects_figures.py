@@ -38,7 +38,8 @@ PANELS: list[tuple[str, dict[str, Any]]] = [
 ]
 
 
-def main() -> None:
+def main(figures: Path = FIGURES) -> None:
+    """Write the figure into ``figures`` (docs/figures by default)."""
     base = read_config_file(ROOT / "examples" / "boulic_walk.toml")
     base["scatterers"] = {"kind": "ellipsoid"}
     with style() as plt:
@@ -46,9 +47,9 @@ def main() -> None:
             1, len(PANELS), figsize=(4.2 * len(PANELS), 3.8), sharey=True, layout="constrained"
         )
         draw(axes, base)
-        FIGURES.mkdir(parents=True, exist_ok=True)
-        save(fig, FIGURES / "effects_spectrograms.png", CAPTION)
-    print(FIGURES / "effects_spectrograms.png")
+        figures.mkdir(parents=True, exist_ok=True)
+        save(fig, figures / "effects_spectrograms.png", CAPTION)
+    print(figures / "effects_spectrograms.png")
 
 
 def draw(axes: Any, base: dict[str, Any]) -> None:

@@ -42,8 +42,9 @@ def run(enabled: bool) -> tuple[object, dict[str, float]]:
     return result, peak
 
 
-def main() -> None:
-    TARGET.parent.mkdir(parents=True, exist_ok=True)
+def main(target: Path = TARGET) -> None:
+    """Write the figure to ``target`` (docs/figures/kinect_walk_conditioning.png by default)."""
+    target.parent.mkdir(parents=True, exist_ok=True)
     with style() as plt:
         fig, axes = plt.subplots(1, 2, figsize=(11, 4.4), sharey=True, layout="constrained")
         for ax, enabled in zip(axes, (False, True), strict=True):
@@ -62,8 +63,8 @@ def main() -> None:
                 ax.set_ylabel("")
             print(state, peak)
         fig.colorbar(im, ax=axes, label="power [dB re peak]")
-        save(fig, TARGET, CAPTION)
-    print(TARGET)
+        save(fig, target, CAPTION)
+    print(target)
 
 
 if __name__ == "__main__":

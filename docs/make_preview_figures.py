@@ -11,23 +11,29 @@ from pathlib import Path
 
 from PIL import Image
 
-from mdframework.cli import main
+from mdframework import cli
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGURES = ROOT / "docs" / "figures"
-FRAME_S = 1.4  # the animation frame shown [s from the record's start]
+FRAME = 8  # the animation frame shown: 8 / FPS = 1.33 s from the record's start
 FPS = 6
 
-if __name__ == "__main__":
-    FIGURES.mkdir(parents=True, exist_ok=True)
+
+def main(figures: Path = FIGURES) -> None:
+    """Write the figures into ``figures`` (docs/figures by default)."""
+    figures.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "walk"
         config = str(ROOT / "examples" / "cmu_walk.toml")
         argv = ["show", config, "--out", str(out), "--fps", str(FPS), "--at", "0.5", "1.4", "2.3"]
-        if main(argv) != 0:
+        if cli.main(argv) != 0:
             raise SystemExit(1)
-        shutil.copyfile(out / "skeleton.png", FIGURES / "cmu_walk_skeleton.png")
+        shutil.copyfile(out / "skeleton.png", figures / "cmu_walk_skeleton.png")
         with Image.open(out / "motion.gif") as gif:
-            gif.seek(round(FRAME_S * FPS))
-            gif.convert("RGB").save(FIGURES / "cmu_walk_preview_frame.png")
-    print(FIGURES / "cmu_walk_skeleton.png", FIGURES / "cmu_walk_preview_frame.png")
+            gif.seek(FRAME)
+            gif.convert("RGB").save(figures / "cmu_walk_preview_frame.png")
+    print(figures / "cmu_walk_skeleton.png", figures / "cmu_walk_preview_frame.png")
+
+
+if __name__ == "__main__":
+    main()

@@ -13,7 +13,7 @@ import tempfile
 import tomllib
 from pathlib import Path
 
-from mdframework.cli import main
+from mdframework import cli
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGURES = ROOT / "docs" / "figures"
@@ -46,18 +46,19 @@ def held_out_recordings(tmp: Path) -> str:
     experiment["evaluation"]["split"] = "recording"
     (tmp / "held_out.json").write_text(json.dumps(experiment))
     out = tmp / "held_out"
-    code = main(["experiment", str(tmp / "held_out.json"), "--out", str(out), "--no-progress"])
+    code = cli.main(["experiment", str(tmp / "held_out.json"), "--out", str(out), "--no-progress"])
     if code != 0:
         raise SystemExit(code)
     return (out / "report.md").read_text()
 
 
-if __name__ == "__main__":
-    FIGURES.mkdir(parents=True, exist_ok=True)
+def main(figures: Path = FIGURES) -> None:
+    """Copy the figures into ``figures`` (docs/figures by default); print the reports."""
+    figures.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
         for name, files in COPIES.items():
             out = Path(tmp) / name
-            code = main(
+            code = cli.main(
                 [
                     "experiment",
                     str(ROOT / "examples" / f"{name}.toml"),
@@ -69,7 +70,11 @@ if __name__ == "__main__":
             if code != 0:
                 raise SystemExit(code)
             for src, dst in files.items():
-                shutil.copyfile(out / src, FIGURES / dst)
+                shutil.copyfile(out / src, figures / dst)
             shutil.copyfile(out / "report.md", Path(tmp) / f"{name}.md")
             print((Path(tmp) / f"{name}.md").read_text())
         print(held_out_recordings(Path(tmp)))
+
+
+if __name__ == "__main__":
+    main()

@@ -59,15 +59,16 @@ def features(res: RunResult) -> dict[str, float]:
     return {name: float(v) for name, v in zip(FEATURE_NAMES, values, strict=True)}
 
 
-def main() -> None:
-    FIGURES.mkdir(parents=True, exist_ok=True)
+def main(figures: Path = FIGURES) -> None:
+    """Write the figure into ``figures`` (docs/figures by default) and print the table."""
+    figures.mkdir(parents=True, exist_ok=True)
     runs = {
         "Boulic (corrected)": boulic(False),
         "Boulic (chen_compatible)": boulic(True),
         "CMU 02_01 walk": cmu(),
         "Kinect UTKinect walk": kinect(),
     }
-    out = FIGURES / "validation_walk_spectrograms.png"
+    out = figures / "validation_walk_spectrograms.png"
     with style() as plt:
         fig, axes = plt.subplots(1, len(runs), figsize=(19, 4.2), sharey=True, layout="constrained")
         image = None
@@ -81,7 +82,7 @@ def main() -> None:
                 ax.set_ylabel("")
         fig.colorbar(image, ax=axes, label="power [dB re peak]")
         save(fig, out, CAPTION)
-    print(f"wrote {out.relative_to(ROOT)}")
+    print(f"wrote {out}")
     print()
     print("| source | " + " | ".join(FEATURE_NAMES) + " |")
     print("|---" * (len(FEATURE_NAMES) + 1) + "|")

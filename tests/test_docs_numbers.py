@@ -66,6 +66,19 @@ def test_the_validation_page_table_is_what_its_script_computes() -> None:
         assert max(abs(q - c) for q, c in zip(quoted, computed, strict=True)) <= 5.0001e-4, name
 
 
+def _check_the_figures_the_page_copies(out: Path, experiment: str) -> None:
+    """The figures of ``mdf experiment examples/<experiment>.toml`` that
+    docs/make_reproduction_figures.py copies into docs/figures exist, each of the shipped copy's
+    size in pixels (the script does not run here: it would repeat these tests' experiments)."""
+    from PIL import Image
+
+    copies = _script("make_reproduction_figures").COPIES[experiment]
+    assert copies
+    for made, shipped in copies.items():
+        with Image.open(out / made) as a, Image.open(ROOT / "docs" / "figures" / shipped) as b:
+            assert a.size == b.size, (made, a.size, b.size)
+
+
 def _half_unit(number: str) -> float:
     """Half a unit of the last digit a number is written with (``-0.762`` -> 0.0005)."""
     decimals = len(number.split(".")[1]) if "." in number else 0
@@ -85,6 +98,7 @@ def test_the_reproduction_page_feature_table_is_the_cross_source_experiments(
     out = tmp_path / "x"
     args = ["experiment", str(EXAMPLES / "experiment_cross_source.toml"), "--out", str(out)]
     assert cli.main([*args, "--no-progress"]) == 0
+    _check_the_figures_the_page_copies(out, "experiment_cross_source")
     with (out / "feature_stats.csv").open() as fh:
         stats = {(r["label"], r["group"]): r for r in csv.DictReader(fh)}
     page = (ROOT / "docs" / "reproducing-erol-gurbuz-2015.md").read_text().splitlines()
@@ -264,6 +278,7 @@ def test_the_reproduction_page_quotes_the_cmu_experiment(tmp_path: Path) -> None
     out = tmp_path / "c"
     args = ["experiment", str(EXAMPLES / "experiment_cmu.toml"), "--out", str(out)]
     assert cli.main([*args, "--no-progress"]) == 0
+    _check_the_figures_the_page_copies(out, "experiment_cmu")
     summary = json.loads((out / "summary.json").read_text())
     cmu = summary["within"]["cmu"]
     page = (ROOT / "docs" / "reproducing-erol-gurbuz-2015.md").read_text()
