@@ -300,3 +300,15 @@ def test_a_knn_metric_that_cannot_be_computed_is_a_config_error() -> None:
     x = np.array([[0.0, 0.0], [1.0, 1.0], [2.0, 0.0]])  # std (0.816, 0.471)
     dist, idx = make().fit(x, np.array(["a", "b", "c"])).neighbours(np.array([[1.0, 0.0]]))
     assert idx[0, 0] == 0 and dist[0, 0] == pytest.approx(1 / np.sqrt(2 / 3), rel=1e-12)
+
+
+def test_a_knn_metric_of_boolean_data_is_a_config_error() -> None:
+    """scikit-learn's metrics of boolean data (jaccard, dice, yule...) turn the standardised
+    features into booleans (every nonzero z-score True): every distance came out 0 and every
+    query got the first training records' class, with nothing but a DataConversionWarning. They
+    are refused naming classifier.metric."""
+    from mdframework.experiment import classifier_factory
+
+    for metric in ("jaccard", "dice", "yule", "russellrao"):
+        with pytest.raises(ConfigError, match=rf"classifier\.metric: '{metric}' is not one of"):
+            classifier_factory({"kind": "knn", "metric": metric}, "e.toml")

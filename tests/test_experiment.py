@@ -917,3 +917,29 @@ def test_generated_walkers_of_other_parameters_are_other_recordings(tmp_path: Pa
         "boulic(n_cycles=3 rv=0.9)",
         "boulic(n_cycles=3 rv=2.0)",
     ]
+
+
+def test_one_walker_written_in_two_ways_is_one_recording(tmp_path: Path) -> None:
+    """Two sources of one class whose motion sections differ in what does not change the
+    walker (its activity label, a default written out, 1 for 1.0) read the same motion: they
+    are one recording, not two (split = 'recording' would train on the walker it tests on).
+    A walker of other data stays another recording."""
+    from mdframework.dataset import plan_records
+
+    p = tmp_path / "d.toml"
+    sources = [
+        "rv = 1.0, n_cycles = 3",
+        'rv = 1, n_cycles = 3, height = 1.8, activity = "stroll"',
+        "n_cycles = 3",  # rv = 1 by default
+        "rv = 1.0, n_cycles = 3, height = 1.7",
+    ]
+    p.write_text(
+        "[record_lengths]\nwalk = 1.0\n[base.radar]\nkind = 'lfm'\n"
+        + "".join(
+            f'[[sources]]\nlabel = "walk"\nmax_records = 1\nmotion = {{ kind = "boulic", {s} }}\n'
+            for s in sources
+        )
+    )
+    names = [s.recording for s in plan_records(*load_dataset_config(p))]
+    assert names[0] == names[1] == names[2] == "boulic(n_cycles=3 rv=1.0)"
+    assert names[3] == "boulic(height=1.7 n_cycles=3 rv=1.0)"

@@ -584,3 +584,28 @@ def test_a_motion_capture_text_file_beyond_the_size_limit_is_refused_unread(
     motion_text = {".bvh", ".asf", ".amc", ".trc", ".txt", ".csv"}
     shipped = [p for p in (EXAMPLES / "data").rglob("*") if p.suffix in motion_text]
     assert max(p.stat().st_size for p in shipped) < limits.MAX_MOTION_TEXT_BYTES / 50
+
+
+def test_a_radars_wrong_spectrogram_fields_are_named_as_its_bug() -> None:
+    """A radar plugin whose ``smaller_spectrogram`` returns something other than a field and
+    an advice (one string) is named, as its bug, by the error that its spectrogram beyond the
+    limit raises (the tuple was unpacked outside the plugin's blame: an anonymous ValueError)."""
+    from mdf_fmcw.waveform import FmcwConfig, FmcwRadar
+
+    from mdframework.pipeline import spectrogram_geometry
+    from mdframework.settings import ProcessingConfig
+
+    class Sloppy(FmcwRadar):
+        def smaller_spectrogram(self, processing: Any) -> Any:
+            return "radar.frame_period"
+
+    wf = Sloppy(FmcwConfig(preset="iwr1443_short_range_3d"))
+    n_pulses = 1200 * wf.sequence.chirps_per_frame
+    with pytest.raises(ValueError) as caught:
+        spectrogram_geometry(wf, n_pulses, ProcessingConfig(nfft=2**20))
+    assert "in smaller_spectrogram() of the radar plugin" in caught.value.__notes__[0]
+    from mdframework.testing import check_radar_waveform
+
+    with pytest.raises(AssertionError, match=r"smaller_spectrogram\(\) must give"):
+        check_radar_waveform(wf)  # the check that the note points to finds it
+    check_radar_waveform(FmcwRadar(FmcwConfig(preset="iwr1443_short_range_3d")))

@@ -635,7 +635,9 @@ def _generated_recording(motion: Mapping[str, Any]) -> str:
     """The recording of a motion read from no file (a generator such as the Boulic walker): its
     kind and parameters, ``boulic(n_cycles=7 rv=0.7)``, so that walkers of other parameters
     are other recordings (they were all one, ``boulic``, which experiments holding out
-    recordings could not hold out) and sources of one walker (spans of it) are one."""
+    recordings could not hold out) and sources of one walker (spans of it) are one. Sources
+    whose motions hold the same data (written otherwise: an activity label, a default written
+    out) take the first one's name (:func:`plan_records`)."""
     params = " ".join(
         f"{k}={json.dumps(v, sort_keys=True, separators=(',', ':'))}"
         for k, v in sorted(motion.items())
@@ -990,6 +992,7 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
     short: list[str] = []
     plan = (config, base_dir)
     prints: dict[str, str] = {}  # motion key -> fingerprint
+    generated: dict[str, str] = {}  # fingerprint -> recording of a motion read from no file
     for entry_no, entry in enumerate(config.sources):
         if entry.recording is not None:
             recorded, too_short = _plan_recordings(config, entry_no, entry, base_dir, len(specs))
@@ -1024,7 +1027,9 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
             short.append(str(where))
             continue
         md = loaded.metadata
-        named = md.get("file") or motion.get("file") or _generated_recording(motion)
+        named = md.get("file") or motion.get("file")
+        if not named:  # a generated motion: one recording per motion data, however written
+            named = generated.setdefault(prints[key], _generated_recording(motion))
         meta = _naming(entry, md, str(named), motion["kind"])
         hop = entry.hop or length
         rz = _randomize(config, entry)

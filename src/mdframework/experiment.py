@@ -377,29 +377,25 @@ def recording_splits(
             raise MdfError(
                 f"evaluation.split = 'recording': class {label!r} has only one recording"
             )
-    splits: list[tuple[NDArray[np.intp], NDArray[np.intp]]] = []
+    n_test = {c: recordings_held_out(len(files[c]), test_fraction) for c in classes}
+
+    def split(held: Sequence[Sequence[str]]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+        """The split holding out ``held[i]``, recordings of class ``classes[i]``."""
+        test_mask = np.zeros(labels.shape[0], dtype=bool)
+        for label, names in zip(classes, held, strict=True):
+            test_mask |= (labels == label) & np.isin(recordings, list(names))
+        return np.flatnonzero(~test_mask), np.flatnonzero(test_mask)
+
     if repeats >= distinct_recording_splits(labels, recordings, test_fraction):  # every one
-        choices = [
-            itertools.combinations(files[c], recordings_held_out(len(files[c]), test_fraction))
-            for c in classes
-        ]
-        for chosen in itertools.product(*choices):
-            test_mask = np.zeros(labels.shape[0], dtype=bool)
-            for label, names in zip(classes, chosen, strict=True):
-                test_mask |= (labels == label) & np.isin(recordings, list(names))
-            splits.append((np.flatnonzero(~test_mask), np.flatnonzero(test_mask)))
-        return splits
+        every = itertools.product(*(itertools.combinations(files[c], n_test[c]) for c in classes))
+        return [split(chosen) for chosen in every]
+    splits: list[tuple[NDArray[np.intp], NDArray[np.intp]]] = []
     seen: set[tuple[int, ...]] = set()
     while len(splits) < repeats:
-        test_mask = np.zeros(labels.shape[0], dtype=bool)
-        for label in classes:
-            n_test = recordings_held_out(len(files[label]), test_fraction)
-            held_out = set(rng.permutation(files[label])[:n_test].tolist())
-            test_mask |= (labels == label) & np.isin(recordings, list(held_out))
-        test = np.flatnonzero(test_mask)
+        train, test = split([rng.permutation(files[c])[: n_test[c]].tolist() for c in classes])
         if tuple(test.tolist()) not in seen:
             seen.add(tuple(test.tolist()))
-            splits.append((np.flatnonzero(~test_mask), test))
+            splits.append((train, test))
     return splits
 
 

@@ -311,7 +311,8 @@ POINTS_HEADER = "frame,t,x,y,z,v,intensity"
 def write_points_csv(path: Path, points: np.ndarray) -> None:
     """``points`` (n_points, 7) as CSV with :data:`POINTS_HEADER`: frame index, t [s from the
     first pulse], x, y, z [m, sensor frame], v [m/s, + approaching], intensity [dB]. Six
-    significant digits, but ten for ``t``: a microsecond in a record of a day."""
+    significant digits, but ten for ``t``: a microsecond up to 10^4 s into the record (2.8 h),
+    10 us in a day-long one."""
     with open(path, "w", encoding="utf-8") as f:
         f.write(POINTS_HEADER + "\n")
         for row in points:

@@ -375,9 +375,9 @@ def spectrogram_geometry(
     except RecordTooShortError as exc:
         raise SceneError(f"processing.window_length: {exc}") from None
     item_bytes = 4 if proc.precision == "float32" else 8
-    with blame(wf, "smaller_spectrogram"):
+    with blame(wf, "smaller_spectrogram"):  # (a wrong return fails in the check: the plugin's)
         fields = wf.smaller_spectrogram(proc)
-    limits.check_spectrogram_cells(geometry.nfft, geometry.n_frames, item_bytes, fields)
+        limits.check_spectrogram_cells(geometry.nfft, geometry.n_frames, item_bytes, fields)
     return geometry
 
 

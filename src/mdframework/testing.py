@@ -345,8 +345,9 @@ def check_radar_waveform(waveform: RadarWaveform) -> None:
     is left out of all these receives). The pulses are the radar's own ``pulse_times`` and the
     Doppler is read from the phase steps between consecutive pulses at
     most 1.5 / prf apart, so radars whose slow time has gaps (FMCW frames) are checked too.
-    The spectrogram of the signal has the geometry ``spectrogram_geometry`` reports, and
-    ``working_memory`` names byte counts."""
+    The spectrogram of the signal has the geometry ``spectrogram_geometry`` reports,
+    ``smaller_spectrogram`` gives a field and an advice, and ``working_memory`` names byte
+    counts."""
     who = _label(waveform)
     fc, prf = waveform.carrier_frequency, waveform.prf
     assert fc > 0 and prf > 0, f"{who}: carrier and PRF must be > 0"
@@ -415,6 +416,10 @@ def _check_spectrogram_geometry(
         f"{who}: the Doppler bins are {step:.6g} Hz apart but spectrogram_geometry() says "
         f"{geometry.doppler_bin:.6g} Hz"
     )
+    fields = waveform.smaller_spectrogram(proc)
+    assert (
+        isinstance(fields, tuple) and len(fields) == 2 and all(isinstance(f, str) for f in fields)
+    ), f"{who}: smaller_spectrogram() must give (field, advice), two strings, got {fields!r}"
 
 
 # --------------------------------------------------------------------------- classifiers

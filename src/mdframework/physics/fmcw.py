@@ -1178,7 +1178,7 @@ def frame_spectrogram(
     in every radar's spectrogram (not :func:`doppler_axis`), and the time of each frame's
     window centre (n_frames,) [s from the first chirp]: ``f T_frame + c T_loop``, ``c`` the
     :func:`~mdframework.physics.spectrogram.window_centre` of the window over the loops
-    (``n_loops / 2`` for the periodic Hann window: the middle of the frame's loops).
+    (``n_loops / 2`` for the periodic Hann window: half a loop after the middle loop).
     """
     # the cosine windows without importing scipy.signal
     from .spectrogram import precision_dtypes, stft_window, window_centre

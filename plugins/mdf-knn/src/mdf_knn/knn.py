@@ -48,8 +48,9 @@ class KnnConfig(PluginConfig):
     k: int = Field(5, ge=1, le=10_000, description="Number of neighbours.")
     metric: str = Field(
         "euclidean",
-        description="Distance: a scikit-learn metric name that needs no parameters (not "
-        "seuclidean, mahalanobis, precomputed or haversine).",
+        description="Distance: a scikit-learn metric name that needs no parameters and takes "
+        "real values (not seuclidean, mahalanobis, precomputed, haversine or the metrics of "
+        "boolean data such as jaccard).",
     )
     tie_rule: Literal["nearest", "lowest"] = Field(
         "nearest",
@@ -64,13 +65,14 @@ class KnnConfig(PluginConfig):
         plugin at its first prediction)."""
         if value == "euclidean":
             return value
+        from sklearn.metrics.pairwise import PAIRWISE_BOOLEAN_FUNCTIONS
         from sklearn.neighbors import VALID_METRICS
 
         # seuclidean and mahalanobis need variances the plugin does not take, precomputed a
-        # distance matrix, haversine two columns of angles
-        usable = sorted(
-            set(VALID_METRICS["brute"]) - {"seuclidean", "mahalanobis", "precomputed", "haversine"}
-        )
+        # distance matrix, haversine two columns of angles; the boolean metrics (jaccard...)
+        # would turn the standardised features into booleans, all of them True
+        unusable = {"seuclidean", "mahalanobis", "precomputed", "haversine"}
+        usable = sorted(set(VALID_METRICS["brute"]) - unusable - set(PAIRWISE_BOOLEAN_FUNCTIONS))
         if value not in usable:
             raise ValueError(f"{value!r} is not one of the metrics {', '.join(usable)}")
         return value
