@@ -806,3 +806,35 @@ def test_a_runs_metadata_holds_a_fingerprint_of_what_it_read(
     assert len(shipped) == 40
     assert copied == shipped
     assert changed != shipped
+
+
+@pytest.mark.parametrize("when", ["taking the lock", "removing the staging folder"])
+def test_ctrl_c_while_the_lock_is_taken_or_the_folder_cleaned_up_leaves_no_lock(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, when: str
+) -> None:
+    """A Ctrl-C that came while the lock file was being written, or while the command cleaned
+    up its staging folder after the run, left ``.mdf.lock`` behind (seen once at the end of a
+    run): the lock had not been handed back yet, or the clean-up stopped before releasing it.
+    Both steps now hold the signal, which interrupts the command once they are done."""
+    out = tmp_path / "o"
+    out.mkdir()
+    if when == "taking the lock":
+        real_write = outdir._write_holder
+
+        def interrupted_write(fd: int, command: str) -> int:
+            signal.raise_signal(signal.SIGINT)
+            return real_write(fd, command)
+
+        monkeypatch.setattr(outdir, "_write_holder", interrupted_write)
+    else:
+        real_rmtree = outdir.shutil.rmtree
+
+        def interrupted_rmtree(path: Any, **kw: Any) -> None:
+            signal.raise_signal(signal.SIGINT)
+            real_rmtree(path, **kw)
+
+        monkeypatch.setattr(outdir.shutil, "rmtree", interrupted_rmtree)
+    with pytest.raises(KeyboardInterrupt):
+        with outdir.output_folder(out, "run", ("*.json",)) as folder:
+            folder.stage()
+    assert sorted(p.name for p in out.iterdir()) == []

@@ -804,7 +804,8 @@ def output_folder(
     folder = None
     ok = False
     try:
-        lock = acquire_lock(out, f"mdf {command}")
+        with _signals_held():  # a Ctrl-C comes after the lock is taken and kept for release
+            lock = acquire_lock(out, f"mdf {command}")
         for partial in out.glob(f"{MARKER_TMP}*"):  # markers a killed command was writing
             partial.unlink(missing_ok=True)
         for marker in out.glob(f"{MARKER_PREFIX}*{MARKER_SUFFIX}"):  # swaps killed half done
@@ -818,15 +819,16 @@ def output_folder(
         yield folder
         ok = True
     finally:
-        if folder is not None:
-            for stage in folder._stages:
-                shutil.rmtree(stage, ignore_errors=True)
-            for fd in folder._stage_locks:
-                os.close(fd)
-        if not ok and created:
-            _remove_if_empty(out, missing)  # while still holding the lock
-        if lock is not None:
-            release_lock(out, lock)
+        with _signals_held():  # a Ctrl-C comes after the clean-up: the lock is always released
+            if folder is not None:
+                for stage in folder._stages:
+                    shutil.rmtree(stage, ignore_errors=True)
+                for fd in folder._stage_locks:
+                    os.close(fd)
+            if not ok and created:
+                _remove_if_empty(out, missing)  # while still holding the lock
+            if lock is not None:
+                release_lock(out, lock)
 
 
 def _empty_folder(path: Path) -> bool:
