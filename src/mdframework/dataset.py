@@ -47,7 +47,7 @@ import json
 import os
 import re
 import warnings
-from collections.abc import Callable, Generator, Iterator, Mapping, Sequence
+from collections.abc import Callable, Generator, Iterable, Iterator, Mapping, Sequence
 from concurrent.futures import as_completed
 from contextlib import AbstractContextManager, closing, contextmanager, nullcontext
 from dataclasses import dataclass, replace
@@ -2268,6 +2268,17 @@ def _verified_index(root: Path) -> str:
     return text
 
 
+def record_arrays(root: Path, ids: Iterable[str]) -> Iterator[dict[str, NDArray[Any]]]:
+    """The arrays of the records ``ids`` (``Dataset.table["id"]``) of the built dataset at
+    ``root``, one record at a time, in order (:func:`read_record`'s arrays), so that a caller
+    that reduces each record (e.g. to its histogram vector) never holds them all. An id that is
+    not a plain file name, or a record file missing or damaged, is a :class:`DataFileError`."""
+    for line, rid in enumerate(ids, start=2):
+        if safe_name(str(rid)) != rid:  # a record id names a file inside records/ only
+            raise DataFileError(root / INDEX, f"record id {str(rid)!r} is not a plain name", line)
+        yield _load_record(root / RECORDS / f"{rid}.npz")
+
+
 def load_dataset(
     path: str | Path, *, spectrograms: bool = True, histograms: bool = False
 ) -> Dataset:
@@ -2305,11 +2316,9 @@ def load_dataset(
     hists: list[NDArray[np.float32] | None] | None = [] if histograms else None
     if spectrograms or histograms:
         maps = []
-        for line, rid in enumerate(table["id"], start=2):
-            if safe_name(str(rid)) != rid:  # a record id names a file inside records/ only
-                raise DataFileError(index, f"record id {str(rid)!r} is not a plain name", line)
-            arrays = _load_record(root / RECORDS / f"{rid}.npz")
-            maps.append(arrays["spectrogram_db"])
+        for arrays in record_arrays(root, table["id"]):
+            if spectrograms:  # (else not kept: histogram records' dB maps are as large)
+                maps.append(arrays["spectrogram_db"])
             velocity = arrays["velocity_mps"] if velocity is None else velocity
             if hists is not None:
                 hists.append(arrays.get("histograms"))
