@@ -581,3 +581,18 @@ def test_histogram_input_names_the_first_record_without_histograms(tmp_path: Pat
     _histogram_dataset(tmp_path / "ds", 30, without=12)
     with pytest.raises(MdfError, match=r"record r012 has no histograms"):
         exp.classifier_inputs(_histogram_config(tmp_path / "ds"), tmp_path / "ds")
+
+
+def test_histogram_input_names_a_missing_or_damaged_record_file(tmp_path: Path) -> None:
+    from mdframework import experiment as exp
+    from mdframework.errors import DataFileError
+
+    _histogram_dataset(tmp_path / "ds", 30)
+    cfg = _histogram_config(tmp_path / "ds")
+    damaged = tmp_path / "ds" / RECORDS / "r007.npz"
+    damaged.write_bytes(damaged.read_bytes()[:-100])  # cut short: its zip directory is gone
+    with pytest.raises(DataFileError, match=r"r007\.npz.*not a complete record file"):
+        exp.classifier_inputs(cfg, tmp_path / "ds")
+    (tmp_path / "ds" / RECORDS / "r003.npz").unlink()
+    with pytest.raises(DataFileError, match=r"r003\.npz.*missing"):
+        exp.classifier_inputs(cfg, tmp_path / "ds")

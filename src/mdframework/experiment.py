@@ -880,7 +880,8 @@ def classifier_inputs(
     missing: list[str] = []  # each record reduced to its vector, never all histograms at once
     widths: set[int] = set()
     vectors, velocity = [], None
-    for rid, arrays in zip(ids, record_arrays(Path(data_dir), ids), strict=True):
+    read = record_arrays(Path(data_dir), ids, ("velocity_mps", "histograms"))
+    for rid, arrays in zip(ids, read, strict=True):
         h = arrays.get("histograms")
         velocity = arrays["velocity_mps"] if velocity is None else velocity
         if h is None:
