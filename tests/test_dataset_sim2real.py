@@ -6,6 +6,7 @@ import json
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -507,3 +508,91 @@ prf = 2400.0
     cfg, base = load_dataset_config(cfg_path)
     with pytest.raises(ConfigError, match=r"sources\[0\] \(kind = 'lfm'\) gives no point clouds"):
         plan_records(cfg, base)
+
+
+def _histogram_dataset(folder: Path, n: int, without: int | None = None) -> list[Any]:
+    """A built dataset of ``n`` histogram records (60 frames of 17 bins) written directly in
+    the dataset format; record ``without`` has no histograms. Returns the histograms."""
+    import csv
+    import hashlib
+    import io
+
+    rng = np.random.default_rng(3)
+    (folder / RECORDS).mkdir(parents=True)
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(["id", "label", "group", "recording", *FEATURE_NAMES])
+    hists = []
+    for i in range(n):
+        h = rng.integers(0, 5, (60, 17)).astype(np.float32)
+        hists.append(h)
+        arrays = {"histograms": h} if i != without else {}
+        np.savez(
+            folder / RECORDS / f"r{i:03d}.npz",
+            spectrogram_db=h.T.copy(),
+            velocity_mps=np.linspace(-2.0, 2.0, 17),
+            time_s=np.arange(60) / 30.0,
+            features=np.zeros(7),
+            meta=np.array("{}"),
+            **arrays,
+        )
+        writer.writerow([f"r{i:03d}", "ab"[i % 2], "g", f"rec{i // 10}", *[0.0] * 7])
+    index = buf.getvalue()
+    (folder / "index.csv").write_text(index)
+    digest = hashlib.sha256(index.encode()).hexdigest()
+    (folder / "dataset.json").write_text(json.dumps({"index_sha256": digest}))
+    return hists
+
+
+def _histogram_config(folder: Path) -> Any:
+    from mdframework import experiment as exp
+
+    return exp.ExperimentConfig.model_validate(
+        {"input": "histogram", "dataset": {"path": str(folder)}, "selection": {"method": "none"}}
+    )
+
+
+def test_histogram_input_holds_one_record_at_a_time(tmp_path: Path) -> None:
+    """``input = "histogram"`` reduces each record to its histogram vector as it reads it: the
+    experiment's input is every record's vector, in index order, while the memory it takes
+    stays below the size of all histograms together (before, every record's histograms and its
+    dB map were held at once, twice that)."""
+    import tracemalloc
+
+    from mdframework import experiment as exp
+    from mdframework.pointcloud import histogram_vector
+
+    hists = _histogram_dataset(tmp_path / "ds", 300)
+    tracemalloc.start()
+    try:
+        _, x, names = exp.classifier_inputs(_histogram_config(tmp_path / "ds"), tmp_path / "ds")
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    want = np.stack([histogram_vector(h.astype(np.float64)) for h in hists])
+    np.testing.assert_array_equal(x, want)
+    assert len(names) == 2 * 17
+    assert peak < 300 * 60 * 17 * 4  # all histograms: 1.2 MB
+
+
+def test_histogram_input_names_the_first_record_without_histograms(tmp_path: Path) -> None:
+    from mdframework import experiment as exp
+
+    _histogram_dataset(tmp_path / "ds", 30, without=12)
+    with pytest.raises(MdfError, match=r"record r012 has no histograms"):
+        exp.classifier_inputs(_histogram_config(tmp_path / "ds"), tmp_path / "ds")
+
+
+def test_histogram_input_names_a_missing_or_damaged_record_file(tmp_path: Path) -> None:
+    from mdframework import experiment as exp
+    from mdframework.errors import DataFileError
+
+    _histogram_dataset(tmp_path / "ds", 30)
+    cfg = _histogram_config(tmp_path / "ds")
+    damaged = tmp_path / "ds" / RECORDS / "r007.npz"
+    damaged.write_bytes(damaged.read_bytes()[:-100])  # cut short: its zip directory is gone
+    with pytest.raises(DataFileError, match=r"r007\.npz.*not a complete record file"):
+        exp.classifier_inputs(cfg, tmp_path / "ds")
+    (tmp_path / "ds" / RECORDS / "r003.npz").unlink()
+    with pytest.raises(DataFileError, match=r"r003\.npz.*missing"):
+        exp.classifier_inputs(cfg, tmp_path / "ds")

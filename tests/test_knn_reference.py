@@ -125,3 +125,60 @@ def test_lowest_rule_equals_scikit_learn_except_at_distance_ties(
             n_same += int(np.sum(~at_cut))
             n_differ += int(np.sum(got[at_cut] != want[at_cut]))
     assert n_same > 5000 and n_differ > 0  # the rule differs where it is documented to
+
+
+def test_nearest_columns_equal_a_whole_stable_sort() -> None:
+    """The partial ranking gives the first k columns of a stable sort of every row, whatever
+    the ties (at the cut, below it, whole rows equal), NaN and infinite values."""
+    from mdf_knn.knn import nearest_columns
+
+    rng = np.random.default_rng(7)
+    n_cut_ties = 0
+    for trial in range(2000):
+        n_rows, n_cols = int(rng.integers(1, 30)), int(rng.integers(1, 50))
+        k = int(rng.integers(1, n_cols + 1))
+        d = np.round(rng.random((n_rows, n_cols)) * rng.integers(1, 6))  # few distinct values
+        if trial % 3 == 0:
+            d = rng.random((n_rows, n_cols))
+        if trial % 7 == 0:
+            d[rng.random(d.shape) < 0.2] = np.nan
+        if trial % 11 == 0:
+            d[rng.random(d.shape) < 0.2] = np.inf
+        if trial % 13 == 0:
+            d[:] = 1.0
+        want = np.argsort(d, axis=1, kind="stable")[:, :k]
+        np.testing.assert_array_equal(nearest_columns(d, k), want)
+        if k < n_cols:
+            ordered = np.sort(d, axis=1)
+            n_cut_ties += int(np.sum(ordered[:, k - 1] == ordered[:, k]))
+    assert n_cut_ties > 1000
+
+
+@pytest.mark.parametrize("metric", ["euclidean", "manhattan"])
+@pytest.mark.parametrize("k", [1, 5, 8])
+def test_neighbours_in_blocks_equal_one_whole_sort(
+    cmu: tuple[NDArray[np.float64], NDArray[np.str_]],
+    k: int,
+    metric: str,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Neighbours found block by block of queries (a block of a few queries here) are those of
+    one stable sort of the whole (queries, training records) distance matrix, distances and
+    indices, on the CMU features' single features and pairs, where ties at the cut abound."""
+    import mdf_knn.knn
+
+    x, y = cmu
+    train, test = np.arange(0, len(y), 3), np.setdiff1d(np.arange(len(y)), np.arange(0, len(y), 3))
+    n_cut_ties = 0
+    for cols in [*itertools.combinations(range(7), 1), *itertools.combinations(range(3), 2)]:
+        xt, xs = x[train][:, list(cols)], x[test][:, list(cols)]
+        model = Knn(Knn.Config(k=k, metric=metric)).fit(xt, y[train])  # type: ignore[arg-type]
+        whole = model._distances(model.scaler_.transform(xs))  # (n_test, n_train)
+        order = np.argsort(whole, axis=1, kind="stable")
+        monkeypatch.setattr(mdf_knn.knn, "_BLOCK_ELEMENTS", 7 * len(train) * len(cols))
+        dist, idx = model.neighbours(xs)
+        np.testing.assert_array_equal(idx, order[:, :k])
+        np.testing.assert_array_equal(dist, np.take_along_axis(whole, order[:, :k], 1))
+        ranked = np.take_along_axis(whole, order[:, : k + 1], 1)
+        n_cut_ties += int(np.sum(ranked[:, k - 1] == ranked[:, k]))
+    assert n_cut_ties > 50

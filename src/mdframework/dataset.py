@@ -47,7 +47,7 @@ import json
 import os
 import re
 import warnings
-from collections.abc import Callable, Generator, Iterator, Mapping, Sequence
+from collections.abc import Callable, Generator, Iterable, Iterator, Mapping, Sequence
 from concurrent.futures import as_completed
 from contextlib import AbstractContextManager, closing, contextmanager, nullcontext
 from dataclasses import dataclass, replace
@@ -1542,6 +1542,18 @@ def read_record(path: Path) -> tuple[dict[str, NDArray[Any]], dict[str, Any]]:
     compressed member (a few megabytes of a crafted file could expand into gigabytes) is a
     corrupt record (``ValueError``), refused before anything is read from it, and so is a
     file that is not a regular one (a pipe, a device)."""
+    with _record_file(path) as data:
+        arrays = {k: data[k] for k in ("spectrogram_db", "velocity_mps", "time_s", "features")}
+        if "histograms" in data.files:
+            arrays["histograms"] = data["histograms"]
+        meta = json.loads(str(data["meta"]))
+    return arrays, meta
+
+
+@contextmanager
+def _record_file(path: Path) -> Iterator[Any]:
+    """A record file opened (``np.load``) once it is known to be a regular file with no
+    compressed member (see :func:`read_record`)."""
     import stat
     import zipfile
 
@@ -1551,11 +1563,7 @@ def read_record(path: Path) -> tuple[dict[str, NDArray[Any]], dict[str, Any]]:
         packed = [i.filename for i in data.zip.infolist() if i.compress_type != zipfile.ZIP_STORED]
         if packed:
             raise ValueError(f"{path}: {packed[0]} is compressed")
-        arrays = {k: data[k] for k in ("spectrogram_db", "velocity_mps", "time_s", "features")}
-        if "histograms" in data.files:
-            arrays["histograms"] = data["histograms"]
-        meta = json.loads(str(data["meta"]))
-    return arrays, meta
+        yield data
 
 
 def _planned_meta(spec: RecordSpec) -> dict[str, Any]:
@@ -2206,13 +2214,17 @@ class Dataset:
     histograms: list[NDArray[np.float32] | None] | None = None
 
 
-def _load_record(path: Path) -> dict[str, NDArray[Any]]:
-    """The arrays of one record of a built dataset; a record file that is missing or damaged
-    (deleted or changed since the build) is a :class:`DataFileError` naming it."""
+def _load_record(path: Path, names: Sequence[str] | None = None) -> dict[str, NDArray[Any]]:
+    """The arrays of one record of a built dataset (those ``names``, else all); a record file
+    that is missing or damaged (deleted or changed since the build) is a
+    :class:`DataFileError` naming it. ``histograms`` is left out where the record has none."""
     import zipfile
 
     try:
-        return read_record(path)[0]
+        if names is None:
+            return read_record(path)[0]
+        with _record_file(path) as data:  # the others are not read at all
+            return {k: data[k] for k in names if k != "histograms" or k in data.files}
     except FileNotFoundError:
         problem = "missing"
     except PermissionError as exc:
@@ -2273,6 +2285,21 @@ def _verified_index(root: Path) -> str:
     return text
 
 
+def record_arrays(
+    root: Path, ids: Iterable[str], names: Sequence[str] | None = None
+) -> Iterator[dict[str, NDArray[Any]]]:
+    """The arrays of the records ``ids`` (``Dataset.table["id"]``) of the built dataset at
+    ``root``, one record at a time, in order, so that a caller that reduces each record (e.g.
+    to its histogram vector) never holds them all: :func:`read_record`'s arrays, or only those
+    ``names`` (the others not read; ``histograms`` left out of a record without them). An id
+    that is not a plain file name, or a record file missing or damaged, is a
+    :class:`DataFileError`."""
+    for line, rid in enumerate(ids, start=2):
+        if safe_name(str(rid)) != rid:  # a record id names a file inside records/ only
+            raise DataFileError(root / INDEX, f"record id {str(rid)!r} is not a plain name", line)
+        yield _load_record(root / RECORDS / f"{rid}.npz", names)
+
+
 def load_dataset(
     path: str | Path, *, spectrograms: bool = True, histograms: bool = False
 ) -> Dataset:
@@ -2310,11 +2337,9 @@ def load_dataset(
     hists: list[NDArray[np.float32] | None] | None = [] if histograms else None
     if spectrograms or histograms:
         maps = []
-        for line, rid in enumerate(table["id"], start=2):
-            if safe_name(str(rid)) != rid:  # a record id names a file inside records/ only
-                raise DataFileError(index, f"record id {str(rid)!r} is not a plain name", line)
-            arrays = _load_record(root / RECORDS / f"{rid}.npz")
-            maps.append(arrays["spectrogram_db"])
+        for arrays in record_arrays(root, table["id"]):
+            if spectrograms:  # (else not kept: histogram records' dB maps are as large)
+                maps.append(arrays["spectrogram_db"])
             velocity = arrays["velocity_mps"] if velocity is None else velocity
             if hists is not None:
                 hists.append(arrays.get("histograms"))

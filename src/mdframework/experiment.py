@@ -52,7 +52,14 @@ from .classify import (
     wrapper_select,
 )
 from .config import blaming_overrides, format_validation_error, read_config_file
-from .dataset import INDEX, Dataset, build_dataset, load_dataset, load_dataset_config
+from .dataset import (
+    INDEX,
+    Dataset,
+    build_dataset,
+    load_dataset,
+    load_dataset_config,
+    record_arrays,
+)
 from .errors import ConfigError, DataFileError, MdfError
 from .features import FEATURE_NAMES
 from .interfaces import Classifier
@@ -864,21 +871,31 @@ def classifier_inputs(
                 row + 2,
             )
         return data, data.features, list(FEATURE_NAMES)
-    data = load_dataset(data_dir, spectrograms=False, histograms=True)
-    hists = data.histograms or []
-    missing = [str(data.table["id"][i]) for i, h in enumerate(hists) if h is None]
+    data = load_dataset(data_dir, spectrograms=False)  # the index; the records one by one:
+    ids = data.table["id"]
+    missing: list[str] = []  # each record reduced to its vector, never all histograms at once
+    widths: set[int] = set()
+    vectors, velocity = [], None
+    read = record_arrays(Path(data_dir), ids, ("velocity_mps", "histograms"))
+    for rid, arrays in zip(ids, read, strict=True):
+        h = arrays.get("histograms")
+        velocity = arrays["velocity_mps"] if velocity is None else velocity
+        if h is None:
+            missing.append(str(rid))
+        elif not missing:
+            widths.add(h.shape[1])
+            vectors.append(histogram_vector(h.astype(np.float64)))
     if missing:
         raise MdfError(
             f"input = 'histogram': record {missing[0]} has no histograms (build simulated "
             "records with representation = 'histogram')"
         )
-    widths = {h.shape[1] for h in hists if h is not None}
     if len(widths) != 1:
         raise MdfError(f"input = 'histogram': records have different bin counts {widths}")
-    x = np.stack([histogram_vector(h.astype(np.float64)) for h in hists if h is not None])
-    assert data.velocity is not None
+    x = np.stack(vectors)
+    assert velocity is not None
     n_bins = widths.pop()
-    width = float(data.velocity[1] - data.velocity[0]) if n_bins > 1 else 1.0
+    width = float(velocity[1] - velocity[0]) if n_bins > 1 else 1.0
     centres, _ = velocity_bins(width, n_bins)
     return data, x, list(histogram_vector_names(centres))
 
