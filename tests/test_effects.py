@@ -772,6 +772,32 @@ def test_attenuation_grows_with_range_as_specified() -> None:
     assert att.metadata["effects"][0]["specific_attenuation_db_per_km"] == pytest.approx(gamma)
 
 
+def test_attenuation_takes_each_added_path_over_its_own_length() -> None:
+    """After multipath, the double-bounce image loses ``2 gamma R_b`` (its own round trip), and
+    a static reflector its own range's loss; listed before them, either would keep the direct
+    path's loss (or none): that order is refused."""
+    from mdframework import SceneError
+
+    gamma = 100.0  # dB/km one way
+    att = {"kind": "attenuation", "gas_db_per_km": gamma}
+    image = {"kind": "multipath", "reflection_magnitude": 1.0, "reflection_phase_deg": 0.0}
+    room = {"kind": "static_scene", "reflectors": [{"position": [0.0, 20.0, 1.0], "rcs_m2": 1.0}]}
+    target = [{"position": [10.0, 0.0, 1.5], "velocity": [0.0, 0.0, 0.0], "rcs": 1.0}]
+    radar_at = (0.0, 0.0, 1.0)
+    res = run(target, [{**image, "paths": "image"}, room, att], radar_position=radar_at)
+    r_b = float(np.hypot(10.0, 2.5))  # radar (z = 1) to the image (z = -1.5)
+    assert res.scatterers.names[1:] == ("target0~image", "static0")
+    assert res.scatterers.rcs[0, 1] == pytest.approx(10 ** (-2 * gamma * r_b / 1e4), rel=1e-9)
+    assert res.scatterers.rcs[0, 2] == pytest.approx(10 ** (-2 * gamma * 20.0 / 1e4), rel=1e-9)
+    for first in (image, room):
+        with pytest.raises(
+            SceneError,
+            match=rf"^effects: attenuation \(effects\[0\]\) is listed before {first['kind']} "
+            rf"\(effects\[1\]\), .*: list attenuation after {first['kind']}$",
+        ):
+            run(target, [att, first], radar_position=radar_at)
+
+
 def test_attenuation_rain_needs_coefficients() -> None:
     with pytest.raises(Exception, match="rain_k"):
         run(APPROACHING, [{"kind": "attenuation", "rain_rate_mm_per_h": 5.0}])

@@ -835,6 +835,21 @@ class Effect(Plugin):
         :class:`~mdframework.errors.SceneError` (naming the ``effects`` list) when this effect
         cannot work with the others in that order. Default: nothing."""
 
+    def refuse_listed_after(self, effects: Sequence[Effect], why: Mapping[str, str]) -> None:
+        """For :meth:`check_effects`: a :class:`~mdframework.errors.SceneError` naming both
+        places in the ``effects`` list when an effect whose name is a key of ``why`` is listed
+        after this one (``why[name]``: what would go wrong, e.g. the scatterers that ``multipath``
+        adds would miss this effect)."""
+        from .errors import SceneError
+
+        mine = next(i for i, e in enumerate(effects) if e is self)
+        for i, e in enumerate(effects[mine + 1 :], mine + 1):
+            if e.name in why:
+                raise SceneError(
+                    f"effects: {self.name} (effects[{mine}]) is listed before {e.name} "
+                    f"(effects[{i}]), so {why[e.name]}: list {self.name} after {e.name}"
+                )
+
     @abstractmethod
     def apply(self, data: Any, context: SceneContext) -> Any:
         """Return the modified ``Scatterers`` (of one block) or ``Received`` (of the record)."""

@@ -42,10 +42,10 @@ bistatic single bounce at ``(R_d + R_b)/2 - |u_d + u_b|/2 h((u_d + u_b)/|u_d + u
 stationary point of the path length over the surface), and the spreading corrections take these
 path lengths. The virtual scatterers' ``centres`` are where they would sit without the shift.
 
-Put ``multipath`` after ``shadowing`` and ``antenna`` in the effects list when combining them:
-images are then made from the shadowed RCS and the antenna weights the direct path. (Placed
-after ``multipath``, the antenna weights each virtual scatterer by its own direction, an
-approximation of ``G(theta_d) G(theta_b)`` for the bounce path.)
+Put ``multipath`` after ``shadowing`` (the bounced paths are then made from the shadowed RCS)
+and before ``antenna`` and ``attenuation`` (which refuse the other order): the antenna then
+weighs the image by ``g(u_b)^2`` and the single bounce by ``g(u_d) g(u_b)``, and the attenuation
+takes each path over its own length (``2 R_b``, ``R_d + R_b``).
 """
 
 from __future__ import annotations
