@@ -335,6 +335,37 @@ def test_clutter_rcs_mode_follows_the_range_equation() -> None:
     assert np.mean(np.abs(out) ** 2) == pytest.approx(a2, rel=0.15)
 
 
+@pytest.mark.parametrize("kind", ["lfm", "cw"])
+def test_clutter_patches_lose_what_their_range_loses_through_the_attenuation(kind: str) -> None:
+    """Ground clutter goes through the same rain as the target: with ``attenuation`` in the
+    scene (listed anywhere) a patch at range ``r`` carries ``-2 gamma r`` dB more (one patch
+    here, the gate fixed at 20 m, no margin), and the summed power follows it (the same draws)."""
+    gamma = 100.0  # dB/km one way
+    patch = {
+        "kind": "clutter",
+        "power": "rcs",
+        "rcs_m2": 1.0,
+        "wind_fraction": 0.3,
+        "patch_spacing_m": 0.5,
+        "margin_m": 0.0,
+        "range_resolution": 1.0,
+    }
+    target = [{"position": [20.0, 0.0, 0.0], "velocity": [-1.0, 0.0, 0.0], "rcs": 1e-6}]
+    radar_cfg = {"kind": kind}
+    plain = run(target, [patch], radar_cfg=radar_cfg, gate=20.0, duration=0.2)
+    for effects in ([patch, {"kind": "attenuation", "gas_db_per_km": gamma}],
+                    [{"kind": "attenuation", "gas_db_per_km": gamma}, patch]):  # fmt: skip
+        res = run(target, effects, radar_cfg=radar_cfg, gate=20.0, duration=0.2)
+        clutter = next(e for e in res.metadata["effects"] if e["kind"] == "clutter")
+        before = plain.metadata["effects"][0]
+        r_lo, r_hi = clutter["patch_range_m"]
+        assert clutter["n_patches"] == 1 and r_lo == r_hi == before["patch_range_m"][0]
+        loss = 10 ** (-2 * gamma * r_lo / 1e4)
+        assert clutter["clutter_power_w"] == pytest.approx(
+            before["clutter_power_w"] * loss, rel=1e-9, abs=0
+        )
+
+
 def test_clutter_csr_in_pipeline_and_zero_velocity_bin() -> None:
     clean = run(APPROACHING, [])
     res = run(APPROACHING, [{"kind": "clutter", "csr_db": 10.0, "wind_fraction": 0.0}])
