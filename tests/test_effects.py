@@ -366,6 +366,20 @@ def test_clutter_patches_lose_what_their_range_loses_through_the_attenuation(kin
         )
 
 
+@pytest.mark.parametrize("noise_first", [True, False])
+def test_snr_and_csr_are_both_relative_to_the_echo_in_either_order(noise_first: bool) -> None:
+    """``snr_db`` and ``csr_db`` are set against the echo as the radar gave it: the noise's
+    level does not count the clutter, nor the clutter's the noise, whichever comes first (it
+    was the signal as each effect got it: 0.4 dB off at 10 dB each)."""
+    echo = float(np.mean(np.abs(run(APPROACHING, []).received.signal) ** 2))
+    noise = {"kind": "noise", "snr_db": 10.0}
+    clutter = {"kind": "clutter", "csr_db": 10.0, "wind_fraction": 0.3}
+    res = run(APPROACHING, [noise, clutter] if noise_first else [clutter, noise])
+    got = {e["kind"]: e for e in res.metadata["effects"]}
+    assert got["noise"]["noise_power_w"] == pytest.approx(echo / 10.0, rel=1e-12, abs=0)
+    assert got["clutter"]["clutter_power_w"] == pytest.approx(echo * 10.0, rel=1e-12, abs=0)
+
+
 def test_clutter_csr_in_pipeline_and_zero_velocity_bin() -> None:
     clean = run(APPROACHING, [])
     res = run(APPROACHING, [{"kind": "clutter", "csr_db": 10.0, "wind_fraction": 0.0}])

@@ -781,7 +781,13 @@ class SceneContext:
     effects of its stage listed after it: :func:`mdframework.pipeline.effect_generators`;
     received-stage effects only: a scatterer-stage effect must not draw random numbers, so that
     it is block-invariant); ``block_start``: index of the block's first
-    pulse in the record (0 for received-stage effects).
+    pulse in the record (0 for received-stage effects); ``echo`` (n_pulses,) complex [sqrt(W)]:
+    received-stage effects only, the record's slow-time signal as the radar gave it, before any
+    received-stage effect (the target's echo, with the paths the scatterer-stage effects added,
+    and the noise and clutter of a radar that puts them in its raw samples): the reference of a
+    level set relative to the signal (the noise's ``snr_db``, the clutter's ``csr_db``), so that
+    it does not depend on the order of the received-stage effects (``None``: take the data as it
+    comes).
     """
 
     radar_position: FloatArray
@@ -793,6 +799,7 @@ class SceneContext:
     waveform: RadarWaveform
     rng: np.random.Generator
     block_start: int = 0
+    echo: ComplexArray | None = None
 
 
 class Effect(Plugin):

@@ -31,8 +31,10 @@ Power: the summed clutter ``c(n)`` is scaled so that its mean power over the rec
 
 - ``power = "csr"``: the clutter-to-signal ratio ``csr_db`` = ``P_c`` over the mean power of the
   compressed return at the gate (the same reference as the ``noise`` effect's SNR), the
-  received signal as it comes: with a radar that adds receiver noise itself (the FMCW
-  radar's ``receiver_noise``) that noise is part of it;
+  received signal as the radar gave it (``SceneContext.echo``: before any received-stage
+  effect, so the ``noise`` effect, listed before or after this one, does not count; with a
+  radar that adds receiver noise itself, the FMCW radar's ``receiver_noise``, that noise is
+  part of it);
 - ``power = "rcs"``: ``rcs_m2``, the clutter RCS of one range-resolution cell (``sigma_0`` times
   the illuminated ground area of the cell); each patch carries ``rcs_m2 x spacing/resolution``
   and ``P_c = sum_k sigma_k mean_n |g_k(n)|^2`` through the waveform's range equation.
@@ -403,8 +405,9 @@ class GroundClutter(Effect):
                 stationary += alpha[lo + k] * resp[k]
                 wind += resp[k] * u[k]
             del resp, u
-        if c.power == "csr":
-            p_sig = float(np.mean(np.abs(data.signal) ** 2))
+        if c.power == "csr":  # relative to the echo, whatever the order of the effects
+            echo = context.echo if context.echo is not None else data.signal
+            p_sig = float(np.mean(np.abs(echo) ** 2))
             p_c = p_sig * 10.0 ** (c.csr_db / 10.0)
         else:
             p_c = float(sigma_k * np.sum(patch_power))
