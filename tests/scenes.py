@@ -235,10 +235,8 @@ def effect_sections(draw: st.DrawFn) -> list[dict[str, Any]]:
     order = draw(st.permutations(list(range(len(out)))))
     effects = [out[i] for i in order]
     kinds = [e["kind"] for e in effects]
-    if {"antenna", "multipath"} <= set(kinds):  # antenna after multipath, else refused
-        i, j = kinds.index("multipath"), kinds.index("antenna")
-        if j < i:
-            effects[i], effects[j] = effects[j], effects[i]
+    if "multipath" in kinds:  # antenna and attenuation after multipath, else refused
+        effects.insert(0, effects.pop(kinds.index("multipath")))
     return effects
 
 

@@ -335,6 +335,51 @@ def test_clutter_rcs_mode_follows_the_range_equation() -> None:
     assert np.mean(np.abs(out) ** 2) == pytest.approx(a2, rel=0.15)
 
 
+@pytest.mark.parametrize("kind", ["lfm", "cw"])
+def test_clutter_patches_lose_what_their_range_loses_through_the_attenuation(kind: str) -> None:
+    """Ground clutter goes through the same rain as the target: with ``attenuation`` in the
+    scene (listed anywhere) a patch at range ``r`` carries ``-2 gamma r`` dB more (one patch
+    here, the gate fixed at 20 m, no margin), and the summed power follows it (the same draws)."""
+    gamma = 100.0  # dB/km one way
+    patch = {
+        "kind": "clutter",
+        "power": "rcs",
+        "rcs_m2": 1.0,
+        "wind_fraction": 0.3,
+        "patch_spacing_m": 0.5,
+        "margin_m": 0.0,
+        "range_resolution": 1.0,
+    }
+    target = [{"position": [20.0, 0.0, 0.0], "velocity": [-1.0, 0.0, 0.0], "rcs": 1e-6}]
+    radar_cfg = {"kind": kind}
+    plain = run(target, [patch], radar_cfg=radar_cfg, gate=20.0, duration=0.2)
+    for effects in ([patch, {"kind": "attenuation", "gas_db_per_km": gamma}],
+                    [{"kind": "attenuation", "gas_db_per_km": gamma}, patch]):  # fmt: skip
+        res = run(target, effects, radar_cfg=radar_cfg, gate=20.0, duration=0.2)
+        clutter = next(e for e in res.metadata["effects"] if e["kind"] == "clutter")
+        before = plain.metadata["effects"][0]
+        r_lo, r_hi = clutter["patch_range_m"]
+        assert clutter["n_patches"] == 1 and r_lo == r_hi == before["patch_range_m"][0]
+        loss = 10 ** (-2 * gamma * r_lo / 1e4)
+        assert clutter["clutter_power_w"] == pytest.approx(
+            before["clutter_power_w"] * loss, rel=1e-9, abs=0
+        )
+
+
+@pytest.mark.parametrize("noise_first", [True, False])
+def test_snr_and_csr_are_both_relative_to_the_echo_in_either_order(noise_first: bool) -> None:
+    """``snr_db`` and ``csr_db`` are set against the echo as the radar gave it: the noise's
+    level does not count the clutter, nor the clutter's the noise, whichever comes first (it
+    was the signal as each effect got it: 0.4 dB off at 10 dB each)."""
+    echo = float(np.mean(np.abs(run(APPROACHING, []).received.signal) ** 2))
+    noise = {"kind": "noise", "snr_db": 10.0}
+    clutter = {"kind": "clutter", "csr_db": 10.0, "wind_fraction": 0.3}
+    res = run(APPROACHING, [noise, clutter] if noise_first else [clutter, noise])
+    got = {e["kind"]: e for e in res.metadata["effects"]}
+    assert got["noise"]["noise_power_w"] == pytest.approx(echo / 10.0, rel=1e-12, abs=0)
+    assert got["clutter"]["clutter_power_w"] == pytest.approx(echo * 10.0, rel=1e-12, abs=0)
+
+
 def test_clutter_csr_in_pipeline_and_zero_velocity_bin() -> None:
     clean = run(APPROACHING, [])
     res = run(APPROACHING, [{"kind": "clutter", "csr_db": 10.0, "wind_fraction": 0.0}])
@@ -770,6 +815,32 @@ def test_attenuation_grows_with_range_as_specified() -> None:
     slope = np.polyfit(rng, loss_db, 1)[0] * 1000
     assert slope == pytest.approx(-2 * gamma, rel=1e-9)
     assert att.metadata["effects"][0]["specific_attenuation_db_per_km"] == pytest.approx(gamma)
+
+
+def test_attenuation_takes_each_added_path_over_its_own_length() -> None:
+    """After multipath, the double-bounce image loses ``2 gamma R_b`` (its own round trip), and
+    a static reflector its own range's loss; listed before them, either would keep the direct
+    path's loss (or none): that order is refused."""
+    from mdframework import SceneError
+
+    gamma = 100.0  # dB/km one way
+    att = {"kind": "attenuation", "gas_db_per_km": gamma}
+    image = {"kind": "multipath", "reflection_magnitude": 1.0, "reflection_phase_deg": 0.0}
+    room = {"kind": "static_scene", "reflectors": [{"position": [0.0, 20.0, 1.0], "rcs_m2": 1.0}]}
+    target = [{"position": [10.0, 0.0, 1.5], "velocity": [0.0, 0.0, 0.0], "rcs": 1.0}]
+    radar_at = (0.0, 0.0, 1.0)
+    res = run(target, [{**image, "paths": "image"}, room, att], radar_position=radar_at)
+    r_b = float(np.hypot(10.0, 2.5))  # radar (z = 1) to the image (z = -1.5)
+    assert res.scatterers.names[1:] == ("target0~image", "static0")
+    assert res.scatterers.rcs[0, 1] == pytest.approx(10 ** (-2 * gamma * r_b / 1e4), rel=1e-9)
+    assert res.scatterers.rcs[0, 2] == pytest.approx(10 ** (-2 * gamma * 20.0 / 1e4), rel=1e-9)
+    for first in (image, room):
+        with pytest.raises(
+            SceneError,
+            match=rf"^effects: attenuation \(effects\[0\]\) is listed before {first['kind']} "
+            rf"\(effects\[1\]\), .*: list attenuation after {first['kind']}$",
+        ):
+            run(target, [att, first], radar_position=radar_at)
 
 
 def test_attenuation_rain_needs_coefficients() -> None:

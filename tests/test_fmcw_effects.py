@@ -251,6 +251,22 @@ def test_the_clutter_patches_rcs_have_a_rayleigh_amplitude_of_unit_mean_power() 
     assert float(np.mean(got.static_rcs < 1.0)) == pytest.approx(1 - np.exp(-1), abs=0.03)
 
 
+def test_the_clutter_patches_in_the_if_samples_are_attenuated_as_the_target() -> None:
+    """With ``attenuation`` in the scene the static patches handed to the IF samples carry
+    the two-way loss of their own ranges, as the slow-time clutter of the other radars does:
+    the summed RCS of the patches (the same draws) drops by that factor, patch by patch."""
+    gamma = 300.0  # dB/km one way
+    att = {"kind": "attenuation", "gas_db_per_km": gamma}
+    plain = run(RADAR, [CLUTTER], length=0.05).metadata["effects"][0]
+    lossy = run(RADAR, [CLUTTER, att], length=0.05).metadata["effects"]
+    got = next(e for e in lossy if e["kind"] == "clutter")
+    assert got["n_patches"] == plain["n_patches"] == 1
+    r = got["patch_range_m"][0]
+    assert got["clutter_rcs_m2"] == pytest.approx(
+        plain["clutter_rcs_m2"] * 10 ** (-2 * gamma * r / 1e4), rel=1e-9
+    )
+
+
 def test_static_scatterers_beyond_the_maximum_range_are_left_out_unless_aliased() -> None:
     """A receiver input's static scatterer 1 m beyond the maximum range adds nothing to the
     range profiles (as a moving one there is refused), unless beyond_max_range = "alias",

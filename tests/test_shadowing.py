@@ -165,3 +165,43 @@ def test_works_with_the_ellipsoid_model(registry: Registry) -> None:
     eff = res.metadata["effects"][0]
     assert eff["occluders"] == "ellipsoids"
     assert max(eff["blocked_fraction"].values()) > 0.0
+
+
+def test_bounced_paths_keep_their_scatterers_visibility_and_multipath_first_is_refused() -> None:
+    """Shadowing before multipath: each bounced path (image, single bounce) is made from its
+    scatterer's shadowed RCS, so it is hidden exactly when the direct path is (the documented
+    approximation). Multipath before shadowing would cast rays to the virtual places and take
+    the copies for occluders (hiding the direct scatterers more often): refused."""
+    import mdf_multipath.plugin
+
+    reg = build_registry(
+        [mdf_mujoco.plugin, mdf_lfm.plugin, mdf_ellipsoid.plugin, mdf_multipath.plugin],
+        autoload=False,
+    )
+    shadow = {"kind": "shadowing", "attenuation_db": 20.0, "decimation": 8}
+    cfg = {
+        "motion": {"kind": "boulic", "rv": 1.0, "duration": 0.5},
+        "scatterers": {"kind": "ellipsoid", "placement": "joints17"},
+        "scene": {"radar_position": [10.0, 0.0, 2.0], "person": {"aspect_deg": 90.0}},
+        "processing": {"keep_scatterers": True, "window_length": 128},
+    }
+
+    def run_with(effects: list[dict[str, Any]]) -> RunResult:
+        return simulate(validate_run_config({**cfg, "effects": effects}, registry=reg), reg)
+
+    plain = run_with([{"kind": "multipath"}]).scatterers
+    hidden = run_with([shadow, {"kind": "multipath"}]).scatterers
+    assert plain is not None and hidden is not None and plain.names == hidden.names
+    assert np.all(hidden.rcs[plain.rcs == 0] == 0)  # no bounced paths of a part on the ground
+    ratio = hidden.rcs / np.where(plain.rcs > 0, plain.rcs, np.nan)
+    n = len(plain.names) // 3  # direct, ~image, ~bounce
+    ratio[:, n:] = np.where(np.isnan(ratio[:, n:]), np.tile(ratio[:, :n], 2), ratio[:, n:])
+    assert set(np.round(ratio[:, :n], 12).ravel()) == {0.01, 1.0}  # some hidden, some not
+    np.testing.assert_allclose(ratio[:, n : 2 * n], ratio[:, :n], rtol=1e-12)
+    np.testing.assert_allclose(ratio[:, 2 * n :], ratio[:, :n], rtol=1e-12)
+    with pytest.raises(
+        SceneError,
+        match=r"^effects: multipath \(effects\[0\]\) is listed before shadowing \(effects\[1\]\)"
+        r", so .*: list multipath after shadowing$",
+    ):
+        run_with([{"kind": "multipath"}, shadow])

@@ -97,3 +97,53 @@ def test_the_documented_config_is_valid() -> None:
     cfg = StaticSceneConfig.model_validate(section)
     pos, _ = room(cfg, np.array([10.0, 0.0, 1.0]))
     assert pos.shape == (21, 3)
+
+
+def test_a_reflector_takes_its_ground_bounces_gains_and_losses_over_its_own_paths() -> None:
+    """The documented order static_scene, multipath, antenna, attenuation: a reflector at ``p``
+    (radar at 1 m, ground at 0) and its bounced paths carry, in closed form, the gains of their
+    own directions (``g(u_d)^2``, ``g(u_b)^2``, ``g(u_d) g(u_b)``) and the losses of their own
+    lengths (``2 R_d``, ``2 R_b``, ``R_d + R_b``), with ``|Gamma|^4`` and ``4 |Gamma|^2`` and the
+    bounce's spreading ``R_m^4 / (R_d^2 R_b^2)``."""
+    from mdf_antenna import one_way_gain
+
+    radar_at, p = np.array([0.0, 0.0, 1.0]), np.array([6.0, 2.0, 0.5])
+    gamma_db, refl, bw = 200.0, 0.5, np.deg2rad(30.0)
+    effects = [
+        {"kind": "static_scene", "reflectors": [{"position": p.tolist(), "rcs_m2": 1.0}]},
+        {"kind": "multipath", "reflection_magnitude": refl, "reflection_phase_deg": 0.0},
+        {"kind": "antenna", "beamwidth_az_deg": 30.0, "pointing": "angles", "azimuth_deg": 0.0},
+        {"kind": "attenuation", "gas_db_per_km": gamma_db},
+    ]
+    target = [{"position": [10.0, 0.0, 1.5], "velocity": [-1.0, 0.0, 0.0], "rcs": 1.0}]
+    cfg = {
+        "motion": {"kind": "point_targets", "length": 0.2, "targets": target},
+        "scatterers": {"kind": "points"},
+        "radar": {"kind": "lfm"},
+        "scene": {"radar_position": radar_at.tolist()},
+        "processing": {"keep_scatterers": True},
+        "effects": effects,
+    }
+    scat = simulate(validate_run_config(cfg)).scatterers
+    assert scat is not None
+    image = p * np.array([1.0, 1.0, -1.0])
+    r_d, r_b = np.linalg.norm(p - radar_at), np.linalg.norm(image - radar_at)
+    r_m = (r_d + r_b) / 2
+
+    def g(d: np.ndarray) -> float:
+        boresight = np.array([1.0, 0.0, 0.0])
+        return float(
+            one_way_gain(d, boresight, pattern="gaussian", beamwidth_az=bw, beamwidth_el=bw)
+        )
+
+    def loss(path: float) -> float:  # two-way over a round trip of 2 path [m]
+        return float(10 ** (-2 * gamma_db * path / 1e4))
+
+    g_d, g_b = g(p - radar_at), g(image - radar_at)
+    expected = {
+        "static0": g_d**2 * loss(r_d),
+        "static0~image": refl**4 * g_b**2 * loss(r_b),
+        "static0~bounce": 4 * refl**2 * r_m**4 / (r_d * r_b) ** 2 * g_d * g_b * loss(r_m),
+    }
+    for name, rcs in expected.items():
+        assert scat.rcs[:, scat.names.index(name)] == pytest.approx(rcs, rel=1e-12, abs=0)

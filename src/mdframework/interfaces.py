@@ -781,7 +781,13 @@ class SceneContext:
     effects of its stage listed after it: :func:`mdframework.pipeline.effect_generators`;
     received-stage effects only: a scatterer-stage effect must not draw random numbers, so that
     it is block-invariant); ``block_start``: index of the block's first
-    pulse in the record (0 for received-stage effects).
+    pulse in the record (0 for received-stage effects); ``echo`` (n_pulses,) complex [sqrt(W)]:
+    received-stage effects only, the record's slow-time signal as the radar gave it, before any
+    received-stage effect (the target's echo, with the paths the scatterer-stage effects added,
+    and the noise and clutter of a radar that puts them in its raw samples): the reference of a
+    level set relative to the signal (the noise's ``snr_db``, the clutter's ``csr_db``), so that
+    it does not depend on the order of the received-stage effects (``None``: take the data as it
+    comes).
     """
 
     radar_position: FloatArray
@@ -793,6 +799,7 @@ class SceneContext:
     waveform: RadarWaveform
     rng: np.random.Generator
     block_start: int = 0
+    echo: ComplexArray | None = None
 
 
 class Effect(Plugin):
@@ -834,6 +841,21 @@ class Effect(Plugin):
         the scene lists, in the listed order (this one among them): raise
         :class:`~mdframework.errors.SceneError` (naming the ``effects`` list) when this effect
         cannot work with the others in that order. Default: nothing."""
+
+    def refuse_listed_after(self, effects: Sequence[Effect], why: Mapping[str, str]) -> None:
+        """For :meth:`check_effects`: a :class:`~mdframework.errors.SceneError` naming both
+        places in the ``effects`` list when an effect whose name is a key of ``why`` is listed
+        after this one (``why[name]``: what would go wrong, e.g. the scatterers that ``multipath``
+        adds would miss this effect)."""
+        from .errors import SceneError
+
+        mine = next(i for i, e in enumerate(effects) if e is self)
+        for i, e in enumerate(effects[mine + 1 :], mine + 1):
+            if e.name in why:
+                raise SceneError(
+                    f"effects: {self.name} (effects[{mine}]) is listed before {e.name} "
+                    f"(effects[{i}]), so {why[e.name]}: list {self.name} after {e.name}"
+                )
 
     @abstractmethod
     def apply(self, data: Any, context: SceneContext) -> Any:

@@ -539,7 +539,9 @@ def _simulate_motion(
     # the target's echo before the received-stage effects (with the noise and clutter of a
     # radar that puts them in its raw samples: its own receiver noise, those handed to it)
     echo = received.signal.copy()
-    context = SceneContext(radar_pos, wf.prf, wf.carrier_frequency, t, stream.gate, None, wf, rng)
+    context = SceneContext(
+        radar_pos, wf.prf, wf.carrier_frequency, t, stream.gate, None, wf, rng, echo=echo
+    )
     received = apply_effects(stages, "received", received, context, generators, handed)
     _check_empty(echo, losses, proc, fixed_gate=sc.gate != "track")
     effects_ran = _describe(stages, "scatterers") + _describe(stages, "received")

@@ -48,7 +48,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field, model_validator
 
-from mdframework import Effect, PluginConfig, Scatterers, SceneContext, SceneError, Skeleton
+from mdframework import Effect, PluginConfig, Scatterers, SceneContext, Skeleton
 from mdframework.settings import AngleDeg
 
 FloatArray = NDArray[np.float64]
@@ -199,13 +199,7 @@ class AntennaPattern(Effect):
         """Refuse an effect listed after this one that adds scatterers the pattern must weigh:
         ``multipath`` (its bounced paths would keep the direct path's gain, not the gain
         toward the ground) and ``static_scene`` (the room would be outside the pattern)."""
-        mine = next(i for i, e in enumerate(effects) if e is self)
-        for i, e in enumerate(effects[mine + 1 :], mine + 1):
-            if e.name in ADDS_SCATTERERS:
-                raise SceneError(
-                    f"effects: antenna (effects[{mine}]) is listed before {e.name} "
-                    f"(effects[{i}]), so {ADDS_SCATTERERS[e.name]}: list antenna after {e.name}"
-                )
+        self.refuse_listed_after(effects, ADDS_SCATTERERS)
 
     def boresight(self, context: SceneContext) -> FloatArray:
         """Boresight vector(s): (3,) or (n_pulses, 1, 3) when tracking."""

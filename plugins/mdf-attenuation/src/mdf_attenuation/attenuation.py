@@ -15,10 +15,16 @@ it differs by a negligible ``2 gamma dR``). The medium is taken as uniform along
 present over all of it (``path_fraction`` < 1 limits it to that fraction of the range, e.g. a
 rain cell). The waveform's constant ``atmospheric_loss_db`` is a separate, range-independent
 loss; use one or the other.
+
+Effects that add scatterers (``multipath``'s ground-bounce paths, ``static_scene``'s room) must
+be listed before this one, so that each of their paths loses what its own length loses (the image
+over its round trip ``2 R_b``, a reflector over its range): listed after it, a bounced path
+would keep the direct path's loss and a reflector none, so that order is refused.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any, Literal
 
 import numpy as np
@@ -85,6 +91,13 @@ def two_way_loss(
     return np.asarray(10.0 ** (-loss_db / 10.0), dtype=np.float64)
 
 
+#: effects that add scatterers, and what listing them after this one would do
+ADDS_SCATTERERS = {
+    "multipath": "the ground-bounce paths would lose the direct path's attenuation, not their own",
+    "static_scene": "the room's reflectors would not be attenuated",
+}
+
+
 class Attenuation(Effect):
     """Scales each scatterer's RCS by the two-way attenuation of its own range."""
 
@@ -97,6 +110,11 @@ class Attenuation(Effect):
         """One-way specific attenuation [dB/km]."""
         c = self.config
         return specific_attenuation(c.gas_db_per_km, c.rain_rate_mm_per_h, c.rain_k, c.rain_alpha)
+
+    def check_effects(self, effects: Sequence[Effect]) -> None:
+        """Refuse an effect listed after this one that adds scatterers (:data:`ADDS_SCATTERERS`):
+        they would not lose what their own path loses."""
+        self.refuse_listed_after(effects, ADDS_SCATTERERS)
 
     def apply(self, data: Scatterers, context: SceneContext) -> Scatterers:
         """Scatterers with RCS reduced by the two-way path loss."""

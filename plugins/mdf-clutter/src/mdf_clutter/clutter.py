@@ -31,11 +31,19 @@ Power: the summed clutter ``c(n)`` is scaled so that its mean power over the rec
 
 - ``power = "csr"``: the clutter-to-signal ratio ``csr_db`` = ``P_c`` over the mean power of the
   compressed return at the gate (the same reference as the ``noise`` effect's SNR), the
-  received signal as it comes: with a radar that adds receiver noise itself (the FMCW
-  radar's ``receiver_noise``) that noise is part of it;
+  received signal as the radar gave it (``SceneContext.echo``: before any received-stage
+  effect, so the ``noise`` effect, listed before or after this one, does not count; with a
+  radar that adds receiver noise itself, the FMCW radar's ``receiver_noise``, that noise is
+  part of it);
 - ``power = "rcs"``: ``rcs_m2``, the clutter RCS of one range-resolution cell (``sigma_0`` times
   the illuminated ground area of the cell); each patch carries ``rcs_m2 x spacing/resolution``
   and ``P_c = sum_k sigma_k mean_n |g_k(n)|^2`` through the waveform's range equation.
+
+The patches cross the same medium as the target: with an ``attenuation`` effect in the scene
+each patch loses the two-way loss of its own range (:meth:`GroundClutter.path_loss`). The
+antenna pattern is not applied: a patch has a range, not a direction, and ``rcs_m2`` is the
+clutter RCS the radar sees in a cell (``sigma_0`` times the cell's area weighted by the two-way
+pattern over it); a gain on top would count the beam twice.
 
 The clutter is added to ``Received.signal``; a range-time map, if any, is passed on unchanged.
 A radar that simulates the clutter in its raw samples (``RadarWaveform.takes_receiver_inputs``:
@@ -47,7 +55,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from typing import Any, Literal
 
 import numpy as np
@@ -60,6 +68,7 @@ from mdframework import (
     RadarWaveform,
     Received,
     ReceiverInput,
+    Scatterers,
     SceneContext,
     SceneError,
     point_responses,
@@ -233,6 +242,27 @@ class GroundClutter(Effect):
     def __init__(self, config: PluginConfig | None = None) -> None:
         super().__init__(config)
         self._stats: dict[str, Any] = {}
+        self._attenuation: tuple[Effect, ...] = ()
+
+    def check_effects(self, effects: Sequence[Effect]) -> None:
+        """Keep the scene's ``attenuation`` effects: the patches lose what their own range
+        loses (:meth:`path_loss`), as the target's scatterers do."""
+        self._attenuation = tuple(e for e in effects if e.name == "attenuation")
+
+    def path_loss(self, context: SceneContext, ranges: FloatArray) -> FloatArray:
+        """Two-way power factor (<= 1) of the scene's ``attenuation`` effects for patches at
+        ``ranges`` (n,) [m] (1 without them): each effect's own ``apply`` on point scatterers
+        at those ranges (its loss depends on the range alone)."""
+        r = np.asarray(ranges, dtype=np.float64)
+        if not self._attenuation:
+            return np.ones(r.shape)
+        radar_at = np.asarray(context.radar_position, dtype=np.float64)
+        positions = radar_at + r[None, :, None] * np.array([1.0, 0.0, 0.0])
+        names = tuple(f"clutter{k}" for k in range(r.size))
+        patches = Scatterers(positions, np.ones((1, r.size)), names)
+        for effect in self._attenuation:
+            patches = effect.apply(patches, context)
+        return np.asarray(patches.rcs[0], dtype=np.float64)
 
     def check_radar(self, waveform: RadarWaveform) -> None:
         """A radar without a range resolution (CW: ``RadarWaveform.range_resolution`` None) needs
@@ -330,13 +360,14 @@ class GroundClutter(Effect):
         """For a radar that simulates the clutter in its raw samples (:meth:`check_radar`:
         ``power = "rcs"``, no wind): the stationary patches as static point scatterers at
         :meth:`patch_ranges`, patch ``k`` of RCS ``rcs_m2 (spacing / resolution) |alpha_k|^2``
-        (``alpha_k`` complex Gaussian of unit mean power: a Rayleigh amplitude; the carrier
-        phase follows from the patch's random range). Patches at or beyond the radar's
-        :attr:`~mdframework.RadarWaveform.max_static_range` are left out (drawn all the same):
+        times its :meth:`path_loss` (``alpha_k`` complex Gaussian of unit mean power: a Rayleigh
+        amplitude; the carrier phase follows from the patch's random range). Patches at or
+        beyond the radar's :attr:`~mdframework.RadarWaveform.max_static_range` are left out
+        (drawn all the same):
         ``n_patches``, ``patch_range_m`` and ``clutter_rcs_m2`` of :meth:`describe` are those
         of the patches simulated, ``n_patches_beyond_max_range`` counts the others."""
         ranges, sigma_k, alpha = self._patches(context)
-        rcs = sigma_k * np.abs(alpha) ** 2
+        rcs = sigma_k * np.abs(alpha) ** 2 * self.path_loss(context, ranges)
         far = context.waveform.max_static_range
         n_all = ranges.size
         if far is not None:
@@ -366,15 +397,17 @@ class GroundClutter(Effect):
         wind = np.zeros(n_p, dtype=np.complex128)
         patch_power = np.empty(n_patch)  # mean_n |g_k(n)|^2 of each unit-RCS patch
         groups = wind_process_groups(rng, n_patch, context.pulse_times, context.prf, spread_hz)
+        loss = np.sqrt(self.path_loss(context, ranges))  # amplitude
         for lo, hi, u in groups:
-            resp = self.responses(context, ranges[lo:hi])
+            resp = self.responses(context, ranges[lo:hi]) * loss[lo:hi, None]
             patch_power[lo:hi] = np.mean(np.abs(resp) ** 2, axis=1)
             for k in range(hi - lo):  # patch after patch: the sums of all patches at once
                 stationary += alpha[lo + k] * resp[k]
                 wind += resp[k] * u[k]
             del resp, u
-        if c.power == "csr":
-            p_sig = float(np.mean(np.abs(data.signal) ** 2))
+        if c.power == "csr":  # relative to the echo, whatever the order of the effects
+            echo = context.echo if context.echo is not None else data.signal
+            p_sig = float(np.mean(np.abs(echo) ** 2))
             p_c = p_sig * 10.0 ** (c.csr_db / 10.0)
         else:
             p_c = float(sigma_k * np.sum(patch_power))

@@ -42,14 +42,18 @@ bistatic single bounce at ``(R_d + R_b)/2 - |u_d + u_b|/2 h((u_d + u_b)/|u_d + u
 stationary point of the path length over the surface), and the spreading corrections take these
 path lengths. The virtual scatterers' ``centres`` are where they would sit without the shift.
 
-Put ``multipath`` after ``shadowing`` and ``antenna`` in the effects list when combining them:
-images are then made from the shadowed RCS and the antenna weights the direct path. (Placed
-after ``multipath``, the antenna weights each virtual scatterer by its own direction, an
-approximation of ``G(theta_d) G(theta_b)`` for the bounce path.)
+Put ``multipath`` after ``shadowing`` (the other order is refused): the bounced paths are then
+made from the shadowed RCS, so each takes the visibility of its scatterer's direct path (an
+approximation: a path arriving from below, through the ground, can be hidden where the direct
+one is not, and the other way round). Put it before ``antenna`` and ``attenuation`` (which
+refuse the other order): the antenna then weighs the image by ``g(u_b)^2`` and the single
+bounce by ``g(u_d) g(u_b)``, and the attenuation takes each path over its own length
+(``2 R_b``, ``R_d + R_b``).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any, Literal
 
 import numpy as np
@@ -104,6 +108,13 @@ def _phase_offset(psi: float, wavelength: float) -> float:
     return -wrapped * wavelength / (4.0 * np.pi)
 
 
+#: what ``shadowing`` listed after this effect would do
+SHADOWED_AFTER = {
+    "shadowing": "it would cast rays to the bounced paths' virtual places, which are not their "
+    "paths, and take those copies' ellipsoids for parts of the body that hide the others",
+}
+
+
 class GroundMultipath(Effect):
     """Adds the ground-bounce virtual scatterers of every scatterer."""
 
@@ -115,6 +126,10 @@ class GroundMultipath(Effect):
     def __init__(self, config: PluginConfig | None = None) -> None:
         super().__init__(config)
         self._stats: dict[str, Any] = {}
+
+    def check_effects(self, effects: Sequence[Effect]) -> None:
+        """Refuse ``shadowing`` listed after this one (:data:`SHADOWED_AFTER`)."""
+        self.refuse_listed_after(effects, SHADOWED_AFTER)
 
     def _aspect_ratio(
         self, data: Scatterers, p: FloatArray, r: FloatArray, r_img: FloatArray

@@ -9,8 +9,11 @@ set in one of two ways:
 
 ``mode = "snr"``
     ``snr_db`` is the **per-pulse SNR after pulse compression at the range gate**:
-    ``SNR = mean_k |y(k)|^2 / sigma^2``, where ``y`` is the noise-free compressed return (the
-    mean over the whole record, so it includes the body's own fluctuations). It is a property of
+    ``SNR = mean_k |y(k)|^2 / sigma^2``, where ``y`` is the compressed return as the radar gave
+    it (``SceneContext.echo``: before any received-stage effect, so the clutter effect, listed
+    before or after this one, does not count; the paths the scatterer-stage effects add, such
+    as multipath's and the room's, do), the mean over the whole record, so it includes the
+    body's own fluctuations. It is a property of
     the slow-time samples, not of the spectrogram: an STFT frame with window ``w`` (length L)
     integrates a tone coherently, so a single tone of power ``P`` peaks at ``P (sum w)^2`` while
     the noise floor per bin is ``sigma^2 sum w^2``; the spectrogram's tone-to-floor ratio is
@@ -237,8 +240,9 @@ class ReceiverNoise(Effect):
     def apply(self, data: Received, context: SceneContext) -> Received:
         """The received data plus noise of power :func:`noise_power`."""
         c = self.config
-        if c.mode == "snr":
-            power = noise_power("snr", signal=data.signal, snr_db=c.snr_db)
+        if c.mode == "snr":  # relative to the echo, whatever the order of the effects
+            echo = context.echo if context.echo is not None else data.signal
+            power = noise_power("snr", signal=echo, snr_db=c.snr_db)
         else:
             power = noise_power(
                 "thermal",

@@ -14,8 +14,8 @@ effect adds such reflectors as point scatterers that keep their place for the wh
 
 Positions ``(n_pulses, n_static, 3)`` are the same at every pulse, so their Doppler is exactly
 0; shapes (for effects that use them) are small spheres. Put ``static_scene`` before effects
-that act on every scatterer (multipath, antenna) so those act on the room as well (``antenna``
-before it is refused).
+that act on every scatterer (multipath, antenna, attenuation) so those act on the room as well
+(``antenna`` or ``attenuation`` before it is refused).
 """
 
 from __future__ import annotations
