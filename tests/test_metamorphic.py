@@ -1008,9 +1008,8 @@ def test_the_return_of_two_scatterers_is_the_sum_of_their_returns(
                 "elevation_deg": float(np.degrees(np.arcsin(direction[2] / gate))),
             }
         )
-    kinds = [e["kind"] for e in effects]
-    if "antenna" in kinds and "multipath" in kinds:  # the antenna after multipath
-        effects = sorted(effects, key=lambda e: e["kind"] == "antenna")
+    # multipath first (the antenna and attenuation after it), the antenna last
+    effects = sorted(effects, key=lambda e: (e["kind"] != "multipath", e["kind"] == "antenna"))
 
     def run(targets: list[dict[str, Any]]) -> np.ndarray:
         cfg = run_config(radar, targets=targets, scene={"gate": gate}, effects=effects)
