@@ -536,6 +536,15 @@ def _splits_words(ev: EvaluationConfig, n: int) -> str:
     return f"{n} split" + ("s" if n != 1 else "")
 
 
+def _caption_splits(ev: EvaluationConfig, n: int) -> str:
+    """``n`` splits of the protocol for a figure's caption, which has no report header beside
+    it to say how the records were split ('10 random splits holding out whole recordings')."""
+    if ev.split == "groups":
+        return _splits_words(ev, n)
+    how = "holding out whole recordings" if ev.split == "recording" else "of the records"
+    return f"{n} random split" + ("s " if n != 1 else " ") + how
+
+
 def _record_splits(
     ev: EvaluationConfig, x: NDArray[np.float64], y: NDArray[Any], seed: int
 ) -> list[tuple[NDArray[np.intp], NDArray[np.intp]]]:
@@ -1066,7 +1075,8 @@ def _report(
                 res["confusion_mean"],
                 res["confusion_std"],
                 title=f"{group}: within-source",
-                caption=f"{caption}; mean ± std over {splits}",
+                caption=f"{caption}; mean ± std over "
+                f"{_caption_splits(cfg.evaluation, res['n_splits'])}",
             )
         )
         ids, truth = data.table["id"][mask], data.labels[mask]
