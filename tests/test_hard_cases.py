@@ -430,7 +430,11 @@ effect_st = st.lists(
     ),
     max_size=3,
     unique_by=lambda e: e["kind"],
-).map(lambda effects: sorted(effects, key=lambda e: e["kind"] == "antenna"))  # after multipath
+).map(  # multipath first, the antenna last (the order the effects require)
+    lambda effects: sorted(
+        effects, key=lambda e: (e["kind"] != "multipath", e["kind"] == "antenna")
+    )
+)
 
 
 @PROPERTY
