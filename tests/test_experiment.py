@@ -544,6 +544,12 @@ def test_the_within_source_caption_names_the_split_protocol(
     with pytest.warns(exp.ExperimentWarning) if split == "recording" else nullcontext():
         exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
     assert captions and captions[0].endswith(words), captions
+    header = {
+        "record": "evaluation: 3 stratified random splits of the records, 60/40.",
+        "recording": "evaluation: up to 3 distinct random splits holding out 40 % of every "
+        "class's recordings (rounded, at least one, never all).",
+    }[split]
+    assert header in (tmp_path / "o" / "report.md").read_text()
 
 
 def test_per_record_predictions_match_the_matrices(kinect_dataset: Path, tmp_path: Path) -> None:

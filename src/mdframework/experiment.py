@@ -523,8 +523,8 @@ def protocol(ev: EvaluationConfig) -> str:
         return f"leave-{ev.by}s-out cross-validation ({folds}, each testing unseen {ev.by}s)"
     if ev.split == "recording":
         return (
-            f"{ev.repeats} random splits holding out {pct} % of every class's recordings "
-            "(rounded, at least one, never all)"
+            f"up to {ev.repeats} distinct random splits holding out {pct} % of every class's "
+            "recordings (rounded, at least one, never all)"
         )
     return f"{ev.repeats} stratified random splits of the records, {100 - pct}/{pct}"
 
