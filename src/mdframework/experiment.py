@@ -541,6 +541,8 @@ def _caption_splits(ev: EvaluationConfig, n: int) -> str:
     it to say how the records were split ('10 random splits holding out whole recordings')."""
     if ev.split == "groups":
         return _splits_words(ev, n)
+    if ev.split == "recording" and n < ev.repeats:  # fewer exist: each made once, none drawn
+        return f"all {n} distinct splits holding out whole recordings"
     how = "holding out whole recordings" if ev.split == "recording" else "of the records"
     return f"{n} random split" + ("s " if n != 1 else " ") + how
 
