@@ -707,3 +707,47 @@ def test_every_effect_contract_breach_is_refused_and_a_valid_output_passes() -> 
     for out, data, error, text in cases:
         with pytest.raises(error, match=text):
             _check_effect_output(out, data)
+
+
+#: what mdframework 0.2 added that a plugin may use (a pattern in its source -> the addition)
+NEW_IN_0_2 = {
+    r"\.max_static_range\b": "RadarWaveform.max_static_range",
+    r"\bdef smaller_spectrogram\b": "RadarWaveform.smaller_spectrogram",
+    r"\.refuse_listed_after\(": "Effect.refuse_listed_after",
+    r"\bcontext\.echo\b": "SceneContext.echo",
+    r"\bMAX_MOTION_TEXT_BYTES\b": "limits.MAX_MOTION_TEXT_BYTES",
+    r"\bMAX_MOTION_ARRAY_BYTES\b": "limits.MAX_MOTION_ARRAY_BYTES",
+    r"\bcheck_file_size\b": "limits.check_file_size",
+    r"\bwindow_centre\b": "physics.spectrogram.window_centre",
+    r"\brecord_arrays\b": "dataset.record_arrays",
+}
+
+
+def test_a_plugin_using_what_mdframework_0_2_added_requires_0_2() -> None:
+    """A plugin distribution (built-in or an example) whose code uses a name mdframework 0.2
+    added declares ``mdframework>=0.2``: installed beside an mdframework 0.1 it would fail at
+    that name, an internal AttributeError, instead of being refused by pip (the TRC, Kinect
+    text, table and BVH readers used the size limits of 0.2 with ``mdframework>=0.1``)."""
+    import re
+    import tomllib
+
+    from conftest import ROOT
+
+    roots = [*sorted((ROOT / "plugins").iterdir()), *sorted((ROOT / "examples").glob("plugin-*"))]
+    wrong = []
+    for root in roots:
+        if not (root / "pyproject.toml").exists():
+            continue
+        project = tomllib.loads((root / "pyproject.toml").read_text())["project"]
+        [pin] = [d for d in project["dependencies"] if re.match(r"mdframework\b", d)]
+        used = sorted(
+            {
+                name
+                for path in sorted((root / "src").rglob("*.py"))
+                for pattern, name in NEW_IN_0_2.items()
+                if re.search(pattern, path.read_text())
+            }
+        )
+        if used and pin != "mdframework>=0.2":
+            wrong.append(f"{project['name']} ({pin}) uses {', '.join(used)}")
+    assert wrong == []

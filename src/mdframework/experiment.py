@@ -541,6 +541,8 @@ def _caption_splits(ev: EvaluationConfig, n: int) -> str:
     it to say how the records were split ('10 random splits holding out whole recordings')."""
     if ev.split == "groups":
         return _splits_words(ev, n)
+    if ev.split == "recording" and n < ev.repeats:  # fewer exist: each made once, none drawn
+        return f"all {n} distinct splits holding out whole recordings"
     how = "holding out whole recordings" if ev.split == "recording" else "of the records"
     return f"{n} random split" + ("s " if n != 1 else " ") + how
 
@@ -882,23 +884,19 @@ def classifier_inputs(
         return data, data.features, list(FEATURE_NAMES)
     data = load_dataset(data_dir, spectrograms=False)  # the index; the records one by one:
     ids = data.table["id"]
-    missing: list[str] = []  # each record reduced to its vector, never all histograms at once
-    widths: set[int] = set()
+    widths: set[int] = set()  # each record reduced to its vector, never all histograms at once
     vectors, velocity = [], None
     read = record_arrays(Path(data_dir), ids, ("velocity_mps", "histograms"))
     for rid, arrays in zip(ids, read, strict=True):
         h = arrays.get("histograms")
-        velocity = arrays["velocity_mps"] if velocity is None else velocity
         if h is None:
-            missing.append(str(rid))
-        elif not missing:
-            widths.add(h.shape[1])
-            vectors.append(histogram_vector(h.astype(np.float64)))
-    if missing:
-        raise MdfError(
-            f"input = 'histogram': record {missing[0]} has no histograms (build simulated "
-            "records with representation = 'histogram')"
-        )
+            raise MdfError(
+                f"input = 'histogram': record {rid} has no histograms (build simulated "
+                "records with representation = 'histogram')"
+            )
+        velocity = arrays["velocity_mps"] if velocity is None else velocity
+        widths.add(h.shape[1])
+        vectors.append(histogram_vector(h.astype(np.float64)))
     if len(widths) != 1:
         raise MdfError(f"input = 'histogram': records have different bin counts {widths}")
     x = np.stack(vectors)
