@@ -821,9 +821,9 @@ def test_ctrl_c_while_the_lock_is_taken_or_the_folder_cleaned_up_leaves_no_lock(
     if when == "taking the lock":
         real_write = outdir._write_holder
 
-        def interrupted_write(fd: int, command: str) -> int:
+        def interrupted_write(fd: int, command: str, folder: Path) -> int:
             signal.raise_signal(signal.SIGINT)
-            return real_write(fd, command)
+            return real_write(fd, command, folder)
 
         monkeypatch.setattr(outdir, "_write_holder", interrupted_write)
     else:
@@ -838,3 +838,45 @@ def test_ctrl_c_while_the_lock_is_taken_or_the_folder_cleaned_up_leaves_no_lock(
         with outdir.output_folder(out, "run", ("*.json",)) as folder:
             folder.stage()
     assert sorted(p.name for p in out.iterdir()) == []
+
+
+def test_a_lock_file_that_cannot_be_written_is_one_line_and_removed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A full disk while the lock's details were written left ``.mdf.lock`` behind and its
+    descriptor open, and ended in an internal error: now one line naming the folder, exit 2,
+    and the folder as it was."""
+    import errno
+
+    out = tmp_path / "o"
+    out.mkdir()
+    opened: list[int] = []
+    real_open = os.open
+
+    def recording_open(path: Any, flags: int, *args: Any, **kw: Any) -> int:
+        fd = real_open(path, flags, *args, **kw)
+        if str(path).endswith(LOCK):
+            opened.append(fd)
+        return fd
+
+    def full(fd: int, data: bytes, offset: int) -> int:
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    closed: list[int] = []
+    real_close = os.close
+
+    def recording_close(fd: int) -> None:
+        closed.append(fd)
+        real_close(fd)
+
+    monkeypatch.setattr(outdir.os, "open", recording_open)
+    monkeypatch.setattr(outdir.os, "close", recording_close)
+    monkeypatch.setattr(outdir.os, "pwrite", full)
+    assert cli.main(["run", str(POINT), "--out", str(out)]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert line == (
+        f"mdf: error: --out {out}: cannot write the lock file (No space left on device); free "
+        "some space or choose another folder"
+    )
+    assert list(out.iterdir()) == []
+    assert opened and set(opened) <= set(closed)

@@ -372,16 +372,28 @@ def _warn_no_locks(folder: Path, exc: OSError) -> None:
     )
 
 
-def _write_holder(fd: int, command: str) -> int:
-    """Write this process's details into the lock file ``fd``; returns ``fd``."""
+def _write_holder(fd: int, command: str, folder: Path) -> int:
+    """Write this process's details into the lock file ``fd`` of ``folder``; returns ``fd``.
+    When they cannot be written (a full disk), the lock file is removed and ``fd`` closed, and
+    :class:`OutputError` names the folder."""
     info = {
         "pid": os.getpid(),
         "command": command,
         "started": _process_start(os.getpid()),
         "host": socket.gethostname(),
     }
-    os.ftruncate(fd, 0)
-    os.pwrite(fd, (json.dumps(info) + "\n").encode(), 0)
+    try:
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, (json.dumps(info) + "\n").encode(), 0)
+    except OSError as exc:
+        try:
+            (folder / LOCK).unlink(missing_ok=True)
+        finally:
+            os.close(fd)
+        raise OutputError(
+            f"--out {folder}: cannot write the lock file ({exc.strerror or exc}); free some "
+            "space or choose another folder"
+        ) from None
     return fd
 
 
@@ -408,7 +420,7 @@ def acquire_lock(folder: Path, command: str) -> int:
         except OSError as exc:
             if exc.errno not in _BUSY:
                 _warn_no_locks(folder, exc)
-                return _write_holder(fd, command)  # removed at the end, as a lock is
+                return _write_holder(fd, command, folder)  # removed at the end, as a lock is
             os.close(fd)
             who = describe_holder(_read_holder(path))
             raise OutputError(
@@ -422,7 +434,7 @@ def acquire_lock(folder: Path, command: str) -> int:
         if not same:
             os.close(fd)
             continue
-        return _write_holder(fd, command)
+        return _write_holder(fd, command, folder)
     raise OutputError(f"--out {folder}: could not take the lock {path}; try again")
 
 
