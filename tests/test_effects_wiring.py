@@ -220,3 +220,22 @@ def test_a_lone_effect_draws_what_it_always_drew(registry: Registry) -> None:
     for seed in (0, 5, 2**63 + 1):
         expected = np.random.default_rng(np.random.SeedSequence(seed).spawn(2)[0])
         assert np.array_equal(draws(registry, ["x"], seed)["x"], expected.standard_normal(5))
+
+
+def test_refuse_listed_after_names_both_places_and_refuses_a_list_without_the_effect() -> None:
+    """Effect.refuse_listed_after (for a plugin's check_effects): one line naming both places
+    in the list when a named effect comes later; a list that does not hold the effect itself
+    (a caller's bug) is a ValueError saying so, not a bare StopIteration."""
+    from mdframework.errors import SceneError
+
+    first, second = ScaleRcs(ScaleConfig()), ScaleRcs(ScaleConfig())
+    second.name = "later"
+    with pytest.raises(SceneError) as info:
+        first.refuse_listed_after([first, second], {"later": "the later one would miss it"})
+    assert str(info.value) == (
+        "effects: scale_rcs (effects[0]) is listed before later (effects[1]), so the later one "
+        "would miss it: list scale_rcs after later"
+    )
+    first.refuse_listed_after([second, first], {"later": "x"})  # listed after: fine
+    with pytest.raises(ValueError, match="effect 'scale_rcs' is not in the list"):
+        first.refuse_listed_after([second], {"later": "x"})

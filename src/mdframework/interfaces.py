@@ -849,7 +849,9 @@ class Effect(Plugin):
         adds would miss this effect)."""
         from .errors import SceneError
 
-        mine = next(i for i, e in enumerate(effects) if e is self)
+        mine = next((i for i, e in enumerate(effects) if e is self), None)
+        if mine is None:  # a caller's bug: check_effects passes the list that holds this effect
+            raise ValueError(f"refuse_listed_after: effect {self.name!r} is not in the list")
         for i, e in enumerate(effects[mine + 1 :], mine + 1):
             if e.name in why:
                 raise SceneError(
