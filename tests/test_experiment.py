@@ -553,9 +553,9 @@ def test_the_within_source_caption_names_the_split_protocol(
         exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
     assert captions and captions[0].endswith(words), captions
     header = {
-        "record": "evaluation: 3 stratified random splits of the records, 60/40.",
-        "recording": "evaluation: up to 3 distinct random splits holding out 40 % of every "
-        "class's recordings (rounded, at least one, never all).",
+        "record": f"evaluation: {repeats} stratified random splits of the records, 60/40.",
+        "recording": f"evaluation: up to {repeats} distinct random splits holding out 40 % of "
+        "every class's recordings (rounded, at least one, never all).",
     }[split]
     assert header in (tmp_path / "o" / "report.md").read_text()
 
