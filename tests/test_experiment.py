@@ -515,6 +515,8 @@ def test_leave_subjects_out_report_states_the_protocol(
     written = json.loads(text, parse_constant=lambda c: pytest.fail(f"{c} in summary.json"))
     punch = written["within"]["kinect"]["classes"].index("punch")
     assert written["within"]["kinect"]["confusion_mean"][punch] == [None, None, None]
+    # leave-subjects-out makes one fold per subject, whatever evaluation.repeats says (10)
+    assert written["within"]["kinect"]["repeats"] == written["within"]["kinect"]["n_splits"] == 3
 
 
 @pytest.mark.parametrize(
@@ -554,8 +556,8 @@ def test_the_within_source_caption_names_the_split_protocol(
     assert captions and captions[0].endswith(words), captions
     header = {
         "record": "evaluation: 3 stratified random splits of the records, 60/40.",
-        "recording": "evaluation: up to 3 distinct random splits holding out 40 % of every "
-        "class's recordings (rounded, at least one, never all).",
+        "recording": f"evaluation: up to {repeats} distinct random splits holding out 40 % of "
+        "every class's recordings (rounded, at least one, never all).",
     }[split]
     assert header in (tmp_path / "o" / "report.md").read_text()
 
@@ -930,6 +932,22 @@ def test_recording_splits_are_distinct_and_all_made_when_fewer_exist() -> None:
         "Recordings held out in every split: boxing 1 of 2, run 1 of 2, walk 1 of 2. These allow "
         "8 distinct splits only, and each is made once (not 10 splits, some of them repeated)."
     )
+
+
+def test_recording_splits_hold_out_several_recordings_of_a_class_once_each() -> None:
+    """Classes of 4 and 5 recordings at test_fraction 0.4 hold out 2 of each: C(4, 2) x
+    C(5, 2) = 6 x 10 = 60 distinct splits. Asked for 70, each of the 60 is made once, each
+    holding out 2 recordings of each class; asked for 30, 30 distinct ones are drawn."""
+    labels = np.array(["a"] * 8 + ["b"] * 10)
+    index = [*range(8), *range(10)]
+    recordings = np.array([f"{c}{i // 2}" for c, i in zip(labels, index, strict=True)])
+    assert exp.distinct_recording_splits(labels, recordings, 0.4) == 60
+    for repeats, n in ((70, 60), (30, 30)):
+        splits = exp.recording_splits(labels, recordings, repeats, 0.4, 2)
+        held = [frozenset(recordings[te].tolist()) for _, te in splits]
+        assert len(held) == len(set(held)) == n
+        for h in held:
+            assert sorted(r[0] for r in h) == ["a", "a", "b", "b"]
 
 
 def test_generated_walkers_of_other_parameters_are_other_recordings(tmp_path: Path) -> None:
