@@ -572,7 +572,48 @@ def test_histogram_input_holds_one_record_at_a_time(tmp_path: Path) -> None:
     want = np.stack([histogram_vector(h.astype(np.float64)) for h in hists])
     np.testing.assert_array_equal(x, want)
     assert len(names) == 2 * 17
+    # named by the records' velocity bins, 0.25 m/s apart from -2 to 2 m/s
+    assert (names[0], names[8], names[16]) == ("mean_-2.00", "mean_+0.00", "mean_+2.00")
+    assert names[17:] == [n.replace("mean_", "std_") for n in names[:17]]
     assert peak < 300 * 60 * 17 * 4  # all histograms: 1.2 MB
+
+
+def test_loading_only_histograms_keeps_no_db_maps(tmp_path: Path) -> None:
+    """load_dataset(spectrograms=False, histograms=True) keeps every record's histograms but
+    not its dB map (as large as its histograms here, 1.2 MB for all 300 together): its memory
+    stays below that of both together."""
+    import tracemalloc
+
+    hists = _histogram_dataset(tmp_path / "ds", 300)
+    tracemalloc.start()
+    try:
+        data = load_dataset(tmp_path / "ds", spectrograms=False, histograms=True)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert data.spectrograms is None and data.histograms is not None
+    for got, want in zip(data.histograms, hists, strict=True):
+        np.testing.assert_array_equal(got, want)
+    assert peak < 1.5 * 300 * 60 * 17 * 4
+
+
+def test_a_record_id_that_is_not_a_plain_name_is_refused_naming_its_line(
+    tmp_path: Path,
+) -> None:
+    """A record id of index.csv names a file inside records/ only: '../r001' (a path out of
+    the folder) is refused, naming index.csv and the id's line, before any file is read."""
+    import hashlib
+
+    from mdframework.errors import DataFileError
+
+    _histogram_dataset(tmp_path / "ds", 3)
+    index = tmp_path / "ds" / "index.csv"
+    text = index.read_text().replace("\nr001,", "\n../r001,")
+    index.write_text(text)
+    digest = hashlib.sha256(text.encode()).hexdigest()
+    (tmp_path / "ds" / "dataset.json").write_text(json.dumps({"index_sha256": digest}))
+    with pytest.raises(DataFileError, match=r"index\.csv:3: record id '\.\./r001' is not a plain"):
+        load_dataset(tmp_path / "ds", spectrograms=False, histograms=True)
 
 
 def test_histogram_input_names_the_first_record_without_histograms(tmp_path: Path) -> None:
