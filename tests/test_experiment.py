@@ -963,12 +963,14 @@ def test_generated_walkers_of_other_parameters_are_other_recordings(tmp_path: Pa
         ("walk", "rv = 0.7, n_cycles = 3, start = 1.0"),
         ("walk", "rv = 0.9, n_cycles = 3"),
         ("brisk", "rv = 2.0, n_cycles = 3"),
+        ("brisk", "rv = 1.5, n_cycles = 3, start = 0.5, duration = 1.5"),
+        ("brisk", ""),
     ]
     p.write_text(
         "[record_lengths]\nwalk = 1.0\nbrisk = 1.0\n[base.radar]\nkind = 'lfm'\n"
         + "".join(
             f'[[sources]]\nlabel = "{label}"\nmax_records = 1\n'
-            f'motion = {{ kind = "boulic", {params} }}\n'
+            f'motion = {{ kind = "boulic"{", " if params else ""}{params} }}\n'
             for label, params in sources
         )
     )
@@ -978,6 +980,8 @@ def test_generated_walkers_of_other_parameters_are_other_recordings(tmp_path: Pa
         "boulic(n_cycles=3 rv=0.7)",
         "boulic(n_cycles=3 rv=0.9)",
         "boulic(n_cycles=3 rv=2.0)",
+        "boulic(n_cycles=3 rv=1.5)",  # a span of it names it as the whole walker does
+        "boulic",  # every parameter its default
     ]
 
 
