@@ -510,9 +510,12 @@ prf = 2400.0
         plan_records(cfg, base)
 
 
-def _histogram_dataset(folder: Path, n: int, without: int | None = None) -> list[Any]:
+def _histogram_dataset(
+    folder: Path, n: int, without: int | None = None, label_group: Any = None
+) -> list[Any]:
     """A built dataset of ``n`` histogram records (60 frames of 17 bins) written directly in
-    the dataset format; record ``without`` has no histograms. Returns the histograms."""
+    the dataset format; record ``without`` has no histograms; ``label_group(i)``: record i's
+    label and group (default: 'a' or 'b' by turns, group 'g'). Returns the histograms."""
     import csv
     import hashlib
     import io
@@ -536,7 +539,8 @@ def _histogram_dataset(folder: Path, n: int, without: int | None = None) -> list
             meta=np.array("{}"),
             **arrays,
         )
-        writer.writerow([f"r{i:03d}", "ab"[i % 2], "g", f"rec{i // 10}", *[0.0] * 7])
+        label, group = ("ab"[i % 2], "g") if label_group is None else label_group(i)
+        writer.writerow([f"r{i:03d}", label, group, f"rec{i // 10}", *[0.0] * 7])
     index = buf.getvalue()
     (folder / "index.csv").write_text(index)
     digest = hashlib.sha256(index.encode()).hexdigest()
@@ -637,3 +641,30 @@ def test_histogram_input_names_a_missing_or_damaged_record_file(tmp_path: Path) 
     (tmp_path / "ds" / RECORDS / "r003.npz").unlink()
     with pytest.raises(DataFileError, match=r"r003\.npz.*missing"):
         exp.classifier_inputs(cfg, tmp_path / "ds")
+
+
+def test_a_class_of_one_source_only_is_named_in_the_cross_source_report(tmp_path: Path) -> None:
+    """Cross-source, a class that only the training group holds ('c', 4 records of g1) is
+    left out of training and named: in the report, as a warning and in summary.json (the
+    score is over a and b, which both groups hold)."""
+    from mdframework import experiment as exp
+
+    def label_group(i: int) -> tuple[str, str]:
+        return ("c", "g1") if i >= 40 else ("ab"[i % 2], ("g1", "g2")[(i // 2) % 2])
+
+    _histogram_dataset(tmp_path / "ds", 44, label_group=label_group)
+    cfg = exp.ExperimentConfig.model_validate(
+        {
+            "input": "histogram",
+            "dataset": {"path": str(tmp_path / "ds")},
+            "selection": {"method": "none"},
+            "evaluation": {"split": "record", "repeats": 2},
+            "cross_source": {"train": "g1", "test": "g2"},
+        }
+    )
+    with pytest.warns(exp.ExperimentWarning, match=r"cross-source: class 'c' left out"):
+        summary = exp.run_experiment(cfg, tmp_path / "o", progress=False)
+    why = "4 training records left out of training: no test record of it"
+    assert summary["cross"]["left_out"] == {"c": why}
+    report = (tmp_path / "o" / "report.md").read_text()
+    assert f"over the classes both sides hold): c ({why})." in report
