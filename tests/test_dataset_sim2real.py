@@ -510,9 +510,12 @@ prf = 2400.0
         plan_records(cfg, base)
 
 
-def _histogram_dataset(folder: Path, n: int, without: int | None = None) -> list[Any]:
+def _histogram_dataset(
+    folder: Path, n: int, without: int | None = None, label_group: Any = None
+) -> list[Any]:
     """A built dataset of ``n`` histogram records (60 frames of 17 bins) written directly in
-    the dataset format; record ``without`` has no histograms. Returns the histograms."""
+    the dataset format; record ``without`` has no histograms; ``label_group(i)``: record i's
+    label and group (default: 'a' or 'b' by turns, group 'g'). Returns the histograms."""
     import csv
     import hashlib
     import io
@@ -536,7 +539,8 @@ def _histogram_dataset(folder: Path, n: int, without: int | None = None) -> list
             meta=np.array("{}"),
             **arrays,
         )
-        writer.writerow([f"r{i:03d}", "ab"[i % 2], "g", f"rec{i // 10}", *[0.0] * 7])
+        label, group = ("ab"[i % 2], "g") if label_group is None else label_group(i)
+        writer.writerow([f"r{i:03d}", label, group, f"rec{i // 10}", *[0.0] * 7])
     index = buf.getvalue()
     (folder / "index.csv").write_text(index)
     digest = hashlib.sha256(index.encode()).hexdigest()
@@ -572,7 +576,48 @@ def test_histogram_input_holds_one_record_at_a_time(tmp_path: Path) -> None:
     want = np.stack([histogram_vector(h.astype(np.float64)) for h in hists])
     np.testing.assert_array_equal(x, want)
     assert len(names) == 2 * 17
+    # named by the records' velocity bins, 0.25 m/s apart from -2 to 2 m/s
+    assert (names[0], names[8], names[16]) == ("mean_-2.00", "mean_+0.00", "mean_+2.00")
+    assert names[17:] == [n.replace("mean_", "std_") for n in names[:17]]
     assert peak < 300 * 60 * 17 * 4  # all histograms: 1.2 MB
+
+
+def test_loading_only_histograms_keeps_no_db_maps(tmp_path: Path) -> None:
+    """load_dataset(spectrograms=False, histograms=True) keeps every record's histograms but
+    not its dB map (as large as its histograms here, 1.2 MB for all 300 together): its memory
+    stays below that of both together."""
+    import tracemalloc
+
+    hists = _histogram_dataset(tmp_path / "ds", 300)
+    tracemalloc.start()
+    try:
+        data = load_dataset(tmp_path / "ds", spectrograms=False, histograms=True)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert data.spectrograms is None and data.histograms is not None
+    for got, want in zip(data.histograms, hists, strict=True):
+        np.testing.assert_array_equal(got, want)
+    assert peak < 1.5 * 300 * 60 * 17 * 4
+
+
+def test_a_record_id_that_is_not_a_plain_name_is_refused_naming_its_line(
+    tmp_path: Path,
+) -> None:
+    """A record id of index.csv names a file inside records/ only: '../r001' (a path out of
+    the folder) is refused, naming index.csv and the id's line, before any file is read."""
+    import hashlib
+
+    from mdframework.errors import DataFileError
+
+    _histogram_dataset(tmp_path / "ds", 3)
+    index = tmp_path / "ds" / "index.csv"
+    text = index.read_text().replace("\nr001,", "\n../r001,")
+    index.write_text(text)
+    digest = hashlib.sha256(text.encode()).hexdigest()
+    (tmp_path / "ds" / "dataset.json").write_text(json.dumps({"index_sha256": digest}))
+    with pytest.raises(DataFileError, match=r"index\.csv:3: record id '\.\./r001' is not a plain"):
+        load_dataset(tmp_path / "ds", spectrograms=False, histograms=True)
 
 
 def test_histogram_input_names_the_first_record_without_histograms(tmp_path: Path) -> None:
@@ -596,3 +641,30 @@ def test_histogram_input_names_a_missing_or_damaged_record_file(tmp_path: Path) 
     (tmp_path / "ds" / RECORDS / "r003.npz").unlink()
     with pytest.raises(DataFileError, match=r"r003\.npz.*missing"):
         exp.classifier_inputs(cfg, tmp_path / "ds")
+
+
+def test_a_class_of_one_source_only_is_named_in_the_cross_source_report(tmp_path: Path) -> None:
+    """Cross-source, a class that only the training group holds ('c', 4 records of g1) is
+    left out of training and named: in the report, as a warning and in summary.json (the
+    score is over a and b, which both groups hold)."""
+    from mdframework import experiment as exp
+
+    def label_group(i: int) -> tuple[str, str]:
+        return ("c", "g1") if i >= 40 else ("ab"[i % 2], ("g1", "g2")[(i // 2) % 2])
+
+    _histogram_dataset(tmp_path / "ds", 44, label_group=label_group)
+    cfg = exp.ExperimentConfig.model_validate(
+        {
+            "input": "histogram",
+            "dataset": {"path": str(tmp_path / "ds")},
+            "selection": {"method": "none"},
+            "evaluation": {"split": "record", "repeats": 2},
+            "cross_source": {"train": "g1", "test": "g2"},
+        }
+    )
+    with pytest.warns(exp.ExperimentWarning, match=r"cross-source: class 'c' left out"):
+        summary = exp.run_experiment(cfg, tmp_path / "o", progress=False)
+    why = "4 training records left out of training: no test record of it"
+    assert summary["cross"]["left_out"] == {"c": why}
+    report = (tmp_path / "o" / "report.md").read_text()
+    assert f"over the classes both sides hold): c ({why})." in report

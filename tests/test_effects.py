@@ -339,7 +339,8 @@ def test_clutter_rcs_mode_follows_the_range_equation() -> None:
 def test_clutter_patches_lose_what_their_range_loses_through_the_attenuation(kind: str) -> None:
     """Ground clutter goes through the same rain as the target: with ``attenuation`` in the
     scene (listed anywhere) a patch at range ``r`` carries ``-2 gamma r`` dB more (one patch
-    here, the gate fixed at 20 m, no margin), and the summed power follows it (the same draws)."""
+    here, the gate fixed at 20 m, no margin), and the summed power follows it (the same draws);
+    two attenuation effects (60 % and 40 % of gamma) lose as much together."""
     gamma = 100.0  # dB/km one way
     patch = {
         "kind": "clutter",
@@ -354,7 +355,9 @@ def test_clutter_patches_lose_what_their_range_loses_through_the_attenuation(kin
     radar_cfg = {"kind": kind}
     plain = run(target, [patch], radar_cfg=radar_cfg, gate=20.0, duration=0.2)
     for effects in ([patch, {"kind": "attenuation", "gas_db_per_km": gamma}],
-                    [{"kind": "attenuation", "gas_db_per_km": gamma}, patch]):  # fmt: skip
+                    [{"kind": "attenuation", "gas_db_per_km": gamma}, patch],
+                    [{"kind": "attenuation", "gas_db_per_km": 0.6 * gamma}, patch,
+                     {"kind": "attenuation", "gas_db_per_km": 0.4 * gamma}]):  # fmt: skip
         res = run(target, effects, radar_cfg=radar_cfg, gate=20.0, duration=0.2)
         clutter = next(e for e in res.metadata["effects"] if e["kind"] == "clutter")
         before = plain.metadata["effects"][0]

@@ -237,5 +237,10 @@ def test_refuse_listed_after_names_both_places_and_refuses_a_list_without_the_ef
         "would miss it: list scale_rcs after later"
     )
     first.refuse_listed_after([second, first], {"later": "x"})  # listed after: fine
+    # the place of this very effect counts, not that of another of its kind; nor is an
+    # effect listed after itself
+    again = ScaleRcs(ScaleConfig())
+    again.refuse_listed_after([first, second, again], {"later": "x"})
+    first.refuse_listed_after([first], {"scale_rcs": "x"})
     with pytest.raises(ValueError, match="effect 'scale_rcs' is not in the list"):
         first.refuse_listed_after([second], {"later": "x"})

@@ -515,6 +515,8 @@ def test_leave_subjects_out_report_states_the_protocol(
     written = json.loads(text, parse_constant=lambda c: pytest.fail(f"{c} in summary.json"))
     punch = written["within"]["kinect"]["classes"].index("punch")
     assert written["within"]["kinect"]["confusion_mean"][punch] == [None, None, None]
+    # leave-subjects-out makes one fold per subject, whatever evaluation.repeats says (10)
+    assert written["within"]["kinect"]["repeats"] == written["within"]["kinect"]["n_splits"] == 3
 
 
 @pytest.mark.parametrize(
@@ -932,6 +934,22 @@ def test_recording_splits_are_distinct_and_all_made_when_fewer_exist() -> None:
     )
 
 
+def test_recording_splits_hold_out_several_recordings_of_a_class_once_each() -> None:
+    """Classes of 4 and 5 recordings at test_fraction 0.4 hold out 2 of each: C(4, 2) x
+    C(5, 2) = 6 x 10 = 60 distinct splits. Asked for 70, each of the 60 is made once, each
+    holding out 2 recordings of each class; asked for 30, 30 distinct ones are drawn."""
+    labels = np.array(["a"] * 8 + ["b"] * 10)
+    index = [*range(8), *range(10)]
+    recordings = np.array([f"{c}{i // 2}" for c, i in zip(labels, index, strict=True)])
+    assert exp.distinct_recording_splits(labels, recordings, 0.4) == 60
+    for repeats, n in ((70, 60), (30, 30)):
+        splits = exp.recording_splits(labels, recordings, repeats, 0.4, 2)
+        held = [frozenset(recordings[te].tolist()) for _, te in splits]
+        assert len(held) == len(set(held)) == n
+        for h in held:
+            assert sorted(r[0] for r in h) == ["a", "a", "b", "b"]
+
+
 def test_generated_walkers_of_other_parameters_are_other_recordings(tmp_path: Path) -> None:
     """Boulic walkers read from no file were all one recording, 'boulic': a class of five
     walkers was 'not evaluated: it has one recording only' under split = 'recording', and
@@ -945,12 +963,14 @@ def test_generated_walkers_of_other_parameters_are_other_recordings(tmp_path: Pa
         ("walk", "rv = 0.7, n_cycles = 3, start = 1.0"),
         ("walk", "rv = 0.9, n_cycles = 3"),
         ("brisk", "rv = 2.0, n_cycles = 3"),
+        ("brisk", "rv = 1.5, n_cycles = 3, start = 0.5, duration = 1.5"),
+        ("brisk", ""),
     ]
     p.write_text(
         "[record_lengths]\nwalk = 1.0\nbrisk = 1.0\n[base.radar]\nkind = 'lfm'\n"
         + "".join(
             f'[[sources]]\nlabel = "{label}"\nmax_records = 1\n'
-            f'motion = {{ kind = "boulic", {params} }}\n'
+            f'motion = {{ kind = "boulic"{", " if params else ""}{params} }}\n'
             for label, params in sources
         )
     )
@@ -960,6 +980,8 @@ def test_generated_walkers_of_other_parameters_are_other_recordings(tmp_path: Pa
         "boulic(n_cycles=3 rv=0.7)",
         "boulic(n_cycles=3 rv=0.9)",
         "boulic(n_cycles=3 rv=2.0)",
+        "boulic(n_cycles=3 rv=1.5)",  # a span of it names it as the whole walker does
+        "boulic",  # every parameter its default
     ]
 
 

@@ -267,16 +267,19 @@ def test_the_clutter_patches_in_the_if_samples_are_attenuated_as_the_target() ->
     )
 
 
-def test_static_scatterers_beyond_the_maximum_range_are_left_out_unless_aliased() -> None:
-    """A receiver input's static scatterer 1 m beyond the maximum range adds nothing to the
-    range profiles (as a moving one there is refused), unless beyond_max_range = "alias",
-    when it folds back into them."""
+@pytest.mark.parametrize("beyond", [0.0, 1.0])
+def test_static_scatterers_beyond_the_maximum_range_are_left_out_unless_aliased(
+    beyond: float,
+) -> None:
+    """A receiver input's static scatterer at the maximum range, or 1 m beyond it, adds
+    nothing to the range profiles (as a moving one there is refused), unless
+    beyond_max_range = "alias", when it folds back into them."""
     from mdframework import ReceiverInput
 
     profiles = {}
     for mode in ("error", "alias"):
         wf = FmcwRadar(FmcwConfig(**RADAR, beyond_max_range=mode))
-        far = np.array([wf.sequence.max_range + 1.0])
+        far = np.array([wf.sequence.max_range + beyond])
         wf.set_receiver_inputs([ReceiverInput("far", static_ranges=far, static_rcs=np.ones(1))])
         origin = np.zeros(3)
         profiles[mode] = wf._static_profiles(origin, wf.sensor_axes(origin))

@@ -609,3 +609,21 @@ def test_a_radars_wrong_spectrogram_fields_are_named_as_its_bug() -> None:
     with pytest.raises(AssertionError, match=r"smaller_spectrogram\(\) must give"):
         check_radar_waveform(wf)  # the check that the note points to finds it
     check_radar_waveform(FmcwRadar(FmcwConfig(preset="iwr1443_short_range_3d")))
+
+
+def test_check_file_size_allows_the_limit_itself_and_names_a_file_it_cannot_examine(
+    tmp_path: Path,
+) -> None:
+    """limits.check_file_size refuses a file of more than max_bytes: one of exactly max_bytes
+    passes, one byte more is refused naming the file, its size and the limit; a file that
+    cannot be examined (missing) is a DataFileError naming it too, not an OSError."""
+    from mdframework import DataFileError, limits
+
+    path = tmp_path / "m.bvh"
+    path.write_bytes(b"x" * 100)
+    limits.check_file_size(path, "a BVH file", 100)
+    with pytest.raises(DataFileError) as err:
+        limits.check_file_size(path, "a BVH file", 99)
+    assert str(err.value) == f"{path}: 100 bytes is beyond the limit of 99 bytes for a BVH file"
+    with pytest.raises(DataFileError, match=r"missing\.bvh: cannot read"):
+        limits.check_file_size(tmp_path / "missing.bvh", "a BVH file", 100)

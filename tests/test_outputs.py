@@ -880,3 +880,20 @@ def test_a_lock_file_that_cannot_be_written_is_one_line_and_removed(
     )
     assert list(out.iterdir()) == []
     assert opened and set(opened) <= set(closed)
+
+
+def test_a_sigterm_held_during_a_step_ends_the_process_once_the_step_is_done() -> None:
+    """A SIGTERM (default action: end the process) that arrives while a step holds the
+    signals is delivered when the step ends: the step finishes, the process ends by that
+    signal, and nothing after the step runs."""
+    script = (
+        "import signal\n"
+        "from mdframework.outdir import _signals_held\n"
+        "with _signals_held():\n"
+        "    signal.raise_signal(signal.SIGTERM)\n"
+        "    print('step done', flush=True)\n"
+        "print('after the step', flush=True)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+    assert done.returncode == -signal.SIGTERM
+    assert done.stdout == "step done\n"

@@ -187,6 +187,12 @@ def test_a_frame_is_stamped_at_its_windows_centre(window: str, length: int, nfft
     to 0.02 samples (hop 1). The periodic windows (Hann, Blackman) are symmetric about their
     L/2-th sample, the boxcar about (L - 1)/2: stamping every window at the middle sample
     (L - 1)/2 put the flip half a sample (0.2 ms at 2400 Hz) after its true time."""
+    assert _flip_stamp_error(window, length, nfft) == pytest.approx(0.0, abs=0.02)
+
+
+def _flip_stamp_error(window: str, length: int, nfft: int) -> float:
+    """How far [samples] the half-power time of a +300 Hz to -300 Hz flip at sample 600.3
+    (2400 Hz, 1200 samples) is from the flip, in a spectrogram of hop 1."""
     fs = 2400.0
     t = np.arange(1200) / fs
     t_rev = 600.3 / fs
@@ -199,7 +205,7 @@ def test_a_frame_is_stamped_at_its_windows_centre(window: str, length: int, nfft
         nfft=nfft,
         precision="float64",
     )
-    assert _half_power_time(s.power, s.doppler, s.time) == pytest.approx(t_rev, abs=0.02 / fs)
+    return (_half_power_time(s.power, s.doppler, s.time) - t_rev) * fs
 
 
 @pytest.mark.parametrize("nfft", [255, 257])
@@ -216,3 +222,24 @@ def test_odd_fft_size_puts_a_tone_on_its_own_bin(nfft: int) -> None:
         )
         assert s.doppler.size == nfft and s.doppler[(nfft - 1) // 2] == 0.0
         np.testing.assert_allclose(s.doppler[np.argmax(s.power, axis=0)], f, atol=1e-9)
+
+
+def test_window_centre_is_the_centroid_of_the_windows_energy() -> None:
+    """window_centre is sum n w(n)^2 / sum w(n)^2 samples from the first: 1.8 for the ramp
+    (0, 1, 2) (its amplitude's centroid would say 5/3), L/2 for the periodic Hann and
+    Blackman windows, within 0.01 sample of L/2 for the periodic Hamming, (L - 1)/2 for the
+    boxcar, and the middle sample for a window without energy. With the Hamming window the
+    frame whose power splits evenly between the two sides of a Doppler flip is stamped within
+    0.04 samples of the flip (its amplitude's centroid is 0.066 samples earlier)."""
+    assert spectrogram.window_centre(np.array([0.0, 1.0, 2.0])) == pytest.approx(1.8, abs=1e-12)
+    assert spectrogram.window_centre(np.array([2.0, 1.0, 0.0])) == pytest.approx(0.2, abs=1e-12)
+    for length in (7, 64, 255):
+        for name in ("hann", "blackman"):
+            w = spectrogram.stft_window(name, length)
+            assert spectrogram.window_centre(w) == pytest.approx(length / 2, abs=1e-9)
+        hamming = spectrogram.stft_window("hamming", length)
+        assert abs(spectrogram.window_centre(hamming) - length / 2) < 0.01
+        boxcar = spectrogram.stft_window("boxcar", length)
+        assert spectrogram.window_centre(boxcar) == pytest.approx((length - 1) / 2, abs=1e-9)
+    assert spectrogram.window_centre(np.zeros(6)) == 2.5
+    assert _flip_stamp_error("hamming", 256, 256) == pytest.approx(0.0, abs=0.04)

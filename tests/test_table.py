@@ -469,6 +469,24 @@ def test_a_compressed_npz_member_beyond_the_size_limit_is_refused_before_it_expa
         f"uncompressed, beyond the limit of {limits.MAX_MOTION_ARRAY_BYTES:,} bytes for an "
         "array of a motion file"
     )
+    # the limit itself is allowed ("at most"): a header declaring exactly that many bytes
+    # is not refused for its size; its data, missing here, is what fails, naming the file and
+    # the array (a bare ValueError of numpy's before)
+    for n, refused in (
+        (limits.MAX_MOTION_ARRAY_BYTES, False),
+        (limits.MAX_MOTION_ARRAY_BYTES + 1, True),
+    ):
+        header = io.BytesIO()
+        np.lib.format.write_array_header_1_0(
+            header, {"descr": "|u1", "fortran_order": False, "shape": (n,)}
+        )
+        with zipfile.ZipFile(forged, "w") as z:
+            z.writestr("positions.npy", header.getvalue())
+        with pytest.raises(DataFileError) as err:
+            read_table(forged, spec)
+        assert ("beyond the limit" in str(err.value)) == refused, err.value
+        if not refused:
+            assert str(err.value).startswith(f"{forged}: array 'positions' cannot be read (")
     small = tmp_path / "small.npz"
     _npz_of_zeros(small, (240, 25, 3))
     assert read_table(small, spec).positions.shape == (240, 25, 3)

@@ -491,6 +491,9 @@ def _npz_shapes(path: Path) -> dict[str, tuple[tuple[int, ...], np.dtype[Any]]]:
 def _read_npz(
     path: Path, spec: TableLayout
 ) -> tuple[FloatArray, tuple[str, ...], FloatArray, str, int]:
+    import zipfile
+    import zlib
+
     shapes = _npz_shapes(path)
     for key, (_shape, dtype) in shapes.items():
         if dtype.hasobject:
@@ -505,7 +508,11 @@ def _read_npz(
                 raise DataFileError(
                     path, f"no array {key!r} ({what}); the arrays are {', '.join(shapes)}"
                 )
-            return np.asarray(z[key])
+            try:
+                return np.asarray(z[key])
+            except (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error) as exc:
+                # a member that holds less than its header declares, or damaged compressed data
+                raise DataFileError(path, f"array {key!r} cannot be read ({exc})") from None
 
         if layout == "wide":
             pos = get("positions", "(n_frames, n_joints, 3) positions").astype(np.float64)
