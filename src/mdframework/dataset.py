@@ -2337,8 +2337,11 @@ def load_dataset(
     hists: list[NDArray[np.float32] | None] | None = [] if histograms else None
     if spectrograms or histograms:
         maps = []
-        for arrays in record_arrays(root, table["id"]):
-            if spectrograms:  # (else not kept: histogram records' dB maps are as large)
+        # without spectrograms only the velocity axis and histograms are read (histogram
+        # records' dB maps are as large as their histograms)
+        names = None if spectrograms else ("velocity_mps", "histograms")
+        for arrays in record_arrays(root, table["id"], names):
+            if spectrograms:
                 maps.append(arrays["spectrogram_db"])
             velocity = arrays["velocity_mps"] if velocity is None else velocity
             if hists is not None:
