@@ -678,9 +678,9 @@ def test_any_block_size_gives_the_run_of_one_block(
     scatterers = {"kind": model} if model != "points" else {"kind": "points", "body": True}
     if radar.get("receiver_noise"):  # the FMCW receiver's own noise (per frame) replaces it
         effects = [e for e in effects if e["kind"] != "noise"]
-    # the body's self-shadowing (rays every d-th pulse of the record) first, then the room
-    # (before the effects on every scatterer)
-    effects = [e for e in (shadowing, room) if e is not None] + effects
+    # the room, then the body's self-shadowing (rays every d-th pulse of the record, the room
+    # among the scatterers it can hide), before the effects on every scatterer
+    effects = [e for e in (room, shadowing) if e is not None] + effects
 
     def run(block_pulses: int) -> RunResult:
         cfg = body_config(radar, scatterers, effects, block_pulses=block_pulses)

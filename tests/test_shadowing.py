@@ -205,3 +205,48 @@ def test_bounced_paths_keep_their_scatterers_visibility_and_multipath_first_is_r
         r", so .*: list multipath after shadowing$",
     ):
         run_with([{"kind": "multipath"}, shadow])
+
+
+def test_the_body_hides_a_reflector_behind_it_and_shadowing_before_static_scene_is_refused() -> (
+    None
+):
+    """static_scene before shadowing: a room reflector straight behind the walker's torso, at
+    the radar's height, is hidden at every pulse (the torso always lies on its ray), and one
+    beside the path never is. Shadowing listed first would never hide the room (it ran before
+    the reflectors existed): refused, naming both places."""
+    import mdf_static_scene.plugin
+
+    reg = build_registry(
+        [mdf_mujoco.plugin, mdf_lfm.plugin, mdf_ellipsoid.plugin, mdf_static_scene.plugin],
+        autoload=False,
+    )
+    shadow = {"kind": "shadowing", "attenuation_db": 20.0, "decimation": 8}
+    room = {
+        "kind": "static_scene",
+        "reflectors": [
+            {"position": [-3.0, 0.0, 1.2], "rcs_m2": 1.0},  # behind the torso
+            {"position": [-3.0, 4.0, 1.2], "rcs_m2": 1.0},  # off to the side
+        ],
+    }
+    cfg = {
+        "motion": {"kind": "boulic", "rv": 1.0, "duration": 0.5},
+        "scatterers": {"kind": "mujoco_body"},
+        "scene": {
+            "radar_position": [10.0, 0.0, 1.2],
+            "person": {"motion": "treadmill", "aspect_deg": 90.0},
+        },
+        "processing": {"window_length": 128},
+    }
+
+    def run_with(effects: list[dict[str, Any]]) -> RunResult:
+        return simulate(validate_run_config({**cfg, "effects": effects}, registry=reg), reg)
+
+    blocked = run_with([room, shadow]).metadata["effects"][1]["blocked_fraction"]
+    assert (blocked["static0"], blocked["static1"]) == (1.0, 0.0)
+    with pytest.raises(
+        SceneError,
+        match=r"^effects: shadowing \(effects\[0\]\) is listed before static_scene "
+        r"\(effects\[1\]\), so the room's reflectors would never be hidden .*: list shadowing "
+        r"after static_scene$",
+    ):
+        run_with([shadow, room])

@@ -28,6 +28,7 @@ cycle, ~1 s, so k = 8 at 2400 Hz still resolves 3.3 ms). The effect runs only wh
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
@@ -48,6 +49,12 @@ if TYPE_CHECKING:
     import mujoco  # type: ignore[import-untyped]
 
 FloatArray = NDArray[np.float64]
+
+#: effect -> why it must not come after ``shadowing`` (:meth:`Shadowing.check_effects`)
+HIDDEN_AFTER = {
+    "static_scene": "the room's reflectors would never be hidden by the person (a reflector "
+    "behind the body would be seen through it)",
+}
 BoolArray = NDArray[np.bool_]
 
 #: Radius key (of ``PART_RADII``) of each canonical segment's capsule.
@@ -134,6 +141,11 @@ class Shadowing(Effect):
     def __init__(self, config: PluginConfig | None = None) -> None:
         super().__init__(config)
         self.start_record()
+
+    def check_effects(self, effects: Sequence[Effect]) -> None:
+        """Refuse ``static_scene`` listed after this one (:data:`HIDDEN_AFTER`): listed before,
+        its reflectors are scatterers the body can hide."""
+        self.refuse_listed_after(effects, HIDDEN_AFTER)
 
     def start_record(self, body: Any = None, radar_position: Any = None) -> None:
         """Reset the ray row carried between blocks and the record's blocked fractions."""
