@@ -386,10 +386,7 @@ def _write_holder(fd: int, command: str, folder: Path) -> int:
         os.ftruncate(fd, 0)
         os.pwrite(fd, (json.dumps(info) + "\n").encode(), 0)
     except OSError as exc:
-        try:
-            (folder / LOCK).unlink(missing_ok=True)
-        finally:
-            os.close(fd)
+        release_lock(folder, fd)
         raise OutputError(
             f"--out {folder}: cannot write the lock file ({exc.strerror or exc}); free some "
             "space or choose another folder"
