@@ -15,11 +15,12 @@ from mdframework.classify import (
     Standardizer,
     balanced_accuracy,
     confusion_matrix,
+    fit_predict,
     optimistic_select,
     wrapper_select,
 )
 from mdframework.interfaces import Classifier
-from mdframework.plugins import default_registry
+from mdframework.plugins import default_registry, is_plugin_bug
 
 
 def knn(k: int = 5, tie_rule: str = "nearest") -> Knn:
@@ -247,6 +248,93 @@ def test_a_classifier_that_fails_is_named_in_the_error(rng: np.random.Generator)
         "in predict() of the classifier plugin 'failing' (test_classify.Failing); check it with "
         "mdframework.testing.check_classifier"
     ]
+
+
+#: what a broken classifier plugin's predict returns for labels ``y`` (test rows), and the
+#: message that names its bug
+WRONG_PREDICTIONS = {
+    "one short": (lambda y: y[:-1], "predict() returned labels of shape (9,), not (10,)"),
+    "a column": (lambda y: y[:, None], "predict() returned labels of shape (10, 1), not (10,)"),
+    "None": (lambda y: None, "predict() returned None, not 10 labels"),
+    "numbers": (
+        lambda y: np.zeros(len(y), dtype=int),
+        "predict() returned labels it was not trained on: 0 (trained on: 'a', 'b')",
+    ),
+    "a new label": (
+        lambda y: np.where(y == "a", "a", "c"),
+        "predict() returned labels it was not trained on: 'c' (trained on: 'a', 'b')",
+    ),
+}
+
+
+@pytest.mark.parametrize("how", sorted(WRONG_PREDICTIONS))
+@pytest.mark.parametrize("selection", ["none", "wrapper"])
+def test_a_classifier_that_predicts_the_wrong_thing_is_named(
+    how: str, selection: str, rng: np.random.Generator
+) -> None:
+    """A classifier plugin whose predict() gives other than one training label per row is its
+    bug, named as such: a label it never saw (integer class codes) was scored as a miss, a
+    balanced accuracy of 0 without a word, and a wrong shape failed in mdframework's own code
+    (or differently with and without the wrapper), naming nobody."""
+    wrong, why = WRONG_PREDICTIONS[how]
+
+    class Wrong(Spy):
+        """Predicts the wrong thing."""
+
+        name = "wrong"
+
+        def predict(self, features: Any) -> Any:
+            return wrong(super().predict(features))
+
+    x, y = rng.normal(size=(20, 3)), np.repeat(["a", "b"], 10)
+    with pytest.raises((TypeError, ValueError)) as caught:
+        if selection == "none":
+            fit_predict(Wrong(), x[::2], y[::2], x[1::2])
+        else:
+            wrapper_select(x, y, Wrong, sizes=(1,), folds=2)
+    text = str(caught.value)
+    if selection == "wrapper":  # the folds are smaller
+        text = text.replace("(5,", "(10,").replace("(4,", "(9,").replace(" 5 ", " 10 ")
+    assert text.startswith(why), caught.value
+    assert is_plugin_bug(caught.value)
+    assert caught.value.__notes__[0].startswith("in predict() of the classifier plugin 'wrong'")
+
+
+def test_a_classifier_whose_fit_returns_none_is_named(rng: np.random.Generator) -> None:
+    """fit() must return the classifier: one that returns None was reported as an
+    AttributeError in predict()."""
+
+    class NoSelf(Spy):
+        """Forgets to return itself."""
+
+        name = "no_self"
+
+        def fit(self, features: Any, labels: Any) -> Any:
+            super().fit(features, labels)
+            return None
+
+    x, y = rng.normal(size=(20, 3)), np.repeat(["a", "b"], 10)
+    with pytest.raises(TypeError, match=r"^fit\(\) returned NoneType, not the classifier") as c:
+        fit_predict(NoSelf(), x, y, x)
+    assert c.value.__notes__[0].startswith("in fit() of the classifier plugin 'no_self'")
+
+
+def test_predicted_labels_in_a_list_are_an_array(rng: np.random.Generator) -> None:
+    """A predict() that returns its labels as a list works with and without the wrapper (the
+    wrapper failed on it with an unnamed TypeError)."""
+
+    class AsList(Spy):
+        """Predicts a list."""
+
+        name = "as_list"
+
+        def predict(self, features: Any) -> Any:
+            return list(super().predict(features))
+
+    x, y = rng.normal(size=(20, 3)), np.repeat(["a", "b"], 10)
+    x[:, 0] += (y == "b") * 20.0
+    assert np.array_equal(fit_predict(AsList(), x, y, x), y)
+    assert wrapper_select(x, y, AsList, sizes=(1,), folds=2).subset == (0,)
 
 
 def test_a_large_constant_feature_is_only_centred() -> None:

@@ -34,7 +34,7 @@ def test_dataset_examples_parse(path: Path) -> None:
     load_dataset_config(path)
 
 
-def test_bad_experiment_config(tmp_path: Path) -> None:
+def test_bad_experiment_config(tmp_path: Path, only_our_plugins: None) -> None:
     p = tmp_path / "e.toml"
     p.write_text('[dataset]\npath = "x"\n[classifier]\nkind = "knn"\nk = 0\n')
     cfg = exp.load_experiment_config(p)

@@ -595,3 +595,81 @@ def test_a_numerical_warning_in_a_record_stops_the_build_however_it_runs(
     assert len(lines) == 1 and lines[0].startswith("mdf: internal error: RuntimeWarning: "), lines
     assert "overflow" in lines[0] and "xyzzy_bug" in lines[0], lines
     assert not (out / "index.csv").exists()
+
+
+@pytest.fixture(scope="module")
+def two_class_dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Built once: point targets approaching and receding, 7 records of 0.5 s each."""
+    from mdframework.dataset import build_dataset, load_dataset_config
+
+    root = tmp_path_factory.mktemp("two_class")
+    sources = "".join(
+        f'[[sources]]\nlabel = "{label}"\nhop = 0.25\nmotion = {{ kind = "point_targets", '
+        f"length = 2.0, targets = [{{ position = [20.0, 0.0, 1.0], velocity = [{v}, 0.0, 0.0], "
+        "rcs = 1.0 }] }\n"
+        for label, v in (("approach", -1.0), ("recede", 1.0))
+    )
+    config = root / "d.toml"
+    config.write_text(
+        "seed = 1\n" + sources + "[record_lengths]\napproach = 0.5\nrecede = 0.5\n"
+        '[base.scatterers]\nkind = "points"\n[base.radar]\nkind = "lfm"\n'
+    )
+    build_dataset(*load_dataset_config(config), root / "ds", progress=False)
+    return root / "ds"
+
+
+#: a third party's classifier (mdf-knn's, subclassed) with a method broken, its [classifier]
+#: option (default k = 1), the exit code and the one line that says why
+FAILING_CLASSIFIER = {
+    "integer class codes": (
+        "    def predict(self, features):\n        return np.zeros(len(features), dtype=int)\n",
+        "",
+        1,
+        "mdf: internal error: ValueError: predict() returned labels it was not trained on: 0 "
+        "(trained on: 'approach', 'recede') (in predict() of the classifier plugin 'xyzzy_bug' "
+        "(mdf_test_xyzzy.XyzzyBug); check it with mdframework.testing.check_classifier; run "
+        "with --debug for the traceback)",
+    ),
+    "its constructor raises": (
+        "    def __init__(self, config=None):\n        raise KeyError('oops')\n",
+        "",
+        1,
+        "mdf: internal error: KeyError: 'oops' (in __init__() of the classifier plugin "
+        "'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug); check it with "
+        "mdframework.testing.check_classifier; run with --debug for the traceback)",
+    ),
+    "the user's bad option": (
+        "",
+        "k = 0",
+        2,
+        "mdf: error: {config}: classifier.k: must be at least 1 (got 0)",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(FAILING_CLASSIFIER))
+def test_a_classifier_plugin_bug_is_an_internal_error_naming_it(
+    case: str,
+    installed: Path,
+    two_class_dataset: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A third party's classifier that predicts labels it never saw (integer class codes) is
+    its bug: the experiment stops naming it (it wrote a report of balanced accuracy 0), and so
+    does one whose constructor raises (it named nobody); a bad option of its own is the user's
+    error, exit 2 naming the field."""
+    method, option, code, why = FAILING_CLASSIFIER[case]
+    base = "import numpy as np\nfrom mdf_knn import Knn as Base\n"
+    install_broken(installed, base, "classifiers", method or "    pass\n")
+    config = tmp_path / "e.toml"
+    config.write_text(
+        f'seed = 0\n[dataset]\npath = "{two_class_dataset}"\n[classifier]\nkind = "xyzzy_bug"\n'
+        f'{option or "k = 1"}\n[selection]\nmethod = "none"\n[evaluation]\nrepeats = 1\n'
+    )
+    capsys.readouterr()
+    out = tmp_path / "o"
+    assert cli.main(["experiment", str(config), "--out", str(out)]) == code
+    lines = without_third_party_warnings(capsys.readouterr().err.strip().splitlines())
+    assert lines == [why.format(config=config)]
+    assert not (out / "report.md").exists()

@@ -26,12 +26,37 @@ def fit_predict(
     classifier: Classifier, x_train: FloatArray, y_train: NDArray[Any], x_test: FloatArray
 ) -> NDArray[Any]:
     """``classifier`` fitted on ``x_train`` (n, n_features) and ``y_train`` (n,), and its
-    labels (m,) of ``x_test`` (m, n_features); an exception from the plugin's ``fit`` or
-    ``predict`` names it (:func:`mdframework.plugins.blame`)."""
+    labels (m,) of ``x_test`` (m, n_features), as an array. An exception from the plugin's
+    ``fit`` or ``predict`` names it (:func:`mdframework.plugins.blame`), and so does a
+    ``fit`` that returns no classifier, or a ``predict`` that gives other than one label per
+    row or a label ``y_train`` does not hold (a wrong result, else scored without a word)."""
     with blame(classifier, "fit"):
         fitted = classifier.fit(x_train, y_train)
+        if not isinstance(fitted, Classifier):
+            raise TypeError(f"fit() returned {type(fitted).__name__}, not the classifier")
     with blame(classifier, "predict"):
-        return fitted.predict(x_test)
+        return _labels(fitted.predict(x_test), x_test.shape[0], y_train)
+
+
+def _labels(predicted: Any, n_rows: int, y_train: NDArray[Any]) -> NDArray[Any]:
+    """``predicted`` as an array when it is one label per row of the ``n_rows``, each one of
+    the training labels ``y_train``; else a ``TypeError`` or ``ValueError`` saying what came."""
+    if predicted is None:
+        raise TypeError(f"predict() returned None, not {n_rows} labels")
+    labels = np.asarray(predicted)
+    if labels.shape != (n_rows,):
+        raise ValueError(
+            f"predict() returned labels of shape {labels.shape}, not ({n_rows},): one per row"
+        )
+    known = set(np.asarray(y_train).tolist())
+    unknown = sorted({repr(v) for v in labels.tolist() if v not in known})
+    if unknown:
+        raise ValueError(
+            f"predict() returned labels it was not trained on: {', '.join(unknown[:3])}"
+            f"{' ...' if len(unknown) > 3 else ''} (trained on: "
+            f"{', '.join(sorted(repr(v) for v in known))})"
+        )
+    return labels
 
 
 @dataclass(frozen=True)

@@ -64,7 +64,7 @@ from .errors import ConfigError, DataFileError, MdfError
 from .features import FEATURE_NAMES
 from .interfaces import Classifier
 from .outdir import output_folder, safe_name
-from .plugins import Registry, default_registry, versions
+from .plugins import Registry, blame, default_registry, versions
 from .pointcloud import histogram_vector, histogram_vector_names, velocity_bins
 from .progress import note, progress_enabled, tqdm_bar
 from .settings import Seed, StrictModel, Workers
@@ -296,7 +296,8 @@ def classifier_factory(
         ) from None
 
     def make() -> Classifier:
-        classifier: Classifier = cls(cfg)  # type: ignore[assignment]
+        with blame(cls, "__init__"):  # an exception there is the plugin's bug, named
+            classifier: Classifier = cls(cfg)  # type: ignore[assignment]
         classifier.seed = seed
         return classifier
 

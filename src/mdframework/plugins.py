@@ -108,19 +108,19 @@ CONTRACT_CHECKS = {
 
 
 @contextmanager
-def blame(plugin: Plugin, method: str) -> Iterator[None]:
-    """Run a call of ``plugin``'s ``method``: an exception it raises, other than an
-    :class:`~mdframework.errors.MdfError` (bad input, the user's), is the plugin's bug, and
-    gets a note naming the plugin, its class and its contract check, which the CLI's internal
-    error shows (``in receive() of the radar plugin 'acme' (acme.Radar); check it with
-    mdframework.testing.check_radar_waveform``)."""
+def blame(plugin: Plugin | type[Plugin], method: str) -> Iterator[None]:
+    """Run a call of ``plugin``'s ``method`` (of the class itself for ``__init__``): an
+    exception it raises, other than an :class:`~mdframework.errors.MdfError` (bad input, the
+    user's), is the plugin's bug, and gets a note naming the plugin, its class and its contract
+    check, which the CLI's internal error shows (``in receive() of the radar plugin 'acme'
+    (acme.Radar); check it with mdframework.testing.check_radar_waveform``)."""
     try:
         yield
     except MdfError:
         raise
     except Exception as exc:
-        cls = type(plugin)
-        interface = next((i for i, s in INTERFACES.items() if isinstance(plugin, s.base)), "")
+        cls = plugin if isinstance(plugin, type) else type(plugin)
+        interface = next((i for i, s in INTERFACES.items() if issubclass(cls, s.base)), "")
         name_plugin_bug(
             exc,
             f"in {method}() of the {interface} plugin {getattr(plugin, 'name', '?')!r} "
