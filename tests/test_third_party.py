@@ -58,6 +58,10 @@ BROKEN = {
         + registering("[XyzzyFx]"),
         "XyzzyFx.Config needs kind: Literal['xyzzy_fx'] = 'xyzzy_fx'",
     ),
+    "exits when imported": (
+        'import sys\nsys.exit("no GPU here")\n',
+        "failed to load: SystemExit: no GPU here",
+    ),
     "kind of another plugin": (
         EFFECT.replace('Literal["xyzzy_fx"] = "xyzzy_fx"', 'Literal["noise"] = "noise"')
         + registering("[XyzzyFx]"),

@@ -395,7 +395,7 @@ def _load_entry_points(
         clock = time.perf_counter()
         try:
             plugin = ep.load()
-        except Exception as exc:
+        except (Exception, SystemExit) as exc:  # sys.exit() at import: the plugin's, not ours
             _reraise_interrupt(exc)
             _warn_disabled(pm, ep.name, f"{dist} failed to load: {type(exc).__name__}: {exc}")
             continue
@@ -413,7 +413,7 @@ def _load_entry_points(
             SLOW_IMPORTS[ep.name] = (dist, took)
 
 
-def _reraise_interrupt(exc: Exception) -> None:
+def _reraise_interrupt(exc: BaseException) -> None:
     """Ctrl-C while a plugin loads ends the command; it does not disable the plugin."""
     if caused_by_interrupt(exc):
         raise KeyboardInterrupt from exc
