@@ -32,6 +32,7 @@ from mdframework.dataset import (
     load_dataset_config,
     plan_records,
     read_record,
+    record_arrays,
 )
 from mdframework.errors import ConfigError, DataFileError, MdfError
 from mdframework.features import FEATURE_NAMES
@@ -100,6 +101,10 @@ def test_plan_and_load(tmp_path: Path) -> None:
     assert list(data.labels) == [r["label"] for r in rows]
     assert isinstance(data.spectrograms, np.ndarray) and data.spectrograms.shape[0] == 10
     assert data.velocity is not None and data.spectrograms.shape[1] == data.velocity.size
+    # the records one at a time, from the folder given as load_dataset takes it (text too: a
+    # str failed with "unsupported operand type(s) for /")
+    one_by_one = [a["spectrogram_db"] for a in record_arrays(str(out), data.table["id"])]
+    assert np.array_equal(np.stack(one_by_one), data.spectrograms)
     # walking toward the radar at aspect 0: positive torso velocity; boxing: about zero
     torso = data.features[:, FEATURE_NAMES.index("torso_mean")]
     assert np.all(torso[data.labels == "walk"][::2] > 0.8)

@@ -2286,7 +2286,7 @@ def _verified_index(root: Path) -> str:
 
 
 def record_arrays(
-    root: Path, ids: Iterable[str], names: Sequence[str] | None = None
+    root: str | Path, ids: Iterable[str], names: Sequence[str] | None = None
 ) -> Iterator[dict[str, NDArray[Any]]]:
     """The arrays of the records ``ids`` (``Dataset.table["id"]``) of the built dataset at
     ``root``, one record at a time, in order, so that a caller that reduces each record (e.g.
@@ -2294,6 +2294,7 @@ def record_arrays(
     ``names`` (the others not read; ``histograms`` left out of a record without them). An id
     that is not a plain file name, or a record file missing or damaged, is a
     :class:`DataFileError`."""
+    root = Path(root)
     for line, rid in enumerate(ids, start=2):
         if safe_name(str(rid)) != rid:  # a record id names a file inside records/ only
             raise DataFileError(root / INDEX, f"record id {str(rid)!r} is not a plain name", line)
@@ -2303,7 +2304,16 @@ def record_arrays(
 def load_dataset(
     path: str | Path, *, spectrograms: bool = True, histograms: bool = False
 ) -> Dataset:
-    """Load a built dataset in one call (arrays plus the index table)."""
+    """Load a built dataset in one call (arrays plus the index table): a :class:`Dataset`.
+
+    ``features`` (n_records, 7) float64 [m/s], ``labels`` and ``groups`` (n_records,) str and
+    ``table`` (every column of ``index.csv``) come from ``index.csv``. ``spectrograms`` (the
+    default) also reads every record's ``spectrogram_db`` (n_doppler, n_frames) float32 [dB re
+    peak], all held at once (:func:`record_arrays` gives them one at a time), and the first
+    record's ``velocity_mps``; ``histograms`` reads each record's per-frame histograms
+    (n_frames, n_bins) float32 (``None`` for a spectrogram record). A folder that is not a
+    complete build, or that a build is writing, is an :class:`MdfError`; an ``index.csv``
+    edited since the build, or a record file missing or damaged, a :class:`DataFileError`."""
     root = Path(path)
     index = root / INDEX
     holder = lock_holder(root)
