@@ -642,6 +642,17 @@ FAILING_CLASSIFIER = {
         "'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug); check it with "
         "mdframework.testing.check_classifier; run with --debug for the traceback)",
     ),
+    "its config's validator raises": (
+        "    class Config(XyzzyConfig):\n"
+        "        @model_validator(mode='after')\n"
+        "        def _bug(self):\n"
+        "            raise TypeError('not a ValueError')\n",
+        "",
+        1,
+        "mdf: internal error: TypeError: not a ValueError (in Config.model_validate() of the "
+        "classifier plugin 'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug); check it with "
+        "mdframework.testing.check_classifier; run with --debug for the traceback)",
+    ),
     "the user's bad option": (
         "",
         "k = 0",
@@ -661,10 +672,13 @@ def test_a_classifier_plugin_bug_is_an_internal_error_naming_it(
 ) -> None:
     """A third party's classifier that predicts labels it never saw (integer class codes) is
     its bug: the experiment stops naming it (it wrote a report of balanced accuracy 0), and so
-    does one whose constructor raises (it named nobody); a bad option of its own is the user's
-    error, exit 2 naming the field."""
+    does one whose constructor or config validator raises (they named nobody); a bad option of
+    its own is the user's error, exit 2 naming the field."""
     method, option, code, why = FAILING_CLASSIFIER[case]
-    base = "import numpy as np\nfrom mdf_knn import Knn as Base\n"
+    base = (
+        "import numpy as np\nfrom pydantic import model_validator\n"
+        "from mdf_knn import Knn as Base\n"
+    )
     install_broken(installed, base, "classifiers", method or "    pass\n")
     config = tmp_path / "e.toml"
     config.write_text(

@@ -286,14 +286,16 @@ def classifier_factory(
         cls = reg.get("classifier", str(kind))
     except KeyError as exc:
         raise ConfigError(f"{source}: classifier.kind: {exc.args[0]}") from None
-    try:
-        cfg = cls.Config.model_validate(section, context={"allow_import": allow_import})
-    except ValidationError as exc:
-        raise ConfigError(
-            format_validation_error(exc, source, section, cls.Config).replace(
-                f"{source}: ", f"{source}: classifier.", 1
-            )
-        ) from None
+    # a validator's exception other than pydantic's is the plugin's bug, named
+    with blame(cls, "Config.model_validate"):
+        try:
+            cfg = cls.Config.model_validate(section, context={"allow_import": allow_import})
+        except ValidationError as exc:
+            raise ConfigError(
+                format_validation_error(exc, source, section, cls.Config).replace(
+                    f"{source}: ", f"{source}: classifier.", 1
+                )
+            ) from None
 
     def make() -> Classifier:
         with blame(cls, "__init__"):  # an exception there is the plugin's bug, named
