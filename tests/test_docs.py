@@ -268,8 +268,11 @@ def test_every_documented_config_parses(block: Block) -> None:
         base_dir = path.parent
     run_fields = {*RunConfigBase.model_fields, "motion", "scatterers", "radar", "effects"}
     fragment_of = None if set(data) <= run_fields else set(data)
-    if "project" in data:  # a distribution's pyproject.toml
+    if "project" in data:  # a distribution's pyproject.toml, whole: it installs as shown
         assert "mdframework" in data["project"]["entry-points"], block.where
+        # (without a version, `pip install -e` of a copy failed: "project must contain
+        # ['version']")
+        assert {"name", "version"} <= set(data["project"]) and "build-system" in data, block.where
     elif "sources" in data or (fragment_of and fragment_of <= set(DatasetConfig.model_fields)):
         if named:  # an abridged copy of a whole file: validate the file
             data = tomllib.loads((ROOT / named.group(1)).read_text())
