@@ -758,11 +758,13 @@ class Classifier(Plugin):
 
     @abstractmethod
     def fit(self, features: FloatArray, labels: NDArray[Any]) -> Classifier:
-        """Fit on ``features`` (n_samples, n_features) and ``labels`` (n_samples,)."""
+        """Fit on ``features`` (n_samples, n_features) float64 and ``labels`` (n_samples,)
+        str; return the fitted classifier (``self``)."""
 
     @abstractmethod
     def predict(self, features: FloatArray) -> NDArray[Any]:
-        """Predicted labels, (n_samples,)."""
+        """Predicted labels (n_samples,), one per row of ``features``, each one of the labels
+        ``fit`` was given (an experiment stops naming the plugin otherwise)."""
 
 
 # --------------------------------------------------------------------------- effects
