@@ -495,16 +495,42 @@ SHORT_RECEIVE = (
 )
 
 
+#: a radar whose constructor fails with a ValueError of its own
+FAILING_INIT = (
+    "    def __init__(self, config=None):\n        super().__init__(config)\n"
+    "        raise ValueError('math domain error')\n"
+)
+#: the radar's broken method, and how the internal error names the plugin
+DATASET_BUGS = {
+    "receive": (
+        SHORT_RECEIVE,
+        "(in receive() of the radar plugin 'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug); check it "
+        "with mdframework.testing.check_radar_waveform; while building record 00000-",
+    ),
+    "constructor": (
+        FAILING_INIT,
+        "(in the radar plugin 'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug) while it was built from its "
+        "config; while building record 00000-",
+    ),
+}
+
+
+@pytest.mark.parametrize("method", sorted(DATASET_BUGS))
 @pytest.mark.parametrize("on_error", ["stop", "skip"])
 def test_a_plugin_bug_in_a_dataset_record_is_an_internal_error_not_the_configs(
-    on_error: str, installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    on_error: str,
+    method: str,
+    installed: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
 ) -> None:
-    """A third party's radar whose receive() breaks its contract with a ValueError, in a
-    dataset build: an internal error naming the plugin, as in `mdf run` (it was the user's
-    error, exit 2 naming the config file, and with on_error = 'skip' every record was skipped
-    as if its config were bad)."""
+    """A third party's radar whose receive() breaks its contract with a ValueError, or whose
+    constructor raises one, in a dataset build: an internal error naming the plugin, as in
+    `mdf run` (it was the user's error, exit 2 naming the config file, and with on_error =
+    'skip' every record was skipped as if its config were bad)."""
+    body, why = DATASET_BUGS[method]
     base = "from dataclasses import replace\nfrom mdf_lfm.waveform import LfmPulseDoppler as Base\n"
-    install_broken(installed, base, "radar_waveforms", SHORT_RECEIVE)
+    install_broken(installed, base, "radar_waveforms", body)
     config = tmp_path / "d.toml"
     config.write_text(f"""
 seed = 1
@@ -522,22 +548,24 @@ kind = "xyzzy_bug"
     assert cli.main(["dataset", "build", str(config), "--out", str(tmp_path / "ds")]) == 1
     lines = without_third_party_warnings(capsys.readouterr().err.strip().splitlines())
     assert len(lines) == 1 and lines[0].startswith("mdf: internal error: ValueError: "), lines
-    assert (
-        "(in receive() of the radar plugin 'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug); check it "
-        "with mdframework.testing.check_radar_waveform; while building record 00000-"
-    ) in lines[0], lines
+    assert why in lines[0], lines
 
 
+@pytest.mark.parametrize(
+    ("method", "body"),
+    [
+        ("load", "    def load(self):\n        return 1 / 0\n"),
+        ("__init__", "    def __init__(self, config=None):\n        1 / 0\n"),
+    ],
+)
 def test_a_recording_source_that_fails_is_an_internal_error_naming_it(
-    installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    method: str, body: str, installed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """A third party's recording source whose load() raises is its bug: the internal error
-    names it and its contract check, as docs/plugins.md says of any plugin's method (it named
-    nobody)."""
+    """A third party's recording source whose load() or constructor raises is its bug: the
+    internal error names it and its contract check, as docs/plugins.md says of any plugin's
+    method (it named nobody)."""
     base = "from mdf_radhar.source import RadharSource as Base\n"
-    install_broken(
-        installed, base, "recording_sources", "    def load(self):\n        return 1 / 0\n"
-    )
+    install_broken(installed, base, "recording_sources", body)
     data = EXAMPLES / "data" / "radhar" / "radhar_walk_subset.npz"
     config = tmp_path / "d.toml"
     config.write_text(f"""
@@ -550,8 +578,8 @@ recording = {{ kind = "xyzzy_bug", file = "{data}" }}
     lines = without_third_party_warnings(capsys.readouterr().err.strip().splitlines())
     assert len(lines) == 1, lines
     assert lines[0].startswith(
-        "mdf: internal error: ZeroDivisionError: division by zero (in load() of the recording "
-        "plugin 'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug); check it with "
+        f"mdf: internal error: ZeroDivisionError: division by zero (in {method}() of the "
+        "recording plugin 'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug); check it with "
         "mdframework.testing.check_recording_source;"
     ), lines
 

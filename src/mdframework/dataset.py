@@ -563,7 +563,8 @@ def _load_recordings(section_json: str, base_dir: str) -> tuple[Recording, ...]:
         cfg = cls.Config.model_validate(section, context={"base_dir": Path(base_dir)})
     except ValidationError as exc:
         raise ConfigError(format_validation_error(exc, "recording", section)) from None
-    source: Any = cls(cfg)
+    with blame(cls, "__init__"):
+        source: Any = cls(cfg)
     assert isinstance(source, RecordingSource)
     with blame(source, "load"):
         return tuple(source.load())

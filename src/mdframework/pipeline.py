@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import conditioning, emptiness, limits, sanity
-from .errors import DataFileError, SceneError
+from .errors import DataFileError, MdfError, SceneError
 from .fingerprint import motion_fingerprint
 from .interfaces import (
     Effect,
@@ -120,10 +120,14 @@ def build_stages(config: RunConfigBase, registry: Registry | None = None) -> Sta
         try:
             return cls(section)
         except Exception as exc:  # a bug in the plugin: the CLI's internal error names it
-            exc.add_note(
+            note = (
                 f"in the {interface} plugin {section.kind!r} "
                 f"({cls.__module__}.{cls.__qualname__}) while it was built from its config"
             )
+            if isinstance(exc, MdfError):  # the plugin refuses the config: the user's
+                exc.add_note(note)
+            else:  # also a ValueError, which a dataset build would take for its record's
+                name_plugin_bug(exc, note)
             raise
 
     source, model = make("motion", cfg.motion), make("scatterers", cfg.scatterers)
