@@ -488,6 +488,23 @@ def test_mdf_plugins_names_a_plugin_that_is_slow_to_import(
     assert 0.2 <= float(mine[0][3]) < 5 and mine[0][4] == "s"
 
 
+def test_what_a_plugin_prints_when_imported_stays_out_of_a_commands_output(
+    installed: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A third party's plugin that prints a banner when imported: `mdf config schema >
+    schema.json` wrote the banner into the JSON, which no JSON reader then took; it goes to
+    stderr."""
+    import json
+
+    body = 'print("xyzzy: hello")\n' + HEADER + EFFECT + registering("[XyzzyFx]")
+    _make_distribution(installed, "xyzzy-fx", "mdf_test_xyzzy", body, "xyzzy_fx")
+    capsys.readouterr()
+    assert cli.main(["config", "schema"]) == 0
+    out, err = capsys.readouterr()
+    assert "xyzzy_fx" in json.dumps(json.loads(out))  # the plugin works, its banner is not in
+    assert "xyzzy: hello" in err
+
+
 #: a radar that drops the last pulse of every block: a ValueError of the plugin's own
 SHORT_RECEIVE = (
     "    def receive(self, block):\n        out = super().receive(block)\n"

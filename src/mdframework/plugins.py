@@ -44,7 +44,7 @@ import time
 import typing
 import warnings
 from collections.abc import Callable, Iterable, Iterator
-from contextlib import contextmanager, suppress
+from contextlib import contextmanager, redirect_stdout, suppress
 from dataclasses import dataclass, field
 from functools import cache
 from typing import Any, Literal, NamedTuple
@@ -394,7 +394,10 @@ def _load_entry_points(
             continue
         clock = time.perf_counter()
         try:
-            plugin = ep.load()
+            # what a plugin prints when imported goes to stderr, not into a command's output
+            # (`mdf config schema > schema.json`)
+            with redirect_stdout(sys.stderr):
+                plugin = ep.load()
         except (Exception, SystemExit) as exc:  # sys.exit() at import: the plugin's, not ours
             _reraise_interrupt(exc)
             _warn_disabled(pm, ep.name, f"{dist} failed to load: {type(exc).__name__}: {exc}")
