@@ -211,6 +211,32 @@ def test_unseen_markers_make_their_joints_invalid(tmp_path: Path) -> None:
     assert c.valid[:, c.index("r_hand")].all()
 
 
+def test_a_file_of_two_subjects_reads_one_subjects_markers_only(tmp_path: Path) -> None:
+    """Vicon and Qualisys prefix each subject's markers (``S1:LASI``, ``S2:LASI``). A joint the
+    first subject lacks markers for must not be taken from the second (whose head, 2 m to the
+    side, was read as the first's head): with several subjects ``subject`` chooses whose
+    markers are read, and without it the file is refused naming them."""
+    body = _body(60, 60.0)
+    other = {j: v + np.array([0.0, 2.0, 0.0]) for j, v in body.items()}
+    first = {f"S1:{k}": v for k, v in pig_markers(body).items() if k[1:] != "FHD"}
+    second = {f"S2:{k}": v for k, v in pig_markers(other).items()}
+    path = tmp_path / "two.c3d"
+    write_c3d(path, {**first, **second}, 60.0, "mm", 0.001)
+    with pytest.raises(DataFileError, match=r"2 subjects \(S1, S2\): give motion.subject"):
+        C3dSource(C3dConfig(file=path)).load()
+    with pytest.raises(DataFileError, match=r"lacks head"):
+        C3dSource(C3dConfig(file=path, subject="S1")).load()
+    with pytest.raises(DataFileError, match=r"'S3' is not one of the file's 2 subjects"):
+        C3dSource(C3dConfig(file=path, subject="S3")).load()
+    m = C3dSource(C3dConfig(file=path, subject="S2")).load()
+    assert m.metadata["subject"] == "S2"
+    assert all(mk.startswith("S2:") for ms in m.metadata["markers"].values() for mk in ms)
+    c = m.canonical()
+    for j in CANONICAL_JOINTS:
+        truth = (other["l_hip"] + other["r_hip"]) / 2 if j == "base" else other[j]
+        assert np.allclose(c.joint(j), truth, atol=1e-4), j
+
+
 # --------------------------------------------------------------------------- bad input
 
 

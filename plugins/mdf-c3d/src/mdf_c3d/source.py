@@ -73,7 +73,10 @@ class C3dConfig(MarkerFileConfig):
         description="The file axis (with sign) that becomes x (forward), y (left) and z (up).",
     )
     subject: str | None = Field(
-        None, description="Subject id for the metadata; default: the file's SUBJECTS:NAMES."
+        None,
+        description="Subject id for the metadata; default: the file's SUBJECTS:NAMES. In a "
+        "file holding several subjects' markers (labels prefixed 'S1:', 'S2:'), the subject "
+        "whose markers are read.",
     )
 
     suffix: ClassVar[str] = ".c3d"
@@ -88,7 +91,11 @@ class TrcConfig(MarkerFileConfig):
         description="The file axis (with sign) that becomes x (forward), y (left) and z (up); "
         "default: OpenSim's lab frame (X forward, Y up, Z right).",
     )
-    subject: str | None = Field(None, description="Subject id for the metadata.")
+    subject: str | None = Field(
+        None,
+        description="Subject id for the metadata. In a file holding several subjects' markers "
+        "(labels prefixed 'S1:', 'S2:'), the subject whose markers are read.",
+    )
 
     suffix: ClassVar[str] = ".trc"
 
@@ -117,11 +124,17 @@ def markers_motion(
     ------
     mdframework.DataFileError
         Markers that do not make the body (the message lists the file's markers and what is
-        missing); fewer than two frames with a marker seen; joints beyond the limits.
+        missing); several subjects' markers without ``config.subject`` choosing one (see
+        :func:`subject_markers`); fewer than two frames with a marker seen; joints beyond the
+        limits.
     """
     from .markersets import MarkerMismatch, detect_marker_set, user_groups
 
     c = config
+    keep = subject_markers(path, labels, c.subject)
+    if keep is not None:
+        labels = tuple(labels[i] for i in keep)
+        positions = positions[:, keep]
     try:
         set_name, mapping = detect_marker_set(labels, user_groups(c.marker_map or {}), c.marker_set)
     except MarkerMismatch as exc:
@@ -154,6 +167,35 @@ def markers_motion(
     }
     skeleton = Skeleton(time, np.where(valid[..., None], pos, np.nan), CANONICAL_JOINTS, valid)
     return Motion(skeleton, meta, {j: j for j in CANONICAL_JOINTS})
+
+
+def subject_markers(path: Path, labels: tuple[str, ...], subject: str | None) -> list[int] | None:
+    """The indices of the markers of ``subject`` when the labels carry more than one subject
+    prefix (``S1:LASI``, ``S2:LASI``: Vicon and Qualisys label each subject's markers so), else
+    None (every marker is the one subject's).
+
+    Raises
+    ------
+    mdframework.DataFileError
+        Several subjects and ``subject`` not given, or not one of them (the message names them).
+    """
+    prefixes = list(dict.fromkeys(lab.rsplit(":", 1)[0] for lab in labels if ":" in lab))
+    if len(prefixes) < 2:
+        return None
+    shown = ", ".join(prefixes)
+    if subject is None:
+        raise DataFileError(
+            path,
+            f"the file holds the markers of {len(prefixes)} subjects ({shown}): give "
+            "motion.subject to choose whose markers to read",
+        )
+    if subject not in prefixes:
+        raise DataFileError(
+            path,
+            f"motion.subject {subject!r} is not one of the file's {len(prefixes)} subjects "
+            f"({shown})",
+        )
+    return [i for i, lab in enumerate(labels) if ":" in lab and lab.rsplit(":", 1)[0] == subject]
 
 
 class C3dSource(MotionSource):
