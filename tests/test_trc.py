@@ -239,6 +239,41 @@ def test_missing_markers_are_nan_and_the_joint_is_invalid_there(tmp_path, lines)
     assert not sk.valid[14, head] and sk.valid[14].sum() == 16 and sk.valid[15].all()
 
 
+def test_a_marker_at_exactly_the_origin_is_missing_in_trc_and_c3d(tmp_path, lines) -> None:
+    """Writers that mark no gap otherwise leave a marker not seen at (0, 0, 0). Averaged into
+    its joint, the lab's origin threw the left ankle of the real walk about 0.2 m for those
+    frames, 10 m/s between frames, with no finding: such a marker is missing, in TRC files and
+    (residual 0, not -1) in C3D files alike, and every other frame is read as before."""
+    heel = 2 + 3 * 19  # L.Heel, one of the left ankle's three markers
+    edited = list(lines)
+    for k in range(31, 41):  # data rows 25..34 (the data start at line 7)
+        fields = edited[k].split("\t")
+        fields[heel : heel + 3] = ["0.000000", "0.000000", "0.000000"]
+        edited[k] = "\t".join(fields)
+    ankle = CANONICAL_JOINTS.index("l_ankle")
+    reference = TrcSource(TrcConfig(file=REAL)).load().skeleton
+    zeros = read_trc(_write(tmp_path, edited))
+    assert (zeros.positions[25:35, 19] == 0).all()
+    c3d = tmp_path / "walk.c3d"
+    write_c3d(
+        c3d,
+        dict(zip(zeros.labels, np.moveaxis(zeros.positions, 1, 0), strict=True)),
+        60.0,
+        "mm",
+        1.0,
+    )
+    for motion in (
+        TrcSource(TrcConfig(file=_write(tmp_path, edited))).load(),
+        C3dSource(C3dConfig(file=c3d, axes=("x", "-z", "y"))).load(),
+    ):
+        sk = motion.skeleton
+        assert not sk.valid[25:35, ankle].any() and motion.metadata["zero_points"] == 10
+        keep = np.ones(sk.valid.shape, dtype=bool)
+        keep[25:35, ankle] = False
+        assert sk.valid[keep].all()
+        np.testing.assert_allclose(sk.positions[keep], reference.positions[keep], atol=1e-4)
+
+
 def test_units_and_frame_rate_overrides(tmp_path, lines) -> None:
     path = _write(tmp_path, _header(list(lines), "Units", "furlongs"))
     motion = TrcSource(TrcConfig(file=path, unit_m=1e-3, frame_rate=120.0)).load()

@@ -113,7 +113,8 @@ def markers_motion(
     """The canonical body from a marker file's tracks.
 
     ``positions`` (n_frames, n_markers, 3) in the file's unit (``unit_m`` metres each), NaN
-    where a marker is not seen; ``labels`` their names; ``rate`` [Hz] the frames' rate;
+    or exactly (0, 0, 0) where a marker is not seen (``zero_points`` in the metadata counts
+    the latter); ``labels`` their names; ``rate`` [Hz] the frames' rate;
     ``time`` (n_frames,) float64 [s] from 0, each frame's time (not uniform where the file
     skips frames). The
     marker set is detected (or taken from ``config``), each canonical joint is the mean of its
@@ -139,8 +140,14 @@ def markers_motion(
         set_name, mapping = detect_marker_set(labels, user_groups(c.marker_map or {}), c.marker_set)
     except MarkerMismatch as exc:
         raise DataFileError(path, str(exc)) from None
+    # a marker at exactly (0, 0, 0) is one not seen: writers that do not mark a gap otherwise
+    # (a C3D point's residual -1, a TRC's empty fields) leave zeros, and a mean with the lab's
+    # origin would throw the joint metres across the room for those frames
+    zeros = np.all(positions == 0.0, axis=2)
     try:
-        means, valid = group_means(positions, labels, mapping)
+        means, valid = group_means(
+            positions, labels, mapping, np.isfinite(positions).all(2) & ~zeros
+        )
     except KeyError as exc:  # pragma: no cover - resolve() only maps present labels
         raise DataFileError(path, f"marker(s) {exc} not in the file") from None
     pos = reorient(means * unit_m, c.axes)
@@ -164,6 +171,7 @@ def markers_motion(
         "marker_set": set_name,
         "markers": {j: list(m) for j, m in mapping.items()},
         "n_frames": int(pos.shape[0]),
+        "zero_points": int(np.count_nonzero(zeros)),
     }
     skeleton = Skeleton(time, np.where(valid[..., None], pos, np.nan), CANONICAL_JOINTS, valid)
     return Motion(skeleton, meta, {j: j for j in CANONICAL_JOINTS})
