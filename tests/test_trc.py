@@ -274,6 +274,62 @@ def test_a_marker_at_exactly_the_origin_is_missing_in_trc_and_c3d(tmp_path, line
         np.testing.assert_allclose(sk.positions[keep], reference.positions[keep], atol=1e-4)
 
 
+def _keypoint_trc(path: Path, keypoints: dict[str, np.ndarray], rate: float) -> Path:
+    """A TRC file as Pose2Sim writes one: metres, OpenSim's frame (Y up, Z right), from
+    keypoint tracks (n, 3) [m] in the project's frame."""
+    names = list(keypoints)
+    n = len(next(iter(keypoints.values())))
+    head = [
+        "PathFileType\t4\t(X/Y/Z)\tkeypoints.trc",
+        "DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\tOrigDataStartFrame\tOrigNumFrames",
+        f"{rate}\t{rate}\t{n}\t{len(names)}\tm\t{rate}\t0\t{n}",
+        "Frame#\tTime\t" + "\t\t\t".join(names),
+        "\t\t" + "\t".join(f"{a}{k + 1}" for k in range(len(names)) for a in "XYZ"),
+        "",
+    ]
+    rows = []
+    for f in range(n):
+        xyz = [
+            v for m in names for v in (keypoints[m][f, 0], keypoints[m][f, 2], -keypoints[m][f, 1])
+        ]
+        rows.append("\t".join([str(f), f"{f / rate:.6f}", *(f"{v:.7f}" for v in xyz)]))
+    path.write_text("\n".join(head + rows) + "\n")
+    return path
+
+
+def test_markerless_keypoints_as_pose2sim_writes_them_make_the_body(tmp_path) -> None:
+    """Pose2Sim (markerless capture) writes TRC files of keypoints named as HALPE_26 or
+    OpenPose's BODY_25 (Hip or MidHip, LHip, LKnee, LAnkle, LBigToe, LSmallToe, Neck, Head or
+    the ears, Nose, LShoulder, LElbow, LWrist, ...): no marker set fitted them, so every user
+    had to map all 17 joints. The keypoints set maps them: the real walk written as keypoints
+    (in metres, Y up) comes back as the same body."""
+    body = TrcSource(TrcConfig(file=REAL)).load().skeleton
+    j = {name: body.positions[:, k] for k, name in enumerate(body.joint_names)}
+    side = np.array([0.0, 0.02, 0.0])
+    halpe = {"Hip": j["base"], "Neck": j["neck"], "Head": j["head"], "Nose": j["head"] + 0.08}
+    for s, c in (("L", "l"), ("R", "r")):
+        for name, joint in (
+            ("Hip", "hip"),
+            ("Knee", "knee"),
+            ("Ankle", "ankle"),
+            ("Shoulder", "shoulder"),
+            ("Elbow", "elbow"),
+            ("Wrist", "hand"),
+        ):
+            halpe[s + name] = j[f"{c}_{joint}"]
+        halpe[s + "BigToe"], halpe[s + "SmallToe"] = j[f"{c}_toe"] + side, j[f"{c}_toe"] - side
+        halpe[s + "Heel"] = j[f"{c}_ankle"] - np.array([0.05, 0.0, 0.05])
+    body25 = {k: v for k, v in halpe.items() if k not in ("Hip", "Head")}
+    body25 |= {"MidHip": j["base"], "LEar": j["head"] + side, "REar": j["head"] - side}
+    for name, keypoints in (("halpe", halpe), ("body25", body25)):
+        motion = TrcSource(
+            TrcConfig(file=_keypoint_trc(tmp_path / f"{name}.trc", keypoints, 60.0))
+        ).load()
+        assert motion.metadata["marker_set"] == "keypoints", name
+        np.testing.assert_allclose(motion.skeleton.positions, body.positions, atol=1e-6)
+        np.testing.assert_allclose(motion.skeleton.time, body.time)
+
+
 def test_units_and_frame_rate_overrides(tmp_path, lines) -> None:
     path = _write(tmp_path, _header(list(lines), "Units", "furlongs"))
     motion = TrcSource(TrcConfig(file=path, unit_m=1e-3, frame_rate=120.0)).load()

@@ -28,7 +28,7 @@ from mdframework import (
 from mdframework.settings import FrameRate, MotionAxes, OrientedMotionConfig
 from mdframework.skeleton import check_canonical_keys, group_means, reorient
 
-MarkerSetName = Literal["auto", "plug-in-gait", "cmu", "opensim-gait"]
+MarkerSetName = Literal["auto", "plug-in-gait", "cmu", "opensim-gait", "keypoints"]
 
 
 class MarkerFileConfig(OrientedMotionConfig):
@@ -37,8 +37,8 @@ class MarkerFileConfig(OrientedMotionConfig):
     file: DataPath = Field(description="The marker file; relative to the config file's folder.")
     marker_set: MarkerSetName = Field(
         "auto",
-        description="Marker names: auto (detected from the labels), plug-in-gait, cmu or "
-        "opensim-gait.",
+        description="Marker names: auto (detected from the labels), plug-in-gait, cmu, "
+        "opensim-gait or keypoints (markerless: Pose2Sim's HALPE_26 or BODY_25 names).",
     )
     marker_map: dict[str, str | list[str]] | None = Field(
         None,
