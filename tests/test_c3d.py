@@ -220,14 +220,21 @@ def test_a_file_of_two_subjects_reads_one_subjects_markers_only(tmp_path: Path) 
     other = {j: v + np.array([0.0, 2.0, 0.0]) for j, v in body.items()}
     first = {f"S1:{k}": v for k, v in pig_markers(body).items() if k[1:] != "FHD"}
     second = {f"S2:{k}": v for k, v in pig_markers(other).items()}
+    prop = {f"Box:Corner{k}": body["base"] + np.array([1.0, 0.0, k / 10]) for k in range(4)}
     path = tmp_path / "two.c3d"
-    write_c3d(path, {**first, **second}, 60.0, "mm", 0.001)
+    write_c3d(path, {**first, **second, **prop}, 60.0, "mm", 0.001)
     with pytest.raises(DataFileError, match=r"2 subjects \(S1, S2\): give motion.subject"):
         C3dSource(C3dConfig(file=path)).load()
     with pytest.raises(DataFileError, match=r"lacks head"):
         C3dSource(C3dConfig(file=path, subject="S1")).load()
     with pytest.raises(DataFileError, match=r"'S3' is not one of the file's 2 subjects"):
         C3dSource(C3dConfig(file=path, subject="S3")).load()
+    # a prop's markers (prefixed too) are no subject's: one person and a box need no subject
+    alone = tmp_path / "one.c3d"
+    write_c3d(alone, {**second, **prop}, 60.0, "mm", 0.001)
+    assert np.allclose(
+        C3dSource(C3dConfig(file=alone)).load().canonical().joint("head"), other["head"], atol=1e-4
+    )
     m = C3dSource(C3dConfig(file=path, subject="S2")).load()
     assert m.metadata["subject"] == "S2"
     assert all(mk.startswith("S2:") for ms in m.metadata["markers"].values() for mk in ms)

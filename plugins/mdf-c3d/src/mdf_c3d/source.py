@@ -9,6 +9,8 @@ or ``marker_map``).
 from __future__ import annotations
 
 import warnings
+from collections.abc import Collection
+from itertools import chain
 from pathlib import Path
 from typing import Any, ClassVar, Literal
 
@@ -129,15 +131,24 @@ def markers_motion(
         :func:`subject_markers`); fewer than two frames with a marker seen; joints beyond the
         limits.
     """
-    from .markersets import MarkerMismatch, detect_marker_set, user_groups
+    from .markersets import (
+        MARKER_SETS,
+        MarkerMismatch,
+        detect_marker_set,
+        strip_prefix,
+        user_groups,
+    )
 
     c = config
-    keep = subject_markers(path, labels, c.subject)
+    groups = user_groups(c.marker_map or {})
+    known = {m for mset in MARKER_SETS.values() for g in mset.joints.values() for m in chain(*g)}
+    known |= {strip_prefix(m) for g in groups.values() for m in chain(*g)}
+    keep = subject_markers(path, labels, c.subject, known)
     if keep is not None:
         labels = tuple(labels[i] for i in keep)
         positions = positions[:, keep]
     try:
-        set_name, mapping = detect_marker_set(labels, user_groups(c.marker_map or {}), c.marker_set)
+        set_name, mapping = detect_marker_set(labels, groups, c.marker_set)
     except MarkerMismatch as exc:
         raise DataFileError(path, str(exc)) from None
     # a marker at exactly (0, 0, 0) is one not seen: writers that do not mark a gap otherwise
@@ -177,33 +188,46 @@ def markers_motion(
     return Motion(skeleton, meta, {j: j for j in CANONICAL_JOINTS})
 
 
-def subject_markers(path: Path, labels: tuple[str, ...], subject: str | None) -> list[int] | None:
-    """The indices of the markers of ``subject`` when the labels carry more than one subject
-    prefix (``S1:LASI``, ``S2:LASI``: Vicon and Qualisys label each subject's markers so), else
-    None (every marker is the one subject's).
+def subject_markers(
+    path: Path, labels: tuple[str, ...], subject: str | None, body_markers: Collection[str]
+) -> list[int] | None:
+    """The indices of the markers of ``subject`` when the labels carry the prefixes of more
+    than one subject (``S1:LASI``, ``S2:LASI``: Vicon and Qualisys label each subject's markers
+    so), else None (every marker is the one subject's). A prefix counts as a subject's when one
+    of its markers is among ``body_markers`` (the names the marker sets and the marker map
+    use), so the prefixes of props (``Box:Corner1``) do not.
 
     Raises
     ------
     mdframework.DataFileError
         Several subjects and ``subject`` not given, or not one of them (the message names them).
     """
-    prefixes = list(dict.fromkeys(lab.rsplit(":", 1)[0] for lab in labels if ":" in lab))
-    if len(prefixes) < 2:
+    from .markersets import strip_prefix
+
+    by_prefix: dict[str, list[int]] = {}
+    for i, lab in enumerate(labels):
+        if ":" in lab:
+            by_prefix.setdefault(lab.rsplit(":", 1)[0], []).append(i)
+    people = [
+        prefix
+        for prefix, members in by_prefix.items()
+        if any(strip_prefix(labels[i]) in body_markers for i in members)
+    ]
+    if len(people) < 2:
         return None
-    shown = ", ".join(prefixes)
+    shown = ", ".join(people)
     if subject is None:
         raise DataFileError(
             path,
-            f"the file holds the markers of {len(prefixes)} subjects ({shown}): give "
+            f"the file holds the markers of {len(people)} subjects ({shown}): give "
             "motion.subject to choose whose markers to read",
         )
-    if subject not in prefixes:
+    if subject not in by_prefix:
         raise DataFileError(
             path,
-            f"motion.subject {subject!r} is not one of the file's {len(prefixes)} subjects "
-            f"({shown})",
+            f"motion.subject {subject!r} is not one of the file's {len(people)} subjects ({shown})",
         )
-    return [i for i, lab in enumerate(labels) if ":" in lab and lab.rsplit(":", 1)[0] == subject]
+    return by_prefix[subject]
 
 
 class C3dSource(MotionSource):
