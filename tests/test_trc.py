@@ -330,6 +330,23 @@ def test_markerless_keypoints_as_pose2sim_writes_them_make_the_body(tmp_path) ->
         np.testing.assert_allclose(motion.skeleton.time, body.time)
 
 
+def test_rows_left_out_and_renumbered_are_named_as_such(tmp_path, lines) -> None:
+    """A writer that leaves out 30 rows (0.5 s at 60 Hz) and renumbers Frame# keeps the gap in
+    Time only. The error said to correct DataRate or give motion.frame_rate, which reads the
+    motion without the gap; it names the jump and says to number the frames as Time does."""
+    data = lines[6:66] + lines[96:]
+    renumbered = [f"{k + 1}\t" + row.split("\t", 1)[1] for k, row in enumerate(data)]
+    path = _write(tmp_path, _header([*lines[:6], *renumbered], "NumFrames", str(len(data))))
+    with pytest.raises(DataFileError) as err:
+        read_trc(path)
+    assert str(err.value) == (
+        f"{path}:67: Time jumps 0.517 s from the row before while Frame# steps by 1 (0.01667 s at "
+        "DataRate 60 Hz): rows were left out and the frames renumbered; the time base is "
+        "Frame# / DataRate, so number the frames as Time says (motion.frame_rate would read the "
+        "motion without the gap)"
+    )
+
+
 def test_units_and_frame_rate_overrides(tmp_path, lines) -> None:
     path = _write(tmp_path, _header(list(lines), "Units", "furlongs"))
     motion = TrcSource(TrcConfig(file=path, unit_m=1e-3, frame_rate=120.0)).load()
