@@ -244,6 +244,23 @@ def test_a_file_of_two_subjects_reads_one_subjects_markers_only(tmp_path: Path) 
         assert np.allclose(c.joint(j), truth, atol=1e-4), j
 
 
+def test_a_joint_whose_marker_is_never_seen_is_named_with_the_marker(tmp_path: Path) -> None:
+    """A marker the file names but never saw (not labelled in any frame) left its joint
+    untracked throughout; the run then stopped saying to choose a record where the joint is
+    tracked, which no record is. The load names the joint, the marker and the marker map."""
+    markers = pig_markers(_body(60, 60.0))
+    markers["LELB"][:] = np.nan
+    path = tmp_path / "noelbow.c3d"
+    write_c3d(path, markers, 60.0, "mm", 0.001)
+    with pytest.raises(DataFileError) as err:
+        C3dSource(C3dConfig(file=path)).load()
+    assert str(err.value) == (
+        f"{path}: joint l_elbow is seen in fewer than two frames: its marker(s) LELB are seen in "
+        "fewer than two frames; give motion.marker_map for l_elbow (markers of the file that are "
+        "seen)"
+    )
+
+
 # --------------------------------------------------------------------------- bad input
 
 

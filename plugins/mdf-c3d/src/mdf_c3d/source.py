@@ -155,10 +155,9 @@ def markers_motion(
     # (a C3D point's residual -1, a TRC's empty fields) leave zeros, and a mean with the lab's
     # origin would throw the joint metres across the room for those frames
     zeros = np.all(positions == 0.0, axis=2)
+    seen = np.isfinite(positions).all(2) & ~zeros  # (n_frames, n_markers)
     try:
-        means, valid = group_means(
-            positions, labels, mapping, np.isfinite(positions).all(2) & ~zeros
-        )
+        means, valid = group_means(positions, labels, mapping, seen)
     except KeyError as exc:  # pragma: no cover - resolve() only maps present labels
         raise DataFileError(path, f"marker(s) {exc} not in the file") from None
     pos = reorient(means * unit_m, c.axes)
@@ -166,6 +165,17 @@ def markers_motion(
         raise DataFileError(
             path, "fewer than two frames where any mapped marker is seen: nothing to move"
         )
+    index = {lab: k for k, lab in enumerate(labels)}
+    for k, (joint, members) in enumerate(mapping.items()):  # canonical order, as means
+        if valid[:, k].sum() < 2:
+            unseen = [m for m in members if seen[:, index[m]].sum() < 2]
+            where = "fewer than two frames" if unseen else "fewer than two frames together"
+            raise DataFileError(
+                path,
+                f"joint {joint} is seen in fewer than two frames: its marker(s) "
+                f"{', '.join(unseen or members)} are seen in {where}; give motion.marker_map "
+                f"for {joint} (markers of the file that are seen)",
+            )
     limits.check_time_stamps(path, time)
     limits.check_values(
         path, pos, limits.MAX_COORDINATE_M, "a joint coordinate", unit=" m", allow_nan=True
