@@ -770,6 +770,18 @@ def test_a_long_gap_is_named_not_bridged_silently(tmp_path: Path) -> None:
     dropped = _trc_rows_edited(tmp_path / "drop.trc", slice(60, 90), None)
     motion, caught = load({"kind": "trc", "file": str(dropped), "activity": "walk"})
     assert [w for w in caught if "the recording has no frame for 0.517 s (0.983-1.500 s)" in w]
+    # a coarse recording is no gapped one: the walk at 4 frames a second (0.25 s apart)
+    real = str(EXAMPLES / "data/trc/opensim_subject01_walk.trc")
+    motion, _ = load({"kind": "trc", "file": real, "activity": "walk"})
+    coarse = motion.skeleton
+    keep = slice(None, None, 15)
+    coarse = Skeleton(
+        coarse.time[keep], coarse.positions[keep], coarse.joint_names, coarse.valid[keep]
+    )
+    checked = check_motion(
+        Motion(coarse, motion.metadata, motion.canonical_map), SanityConfig(cadence=False)
+    )
+    assert checked.metadata["sanity"]["gaps"]["count"] == 0
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         for name, recording in _recordings().items():

@@ -220,12 +220,16 @@ def long_gaps(time: FloatArray, valid: BoolArray, max_gap_s: float) -> list[dict
     """Gaps longer than ``max_gap_s`` [s] that interpolation bridges, longest first: a joint
     untracked between two tracked frames (``joint`` its name index), or a step between frames
     (``joint`` None: frames the recording lacks). ``time`` (n_frames,) [s]; ``valid``
-    (n_frames, n_joints) bool. Each item: joint, from_s and to_s (the frames around the gap,
-    from the first frame), duration_s."""
+    (n_frames, n_joints) bool. A step between frames counts when also longer than
+    :data:`GAP_STEP_RATIO` times the median step. Each item: joint, from_s and to_s (the
+    frames around the gap, from the first frame), duration_s."""
     t = np.asarray(time, dtype=np.float64)
     out: list[dict[str, Any]] = []
     step = np.diff(t)
-    for k in np.flatnonzero(step > max_gap_s):
+    # frames the recording lacks: a step longer than max_gap_s and than a frame period (a
+    # recording of 4 frames a second is coarse, not gapped)
+    longest = max(max_gap_s, GAP_STEP_RATIO * float(np.median(step))) if step.size else max_gap_s
+    for k in np.flatnonzero(step > longest):
         out.append({"joint": None, "from_s": t[k] - t[0], "to_s": t[k + 1] - t[0]})
     for j in range(valid.shape[1]):
         seen = t[valid[:, j]]

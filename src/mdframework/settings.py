@@ -193,9 +193,10 @@ class SanityConfig(StrictModel):
     )
     gaps: Literal["warn", "ignore", "error"] = Field(
         "warn",
-        description="A joint untracked, or every joint without a frame, for longer than "
-        "max_gap_s between tracked frames (markers hidden from the cameras, frames a tracker "
-        "dropped), which the simulation bridges by interpolation: warn, flag silently, or stop.",
+        description="A joint untracked, or every joint without a frame (a step longer than "
+        "1.5 frame periods too), for longer than max_gap_s between tracked frames (markers "
+        "hidden from the cameras, frames a tracker dropped), which the simulation bridges by "
+        "interpolation: warn, flag silently, or stop.",
     )
     max_gap_s: PositiveSeconds = Field(
         0.2,
