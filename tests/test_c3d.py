@@ -211,6 +211,56 @@ def test_unseen_markers_make_their_joints_invalid(tmp_path: Path) -> None:
     assert c.valid[:, c.index("r_hand")].all()
 
 
+def test_a_file_of_two_subjects_reads_one_subjects_markers_only(tmp_path: Path) -> None:
+    """Vicon and Qualisys prefix each subject's markers (``S1:LASI``, ``S2:LASI``). A joint the
+    first subject lacks markers for must not be taken from the second (whose head, 2 m to the
+    side, was read as the first's head): with several subjects ``subject`` chooses whose
+    markers are read, and without it the file is refused naming them."""
+    body = _body(60, 60.0)
+    other = {j: v + np.array([0.0, 2.0, 0.0]) for j, v in body.items()}
+    first = {f"S1:{k}": v for k, v in pig_markers(body).items() if k[1:] != "FHD"}
+    second = {f"S2:{k}": v for k, v in pig_markers(other).items()}
+    prop = {f"Box:Corner{k}": body["base"] + np.array([1.0, 0.0, k / 10]) for k in range(4)}
+    path = tmp_path / "two.c3d"
+    write_c3d(path, {**first, **second, **prop}, 60.0, "mm", 0.001)
+    with pytest.raises(DataFileError, match=r"2 subjects \(S1, S2\): give motion.subject"):
+        C3dSource(C3dConfig(file=path)).load()
+    with pytest.raises(DataFileError, match=r"lacks head"):
+        C3dSource(C3dConfig(file=path, subject="S1")).load()
+    with pytest.raises(DataFileError, match=r"'S3' is not one of the file's 2 subjects"):
+        C3dSource(C3dConfig(file=path, subject="S3")).load()
+    # a prop's markers (prefixed too) are no subject's: one person and a box need no subject
+    alone = tmp_path / "one.c3d"
+    write_c3d(alone, {**second, **prop}, 60.0, "mm", 0.001)
+    assert np.allclose(
+        C3dSource(C3dConfig(file=alone)).load().canonical().joint("head"), other["head"], atol=1e-4
+    )
+    m = C3dSource(C3dConfig(file=path, subject="S2")).load()
+    assert m.metadata["subject"] == "S2"
+    assert all(mk.startswith("S2:") for ms in m.metadata["markers"].values() for mk in ms)
+    c = m.canonical()
+    for j in CANONICAL_JOINTS:
+        truth = (other["l_hip"] + other["r_hip"]) / 2 if j == "base" else other[j]
+        assert np.allclose(c.joint(j), truth, atol=1e-4), j
+
+
+def test_a_joint_whose_marker_is_never_seen_is_named_with_the_marker(tmp_path: Path) -> None:
+    """A marker the file names but never saw (not labelled in any frame) left its joint
+    untracked throughout; the run then stopped saying to choose a record where the joint is
+    tracked, which no record is. The load names the joint, the marker and the marker map."""
+    markers = pig_markers(_body(60, 60.0))
+    markers["LELB"][:] = np.nan
+    path = tmp_path / "noelbow.c3d"
+    write_c3d(path, markers, 60.0, "mm", 0.001)
+    with pytest.raises(DataFileError) as err:
+        C3dSource(C3dConfig(file=path)).load()
+    assert str(err.value) == (
+        f"{path}: joint l_elbow is seen in fewer than two frames: its marker(s) LELB are seen in "
+        "fewer than two frames; give motion.marker_map for l_elbow (markers of the file that are "
+        "seen)"
+    )
+
+
 # --------------------------------------------------------------------------- bad input
 
 

@@ -474,6 +474,44 @@ def test_ntu_layout(tmp_path: Path) -> None:
     assert np.allclose(back.positions[0, 0], rec.positions[0, v1["HipCenter"]], atol=1e-6)
 
 
+def test_ntu_reads_the_body_in_most_frames_and_names_every_body(tmp_path: Path) -> None:
+    """NTU's Kinect v2 sometimes reports a short false body before the person (and two-person
+    actions hold two). The first body seen was read: here 15 frames of a false body, and the
+    person walking through all 100 frames was dropped without a word. The default is the body
+    in most frames, with a warning naming every body; motion.body chooses one."""
+    rec = read_utkinect(UT)
+    person = ntu_text(rec, bodies=1).splitlines()
+    n = int(person[0])
+    lines = [str(n)]
+    for k in range(n):
+        frame = person[1 + 28 * k + 1 : 1 + 28 * (k + 1)]  # the body line, "25", 25 joints
+        false = ["72057594037931000 0 0 0 0 0 0 0 0 1", "25"] + [
+            "0.5 0.2 3.0 1 1 1 1 1 0 0 0 1"
+        ] * 25
+        lines += [str(2 if k < 15 else 1), *(false if k < 15 else []), *frame]
+    path = tmp_path / "S001C001P001R001A060.skeleton"
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.warns(
+        UserWarning,
+        match=r"2 bodies \(body 1 \(id 72057594037931000, 15 frames\), "
+        r"body 2 \(id 72057594037931101, \d+ frames\)\); reading body 2.*motion.body",
+    ):
+        m = KinectSource(KinectConfig(format="ntu", file=path)).load()
+    assert m.metadata["body_id"] == "72057594037931101" and m.metadata["bodies"] == 2
+    v1 = {name: i for i, name in enumerate(KINECT_V1_JOINTS)}
+    back = read_ntu(path)
+    assert back.time.shape[0] == rec.time.shape[0]
+    np.testing.assert_allclose(back.positions[:, 0], rec.positions[:, v1["HipCenter"]], atol=1e-6)
+    false_body = read_ntu(path, body=1)
+    assert false_body.time.shape[0] == 15 and np.allclose(
+        false_body.positions[:, 0], [0.5, 0.2, 3.0]
+    )
+    with pytest.raises(DataFileError, match=r"motion.body is 3, but the file holds 2 bodies"):
+        read_ntu(path, body=3)
+    with pytest.raises(ValueError, match="body applies to the ntu format only"):
+        KinectConfig(format="utkinect", file=UT, body=1)
+
+
 # --------------------------------------------------------------------------- bad input
 
 

@@ -732,6 +732,62 @@ def test_a_left_handed_file_is_read_as_the_body_it_holds(tmp_path: Path) -> None
     assert foot_facing_cosine(read) == foot_facing_cosine(body)
 
 
+def _trc_rows_edited(dst: Path, rows: slice, blank_marker: str | None) -> Path:
+    """The shipped TRC walk with the data ``rows`` (0-based) left out, or, given a marker,
+    with that marker's fields left empty there (not seen by the cameras)."""
+    lines = (EXAMPLES / "data/trc/opensim_subject01_walk.trc").read_text().splitlines()
+    head, data = lines[:6], lines[6:]
+    names = [f.strip() for f in lines[3].split("\t")[2:] if f.strip()]
+    if blank_marker is None:
+        del data[rows]
+        head[2] = head[2].replace("\t       151\t", f"\t       {len(data)}\t", 1)
+    else:
+        col = 2 + 3 * names.index(blank_marker)
+        for k in range(*rows.indices(len(data))):
+            cells = data[k].split("\t")
+            cells[col : col + 3] = ["", "", ""]
+            data[k] = "\t".join(cells)
+    dst.write_text("\n".join(head + data) + "\n")
+    return dst
+
+
+def test_a_long_gap_is_named_not_bridged_silently(tmp_path: Path) -> None:
+    """A marker hidden from the cameras for 1.5 s (the left heel of the real TRC walk, one of
+    the left ankle's three markers) and 0.5 s of frames a tracker dropped were bridged by the
+    simulation's interpolation without a word: the sanity check names the joint and the
+    times, and refuses the motion with gaps = "error". The shipped recordings have none."""
+    heel = _trc_rows_edited(tmp_path / "heel.trc", slice(30, 120), "L.Heel")
+    section = {"kind": "trc", "file": str(heel), "activity": "walk"}
+    motion, caught = load(section)
+    gaps = motion.metadata["sanity"]["gaps"]
+    assert gaps["count"] == 1 and gaps["items"][0]["joint"] == "l_ankle"
+    expected = "l_ankle is untracked for 1.517 s (0.483-2.000 s), longer than "
+    assert [w for w in caught if expected in w and str(heel) in w], caught
+    with pytest.raises(DataFileError, match=r"heel.trc: motion sanity: l_ankle is untracked"):
+        load(section, gaps="error")
+    _, caught = load(section, max_gap_s=2.0)
+    assert not [w for w in caught if "untracked" in w]
+    dropped = _trc_rows_edited(tmp_path / "drop.trc", slice(60, 90), None)
+    motion, caught = load({"kind": "trc", "file": str(dropped), "activity": "walk"})
+    assert [w for w in caught if "the recording has no frame for 0.517 s (0.983-1.500 s)" in w]
+    # a coarse recording is no gapped one: the walk at 4 frames a second (0.25 s apart)
+    real = str(EXAMPLES / "data/trc/opensim_subject01_walk.trc")
+    motion, _ = load({"kind": "trc", "file": real, "activity": "walk"})
+    coarse = motion.skeleton
+    keep = slice(None, None, 15)
+    coarse = Skeleton(
+        coarse.time[keep], coarse.positions[keep], coarse.joint_names, coarse.valid[keep]
+    )
+    checked = check_motion(
+        Motion(coarse, motion.metadata, motion.canonical_map), SanityConfig(cadence=False)
+    )
+    assert checked.metadata["sanity"]["gaps"]["count"] == 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for name, recording in _recordings().items():
+            assert load(recording)[0].metadata["sanity"]["gaps"]["count"] == 0, name
+
+
 def test_a_body_read_in_the_wrong_length_unit_is_flagged() -> None:
     """The real 16_21 walk (cgspeed's unit, 1/0.45 inch) read as inches, as CMU's files are
     often said to be: a body 0.45 times its size, legs of 0.38 m, walking at 0.77 m/s, which

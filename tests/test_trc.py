@@ -239,6 +239,114 @@ def test_missing_markers_are_nan_and_the_joint_is_invalid_there(tmp_path, lines)
     assert not sk.valid[14, head] and sk.valid[14].sum() == 16 and sk.valid[15].all()
 
 
+def test_a_marker_at_exactly_the_origin_is_missing_in_trc_and_c3d(tmp_path, lines) -> None:
+    """Writers that mark no gap otherwise leave a marker not seen at (0, 0, 0). Averaged into
+    its joint, the lab's origin threw the left ankle of the real walk about 0.2 m for those
+    frames, 10 m/s between frames, with no finding: such a marker is missing, in TRC files and
+    (residual 0, not -1) in C3D files alike, and every other frame is read as before."""
+    heel = 2 + 3 * 19  # L.Heel, one of the left ankle's three markers
+    edited = list(lines)
+    for k in range(31, 41):  # data rows 25..34 (the data start at line 7)
+        fields = edited[k].split("\t")
+        fields[heel : heel + 3] = ["0.000000", "0.000000", "0.000000"]
+        edited[k] = "\t".join(fields)
+    ankle = CANONICAL_JOINTS.index("l_ankle")
+    reference = TrcSource(TrcConfig(file=REAL)).load().skeleton
+    zeros = read_trc(_write(tmp_path, edited))
+    assert (zeros.positions[25:35, 19] == 0).all()
+    c3d = tmp_path / "walk.c3d"
+    write_c3d(
+        c3d,
+        dict(zip(zeros.labels, np.moveaxis(zeros.positions, 1, 0), strict=True)),
+        60.0,
+        "mm",
+        1.0,
+    )
+    for motion in (
+        TrcSource(TrcConfig(file=_write(tmp_path, edited))).load(),
+        C3dSource(C3dConfig(file=c3d, axes=("x", "-z", "y"))).load(),
+    ):
+        sk = motion.skeleton
+        assert not sk.valid[25:35, ankle].any() and motion.metadata["zero_points"] == 10
+        keep = np.ones(sk.valid.shape, dtype=bool)
+        keep[25:35, ankle] = False
+        assert sk.valid[keep].all()
+        np.testing.assert_allclose(sk.positions[keep], reference.positions[keep], atol=1e-4)
+
+
+def _keypoint_trc(path: Path, keypoints: dict[str, np.ndarray], rate: float) -> Path:
+    """A TRC file as Pose2Sim writes one: metres, OpenSim's frame (Y up, Z right), from
+    keypoint tracks (n, 3) [m] in the project's frame."""
+    names = list(keypoints)
+    n = len(next(iter(keypoints.values())))
+    head = [
+        "PathFileType\t4\t(X/Y/Z)\tkeypoints.trc",
+        "DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\tOrigDataStartFrame\tOrigNumFrames",
+        f"{rate}\t{rate}\t{n}\t{len(names)}\tm\t{rate}\t0\t{n}",
+        "Frame#\tTime\t" + "\t\t\t".join(names),
+        "\t\t" + "\t".join(f"{a}{k + 1}" for k in range(len(names)) for a in "XYZ"),
+        "",
+    ]
+    rows = []
+    for f in range(n):
+        xyz = [
+            v for m in names for v in (keypoints[m][f, 0], keypoints[m][f, 2], -keypoints[m][f, 1])
+        ]
+        rows.append("\t".join([str(f), f"{f / rate:.6f}", *(f"{v:.7f}" for v in xyz)]))
+    path.write_text("\n".join(head + rows) + "\n")
+    return path
+
+
+def test_markerless_keypoints_as_pose2sim_writes_them_make_the_body(tmp_path) -> None:
+    """Pose2Sim (markerless capture) writes TRC files of keypoints named as HALPE_26 or
+    OpenPose's BODY_25 (Hip or MidHip, LHip, LKnee, LAnkle, LBigToe, LSmallToe, Neck, Head or
+    the ears, Nose, LShoulder, LElbow, LWrist, ...): no marker set fitted them, so every user
+    had to map all 17 joints. The keypoints set maps them: the real walk written as keypoints
+    (in metres, Y up) comes back as the same body."""
+    body = TrcSource(TrcConfig(file=REAL)).load().skeleton
+    j = {name: body.positions[:, k] for k, name in enumerate(body.joint_names)}
+    side = np.array([0.0, 0.02, 0.0])
+    halpe = {"Hip": j["base"], "Neck": j["neck"], "Head": j["head"], "Nose": j["head"] + 0.08}
+    for s, c in (("L", "l"), ("R", "r")):
+        for name, joint in (
+            ("Hip", "hip"),
+            ("Knee", "knee"),
+            ("Ankle", "ankle"),
+            ("Shoulder", "shoulder"),
+            ("Elbow", "elbow"),
+            ("Wrist", "hand"),
+        ):
+            halpe[s + name] = j[f"{c}_{joint}"]
+        halpe[s + "BigToe"], halpe[s + "SmallToe"] = j[f"{c}_toe"] + side, j[f"{c}_toe"] - side
+        halpe[s + "Heel"] = j[f"{c}_ankle"] - np.array([0.05, 0.0, 0.05])
+    body25 = {k: v for k, v in halpe.items() if k not in ("Hip", "Head")}
+    body25 |= {"MidHip": j["base"], "LEar": j["head"] + side, "REar": j["head"] - side}
+    for name, keypoints in (("halpe", halpe), ("body25", body25)):
+        motion = TrcSource(
+            TrcConfig(file=_keypoint_trc(tmp_path / f"{name}.trc", keypoints, 60.0))
+        ).load()
+        assert motion.metadata["marker_set"] == "keypoints", name
+        np.testing.assert_allclose(motion.skeleton.positions, body.positions, atol=1e-6)
+        np.testing.assert_allclose(motion.skeleton.time, body.time)
+
+
+def test_rows_left_out_and_renumbered_are_named_as_such(tmp_path, lines) -> None:
+    """A writer that leaves out 30 rows (0.5 s at 60 Hz) and renumbers Frame# keeps the gap in
+    Time only. The error said to correct DataRate or give motion.frame_rate, which reads the
+    motion without the gap; it names the jump and says to number the frames as Time does."""
+    data = lines[6:66] + lines[96:]
+    renumbered = [f"{k + 1}\t" + row.split("\t", 1)[1] for k, row in enumerate(data)]
+    path = _write(tmp_path, _header([*lines[:6], *renumbered], "NumFrames", str(len(data))))
+    with pytest.raises(DataFileError) as err:
+        read_trc(path)
+    assert str(err.value) == (
+        f"{path}:67: Time jumps 0.517 s from the row before while Frame# steps by 1 (0.01667 s at "
+        "DataRate 60 Hz): rows were left out and the frames renumbered; the time base is "
+        "Frame# / DataRate, so number the frames as Time says (motion.frame_rate would read the "
+        "motion without the gap)"
+    )
+
+
 def test_units_and_frame_rate_overrides(tmp_path, lines) -> None:
     path = _write(tmp_path, _header(list(lines), "Units", "furlongs"))
     motion = TrcSource(TrcConfig(file=path, unit_m=1e-3, frame_rate=120.0)).load()

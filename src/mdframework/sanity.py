@@ -216,6 +216,33 @@ def _measured(time: FloatArray, valid: BoolArray | None, shape: tuple[int, ...])
     return ok
 
 
+def long_gaps(time: FloatArray, valid: BoolArray, max_gap_s: float) -> list[dict[str, Any]]:
+    """Gaps longer than ``max_gap_s`` [s] that interpolation bridges, longest first: a joint
+    untracked between two tracked frames (``joint`` its name index), or a step between frames
+    (``joint`` None: frames the recording lacks). ``time`` (n_frames,) [s]; ``valid``
+    (n_frames, n_joints) bool. A step between frames counts when also longer than
+    :data:`GAP_STEP_RATIO` times the median step. Each item: joint, from_s and to_s (the
+    frames around the gap, from the first frame), duration_s."""
+    t = np.asarray(time, dtype=np.float64)
+    out: list[dict[str, Any]] = []
+    step = np.diff(t)
+    # frames the recording lacks: a step longer than max_gap_s and than a frame period (a
+    # recording of 4 frames a second is coarse, not gapped)
+    longest = max(max_gap_s, GAP_STEP_RATIO * float(np.median(step))) if step.size else max_gap_s
+    for k in np.flatnonzero(step > longest):
+        out.append({"joint": None, "from_s": t[k] - t[0], "to_s": t[k + 1] - t[0]})
+    for j in range(valid.shape[1]):
+        seen = t[valid[:, j]]
+        for k in np.flatnonzero(np.diff(seen) > max_gap_s):
+            around = (t > seen[k]) & (t < seen[k + 1])  # frames inside, all untracked
+            if around.any():
+                out.append({"joint": j, "from_s": seen[k] - t[0], "to_s": seen[k + 1] - t[0]})
+    for g in out:
+        g["from_s"], g["to_s"] = round(float(g["from_s"]), 6), round(float(g["to_s"]), 6)
+        g["duration_s"] = round(g["to_s"] - g["from_s"], 6)
+    return sorted(out, key=lambda g: -g["duration_s"])
+
+
 def _glitch_mask(
     e: FloatArray,
     measured: BoolArray,
@@ -528,6 +555,28 @@ def check_motion(motion: Motion, config: SanityConfig) -> Motion:
                 f"{len(over)} joint limit(s) exceeded, e.g. {worst['joint']} {worst['quantity']} "
                 f"{worst['max']:.3g} {unit} > {worst['limit']:.3g} at "
                 f"{worst['first_time_s']:.3f} s",
+            )
+        )
+
+    gaps = long_gaps(body.time, body.valid, config.max_gap_s)
+    for g in gaps:
+        g["joint"] = None if g["joint"] is None else body.joint_names[g["joint"]]
+    report["gaps"] = {
+        "count": len(gaps),
+        "max_gap_s": config.max_gap_s,
+        "items": gaps[:_MAX_LISTED],
+    }
+    if gaps:
+        g = gaps[0]
+        what = "the recording has no frame" if g["joint"] is None else f"{g['joint']} is untracked"
+        more = f" (and {len(gaps) - 1} more such gap(s))" if len(gaps) > 1 else ""
+        notes.append(
+            (
+                config.gaps,
+                f"{what} for {g['duration_s']:.3f} s ({g['from_s']:.3f}-{g['to_s']:.3f} s), "
+                f"longer than motion.sanity.max_gap_s = {config.max_gap_s:g} s{more}: the "
+                "simulation interpolates across such gaps; choose a record without them "
+                "(motion.start, motion.duration) or fill them in the file",
             )
         )
 

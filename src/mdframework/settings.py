@@ -191,6 +191,18 @@ class SanityConfig(StrictModel):
         description="Smallest median height [m] of the head above the pelvis of an upright "
         "body (the shipped recordings give 0.45-0.8 m).",
     )
+    gaps: Literal["warn", "ignore", "error"] = Field(
+        "warn",
+        description="A joint untracked, or every joint without a frame (a step longer than "
+        "1.5 frame periods too), for longer than max_gap_s between tracked frames (markers "
+        "hidden from the cameras, frames a tracker dropped), which the simulation bridges by "
+        "interpolation: warn, flag silently, or stop.",
+    )
+    max_gap_s: PositiveSeconds = Field(
+        0.2,
+        description="Longest gap [s] bridged without a finding (0.2 s: about a fifth of a gait "
+        "cycle, conditioning's max_gap_s).",
+    )
     size: Literal["warn", "ignore", "error"] = Field(
         "warn",
         description="A body whose legs (hip to knee to ankle, median over the frames) are "

@@ -22,6 +22,12 @@ opensim-gait       The 41 markers of OpenSim's gait examples (Gait2354/Gait2392 
                    cluster's lowest marker and the shank cluster's highest: the set has no knee
                    marker), ankles ``L.Heel L.Midfoot.Sup L.Midfoot.Lat``, toes
                    ``L.Toe.Lat L.Toe.Med``; and the same on the right.
+keypoints          Markerless keypoints, joint centres already (Pose2Sim's TRC files, HALPE_26
+                   or OpenPose BODY_25 names): pelvis ``Hip`` (or ``MidHip``, or
+                   ``LHip RHip``), neck ``Neck``, head ``Head`` (or ``LEar REar``, or
+                   ``Nose``), shoulders ``LShoulder``, elbows ``LElbow``, hands ``LWrist``,
+                   hips ``LHip``, knees ``LKnee``, ankles ``LAnkle``, toes
+                   ``LBigToe LSmallToe``; and the same on the right.
 =================  ============================================================================
 
 A mean of skin markers is not the joint centre: the knee and ankle markers sit on the lateral
@@ -126,6 +132,27 @@ MARKER_SETS: dict[str, MarkerSet] = {
             ),
         },
         ("V.Sacral", "R.Thigh.Upper", "R.Shank.Upper", "Top.Head", "R.Temple"),
+    ),
+    "keypoints": MarkerSet(
+        "keypoints",
+        "Markerless keypoints (Pose2Sim's TRC files: HALPE_26, OpenPose BODY_25)",
+        {
+            "base": (("Hip",), ("MidHip",), ("LHip", "RHip")),
+            "neck": (("Neck",),),
+            "head": (("Head",), ("LEar", "REar"), ("Nose",)),
+            **_mirror(
+                {
+                    "l_shoulder": (("LShoulder",),),
+                    "l_elbow": (("LElbow",),),
+                    "l_hand": (("LWrist",),),
+                    "l_hip": (("LHip",),),
+                    "l_knee": (("LKnee",),),
+                    "l_ankle": (("LAnkle",),),
+                    "l_toe": (("LBigToe", "LSmallToe"), ("LBigToe",)),
+                }
+            ),
+        },
+        ("LBigToe", "RBigToe", "LSmallToe", "RHeel", "LShoulder", "RWrist"),
     ),
 }
 

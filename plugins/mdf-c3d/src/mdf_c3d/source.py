@@ -9,6 +9,8 @@ or ``marker_map``).
 from __future__ import annotations
 
 import warnings
+from collections.abc import Collection
+from itertools import chain
 from pathlib import Path
 from typing import Any, ClassVar, Literal
 
@@ -28,7 +30,7 @@ from mdframework import (
 from mdframework.settings import FrameRate, MotionAxes, OrientedMotionConfig
 from mdframework.skeleton import check_canonical_keys, group_means, reorient
 
-MarkerSetName = Literal["auto", "plug-in-gait", "cmu", "opensim-gait"]
+MarkerSetName = Literal["auto", "plug-in-gait", "cmu", "opensim-gait", "keypoints"]
 
 
 class MarkerFileConfig(OrientedMotionConfig):
@@ -37,8 +39,8 @@ class MarkerFileConfig(OrientedMotionConfig):
     file: DataPath = Field(description="The marker file; relative to the config file's folder.")
     marker_set: MarkerSetName = Field(
         "auto",
-        description="Marker names: auto (detected from the labels), plug-in-gait, cmu or "
-        "opensim-gait.",
+        description="Marker names: auto (detected from the labels), plug-in-gait, cmu, "
+        "opensim-gait or keypoints (markerless: Pose2Sim's HALPE_26 or BODY_25 names).",
     )
     marker_map: dict[str, str | list[str]] | None = Field(
         None,
@@ -73,7 +75,10 @@ class C3dConfig(MarkerFileConfig):
         description="The file axis (with sign) that becomes x (forward), y (left) and z (up).",
     )
     subject: str | None = Field(
-        None, description="Subject id for the metadata; default: the file's SUBJECTS:NAMES."
+        None,
+        description="Subject id for the metadata; default: the file's SUBJECTS:NAMES. In a "
+        "file holding several subjects' markers (labels prefixed 'S1:', 'S2:'), the subject "
+        "whose markers are read.",
     )
 
     suffix: ClassVar[str] = ".c3d"
@@ -88,7 +93,11 @@ class TrcConfig(MarkerFileConfig):
         description="The file axis (with sign) that becomes x (forward), y (left) and z (up); "
         "default: OpenSim's lab frame (X forward, Y up, Z right).",
     )
-    subject: str | None = Field(None, description="Subject id for the metadata.")
+    subject: str | None = Field(
+        None,
+        description="Subject id for the metadata. In a file holding several subjects' markers "
+        "(labels prefixed 'S1:', 'S2:'), the subject whose markers are read.",
+    )
 
     suffix: ClassVar[str] = ".trc"
 
@@ -106,7 +115,8 @@ def markers_motion(
     """The canonical body from a marker file's tracks.
 
     ``positions`` (n_frames, n_markers, 3) in the file's unit (``unit_m`` metres each), NaN
-    where a marker is not seen; ``labels`` their names; ``rate`` [Hz] the frames' rate;
+    or exactly (0, 0, 0) where a marker is not seen (``zero_points`` in the metadata counts
+    the latter); ``labels`` their names; ``rate`` [Hz] the frames' rate;
     ``time`` (n_frames,) float64 [s] from 0, each frame's time (not uniform where the file
     skips frames). The
     marker set is detected (or taken from ``config``), each canonical joint is the mean of its
@@ -117,17 +127,37 @@ def markers_motion(
     ------
     mdframework.DataFileError
         Markers that do not make the body (the message lists the file's markers and what is
-        missing); fewer than two frames with a marker seen; joints beyond the limits.
+        missing); several subjects' markers without ``config.subject`` choosing one (see
+        :func:`subject_markers`); fewer than two frames with a marker seen; joints beyond the
+        limits.
     """
-    from .markersets import MarkerMismatch, detect_marker_set, user_groups
+    from .markersets import (
+        MARKER_SETS,
+        MarkerMismatch,
+        detect_marker_set,
+        strip_prefix,
+        user_groups,
+    )
 
     c = config
+    groups = user_groups(c.marker_map or {})
+    known = {m for mset in MARKER_SETS.values() for g in mset.joints.values() for m in chain(*g)}
+    known |= {strip_prefix(m) for g in groups.values() for m in chain(*g)}
+    keep = subject_markers(path, labels, c.subject, known)
+    if keep is not None:
+        labels = tuple(labels[i] for i in keep)
+        positions = positions[:, keep]
     try:
-        set_name, mapping = detect_marker_set(labels, user_groups(c.marker_map or {}), c.marker_set)
+        set_name, mapping = detect_marker_set(labels, groups, c.marker_set)
     except MarkerMismatch as exc:
         raise DataFileError(path, str(exc)) from None
+    # a marker at exactly (0, 0, 0) is one not seen: writers that do not mark a gap otherwise
+    # (a C3D point's residual -1, a TRC's empty fields) leave zeros, and a mean with the lab's
+    # origin would throw the joint metres across the room for those frames
+    zeros = np.all(positions == 0.0, axis=2)
+    seen = np.isfinite(positions).all(2) & ~zeros  # (n_frames, n_markers)
     try:
-        means, valid = group_means(positions, labels, mapping)
+        means, valid = group_means(positions, labels, mapping, seen)
     except KeyError as exc:  # pragma: no cover - resolve() only maps present labels
         raise DataFileError(path, f"marker(s) {exc} not in the file") from None
     pos = reorient(means * unit_m, c.axes)
@@ -135,6 +165,17 @@ def markers_motion(
         raise DataFileError(
             path, "fewer than two frames where any mapped marker is seen: nothing to move"
         )
+    index = {lab: k for k, lab in enumerate(labels)}
+    for k, (joint, members) in enumerate(mapping.items()):  # canonical order, as means
+        if valid[:, k].sum() < 2:
+            unseen = [m for m in members if seen[:, index[m]].sum() < 2]
+            where = "fewer than two frames" if unseen else "fewer than two frames together"
+            raise DataFileError(
+                path,
+                f"joint {joint} is seen in fewer than two frames: its marker(s) "
+                f"{', '.join(unseen or members)} are seen in {where}; give motion.marker_map "
+                f"for {joint} (markers of the file that are seen)",
+            )
     limits.check_time_stamps(path, time)
     limits.check_values(
         path, pos, limits.MAX_COORDINATE_M, "a joint coordinate", unit=" m", allow_nan=True
@@ -151,9 +192,52 @@ def markers_motion(
         "marker_set": set_name,
         "markers": {j: list(m) for j, m in mapping.items()},
         "n_frames": int(pos.shape[0]),
+        "zero_points": int(np.count_nonzero(zeros)),
     }
     skeleton = Skeleton(time, np.where(valid[..., None], pos, np.nan), CANONICAL_JOINTS, valid)
     return Motion(skeleton, meta, {j: j for j in CANONICAL_JOINTS})
+
+
+def subject_markers(
+    path: Path, labels: tuple[str, ...], subject: str | None, body_markers: Collection[str]
+) -> list[int] | None:
+    """The indices of the markers of ``subject`` when the labels carry the prefixes of more
+    than one subject (``S1:LASI``, ``S2:LASI``: Vicon and Qualisys label each subject's markers
+    so), else None (every marker is the one subject's). A prefix counts as a subject's when one
+    of its markers is among ``body_markers`` (the names the marker sets and the marker map
+    use), so the prefixes of props (``Box:Corner1``) do not.
+
+    Raises
+    ------
+    mdframework.DataFileError
+        Several subjects and ``subject`` not given, or not one of them (the message names them).
+    """
+    from .markersets import strip_prefix
+
+    by_prefix: dict[str, list[int]] = {}
+    for i, lab in enumerate(labels):
+        if ":" in lab:
+            by_prefix.setdefault(lab.rsplit(":", 1)[0], []).append(i)
+    people = [
+        prefix
+        for prefix, members in by_prefix.items()
+        if any(strip_prefix(labels[i]) in body_markers for i in members)
+    ]
+    if len(people) < 2:
+        return None
+    shown = ", ".join(people)
+    if subject is None:
+        raise DataFileError(
+            path,
+            f"the file holds the markers of {len(people)} subjects ({shown}): give "
+            "motion.subject to choose whose markers to read",
+        )
+    if subject not in by_prefix:
+        raise DataFileError(
+            path,
+            f"motion.subject {subject!r} is not one of the file's {len(people)} subjects ({shown})",
+        )
+    return by_prefix[subject]
 
 
 class C3dSource(MotionSource):

@@ -280,6 +280,23 @@ def _check_time_column(
     tolerance = 0.5 / rate + 1e-6
     if np.any(off > tolerance):
         k = int(np.argmax(off > tolerance))
+        steps, frame_steps = np.diff(column), np.diff(frames)
+        # the rows skip time that Frame# does not (renumbered frames), as opposed to a wrong
+        # DataRate, whose every Time step disagrees alike
+        if (
+            k
+            and steps[k - 1] > 1.5 * np.median(steps)
+            and frame_steps[k - 1] <= np.median(frame_steps)
+        ):
+            raise DataFileError(
+                path,
+                f"Time jumps {steps[k - 1]:.4g} s from the row before while Frame# steps by "
+                f"{frame_steps[k - 1]} ({frame_steps[k - 1] / rate:.4g} s "
+                f"at DataRate {rate:g} Hz): rows were left out and the frames renumbered; the "
+                "time base is Frame# / DataRate, so number the frames as Time says "
+                "(motion.frame_rate would read the motion without the gap)",
+                line_of[k],
+            )
         raise DataFileError(
             path,
             f"Time {column[k]:g} s disagrees with Frame# {frames[k]} at the header's DataRate "

@@ -32,12 +32,14 @@ Formats
 ``ntu``
     NTU RGB+D ``.skeleton`` (Kinect v2, 25 joints): frame count; per frame a body count and per
     body a line of 10 body values, a joint count and one line of 12 values per joint
-    (x y z depthX depthY colorX colorY qw qx qy qz trackingState); 30 frames per second.
+    (x y z depthX depthY colorX colorY qw qx qy qz trackingState); 30 frames per second. One
+    body is read (:func:`read_ntu`).
 """
 
 from __future__ import annotations
 
 import re
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -435,10 +437,21 @@ def read_precog(path: Path, rate_hz: float = PRECOG_RATE_HZ) -> Recording:
 # --------------------------------------------------------------------------- NTU RGB+D
 
 
-def read_ntu(path: Path, rate_hz: float = NTU_RATE_HZ, min_tracking: int = 1) -> Recording:
-    """Read an NTU RGB+D ``.skeleton`` file (Kinect v2): the first body seen is followed by its
-    body id; frames without it are untracked. ``min_tracking``: joints whose trackingState is
-    below it (0 not tracked, 1 inferred, 2 tracked) are untracked."""
+def read_ntu(
+    path: Path, rate_hz: float = NTU_RATE_HZ, min_tracking: int = 1, body: int | None = None
+) -> Recording:
+    """Read an NTU RGB+D ``.skeleton`` file (Kinect v2): one body, followed by its body id;
+    frames without it are untracked. ``min_tracking``: joints whose trackingState is below it
+    (0 not tracked, 1 inferred, 2 tracked) are untracked. ``body``: the body to read, numbered
+    1, 2, ... in the order the file first shows them; default: the one in most frames (the
+    first of those), with a warning naming every body when the file holds several (a second
+    person, or one of the short false bodies the Kinect sometimes reports).
+
+    Raises
+    ------
+    mdframework.DataFileError
+        A malformed file (naming the line), or ``body`` beyond the bodies the file holds.
+    """
     lines = read_text(path)
     pos_i = 0
     # non-blank lines from each line on: declared counts are checked against them before
@@ -468,9 +481,7 @@ def read_ntu(path: Path, rate_hz: float = NTU_RATE_HZ, min_tracking: int = 1) ->
         return int(v)
 
     n_frames = count("the frame count", 1)
-    body_id: str | None = None
-    pos = np.full((n_frames, 25, 3), np.nan)
-    state = np.zeros((n_frames, 25))
+    seen: dict[str, list[tuple[int, FloatArray]]] = {}  # body id -> (frame, its 25 x 12 values)
     for k in range(n_frames):
         n_bodies = count(f"the body count of frame {k + 1}", 27)
         for _ in range(n_bodies):
@@ -486,17 +497,43 @@ def read_ntu(path: Path, rate_hz: float = NTU_RATE_HZ, min_tracking: int = 1) ->
                 limits.check_values(
                     path, vals[j, None, 3:], limits.MAX_FILE_COORDINATE, "joint value", [ln]
                 )
-            if body_id is None:
-                body_id = info[0]
-            if info[0] == body_id:
-                pos[k] = vals[:, :3]
-                state[k] = vals[:, 11]
+            seen.setdefault(info[0], []).append((k, vals))
     rest = [ln for ln in lines[pos_i:] if ln.strip()]
     if rest:
         raise DataFileError(path, f"{len(rest)} line(s) after the last frame", pos_i + 1)
+    ids = list(seen)
+    listed = ", ".join(f"body {i + 1} (id {b}, {len(seen[b])} frames)" for i, b in enumerate(ids))
+    if body is not None and body > len(ids):
+        raise DataFileError(
+            path, f"motion.body is {body}, but the file holds {len(ids)} bodies ({listed})"
+        )
+    index = (
+        body - 1
+        if body is not None
+        else max(range(len(ids)), key=lambda i: len(seen[ids[i]]), default=0)
+    )
+    body_id = ids[index] if ids else None
+    tie = sum(len(seen[b]) == len(seen[body_id]) for b in ids) > 1 if body_id else False
+    if body is None and len(ids) > 1:
+        warnings.warn(
+            f"{path}: the file holds {len(ids)} bodies ({listed}); reading body {index + 1}, "
+            f"the {'first ' if tie else ''}one in most frames: set motion.body to read another",
+            stacklevel=2,
+        )
+    pos = np.full((n_frames, 25, 3), np.nan)
+    state = np.zeros((n_frames, 25))
+    for k, vals in seen.get(body_id, []) if body_id is not None else []:
+        pos[k] = vals[:, :3]
+        state[k] = vals[:, 11]
     fr = np.arange(n_frames, dtype=np.int64)
     valid = np.all(np.isfinite(pos), axis=2) & (state >= min_tracking)
-    meta = {"format": "ntu", "frame_rate_hz": rate_hz, "body_id": body_id}
+    meta = {
+        "format": "ntu",
+        "frame_rate_hz": rate_hz,
+        "body_id": body_id,
+        "body": index + 1,
+        "bodies": len(ids),
+    }
     return _finish(path, KINECT_V2_JOINTS, fr / rate_hz, pos, fr, valid, KINECT_V2_CANONICAL, meta)
 
 

@@ -133,12 +133,22 @@ class KinectConfig(MotionConfig):
         description="NTU: joints below this trackingState (1 inferred, 2 tracked) are gaps.",
     )
 
+    body: int | None = Field(
+        None,
+        ge=1,
+        le=limits.MAX_FRAMES,
+        description="NTU: the body to read, numbered 1, 2, ... in the order the file first "
+        "shows them; default: the one in most frames (with a warning when there are several).",
+    )
+
     @model_validator(mode="after")
     def _check(self) -> KinectConfig:
         if self.segment is not None and self.format not in ("utkinect", "precog"):
             raise ValueError("segment applies to the utkinect and precog formats only")
         if (self.labels is not None or self.sequence is not None) and self.format != "utkinect":
             raise ValueError("labels and sequence apply to the utkinect format only")
+        if self.body is not None and self.format != "ntu":
+            raise ValueError("body applies to the ntu format only")
         if self.frame_rate is not None and self.format == "nite":
             raise ValueError("NiTE recordings carry their own time stamps; frame_rate is unused")
         return self
@@ -162,7 +172,7 @@ class KinectSource(MotionSource):
         if c.format == "precog":
             return read_precog(path, c.frame_rate or PRECOG_RATE_HZ)
         if c.format == "ntu":
-            return read_ntu(path, c.frame_rate or NTU_RATE_HZ, c.min_tracking)
+            return read_ntu(path, c.frame_rate or NTU_RATE_HZ, c.min_tracking, c.body)
         return read_nite(path, c.foot_length, c.min_confidence)
 
     def load(self) -> Motion:
