@@ -1009,3 +1009,34 @@ def test_one_walker_written_in_two_ways_is_one_recording(tmp_path: Path) -> None
     names = [s.recording for s in plan_records(*load_dataset_config(p))]
     assert names[0] == names[1] == names[2] == "boulic(n_cycles=3 rv=1.0)"
     assert names[3] == "boulic(height=1.7 n_cycles=3 rv=1.0)"
+
+
+def test_the_largest_experiment_seed_runs_and_a_larger_one_is_a_config_error(
+    rng: np.random.Generator, tmp_path: Path
+) -> None:
+    """scikit-learn takes random states below 2**32 only: the seed 2**32 - 1 ran into an
+    internal error ('Seed must be between 0 and 2**32 - 1') in the wrapper's folds of the
+    second split (seeded seed + split), and a seed of 2**32 or more in the first. The largest
+    seed runs, the folds' seeds wrapping around, as the random forest does; a larger one is
+    refused naming the field."""
+    x, y = _toy(rng)
+    cfg = exp.ExperimentConfig.model_validate(
+        {
+            "seed": 2**32 - 1,
+            "dataset": {"path": "unused"},
+            "evaluation": {"repeats": 3},
+            "selection": {"method": "wrapper", "sizes": [2], "folds": 2},
+            "classifier": {
+                "kind": "sklearn",
+                "estimator": "sklearn.ensemble.RandomForestClassifier",
+                "params": {"n_estimators": 3},
+            },
+        }
+    )
+    factory = exp.classifier_factory(cfg.classifier, "t", seed=cfg.seed)
+    res = exp.within_source(cfg, factory, x, y, None)
+    assert res["balanced_accuracy_mean"] > 0.9  # the toy's classes are well apart
+    p = tmp_path / "e.toml"
+    p.write_text(f'seed = {2**32}\n[dataset]\npath = "x"\n')
+    with pytest.raises(ConfigError, match=r"e\.toml: seed: must be at most 4294967295"):
+        exp.load_experiment_config(p)
