@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import hashlib
 import json
 import os
 from contextlib import nullcontext
@@ -808,9 +809,10 @@ def test_every_confusion_matrix_is_captioned(
 def test_summary_json_holds_what_repeats_the_experiment(
     kinect_dataset: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """summary.json names the experiment's config (seed, classifier, selection, evaluation)
-    and the versions of the software: the config read back from it repeats the experiment
-    exactly (the seed was nowhere in the report folder, and no version anywhere)."""
+    """summary.json names the experiment's config (seed, classifier, selection, evaluation),
+    the versions of the software and the SHA-256 of the dataset's index.csv: the config read
+    back from it repeats the experiment exactly (the seed was nowhere in the report folder, and
+    no version anywhere; nothing said which dataset a folder named by `path` held then)."""
     import importlib.metadata
 
     e = _experiment(
@@ -831,6 +833,9 @@ def test_summary_json_holds_what_repeats_the_experiment(
     assert written["config"]["seed"] == 11
     assert written["config"]["dataset"]["path"] == str(kinect_dataset)  # read from anywhere
     assert written["config"]["classifier"]["params"] == {"n_estimators": 3, "max_features": 1}
+    # which dataset: its index.csv (ids, which digest what makes each record, and features)
+    index = (kinect_dataset / "index.csv").read_bytes()
+    assert written["dataset_index_sha256"] == hashlib.sha256(index).hexdigest()
     versions = written["versions"]
     assert versions["mdframework"] == importlib.metadata.version("mdframework")
     assert versions["scikit-learn"] == importlib.metadata.version("scikit-learn")

@@ -28,6 +28,7 @@ predicted label of every test record); ``cross_confusion.csv/png``, ``cross_pred
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
 import itertools
 import json
@@ -43,6 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field, ValidationError, model_validator
 
+from . import limits
 from .classify import (
     Selection,
     balanced_accuracy,
@@ -998,8 +1000,11 @@ def _report(
 
     figures: list[Callable[[], None]] = []  # drawn at the end
 
+    index = limits.read_file_bytes(Path(data_dir) / INDEX)
     summary: dict[str, Any] = {
         "dataset": str(data_dir),
+        # which dataset: its index names every record (an id digests what makes its arrays)
+        "dataset_index_sha256": hashlib.sha256(index).hexdigest(),
         "n_records": len(data.labels),
         "within": {},
         "cross": None,
