@@ -759,14 +759,14 @@ class FmcwRadar(RadarWaveform):
     def _noise(self, frame: int, n_rx: int) -> NDArray[np.complex64] | None:
         """Complex white noise of one frame, (chirps_per_frame, n_rx, n_samples) complex64:
         the receiver's (``receiver_noise``), seeded by (``noise_seed``, else the run's seed,
-        frame index), plus each
-        noise effect's in the IF, seeded by (its key, frame index): the same whatever the
-        blocks."""
+        frame index), plus each noise effect's in the IF, seeded by (its key, frame index): the
+        same whatever the blocks."""
         shape = (self.sequence.chirps_per_frame, n_rx, self.config.n_samples)
         draws = [(i.noise_power, i.noise_key) for i in self._inputs if i.noise_power > 0]
         if self.config.receiver_noise:
             own = self.config.noise_seed
-            key = own if own is not None else (self.seed or 0)
+            run_seed = getattr(self, "seed", None)  # (an mdframework without the attribute)
+            key = own if own is not None else (run_seed or 0)
             draws.insert(0, (self.thermal_noise_power(), key))
         noise: NDArray[np.complex64] | None = None
         for power, key in draws:
