@@ -150,6 +150,7 @@ def _fixed_sensor(cfg: dict[str, Any]) -> None:
     params = cfg["randomize"]["params"]
     for key in [k for k in params if k.startswith("radar.")]:
         params.pop(key)
+    cfg["base"]["radar"]["noise_seed"] = 0  # else each record's own seed
 
 
 def _source_draws_as(label: str, **draws: Any) -> Callable[[dict[str, Any]], None]:

@@ -185,9 +185,16 @@ def test_augmentation_factors_stay_within_their_ranges() -> None:
 
 
 def _first_draws(randomize: dict, seed: int = 7) -> dict:
-    """Record 0's draws, as the planner makes them (its generator's seed)."""
+    """Record 0's draws in :func:`_plan`, as the planner makes them: seeded by what the record
+    is (its source's motion, the first of that motion, window start 0, no variations, draw 0)."""
+    from conftest import EXAMPLES
+
+    from mdframework.dataset import _record_key
+
+    motion = {"kind": "cmu", "file": str(EXAMPLES / "data" / "cmu" / "bvh" / "16_21.bvh")}
+    key = _record_key(seed, [motion, 0, 0.0, [None] * 5, 0])
     rz = Randomization.model_validate(randomize)
-    return rz.sample(np.random.default_rng(np.random.SeedSequence([seed, 0, 1])))
+    return rz.sample(np.random.default_rng(np.random.SeedSequence([*key, 1])))
 
 
 def _plan(tmp_path, source_extra: dict, randomize: dict, **top: object) -> None:

@@ -88,6 +88,44 @@ def assert_same(a: Path, b: Path) -> None:
     assert (a / "index.csv").read_text() == (b / "index.csv").read_text()
 
 
+def _seeds_by_window(specs: list[Any]) -> dict[tuple[Any, ...], tuple[Any, ...]]:
+    """Each record's seed and random draws by its source file, window, aspect and draw number."""
+    out: dict[tuple[Any, ...], tuple[Any, ...]] = {}
+    for spec in specs:
+        m = spec.run_config["motion"]
+        where = (m["file"], m["start"], spec.run_config["scene"]["person"]["aspect_deg"])
+        n = sum(k[:3] == where for k in out)
+        out[(*where, n)] = (spec.run_config["seed"], json.dumps(spec.draws))
+    return out
+
+
+def test_adding_records_leaves_the_other_records_seeds_and_draws(tmp_path: Path) -> None:
+    """A record's seed and random draws derive from what the record is (its source's motion,
+    its window, its grid point, its draw number), not from its number in the dataset: another
+    aspect, another source before the others or more boxing windows left every other record's
+    noise and draws as they were (they shifted every later record's)."""
+    extra = "[randomize]\ndraws = 2\nradar_height = { uniform = [1.0, 2.0] }\n"
+    first = write_config(tmp_path / "a.toml")
+    first.write_text(first.read_text() + extra)
+    cfg, base = load_dataset_config(first)
+    before = _seeds_by_window(plan_records(cfg, base))
+    more = write_config(tmp_path / "b.toml", boxing_records=3, aspects="[0.0, 20.0, 45.0]")
+    text = more.read_text().replace(
+        "[[sources]]",
+        f'[[sources]]\nlabel = "jump"\nmotion = {{ kind = "cmu", file = '
+        f'"{CMU / "bvh" / "13_41.bvh"}" }}\nmax_records = 1\n[[sources]]',
+        1,
+    )
+    more.write_text(text.replace("walk = 1.0", "walk = 1.0\njump = 1.0") + extra)
+    cfg, base = load_dataset_config(more)
+    after = _seeds_by_window(plan_records(cfg, base))
+    # windows: walk 2, run 1, boxing 2 then 3, jump 1; x 2 then 3 aspects x 2 draws
+    assert (len(before), len(after)) == (5 * 2 * 2, 7 * 3 * 2)
+    assert {k: after[k] for k in before} == before
+    # and every record its own seed and draws
+    assert len({v[0] for v in after.values()}) == len({v[1] for v in after.values()}) == len(after)
+
+
 def test_plan_and_load(tmp_path: Path) -> None:
     cfg, base = load_dataset_config(write_config(tmp_path / "d.toml"))
     specs = plan_records(cfg, base)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import hashlib
 import json
 import os
 from contextlib import nullcontext
@@ -808,9 +809,10 @@ def test_every_confusion_matrix_is_captioned(
 def test_summary_json_holds_what_repeats_the_experiment(
     kinect_dataset: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """summary.json names the experiment's config (seed, classifier, selection, evaluation)
-    and the versions of the software: the config read back from it repeats the experiment
-    exactly (the seed was nowhere in the report folder, and no version anywhere)."""
+    """summary.json names the experiment's config (seed, classifier, selection, evaluation),
+    the versions of the software and the SHA-256 of the dataset's index.csv: the config read
+    back from it repeats the experiment exactly (the seed was nowhere in the report folder, and
+    no version anywhere; nothing said which dataset a folder named by `path` held then)."""
     import importlib.metadata
 
     e = _experiment(
@@ -831,6 +833,9 @@ def test_summary_json_holds_what_repeats_the_experiment(
     assert written["config"]["seed"] == 11
     assert written["config"]["dataset"]["path"] == str(kinect_dataset)  # read from anywhere
     assert written["config"]["classifier"]["params"] == {"n_estimators": 3, "max_features": 1}
+    # which dataset: its index.csv (ids, which digest what makes each record, and features)
+    index = (kinect_dataset / "index.csv").read_bytes()
+    assert written["dataset_index_sha256"] == hashlib.sha256(index).hexdigest()
     versions = written["versions"]
     assert versions["mdframework"] == importlib.metadata.version("mdframework")
     assert versions["scikit-learn"] == importlib.metadata.version("scikit-learn")
@@ -1009,3 +1014,34 @@ def test_one_walker_written_in_two_ways_is_one_recording(tmp_path: Path) -> None
     names = [s.recording for s in plan_records(*load_dataset_config(p))]
     assert names[0] == names[1] == names[2] == "boulic(n_cycles=3 rv=1.0)"
     assert names[3] == "boulic(height=1.7 n_cycles=3 rv=1.0)"
+
+
+def test_the_largest_experiment_seed_runs_and_a_larger_one_is_a_config_error(
+    rng: np.random.Generator, tmp_path: Path
+) -> None:
+    """scikit-learn takes random states below 2**32 only: the seed 2**32 - 1 ran into an
+    internal error ('Seed must be between 0 and 2**32 - 1') in the wrapper's folds of the
+    second split (seeded seed + split), and a seed of 2**32 or more in the first. The largest
+    seed runs, the folds' seeds wrapping around, as the random forest does; a larger one is
+    refused naming the field."""
+    x, y = _toy(rng)
+    cfg = exp.ExperimentConfig.model_validate(
+        {
+            "seed": 2**32 - 1,
+            "dataset": {"path": "unused"},
+            "evaluation": {"repeats": 3},
+            "selection": {"method": "wrapper", "sizes": [2], "folds": 2},
+            "classifier": {
+                "kind": "sklearn",
+                "estimator": "sklearn.ensemble.RandomForestClassifier",
+                "params": {"n_estimators": 3},
+            },
+        }
+    )
+    factory = exp.classifier_factory(cfg.classifier, "t", seed=cfg.seed)
+    res = exp.within_source(cfg, factory, x, y, None)
+    assert res["balanced_accuracy_mean"] > 0.9  # the toy's classes are well apart
+    p = tmp_path / "e.toml"
+    p.write_text(f'seed = {2**32}\n[dataset]\npath = "x"\n')
+    with pytest.raises(ConfigError, match=r"e\.toml: seed: must be at most 4294967295"):
+        exp.load_experiment_config(p)

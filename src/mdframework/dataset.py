@@ -23,17 +23,17 @@ representation simulated records get with ``representation = "histogram"``.
     DIR/dataset.json       the config, the feature names and units, the record count, the
                            SHA-256 of index.csv (load_dataset refuses an index changed since)
 
-Records are independent pure functions of their spec (including a seed derived from the
-dataset seed and the record's index), so the result is identical whatever the number of workers
-or the scheduler. A record's id is its index and a digest of what makes its arrays, the
-contents of the motion or recording it is cut from included (:func:`motion_fingerprint`); its
-label, group, subject and dataset are not in it and are rewritten into a kept record when the
-config changes them. A killed build, run again, keeps every complete record, removes temp
-files and redoes records whose file is missing, cut short or corrupt. It resumes only into a
-folder built from the same config (the marker ``.mdf-dataset.json`` holds it; a different
-config is an error naming the difference, or with ``force`` a rebuild that keeps the old
-dataset whole until the new index is written). The folder rules are those of
-:mod:`mdframework.outdir`.
+Records are independent pure functions of their spec (including a seed derived from the dataset
+seed and what the record is: its source's motion, window, grid point and draw), so the result is
+identical whatever the number of workers or the scheduler. A record's id is its index and a
+digest of what makes its arrays, the contents of the motion or recording it is cut from included
+(:func:`motion_fingerprint`); its label, group, subject and dataset are not in it and are
+rewritten into a kept record when the config changes them. A killed build, run again, keeps
+every complete record, removes temp files and redoes records whose file is missing, cut short or
+corrupt. It resumes only into a folder built from the same config (the marker
+``.mdf-dataset.json`` holds it; a different config is an error naming the difference, or with
+``force`` a rebuild that keeps the old dataset whole until the new index is written). The folder
+rules are those of :mod:`mdframework.outdir`.
 """
 
 from __future__ import annotations
@@ -514,8 +514,19 @@ def _forget_loaded() -> None:
     _load_recordings.cache_clear()
 
 
-def _record_seed(seed: int, index: int) -> int:
-    return int(np.random.SeedSequence([seed, index]).generate_state(1)[0])
+def _record_key(seed: int, what: Sequence[Any]) -> list[int]:
+    """The entropy of a record's random numbers: the dataset's ``seed`` and a digest of what
+    the record is (``what``: its source's motion section and the number of earlier sources of
+    the same motion, its window's start, its grid point, its draw), never its number in the
+    dataset, so that records added to or left out of a config leave the others' draws."""
+    text = json.dumps(list(what), sort_keys=True, separators=(",", ":"), default=str)
+    digest = hashlib.sha256(text.encode()).digest()
+    return [seed, *(int.from_bytes(digest[i : i + 4], "little") for i in range(0, 16, 4))]
+
+
+def _record_seed(key: list[int]) -> int:
+    """A record's run seed (32 bits) from its :func:`_record_key`."""
+    return int(np.random.SeedSequence(key).generate_state(1)[0])
 
 
 def _scene_for(base_scene: dict[str, Any], variation: dict[str, Any]) -> dict[str, Any]:
@@ -900,8 +911,8 @@ def _randomize(config: DatasetConfig, entry: SourceEntry) -> Randomization:
 _PER_RECORD = {
     "motion": "each record's motion is its source's own `motion` table; give settings such as "
     "`sanity` there",
-    "seed": "each record's seed derives from the dataset's top-level `seed` and the record's "
-    "number; set that one",
+    "seed": "each record's seed derives from the dataset's top-level `seed` and what the "
+    "record is; set that one",
 }
 
 
@@ -1047,9 +1058,12 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                 f"{limits.MAX_RECORDS:,} records; raise hop or set max_records"
             )
         starts = span_start + np.arange(n_windows) * hop
+        # a source is known by its motion (and among sources of one motion, by its place)
+        same = sum(e.motion == entry.motion for e in config.sources[:entry_no] if not e.recording)
+        source_key = [entry.motion, same]
         points_checked = hist is None  # histograms need a radar with point clouds: checked once
         for start in starts:
-            for (aspect, rng_, rheight, rpos, height), _draw in itertools.product(
+            for (aspect, rng_, rheight, rpos, height), draw_no in itertools.product(
                 grid, range(n_draws)
             ):
                 section = {**motion, "start": round(float(start), 9), "duration": length}
@@ -1067,9 +1081,11 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                 )
                 index = len(specs)
                 record = f"sources[{entry_no}] record {index}"
+                point = [aspect, rng_, rheight, rpos, height]
+                entropy = _record_key(config.seed, [*source_key, section["start"], point, draw_no])
                 draws = None
                 if rz.active():
-                    rng = np.random.default_rng(np.random.SeedSequence([config.seed, index, 1]))
+                    rng = np.random.default_rng(np.random.SeedSequence([*entropy, 1]))
                     draws = rz.sample(rng)
                     _apply_draws(run, section, draws, f"sources[{entry_no}]")
                 asked = None
@@ -1077,7 +1093,7 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                     placing = _validate_planned(run, record, draws, origins, entry_no, plan)
                     run["scene"] = _place_record(run, placing, loaded)
                     asked = placing.scene.person.aspect_deg
-                run["seed"] = _record_seed(config.seed, index)
+                run["seed"] = _record_seed(entropy)
                 content, naming = prints[key], meta
                 if draws and any(
                     p.startswith("motion.") and isinstance(d, str) for p, d in draws.items()

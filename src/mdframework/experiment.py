@@ -28,6 +28,7 @@ predicted label of every test record); ``cross_confusion.csv/png``, ``cross_pred
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
 import itertools
 import json
@@ -43,6 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field, ValidationError, model_validator
 
+from . import limits
 from .classify import (
     Selection,
     balanced_accuracy,
@@ -67,7 +69,7 @@ from .outdir import output_folder, safe_name
 from .plugins import Registry, blame, default_registry, versions
 from .pointcloud import histogram_vector, histogram_vector_names, velocity_bins
 from .progress import note, progress_enabled, tqdm_bar
-from .settings import Seed, StrictModel, Workers
+from .settings import StrictModel, Workers
 
 #: every name an experiment writes in its folder (group names are made safe by ``safe_name``)
 EXPERIMENT_FILES = (
@@ -209,7 +211,13 @@ class ReportConfig(StrictModel):
 class ExperimentConfig(StrictModel):
     """An experiment."""
 
-    seed: Seed = Field(0)
+    seed: int = Field(
+        0,
+        ge=0,
+        le=2**32 - 1,
+        description="Seed of the random splits, the wrapper's folds and the classifier "
+        "(scikit-learn takes random states of 32 bits).",
+    )
     dataset: DatasetRef
     input: Literal["features", "histogram"] = Field(
         "features",
@@ -682,7 +690,8 @@ def within_source(
     counts = {c: int(np.sum(y == c)) for c in classes}
     for rep, (train, test) in enumerate(bar):
         units = None if recordings is None else recordings[train]
-        sel = _select(cfg, factory, x[train], y[train], cfg.seed + rep, counts, units, untested)
+        fold_seed = (cfg.seed + rep) % 2**32  # scikit-learn's random states are 32-bit
+        sel = _select(cfg, factory, x[train], y[train], fold_seed, counts, units, untested)
         pred = _fit_predict(factory, x[train], y[train], x[test], sel.subset)
         predictions.append((rep, test, pred))
         trained = set(y[train].tolist())
@@ -994,8 +1003,11 @@ def _report(
 
     figures: list[Callable[[], None]] = []  # drawn at the end
 
+    index = limits.read_file_bytes(Path(data_dir) / INDEX)
     summary: dict[str, Any] = {
         "dataset": str(data_dir),
+        # which dataset: its index names every record (an id digests what makes its arrays)
+        "dataset_index_sha256": hashlib.sha256(index).hexdigest(),
         "n_records": len(data.labels),
         "within": {},
         "cross": None,

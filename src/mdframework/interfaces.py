@@ -466,6 +466,11 @@ class RadarWaveform(Plugin):
     #: Blocks hold a multiple of this many pulses (e.g. the pulses of one FMCW frame, so that no
     #: frame straddles two blocks).
     block_multiple: ClassVar[int] = 1
+    #: The run's ``seed``, set by the framework on the radar it builds for a run (``None``
+    #: outside one): a radar that draws random numbers itself (its receiver noise) seeds them
+    #: from it, unless its config gives a seed of its own, so that the run's seed, and each
+    #: dataset record's, reaches every random draw.
+    seed: int | None = None
 
     @property
     @abstractmethod

@@ -132,6 +132,7 @@ def build_stages(config: RunConfigBase, registry: Registry | None = None) -> Sta
 
     source, model = make("motion", cfg.motion), make("scatterers", cfg.scatterers)
     waveform = make("radar", cfg.radar)
+    waveform.seed = cfg.seed  # its own random draws (receiver noise) follow the run's seed
     effects = tuple(make("effects", e) for e in cfg.effects)
     for effect in effects:  # e.g. clutter needs a bandwidth: refused before any pulse
         with blame(effect, "check_radar"):

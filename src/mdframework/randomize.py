@@ -1,7 +1,8 @@
 """Domain randomisation: scene and motion parameters drawn per record from distributions.
 
 A dataset config's ``[randomize]`` section names distributions; every record draws its own
-values from a generator seeded by the dataset seed and the record's index, so a dataset is the
+values from a generator seeded by the dataset seed and what the record is (its source's motion,
+window, grid point and draw; see :func:`mdframework.dataset.plan_records`), so a dataset is the
 same whatever the number of workers, and every drawn value is written to the dataset table
 (``index.csv`` columns ``draw.<name>``).
 
@@ -126,7 +127,7 @@ class Randomization(StrictModel):
             if path.split(".")[0] == "seed":
                 raise ValueError(
                     f"\"{path}\": each record's seed derives from the dataset's top-level seed "
-                    "and the record's number; it is not drawn"
+                    "and what the record is; it is not drawn"
                 )
             if "." not in path:
                 raise ValueError(

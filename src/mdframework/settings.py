@@ -568,7 +568,12 @@ class FiguresConfig(StrictModel):
 class RunConfigBase(StrictModel):
     """Fields every run config has besides the plugin sections."""
 
-    seed: Seed = Field(0, description="Seed of every random draw in the run.")
+    seed: Seed = Field(
+        0,
+        description="Seed of every random draw in the run (noise, clutter, the FMCW radar's "
+        "receiver noise), except a plugin's own seed field that the config gives (the "
+        "static_scene room's seed, the FMCW radar's noise_seed).",
+    )
 
     scene: SceneConfig = Field(default_factory=SceneConfig, description="The scene.")
     processing: ProcessingConfig = Field(

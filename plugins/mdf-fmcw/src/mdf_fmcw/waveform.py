@@ -190,7 +190,11 @@ class FmcwConfig(RadarPowerConfig):
         description="Receiver noise figure F [dB]: complex white noise of power k T0 F fs per "
         "ADC sample.",
     )
-    noise_seed: Seed = Field(0, description="Seed of the receiver noise (per frame).")
+    noise_seed: Seed | None = Field(
+        None,
+        description="Seed of the receiver noise (per frame); default: the run's seed (each "
+        "dataset record's own).",
+    )
     gate_width: float = Field(
         2.0,
         gt=0,
@@ -754,13 +758,16 @@ class FmcwRadar(RadarWaveform):
 
     def _noise(self, frame: int, n_rx: int) -> NDArray[np.complex64] | None:
         """Complex white noise of one frame, (chirps_per_frame, n_rx, n_samples) complex64:
-        the receiver's (``receiver_noise``), seeded by (noise_seed, frame index), plus each
-        noise effect's in the IF, seeded by (its key, frame index): the same whatever the
-        blocks."""
+        the receiver's (``receiver_noise``), seeded by (``noise_seed``, else the run's seed,
+        frame index), plus each noise effect's in the IF, seeded by (its key, frame index): the
+        same whatever the blocks."""
         shape = (self.sequence.chirps_per_frame, n_rx, self.config.n_samples)
         draws = [(i.noise_power, i.noise_key) for i in self._inputs if i.noise_power > 0]
         if self.config.receiver_noise:
-            draws.insert(0, (self.thermal_noise_power(), self.config.noise_seed))
+            own = self.config.noise_seed
+            run_seed = getattr(self, "seed", None)  # (an mdframework without the attribute)
+            key = own if own is not None else (run_seed or 0)
+            draws.insert(0, (self.thermal_noise_power(), key))
         noise: NDArray[np.complex64] | None = None
         for power, key in draws:
             one = complex_noise(np.random.default_rng([key, frame]), shape, power)

@@ -60,7 +60,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field
 
-from mdframework import Effect, PluginConfig, Scatterers, SceneContext, SceneError
+from mdframework import Effect, PluginConfig, Scatterers, SceneContext, SceneError, Skeleton
 from mdframework.physics import radar, rcs
 from mdframework.settings import AngleDeg, Coordinate
 
@@ -126,6 +126,11 @@ class GroundMultipath(Effect):
     def __init__(self, config: PluginConfig | None = None) -> None:
         super().__init__(config)
         self._stats: dict[str, Any] = {}
+        self._extra = [0, 0]  # the record's sum of R_b - R_d [2**-20 m] and its count
+
+    def start_record(self, body: Skeleton, radar_position: FloatArray) -> None:
+        """Start the record's sums of the extra path lengths (:meth:`describe`)."""
+        self._extra = [0, 0]
 
     def check_effects(self, effects: Sequence[Effect]) -> None:
         """Refuse ``shadowing`` listed after this one (:data:`SHADOWED_AFTER`)."""
@@ -220,11 +225,14 @@ class GroundMultipath(Effect):
             ax_img = data.axes.copy()
             ax_img[..., 2] *= -1.0
             axes = np.concatenate([data.axes, ax_img, data.axes][:n_copies], axis=1)
+        # summed exactly, in whole steps of 2**-20 m (about 1 um), so that the record's mean
+        # has the same bits whatever its cut into blocks (a float sum's rounding would not)
+        steps = np.rint((r_b - r_d) * 2.0**20).astype(np.int64)
+        self._extra[0] += int(steps.sum())
+        self._extra[1] += int(steps.size)
+        bounce = self._extra[0] / max(self._extra[1], 1) / 2.0**20
         self._stats = {
-            "extra_path_m": {
-                "image_mean": float(np.mean(2.0 * (r_b - r_d))),
-                "bounce_mean": float(np.mean(r_b - r_d)),
-            },
+            "extra_path_m": {"image_mean": 2.0 * bounce, "bounce_mean": bounce},
             "n_virtual_scatterers": int(len(names) - len(data.names)),
         }
         return Scatterers(
@@ -242,5 +250,6 @@ class GroundMultipath(Effect):
         )
 
     def describe(self) -> dict[str, Any]:
-        """The config plus the mean extra round-trip path lengths [m]."""
+        """The config plus the mean extra round-trip path lengths [m] over the record's pulses
+        and scatterers (to about 1 um)."""
         return {**self.config.model_dump(), **self._stats}
