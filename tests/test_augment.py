@@ -186,13 +186,16 @@ def test_augmentation_factors_stay_within_their_ranges() -> None:
 
 def _first_draws(randomize: dict, seed: int = 7) -> dict:
     """Record 0's draws in :func:`_plan`, as the planner makes them: seeded by what the record
-    is (its source's motion, the first of that motion, window start 0, no variations, draw 0)."""
+    is (its motion's contents, the first of that motion, window start 0, no variations, draw
+    0)."""
     from conftest import EXAMPLES
 
-    from mdframework.dataset import _record_key
+    from mdframework.dataset import _load_motion, _motion_key, _record_key
+    from mdframework.fingerprint import motion_fingerprint
 
     motion = {"kind": "cmu", "file": str(EXAMPLES / "data" / "cmu" / "bvh" / "16_21.bvh")}
-    key = _record_key(seed, [motion, 0, 0.0, [None] * 5, 0])
+    content = motion_fingerprint(_load_motion(_motion_key(motion), str(EXAMPLES)))
+    key = _record_key(seed, [content, 0, 0.0, [None] * 5, 0])
     rz = Randomization.model_validate(randomize)
     return rz.sample(np.random.default_rng(np.random.SeedSequence([*key, 1])))
 

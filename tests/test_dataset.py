@@ -6,6 +6,7 @@ import importlib.metadata
 import json
 import os
 import re
+import shutil
 import signal
 import socket
 import subprocess
@@ -124,6 +125,30 @@ def test_adding_records_leaves_the_other_records_seeds_and_draws(tmp_path: Path)
     assert {k: after[k] for k in before} == before
     # and every record its own seed and draws
     assert len({v[0] for v in after.values()}) == len({v[1] for v in after.values()}) == len(after)
+
+
+def test_a_copy_elsewhere_draws_the_same(tmp_path: Path) -> None:
+    """A record's seed and draws derive from its motion's contents, not its file's path: the
+    same config with its motion files copied to another folder, named by a relative path or
+    an absolute one, draws the same (the path as written changed every record's draws)."""
+    extra = "[randomize]\ndraws = 2\nradar_height = { uniform = [1.0, 2.0] }\n"
+    first = write_config(tmp_path / "a.toml")
+    first.write_text(first.read_text() + extra)
+    copy = tmp_path / "elsewhere"
+    copy.mkdir()
+    text = first.read_text()
+    for name in ("asf-amc/02_01.amc", "asf-amc/02.asf", "asf-amc/09_06.amc", "asf-amc/09.asf"):
+        shutil.copy(CMU / name, copy / Path(name).name)
+    shutil.copy(CMU / "bvh" / "80_10.bvh", copy / "80_10.bvh")
+    text = text.replace(f"{CMU / 'asf-amc'}/", "").replace(f"{CMU / 'bvh'}/", "")
+    (copy / "b.toml").write_text(text)
+
+    def seeds(path: Path) -> list[tuple[Any, str]]:
+        specs = plan_records(*load_dataset_config(path))
+        return [(s.run_config["seed"], json.dumps(s.draws)) for s in specs]
+
+    before = seeds(first)
+    assert seeds(copy / "b.toml") == before and len(set(before)) == len(before)
 
 
 def test_plan_and_load(tmp_path: Path) -> None:

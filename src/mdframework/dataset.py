@@ -516,9 +516,10 @@ def _forget_loaded() -> None:
 
 def _record_key(seed: int, what: Sequence[Any]) -> list[int]:
     """The entropy of a record's random numbers: the dataset's ``seed`` and a digest of what
-    the record is (``what``: its source's motion section and the number of earlier sources of
-    the same motion, its window's start, its grid point, its draw), never its number in the
-    dataset, so that records added to or left out of a config leave the others' draws."""
+    the record is (``what``: its source's motion fingerprint and the number of earlier sources
+    of the same motion, its window's start, its grid point, its draw), never its number in the
+    dataset or its file's path, so that records added to or left out of a config leave the
+    others' draws, and a copy of the config and data elsewhere draws the same."""
     text = json.dumps(list(what), sort_keys=True, separators=(",", ":"), default=str)
     digest = hashlib.sha256(text.encode()).digest()
     return [seed, *(int.from_bytes(digest[i : i + 4], "little") for i in range(0, 16, 4))]
@@ -1005,6 +1006,7 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
     plan = (config, base_dir)
     prints: dict[str, str] = {}  # motion key -> fingerprint
     generated: dict[str, str] = {}  # fingerprint -> recording of a motion read from no file
+    sources_of: dict[str, int] = {}  # fingerprint -> sources of that motion so far
     for entry_no, entry in enumerate(config.sources):
         if entry.recording is not None:
             recorded, too_short = _plan_recordings(config, entry_no, entry, base_dir, len(specs))
@@ -1058,9 +1060,11 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                 f"{limits.MAX_RECORDS:,} records; raise hop or set max_records"
             )
         starts = span_start + np.arange(n_windows) * hop
-        # a source is known by its motion (and among sources of one motion, by its place)
-        same = sum(e.motion == entry.motion for e in config.sources[:entry_no] if not e.recording)
-        source_key = [entry.motion, same]
+        # a source is known by its motion's contents, wherever its file lies (and among
+        # sources of one motion, by its place)
+        same = sources_of.get(prints[key], 0)
+        sources_of[prints[key]] = same + 1
+        source_key = [prints[key], same]
         points_checked = hist is None  # histograms need a radar with point clouds: checked once
         for start in starts:
             for (aspect, rng_, rheight, rpos, height), draw_no in itertools.product(
