@@ -152,15 +152,16 @@ def main() -> None:
             )
             for length in args.lengths
         }
+        report[path] = {"records": rows}
         first, last = rows[f"{args.lengths[0]:g}s"], rows[f"{args.lengths[-1]:g}s"]
         ratio = args.lengths[-1] / args.lengths[0]
-        exponent = math.log(last["wall_s"] / first["wall_s"]) / math.log(ratio)
-        cpu_exponent = math.log(last["cpu_s"] / first["cpu_s"]) / math.log(ratio)
-        report[path] = {
-            "records": rows,
-            "time_exponent": round(exponent, 3),
-            "cpu_time_exponent": round(cpu_exponent, 3),
-        }
+        if ratio != 1.0:  # one length: no exponent
+            exponent = math.log(last["wall_s"] / first["wall_s"]) / math.log(ratio)
+            cpu_exponent = math.log(last["cpu_s"] / first["cpu_s"]) / math.log(ratio)
+            report[path] |= {
+                "time_exponent": round(exponent, 3),
+                "cpu_time_exponent": round(cpu_exponent, 3),
+            }
         print(json.dumps({path: report[path]}), flush=True)
     print(json.dumps(report, indent=2))
 
