@@ -16,8 +16,12 @@ replaces the treadmill by the Boulic walker walking straight away from the radar
 start, 0.88 m/s), so the range span the tracking gate covers, and with it the clutter's patch
 count, grows with the record.
 
-    .venv/bin/python benchmarks/bench_memory.py [--lengths 6 600] [--paths analytic raw fmcw]
-        [--effects] [--motion treadmill|walk]
+``--effect NAME ...`` runs the named effects alone, in that order (instead of ``--effects``'
+set); ``--paths cw`` adds a 24 GHz CW radar sampled at 2 kHz; ``--block N`` sets
+``processing.block_pulses``; one length gives no exponent.
+
+    .venv/bin/python benchmarks/bench_memory.py [--lengths 6 600] [--paths analytic raw cw fmcw]
+        [--effects | --effect NAME ...] [--motion treadmill|walk] [--block N]
 """
 
 from __future__ import annotations
