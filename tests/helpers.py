@@ -4,13 +4,15 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
 from mdframework import DataFileError
 from mdframework.config import validate_run_config
 from mdframework.pipeline import RunResult, simulate
+
+T = TypeVar("T")
 
 
 def point_run(
@@ -124,18 +126,28 @@ kind = "{radar}"
     return path
 
 
-def data_error_and_peak(call: Callable[[], object]) -> tuple[DataFileError, int]:
-    """The :class:`DataFileError` that ``call`` raises (pytest fails if none) and the peak of
-    the memory traced while it ran [bytes] (numpy's arrays included)."""
+def traced_peak(call: Callable[[], T]) -> tuple[T, int]:
+    """What ``call`` returns and the peak of the memory traced while it ran [bytes] (numpy's
+    arrays included)."""
     import tracemalloc
-
-    import pytest
 
     tracemalloc.start()
     try:
-        with pytest.raises(DataFileError) as exc:
-            call()
+        out = call()
         peak = tracemalloc.get_traced_memory()[1]
     finally:
         tracemalloc.stop()
-    return exc.value, peak
+    return out, peak
+
+
+def data_error_and_peak(call: Callable[[], object]) -> tuple[DataFileError, int]:
+    """The :class:`DataFileError` that ``call`` raises (pytest fails if none) and the peak of
+    the memory traced while it ran [bytes] (numpy's arrays included)."""
+    import pytest
+
+    def raised() -> DataFileError:
+        with pytest.raises(DataFileError) as exc:
+            call()
+        return exc.value
+
+    return traced_peak(raised)

@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from helpers import traced_peak
 from mdf_antenna import one_way_gain
 from mdf_antenna.antenna import SINC2_HALF_POWER
 from mdf_clutter import GroundClutter, clutter
@@ -473,6 +474,31 @@ def test_clutter_memory_does_not_grow_with_the_patch_count(
     assert peak < 40 * n * 16  # 40 complex slow-time signals: 5 MB
 
 
+@pytest.mark.parametrize(("path", "n", "margin"), [("analytic", 20_000, None), ("raw", 8_000, 0.5)])
+def test_clutter_memory_grows_with_the_record_by_a_few_signals(
+    path: str, n: int, margin: float | None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Records of n and 3n pulses (calls of the waveform of 2000 pulses): the clutter's peak
+    memory grows by a dozen slow-time signals (its sums, the wind-blown process), on the
+    analytic and the raw LFM path, whose working arrays do not grow. Each call of the
+    waveform spanned the whole record: the patches' positions (n, 16, 3) and, on the raw path,
+    a range-time map of every pulse (a 10-minute record with clutter peaked above 1.2 GB)."""
+
+    def peak(pulses: int) -> int:
+        monkeypatch.setattr(clutter, "WIND_GRID_VALUES", pulses)  # one process at a time
+        wf = LfmPulseDoppler(LfmPulseDoppler.Config(path=path))
+        ctx = dataclasses.replace(clutter_context(15.0, pulses), waveform=wf)
+        eff = GroundClutter(GroundClutter.Config(csr_db=0.0, margin_m=margin))
+        _, traced = traced_peak(lambda: eff.apply(Received(np.ones(pulses, complex)), ctx))
+        assert eff.describe()["n_patches"] == (17 if margin is None else 3)
+        return traced
+
+    monkeypatch.setattr(clutter, "PULSES_PER_CALL", 2000)
+    peak(n)  # the first call imports what the radar needs (scipy.signal on the raw path)
+    small = peak(n)
+    assert peak(3 * n) - small < 12 * (2 * n) * 16
+
+
 def test_clutter_with_a_radar_without_bandwidth_is_refused_before_any_pulse() -> None:
     """A CW radar gives no range resolution: the clutter effect without ``range_resolution`` is
     refused when the run's plugins are built (the radar never receives a pulse), on one line
@@ -522,6 +548,44 @@ def test_clutter_on_an_fmcw_radar_with_receiver_noise_holds_no_copy_of_that_nois
     first_slot = noisy[::3]  # one TX's chirps: one virtual antenna's slow time
     dc_fraction = abs(np.mean(first_slot)) ** 2 / np.mean(np.abs(first_slot) ** 2)
     assert dc_fraction > 0.999  # all of the stationary clutter at zero Doppler
+
+
+@pytest.mark.parametrize("radar", ["lfm", "fmcw"])
+def test_clutter_made_a_part_of_the_record_at_a_time_is_the_clutter_made_at_once(
+    radar: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The patches' responses made 100 pulses at a time (on the FMCW radar, rounded down to its
+    whole frames of 48 chirps: 96) give the clutter made from one call per patch group over the
+    whole record, under a tracking gate (108 and 18 patches), in both power modes."""
+    from mdf_fmcw import FmcwRadar
+
+    if radar == "fmcw":
+        wf: Any = FmcwRadar(FmcwRadar.Config(preset="iwr1443_short_range_3d"))
+        t = wf.pulse_times(0.0, 0.5)
+        assert wf.block_multiple == 48
+    else:
+        wf = LfmPulseDoppler(LfmPulseDoppler.Config())
+        t = np.arange(1000) / 2400.0
+    n = t.size
+    skel = Skeleton(t, np.zeros((n, 1, 3)), ("target0",))
+    gate = np.linspace(3.0, 5.0, n)
+    signal = np.exp(2j * np.pi * 40.0 * t) * 1e-6
+
+    def clutter_of(power: str, per_call: int) -> np.ndarray:
+        monkeypatch.setattr(clutter, "PULSES_PER_CALL", per_call)
+        ctx = SceneContext(
+            np.zeros(3), wf.prf, wf.carrier_frequency, t, gate, skel, wf, np.random.default_rng(3)
+        )
+        cfg = GroundClutter.Config(power=power, csr_db=0.0, rcs_m2=1.0, wind_fraction=0.4)
+        eff = GroundClutter(cfg)
+        out = eff.apply(Received(signal.copy()), ctx).signal - signal
+        assert eff.describe()["n_patches"] == (108 if radar == "fmcw" else 18)
+        return out
+
+    for power in ("csr", "rcs"):
+        whole = clutter_of(power, 1 << 30)
+        assert np.mean(np.abs(whole) ** 2) > 0
+        np.testing.assert_allclose(clutter_of(power, 100), whole, rtol=1e-12, atol=0.0)
 
 
 def test_a_radar_may_set_its_own_range_resolution() -> None:

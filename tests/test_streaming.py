@@ -261,6 +261,21 @@ def test_records_of_one_window_are_the_same_whether_its_interpolant_is_reused() 
     assert not np.array_equal(in_a_row[0].received.signal, in_a_row[2].received.signal)
 
 
+def test_a_runs_interpolant_is_not_kept_once_its_motion_is_gone() -> None:
+    """`simulate` loads its own motion: once it returns, no record can share its window's
+    interpolant, which is let go (a 10-minute walk of the 380 Hz Boulic walker held 93 MB of
+    it while `mdf run` wrote its files and drew its figures, and a library user held it until
+    the next run); the result does not need it."""
+    import gc
+
+    cfg = validate_run_config({"motion": {**CMU_WALK, "duration": 0.5}}, base_dir=EXAMPLES)
+    pipeline._LAST_WINDOW.clear()
+    result = simulate(cfg)
+    gc.collect()
+    assert pipeline._LAST_WINDOW == []
+    assert np.max(np.abs(result.received.signal)) > 0
+
+
 def test_another_body_with_the_same_window_does_not_reuse_the_interpolant() -> None:
     """Two recordings cut at the same frames (a CMU walk and a CMU boxing trial, both 120 Hz),
     one after the other: the second record is the one built afresh, not one made from the

@@ -150,17 +150,31 @@ def memory_estimate(
     block_pulses: int,
     keep_scatterers: bool = False,
     stft_bytes: int = 4,
+    motion_bytes: int = 0,
 ) -> dict[str, float]:
-    """The arrays a run holds at once [MiB]: per pulse the time, gate and complex signal
-    (8 + 8 + 16 bytes); the scatterers' arrays (:data:`SCATTERER_PULSE_BYTES` per scatterer)
-    of one block of ``block_pulses`` (of every pulse with ``keep_scatterers``); the
-    spectrogram's power (``stft_bytes`` per value) and its float64 dB map."""
+    """The arrays a run holds at once [MiB]: per pulse the time, gate, complex signal and the
+    echo the received-stage effects refer to (8 + 8 + 16 + 16 bytes); the scatterers' arrays
+    (:data:`SCATTERER_PULSE_BYTES` per scatterer) of one block of ``block_pulses`` (of every
+    pulse with ``keep_scatterers``); the spectrogram's power (``stft_bytes`` per value) and its
+    float32 dB map; with ``motion_bytes`` the motion's arrays (:func:`motion_memory`)."""
     rows = n_pulses if keep_scatterers else min(n_pulses, block_pulses)
-    return {
-        "signal": n_pulses * 32 / MIB,
+    terms = {
+        "signal": n_pulses * 48 / MIB,
         "scatterers": rows * n_scatterers * SCATTERER_PULSE_BYTES / MIB,
-        "spectrogram": n_doppler * n_frames * (stft_bytes + 8) / MIB,
+        "spectrogram": n_doppler * n_frames * (stft_bytes + 4) / MIB,
     }
+    return terms | ({"motion": motion_bytes / MIB} if motion_bytes else {})
+
+
+def motion_memory(motion: Motion, body: Skeleton, window_frames: int) -> int:
+    """The motion's arrays a run holds [bytes]: the recording's positions, the canonical body
+    when it is another array (``body``: the body the run uses, whole recording), and three of
+    the record's window of ``window_frames`` frames (the placed body and the interpolants of
+    the unplaced and the placed window): 8 bytes a coordinate each. A 380 Hz walker holds
+    about four times its joints' frames (93 MB a copy for 10 minutes)."""
+    source = motion.skeleton.positions
+    canonical = 0 if body.positions is source else body.positions.nbytes
+    return int(source.nbytes + canonical + 3 * window_frames * body.n_joints * 3 * 8)
 
 
 def count_scatterers(
@@ -207,8 +221,8 @@ def plan_run(
 
     if motion is None:
         motion = load_motion(stages.source)
-    body, _, _, where = prepare_body(config, stages, motion, radar_pos)
-    body = placed(body, where)
+    unplaced, _, _, where = prepare_body(config, stages, motion, radar_pos)
+    body = placed(unplaced, where)
     t_start, t_end = record_window(body, cfg.motion.start, cfg.motion.duration)
     limits.check_pulses(
         t_end - t_start, wf.pulse_rate, body.n_joints, "motion.duration", proc.keep_scatterers
@@ -234,6 +248,7 @@ def plan_run(
     speed = max(speed, interpolated_radial_speed(body, t, method, radar_pos))
     v_max = float(wf.max_unambiguous_velocity)
     n_scatterers = count_scatterers(config, stages, motion, body, t)
+    window = interpolation.window_frames(body.time, float(t[0]), float(t[-1]))
     terms = memory_estimate(
         n_pulses,
         n_scatterers,
@@ -242,6 +257,7 @@ def plan_run(
         proc.block_pulses,
         proc.keep_scatterers,
         4 if proc.precision == "float32" else 8,
+        motion_memory(motion, unplaced, int(window.stop - window.start)),
     )
     terms.update({name: size / MIB for name, size in wf.working_memory().items()})
     return RunPlan(

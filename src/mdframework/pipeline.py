@@ -665,8 +665,15 @@ def _window_resampler(
         if ref() is body and (start, stop, last_method) == key:
             return resampler
     resampler = interpolation.TrackResampler(near.time, near.positions, near.valid, method)
-    _LAST_WINDOW[:] = [(weakref.ref(body), *key, resampler)]
+    _LAST_WINDOW[:] = [(weakref.ref(body, _forget_window), *key, resampler)]
     return resampler
+
+
+def _forget_window(dead: weakref.ref[Skeleton]) -> None:
+    """Drop the kept resampler once its body is gone (no record can share it any more): a
+    long record's interpolants are not held after its run, while its files are written."""
+    if _LAST_WINDOW and _LAST_WINDOW[0][0] is dead:
+        _LAST_WINDOW.clear()
 
 
 def _blocks(n: int, size: int, multiple: int) -> list[tuple[int, int]]:

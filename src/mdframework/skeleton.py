@@ -196,8 +196,11 @@ class Skeleton:
         return self.positions[:, self.index(name), :]
 
     def select(self, names: Sequence[str]) -> Skeleton:
-        """A skeleton with only the named joints, in the given order."""
+        """A skeleton with only the named joints, in the given order (sharing this one's arrays
+        when those are all its joints in its order: no copy of a long recording)."""
         idx = [self.index(n) for n in names]
+        if idx == list(range(self.n_joints)):
+            return Skeleton(self.time, self.positions, tuple(names), self.valid)
         return Skeleton(self.time, self.positions[:, idx], tuple(names), self.valid[:, idx])
 
     def window(self, start: float | None = None, duration: float | None = None) -> Skeleton:

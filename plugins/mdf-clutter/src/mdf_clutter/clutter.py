@@ -155,6 +155,13 @@ WIND_GRID_VALUES = 1 << 22
 #: pays it once for so many.
 PATCHES_PER_CALL = 16
 
+#: Pulses of one call of the waveform in :meth:`GroundClutter.apply` (rounded down to a multiple
+#: of the radar's ``block_multiple``, at least one): the patches' positions, responses and the
+#: radar's own working arrays (the raw path's range-time rows) span so many pulses, not the
+#: record (a 10-minute record at 2400 Hz held 0.5 GB of positions per call on the analytic path
+#: and 1 GB more of range-time rows on the raw path).
+PULSES_PER_CALL = 1 << 16
+
 
 def wind_processes(
     rng: np.random.Generator, n_series: int, times: FloatArray, prf: float, spread_hz: float
@@ -383,9 +390,10 @@ class GroundClutter(Effect):
         return ReceiverInput(self.name, static_ranges=ranges, static_rcs=rcs)
 
     def apply(self, data: Received, context: SceneContext) -> Received:
-        """The received data plus clutter. The patches' responses and wind-blown processes are
-        made a group of patches at a time (:func:`wind_process_groups`) and summed, so memory
-        grows with the pulses, not with the pulses times the patches."""
+        """The received data plus clutter. The patches' wind-blown processes are made a group
+        of patches at a time (:func:`wind_process_groups`), their responses a few patches and
+        :data:`PULSES_PER_CALL` pulses at a time, and summed, so memory grows with the pulses
+        (a few slow-time signals), not with the pulses times the patches."""
         c = self.config
         ranges, sigma_k, alpha = self._patches(context)
         n_patch = ranges.size
@@ -398,13 +406,25 @@ class GroundClutter(Effect):
         patch_power = np.empty(n_patch)  # mean_n |g_k(n)|^2 of each unit-RCS patch
         groups = wind_process_groups(rng, n_patch, context.pulse_times, context.prf, spread_hz)
         loss = np.sqrt(self.path_loss(context, ranges))  # amplitude
+        multiple = max(1, int(context.waveform.block_multiple))
+        step = max(multiple, PULSES_PER_CALL - PULSES_PER_CALL % multiple)
         for lo, hi, u in groups:
-            resp = self.responses(context, ranges[lo:hi]) * loss[lo:hi, None]
-            patch_power[lo:hi] = np.mean(np.abs(resp) ** 2, axis=1)
-            for k in range(hi - lo):  # patch after patch: the sums of all patches at once
-                stationary += alpha[lo + k] * resp[k]
-                wind += resp[k] * u[k]
-            del resp, u
+            energy = np.zeros(hi - lo)
+            for a in range(0, n_p, step):  # a few patches' responses over a part of the record
+                b = min(a + step, n_p)
+                part = dataclasses.replace(
+                    context,
+                    pulse_times=np.asarray(context.pulse_times)[a:b],
+                    gate_range=np.asarray(context.gate_range)[a:b],
+                )
+                resp = self.responses(part, ranges[lo:hi]) * loss[lo:hi, None]
+                energy += np.sum(np.abs(resp) ** 2, axis=1)
+                for k in range(hi - lo):  # patch after patch: the sums of all patches at once
+                    stationary[a:b] += alpha[lo + k] * resp[k]
+                    wind[a:b] += resp[k] * u[k, a:b]
+                del resp
+            patch_power[lo:hi] = energy / n_p
+            del u
         if c.power == "csr":  # relative to the echo, whatever the order of the effects
             echo = context.echo if context.echo is not None else data.signal
             p_sig = float(np.mean(np.abs(echo) ** 2))

@@ -274,8 +274,11 @@ class WalkerBody:
             q[:, adr] = sign * deg * tracks[side][track]
         return q
 
-    def kinematics(self, qpos: FloatArray) -> Frames:
-        """Run ``mj_kinematics`` for every row of ``qpos`` (n, nq) and collect the frames.
+    def kinematics(self, qpos: FloatArray, geoms: bool = True) -> Frames:
+        """Run ``mj_kinematics`` for every row of ``qpos`` (n, nq) and collect the frames;
+        ``geoms`` False collects the joints alone (``centres`` (n, 0, 3) and ``rotations``
+        (n, 0, 3, 3)): a motion source's frames, without the geoms' arrays, seven times the
+        joints' memory.
 
         In chen-compatible mode the elbow sites are moved to Chen's frozen-height position (Q4);
         the geoms stay rigid."""
@@ -288,29 +291,31 @@ class WalkerBody:
         # sites and geoms frame by frame) and pick the sites and geoms once for all frames
         site_xpos, geom_xpos, geom_xmat, d_qpos = d.site_xpos, d.geom_xpos, d.geom_xmat, d.qpos
         all_sites = np.empty((n, *site_xpos.shape))
-        all_pos = np.empty((n, *geom_xpos.shape))
-        all_mat = np.empty((n, *geom_xmat.shape))
+        all_pos = np.empty((n if geoms else 0, *geom_xpos.shape))
+        all_mat = np.empty((n if geoms else 0, *geom_xmat.shape))
         quirk = self.gait.chen_compatible
-        body_xpos, body_xmat = d.xpos, d.xmat
-        all_bpos = np.empty((n, *body_xpos.shape)) if quirk else None
-        all_bmat = np.empty((n, *body_xmat.shape)) if quirk else None
+        thorax = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "thorax")
+        thorax_xpos, thorax_xmat = d.xpos[thorax], d.xmat[thorax]
+        all_bpos = np.empty((n, 3)) if quirk else None
+        all_bmat = np.empty((n, 9)) if quirk else None
         kinematics = mujoco.mj_kinematics
         for i in range(n):
             d_qpos[:] = qpos[i]
             kinematics(m, d)
             all_sites[i] = site_xpos
-            all_pos[i] = geom_xpos
-            all_mat[i] = geom_xmat
+            if geoms:
+                all_pos[i] = geom_xpos
+                all_mat[i] = geom_xmat
             if all_bpos is not None and all_bmat is not None:
-                all_bpos[i] = body_xpos
-                all_bmat[i] = body_xmat
+                all_bpos[i] = thorax_xpos
+                all_bmat[i] = thorax_xmat
         joints = all_sites[:, self._site_ids]
-        rot = all_mat[:, self._geom_ids].reshape(n, len(PART_NAMES), 3, 3)
+        del all_sites
+        ids = self._geom_ids if geoms else self._geom_ids[:0]
+        rot = all_mat[:, ids].reshape(all_mat.shape[0], ids.size, 3, 3)
         if all_bpos is not None and all_bmat is not None:
-            thorax = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "thorax")
-            mat = all_bmat[:, thorax].reshape(n, 3, 3)
-            joints = self._freeze_elbows(joints, all_bpos[:, thorax], mat)
-        return Frames(joints, all_pos[:, self._geom_ids], rot, self.semi_axes)
+            joints = self._freeze_elbows(joints, all_bpos, all_bmat.reshape(n, 3, 3))
+        return Frames(joints, all_pos[:, ids], rot, self.semi_axes)
 
     def _freeze_elbows(self, joints: FloatArray, pos: FloatArray, mat: FloatArray) -> FloatArray:
         out = joints.copy()
@@ -321,6 +326,6 @@ class WalkerBody:
             out[:, k] = pos + np.einsum("nij,nj->ni", mat, local)
         return out
 
-    def frames(self, time: FloatArray) -> Frames:
-        """Kinematics at ``time`` (n,) [s]."""
-        return self.kinematics(self.qpos(time))
+    def frames(self, time: FloatArray, geoms: bool = True) -> Frames:
+        """Kinematics at ``time`` (n,) [s] (``geoms``: see :meth:`kinematics`)."""
+        return self.kinematics(self.qpos(time), geoms)

@@ -120,7 +120,7 @@ class BoulicWalker(MotionSource):
         g = self.gait()
         n = self.n_cycles(g) * g.nt
         t = np.arange(n + 1, dtype=np.float64) * (g.cycle_duration / g.nt)
-        frames = WalkerBody(g).frames(t)
+        frames = WalkerBody(g).frames(t, geoms=False)  # the joints alone
         meta = {
             "source": "boulic",
             "activity": self.config.activity,
