@@ -788,6 +788,23 @@ def test_a_long_gap_is_named_not_bridged_silently(tmp_path: Path) -> None:
             assert load(recording)[0].metadata["sanity"]["gaps"]["count"] == 0, name
 
 
+def test_a_gap_outside_the_record_is_still_named_and_the_way_out_is_right(
+    tmp_path: Path,
+) -> None:
+    """The gaps check reads the whole file, not the record's window: a record cut after the
+    gap (motion.start, motion.duration) still gets the finding, so the message may not send
+    the user to motion.start and motion.duration alone (it did, and with gaps = "error" the
+    run stopped whatever record was chosen): it says the whole file is checked and how to go
+    on without filling the gap."""
+    heel = _trc_rows_edited(tmp_path / "heel.trc", slice(30, 120), "L.Heel")
+    section = {"kind": "trc", "file": str(heel), "activity": "walk", "start": 2.05}
+    with pytest.raises(DataFileError) as caught:
+        load({**section, "duration": 0.4}, gaps="error")
+    message = str(caught.value)
+    assert "the check reads the whole file" in message
+    assert "motion.sanity.gaps = 'ignore'" in message
+
+
 def test_a_body_read_in_the_wrong_length_unit_is_flagged() -> None:
     """The real 16_21 walk (cgspeed's unit, 1/0.45 inch) read as inches, as CMU's files are
     often said to be: a body 0.45 times its size, legs of 0.38 m, walking at 0.77 m/s, which

@@ -575,8 +575,9 @@ def check_motion(motion: Motion, config: SanityConfig) -> Motion:
                 config.gaps,
                 f"{what} for {g['duration_s']:.3f} s ({g['from_s']:.3f}-{g['to_s']:.3f} s), "
                 f"longer than motion.sanity.max_gap_s = {config.max_gap_s:g} s{more}: the "
-                "simulation interpolates across such gaps; choose a record without them "
-                "(motion.start, motion.duration) or fill them in the file",
+                "simulation interpolates across such gaps in the records that span them; fill "
+                "them in the file, or cut records without them (motion.start, motion.duration) "
+                "and set motion.sanity.gaps = 'ignore' (the check reads the whole file)",
             )
         )
 
