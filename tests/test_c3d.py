@@ -229,6 +229,9 @@ def test_a_file_of_two_subjects_reads_one_subjects_markers_only(tmp_path: Path) 
         C3dSource(C3dConfig(file=path, subject="S1")).load()
     with pytest.raises(DataFileError, match=r"'S3' is not one of the file's 2 subjects"):
         C3dSource(C3dConfig(file=path, subject="S3")).load()
+    # a prop's prefix is no subject either (its markers were read, and refused as a body)
+    with pytest.raises(DataFileError, match=r"'Box' is not one of the file's 2 subjects"):
+        C3dSource(C3dConfig(file=path, subject="Box")).load()
     # a prop's markers (prefixed too) are no subject's: one person and a box need no subject
     alone = tmp_path / "one.c3d"
     write_c3d(alone, {**second, **prop}, 60.0, "mm", 0.001)

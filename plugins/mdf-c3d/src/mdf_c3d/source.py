@@ -232,7 +232,7 @@ def subject_markers(
             f"the file holds the markers of {len(people)} subjects ({shown}): give "
             "motion.subject to choose whose markers to read",
         )
-    if subject not in by_prefix:
+    if subject not in people:
         raise DataFileError(
             path,
             f"motion.subject {subject!r} is not one of the file's {len(people)} subjects ({shown})",
