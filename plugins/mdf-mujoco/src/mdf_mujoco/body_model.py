@@ -276,9 +276,9 @@ class WalkerBody:
 
     def kinematics(self, qpos: FloatArray, geoms: bool = True) -> Frames:
         """Run ``mj_kinematics`` for every row of ``qpos`` (n, nq) and collect the frames;
-        ``geoms`` False collects the joints alone (``centres`` (n, 0, 3) and ``rotations``
-        (n, 0, 3, 3)): a motion source's frames, without the geoms' arrays, seven times the
-        joints' memory.
+        ``geoms`` False collects the joints alone (``centres`` (0, 0, 3) and ``rotations``
+        (0, 0, 3, 3), empty): a motion source's frames, without the geoms' arrays, seven times
+        the joints' memory.
 
         In chen-compatible mode the elbow sites are moved to Chen's frozen-height position (Q4);
         the geoms stay rigid."""
