@@ -232,11 +232,10 @@ def long_gaps(time: FloatArray, valid: BoolArray, max_gap_s: float) -> list[dict
     for k in np.flatnonzero(step > longest):
         out.append({"joint": None, "from_s": t[k] - t[0], "to_s": t[k + 1] - t[0]})
     for j in range(valid.shape[1]):
-        seen = t[valid[:, j]]
-        for k in np.flatnonzero(np.diff(seen) > max_gap_s):
-            around = (t > seen[k]) & (t < seen[k + 1])  # frames inside, all untracked
-            if around.any():
-                out.append({"joint": j, "from_s": seen[k] - t[0], "to_s": seen[k + 1] - t[0]})
+        seen = np.flatnonzero(valid[:, j])
+        # with frames inside, all untracked (a long step alone is a frame gap, above)
+        for k in np.flatnonzero((np.diff(t[seen]) > max_gap_s) & (np.diff(seen) > 1)):
+            out.append({"joint": j, "from_s": t[seen[k]] - t[0], "to_s": t[seen[k + 1]] - t[0]})
     for g in out:
         g["from_s"], g["to_s"] = round(float(g["from_s"]), 6), round(float(g["to_s"]), 6)
         g["duration_s"] = round(g["to_s"] - g["from_s"], 6)
