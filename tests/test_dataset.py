@@ -127,6 +127,28 @@ def test_adding_records_leaves_the_other_records_seeds_and_draws(tmp_path: Path)
     assert len({v[0] for v in after.values()}) == len({v[1] for v in after.values()}) == len(after)
 
 
+def test_a_variation_value_given_twice_gives_records_of_their_own_seeds(tmp_path: Path) -> None:
+    """Two records alike but for their place in the grid (an aspect given twice: two noise
+    realisations of one view, as the seeds from the record's number gave) have seeds and
+    draws of their own; derived from what the record is alone, they were the same record
+    twice, a test record's copy in the training set. The others keep theirs."""
+    extra = "[randomize]\ndraws = 2\nradar_height = { uniform = [1.0, 2.0] }\n"
+    once = write_config(tmp_path / "a.toml", aspects="[0.0]")
+    once.write_text(once.read_text() + extra)
+    twice = write_config(tmp_path / "b.toml", aspects="[0.0, 0.0]")
+    twice.write_text(twice.read_text() + extra)
+    single = [
+        (s.run_config["seed"], json.dumps(s.draws))
+        for s in plan_records(*load_dataset_config(once))
+    ]
+    double = [
+        (s.run_config["seed"], json.dumps(s.draws))
+        for s in plan_records(*load_dataset_config(twice))
+    ]
+    assert len(double) == 2 * len(single) and len(set(double)) == len(double)
+    assert set(single) <= set(double)
+
+
 def test_a_copy_elsewhere_draws_the_same(tmp_path: Path) -> None:
     """A record's seed and draws derive from its motion's contents, not its file's path: the
     same config with its motion files copied to another folder, named by a relative path or

@@ -517,7 +517,8 @@ def _forget_loaded() -> None:
 def _record_key(seed: int, what: Sequence[Any]) -> list[int]:
     """The entropy of a record's random numbers: the dataset's ``seed`` and a digest of what
     the record is (``what``: its source's motion fingerprint and the number of earlier sources
-    of the same motion, its window's start, its grid point, its draw), never its number in the
+    of the same motion, its window's start, its grid point, its draw; and, for a grid point
+    given twice, how many records alike come before it), never its number in the
     dataset or its file's path, so that records added to or left out of a config leave the
     others' draws, and a copy of the config and data elsewhere draws the same."""
     text = json.dumps(list(what), sort_keys=True, separators=(",", ":"), default=str)
@@ -1007,6 +1008,7 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
     prints: dict[str, str] = {}  # motion key -> fingerprint
     generated: dict[str, str] = {}  # fingerprint -> recording of a motion read from no file
     sources_of: dict[str, int] = {}  # fingerprint -> sources of that motion so far
+    keys_of: dict[tuple[int, ...], int] = {}  # a record's key -> records of that key so far
     for entry_no, entry in enumerate(config.sources):
         if entry.recording is not None:
             recorded, too_short = _plan_recordings(config, entry_no, entry, base_dir, len(specs))
@@ -1086,7 +1088,13 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                 index = len(specs)
                 record = f"sources[{entry_no}] record {index}"
                 point = [aspect, rng_, rheight, rpos, height]
-                entropy = _record_key(config.seed, [*source_key, section["start"], point, draw_no])
+                what = [*source_key, section["start"], point, draw_no]
+                entropy = _record_key(config.seed, what)
+                # a grid point given twice (an aspect listed twice) is another record alike
+                same_key = keys_of.get(tuple(entropy), 0)
+                keys_of[tuple(entropy)] = same_key + 1
+                if same_key:
+                    entropy = _record_key(config.seed, [*what, same_key])
                 draws = None
                 if rz.active():
                     rng = np.random.default_rng(np.random.SeedSequence([*entropy, 1]))
