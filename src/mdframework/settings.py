@@ -571,8 +571,8 @@ class RunConfigBase(StrictModel):
     seed: Seed = Field(
         0,
         description="Seed of every random draw in the run (noise, clutter, the FMCW radar's "
-        "receiver noise), except a plugin's own seed field that the config gives (the "
-        "static_scene room's seed, the FMCW radar's noise_seed).",
+        "receiver noise), except the static_scene room, always drawn from that effect's own "
+        "seed (default 0), and the FMCW radar's receiver noise when its noise_seed is given.",
     )
 
     scene: SceneConfig = Field(default_factory=SceneConfig, description="The scene.")
