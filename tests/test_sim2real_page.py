@@ -111,6 +111,17 @@ def test_the_prose_figures_derived_from_the_results() -> None:
     assert below is not None
     gaps = [100 * (real[k]["mean"] - sim[k]["mean"]) for k in inputs]
     assert list(below.groups()) == [f"{g:.0f}" for g in gaps]
+    # the range of one seed's score over the seeds, in whole per cent
+    spread = re.search(
+        r"k-NN on the histograms scores between (\d+) and (\d+) % over the (\w+) seeds, the "
+        r"forest between (\d+) and (\d+) %",
+        prose,
+    )
+    assert spread is not None
+    words = {3: "three", 5: "five", 10: "ten"}
+    assert spread.group(3) == words.get(len(results["seeds"]))
+    ranges = [f(sim[k]["scores"]) for k in inputs for f in (min, max)]
+    assert [spread.group(i) for i in (1, 2, 4, 5)] == [f"{100 * v:.0f}" for v in ranges]
     times = re.search(
         r"simulated frames also hold ([\d.]+) to ([\d.]+) times as many points", prose
     )
