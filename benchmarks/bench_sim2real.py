@@ -13,7 +13,7 @@ balanced accuracy and per-class rates, then mean and std over the seeds. The rea
 reference uses the same input and classifier, trained on real recordings and tested on held-out
 real recordings (``--repeats`` random splits holding out 5 of the 12 recordings of every class).
 
-    .venv/bin/python benchmarks/bench_sim2real.py [--seeds 0 1 2] [--variants full,...]
+    .venv/bin/python benchmarks/bench_sim2real.py [--seeds 0 1 ... 9] [--variants full,...]
         [--workers N] [--out out/bench_sim2real] [--docs]
 
 Writes ``results.json`` and ``results.md`` (the tables of ``docs/sim-to-real.md``, with the
@@ -339,7 +339,7 @@ def _summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
+    parser.add_argument("--seeds", type=int, nargs="+", default=list(range(10)))
     parser.add_argument("--variants", default=",".join(VARIANTS))
     parser.add_argument("--classifiers", default=",".join(CLASSIFIERS))
     parser.add_argument("--workers", type=int, default=None)
