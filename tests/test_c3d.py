@@ -205,7 +205,9 @@ def test_unseen_markers_make_their_joints_invalid(tmp_path: Path) -> None:
     markers["LWRA"][10:15] = np.nan  # ezc3d writes NaN points as not seen (residual -1)
     path = tmp_path / "gap.c3d"
     write_c3d(path, markers, 50.0, "m", 1.0)
-    c = C3dSource(C3dConfig(file=path)).load().canonical()
+    m = C3dSource(C3dConfig(file=path)).load()
+    assert m.metadata["zero_points"] == 0  # a marker not seen, not one at the origin
+    c = m.canonical()
     hand = c.index("l_hand")
     assert not c.valid[10:15, hand].any() and c.valid[:10, hand].all()
     assert c.valid[:, c.index("r_hand")].all()
@@ -247,12 +249,33 @@ def test_a_file_of_two_subjects_reads_one_subjects_markers_only(tmp_path: Path) 
         assert np.allclose(c.joint(j), truth, atol=1e-4), j
 
 
-def test_a_joint_whose_marker_is_never_seen_is_named_with_the_marker(tmp_path: Path) -> None:
-    """A marker the file names but never saw (not labelled in any frame) left its joint
-    untracked throughout; the run then stopped saying to choose a record where the joint is
-    tracked, which no record is. The load names the joint, the marker and the marker map."""
+def test_subjects_of_marker_map_names_alone_are_told_apart(tmp_path: Path) -> None:
+    """A subject's markers named in motion.marker_map only (no marker set's names) still make
+    the prefix a subject's: two such subjects without motion.subject are refused, and S2 is
+    read when chosen."""
+    body = _body(30, 60.0)
+    other = {j: v + np.array([0.0, 2.0, 0.0]) for j, v in body.items()}
+    markers = {f"S1:J_{j}": body[j] for j in CANONICAL_JOINTS}
+    markers |= {f"S2:J_{j}": other[j] for j in CANONICAL_JOINTS}
+    path = tmp_path / "custom.c3d"
+    write_c3d(path, markers, 60.0, "mm", 0.001)
+    mapping = {j: f"J_{j}" for j in CANONICAL_JOINTS}
+    with pytest.raises(DataFileError, match=r"2 subjects \(S1, S2\): give motion.subject"):
+        C3dSource(C3dConfig(file=path, marker_map=mapping)).load()
+    c = C3dSource(C3dConfig(file=path, marker_map=mapping, subject="S2")).load().canonical()
+    assert np.allclose(c.joint("head"), other["head"], atol=1e-4)
+
+
+@pytest.mark.parametrize("seen", [0, 1])
+def test_a_joint_whose_marker_is_never_seen_is_named_with_the_marker(
+    tmp_path: Path, seen: int
+) -> None:
+    """A marker the file names but never saw (not labelled in any frame, or in one only) left
+    its joint untracked throughout; the run then stopped saying to choose a record where the
+    joint is tracked, which no record is. The load names the joint, the marker and the marker
+    map."""
     markers = pig_markers(_body(60, 60.0))
-    markers["LELB"][:] = np.nan
+    markers["LELB"][seen:] = np.nan
     path = tmp_path / "noelbow.c3d"
     write_c3d(path, markers, 60.0, "mm", 0.001)
     with pytest.raises(DataFileError) as err:

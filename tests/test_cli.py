@@ -922,6 +922,27 @@ def test_check_counts_a_long_walks_motion_and_echo_and_a_float32_db_map() -> Non
     assert plan.memory_terms_mib["motion"] > 0.4 * plan.memory_terms_mib["spectrogram"]
 
 
+def test_check_memory_terms_of_the_echo_and_a_shared_canonical_body() -> None:
+    """The signal term counts the echo the received-stage effects refer to (8 + 8 + 16 + 16
+    bytes a pulse), and a canonical body that shares the recording's arrays is not counted
+    twice; one of its own is."""
+    from mdf_mujoco.source import BoulicConfig, BoulicWalker
+
+    from mdframework.check import MIB, memory_estimate, motion_memory
+    from mdframework.skeleton import Skeleton
+
+    terms = memory_estimate(1000, 0, 1, 1, 100)
+    assert terms["signal"] == pytest.approx(1000 * 48 / MIB)
+    assert "motion" not in terms
+    motion = BoulicWalker(BoulicConfig(n_cycles=2, nt=64)).load()
+    body = motion.canonical()
+    window = 3 * body.n_joints * 3 * 8 * 10
+    source = motion.skeleton.positions.nbytes
+    assert motion_memory(motion, body, 10) == source + window
+    copy = Skeleton(body.time, body.positions.copy(), body.joint_names, body.valid)
+    assert motion_memory(motion, copy, 10) == 2 * source + window
+
+
 def test_getting_started_quotes_the_raw_walks_fast_time_memory() -> None:
     from mdframework.check import plan_run
 

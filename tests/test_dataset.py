@@ -149,6 +149,56 @@ def test_a_variation_value_given_twice_gives_records_of_their_own_seeds(tmp_path
     assert set(single) <= set(double)
 
 
+def test_a_grid_point_given_three_times_gives_three_records_of_their_own(
+    tmp_path: Path,
+) -> None:
+    """Each record alike (an aspect given three times) is told from the ones before it by
+    its count of them, not by a mark of being a copy: the third was the second again."""
+    extra = "[randomize]\ndraws = 2\nradar_height = { uniform = [1.0, 2.0] }\n"
+    thrice = write_config(tmp_path / "c.toml", aspects="[0.0, 0.0, 0.0]")
+    thrice.write_text(thrice.read_text() + extra)
+    seeds = [
+        (s.run_config["seed"], json.dumps(s.draws))
+        for s in plan_records(*load_dataset_config(thrice))
+    ]
+    assert len(seeds) == 5 * 3 * 2 and len(set(seeds)) == len(seeds)
+
+
+def test_the_dataset_seed_reaches_every_records_seed_and_draws(tmp_path: Path) -> None:
+    """Another top-level seed gives every record another run seed and other draws (the seed
+    is in each record's key, besides what the record is)."""
+    extra = "[randomize]\ndraws = 2\nradar_height = { uniform = [1.0, 2.0] }\n"
+    by_seed = []
+    for seed in (7, 8):
+        path = write_config(tmp_path / f"s{seed}.toml")
+        path.write_text(path.read_text().replace("seed = 7", f"seed = {seed}") + extra)
+        by_seed.append(_seeds_by_window(plan_records(*load_dataset_config(path))))
+    assert by_seed[0].keys() == by_seed[1].keys()
+    for k in by_seed[0]:
+        assert by_seed[0][k][0] != by_seed[1][k][0], k
+        assert by_seed[0][k][1] != by_seed[1][k][1], k
+
+
+def test_a_later_motion_start_keeps_the_seeds_of_the_windows_it_keeps(tmp_path: Path) -> None:
+    """A window is known by its start in the motion: a source's motion.start moved on by one
+    record length drops the first window and leaves the later windows' seeds and draws as
+    they were (counted among the source's windows, every one would have shifted)."""
+    extra = "[randomize]\ndraws = 2\nradar_height = { uniform = [1.0, 2.0] }\n"
+    first = write_config(tmp_path / "a.toml", boxing_records=3)
+    first.write_text(first.read_text() + extra)
+    later = write_config(tmp_path / "b.toml", boxing_records=2)
+    boxing = f'file = "{CMU / "bvh" / "80_10.bvh"}"'
+    later.write_text(later.read_text().replace(boxing, f"{boxing}, start = 1.0") + extra)
+    before = _seeds_by_window(plan_records(*load_dataset_config(first)))
+    after = _seeds_by_window(plan_records(*load_dataset_config(later)))
+    kept = {k: v for k, v in after.items() if "80_10" in str(k[0])}
+    assert sorted({k[1] for k in kept}) == [1.0, 2.0]
+    assert {k: before[k] for k in kept} == kept
+    assert {k: v for k, v in before.items() if "80_10" not in str(k[0])} == {
+        k: v for k, v in after.items() if "80_10" not in str(k[0])
+    }
+
+
 def test_a_copy_elsewhere_draws_the_same(tmp_path: Path) -> None:
     """A record's seed and draws derive from its motion's contents, not its file's path: the
     same config with its motion files copied to another folder, named by a relative path or

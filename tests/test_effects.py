@@ -21,7 +21,13 @@ from mdframework.config import validate_run_config
 from mdframework.constants import BOLTZMANN, SPEED_OF_LIGHT
 from mdframework.physics import radar
 from mdframework.physics.spectrogram import spectrogram
-from mdframework.pipeline import RunResult, simulate
+from mdframework.pipeline import (
+    RunResult,
+    build_stages,
+    load_motion,
+    simulate,
+    simulate_motion,
+)
 from mdframework.plugins import default_registry
 
 LAM = SPEED_OF_LIGHT / 15e9
@@ -668,6 +674,36 @@ def test_multipath_extra_path_is_the_records_mean_whatever_the_blocks() -> None:
         assert out[-1]["image_mean"] == pytest.approx(np.mean(2.0 * (rb - rd)), abs=2e-6)
         assert out[-1]["bounce_mean"] == pytest.approx(np.mean(rb - rd), abs=1e-6)
     assert out[0] == out[1]  # to the bit
+
+
+def test_multipath_extra_path_of_a_second_record_is_its_own() -> None:
+    """Stages reused for another record (a dataset worker's) start the sums again: the second
+    record's mean is its own, not the mean of both."""
+
+    def config(start: float) -> Any:
+        return validate_run_config(
+            {
+                "motion": {
+                    "kind": "point_targets",
+                    "length": 1.0,
+                    "targets": MP_TARGET,
+                    "start": start,
+                    "duration": 0.5,
+                },
+                "scatterers": {"kind": "points"},
+                "radar": {"kind": "lfm", "precision": "float64"},
+                "scene": {"radar_position": list(MP_RADAR)},
+                "effects": [{"kind": "multipath"}],
+            }
+        )
+
+    stages = build_stages(config(0.0))
+    motion = load_motion(stages.source)
+    first = simulate_motion(config(0.0), stages, motion).metadata["effects"][0]
+    second = simulate_motion(config(0.5), stages, motion).metadata["effects"][0]
+    alone = simulate(config(0.5)).metadata["effects"][0]
+    assert second["extra_path_m"] == alone["extra_path_m"]
+    assert alone["extra_path_m"]["bounce_mean"] > first["extra_path_m"]["bounce_mean"] + 0.5
 
 
 def test_multipath_image_at_right_doppler() -> None:

@@ -1045,3 +1045,6 @@ def test_the_largest_experiment_seed_runs_and_a_larger_one_is_a_config_error(
     p.write_text(f'seed = {2**32}\n[dataset]\npath = "x"\n')
     with pytest.raises(ConfigError, match=r"e\.toml: seed: must be at most 4294967295"):
         exp.load_experiment_config(p)
+    p.write_text('seed = -1\n[dataset]\npath = "x"\n')  # nor a negative one
+    with pytest.raises(ConfigError, match=r"e\.toml: seed: must be at least 0 \(got -1\)"):
+        exp.load_experiment_config(p)

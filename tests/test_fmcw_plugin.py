@@ -1044,6 +1044,7 @@ def test_the_receiver_noise_follows_the_runs_seed_unless_noise_seed_is_given() -
     assert not np.array_equal(one, two)
     assert np.array_equal(signal(0), signal(0, noise_seed=0))
     assert np.array_equal(signal(1, noise_seed=5), signal(2, noise_seed=5))
+    assert np.array_equal(signal(0), signal(3, noise_seed=0))  # 0 given is not "not given"
     assert np.array_equal(one, signal(1))
     assert np.array_equal(one, signal(7, noise_seed=1))  # the run's seed stands for noise_seed
 

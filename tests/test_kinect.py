@@ -465,7 +465,8 @@ def test_ntu_layout(tmp_path: Path) -> None:
     rec = read_utkinect(UT)
     path = tmp_path / "S001C001P001R001A001.skeleton"
     path.write_text(ntu_text(rec, bodies=2, drop_frame=5))
-    m = KinectSource(KinectConfig(format="ntu", file=path)).load()
+    with pytest.warns(UserWarning, match=r"reading body 1, the first one in most frames"):
+        m = KinectSource(KinectConfig(format="ntu", file=path)).load()
     assert m.skeleton.n_joints == 25
     assert not m.skeleton.valid[5].any() and m.skeleton.valid[6].all()
     assert np.allclose(np.diff(m.skeleton.time), 1 / 30)
@@ -498,11 +499,16 @@ def test_ntu_reads_the_body_in_most_frames_and_names_every_body(tmp_path: Path) 
     ):
         m = KinectSource(KinectConfig(format="ntu", file=path)).load()
     assert m.metadata["body_id"] == "72057594037931101" and m.metadata["bodies"] == 2
+    assert m.metadata["body"] == 2
     v1 = {name: i for i, name in enumerate(KINECT_V1_JOINTS)}
     back = read_ntu(path)
     assert back.time.shape[0] == rec.time.shape[0]
     np.testing.assert_allclose(back.positions[:, 0], rec.positions[:, v1["HipCenter"]], atol=1e-6)
-    false_body = read_ntu(path, body=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the body chosen: nothing to warn of
+        false_body = read_ntu(path, body=1)
+        chosen = KinectSource(KinectConfig(format="ntu", file=path, body=1)).load()
+    assert chosen.metadata["body"] == 1 and chosen.metadata["body_id"] == "72057594037931000"
     assert false_body.time.shape[0] == 15 and np.allclose(
         false_body.positions[:, 0], [0.5, 0.2, 3.0]
     )

@@ -31,6 +31,7 @@ from mdframework.sanity import (
     foot_facing_cosine,
     head_rise,
     leg_length,
+    long_gaps,
     turns,
 )
 from mdframework.settings import SanityConfig
@@ -803,6 +804,55 @@ def test_a_gap_outside_the_record_is_still_named_and_the_way_out_is_right(
     message = str(caught.value)
     assert "the check reads the whole file" in message
     assert "motion.sanity.gaps = 'ignore'" in message
+
+
+def test_long_gaps_takes_only_gaps_longer_than_the_limit_and_a_frame_and_a_half() -> None:
+    """long_gaps' rules on frames 0.125 s apart from 5 s: a step counts when longer (not as
+    long) than max_gap_s and than 1.5 median steps; a joint untracked for one frame between
+    tracked ones counts when that spans more than max_gap_s; times are from the first frame;
+    the longest comes first."""
+    t = 5.0 + 0.125 * np.arange(12.0)
+    valid = np.ones((12, 2), dtype=bool)
+    assert long_gaps(t, valid, 0.25) == []
+    stepped = t.copy()
+    stepped[6:] += 0.125  # one step of 0.25 s: as long as max_gap_s, not longer
+    assert long_gaps(stepped, valid, 0.25) == []
+    # 0.175 s: longer than max_gap_s = 0.1 but not than 1.5 frames (0.1875 s)
+    stepped = t.copy()
+    stepped[6:] += 0.05
+    assert long_gaps(stepped, valid, 0.1) == []
+    holes = valid.copy()
+    holes[3, 0] = False  # joint 0: one frame untracked, 0.25 s between tracked frames
+    holes[7:10, 1] = False  # joint 1: three frames, 0.5 s
+    longer = {"joint": 1, "from_s": 0.75, "to_s": 1.25, "duration_s": 0.5}
+    assert long_gaps(t, holes, 0.2) == [
+        longer,
+        {"joint": 0, "from_s": 0.25, "to_s": 0.5, "duration_s": 0.25},
+    ]
+    assert long_gaps(t, holes, 0.25) == [longer]
+
+
+def test_several_gaps_are_listed_and_counted_in_the_warning() -> None:
+    """Every gap is in the report (up to the listed limit) and the warning names the longest
+    and how many more there are."""
+    real = str(EXAMPLES / "data/trc/opensim_subject01_walk.trc")
+    motion, _ = load({"kind": "trc", "file": real, "activity": "walk"})
+    body = motion.skeleton
+    valid = body.valid.copy()
+    valid[30:90, body.index("l_knee")] = False
+    valid[30:60, body.index("r_knee")] = False
+    gapped = Skeleton(body.time, body.positions, body.joint_names, valid)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        checked = check_motion(
+            Motion(gapped, motion.metadata, motion.canonical_map), SanityConfig(cadence=False)
+        )
+    gaps = checked.metadata["sanity"]["gaps"]
+    assert gaps["count"] == 2
+    assert [g["joint"] for g in gaps["items"]] == ["l_knee", "r_knee"]
+    said = [str(w.message) for w in caught if "untracked" in str(w.message)]
+    assert len(said) == 1 and "l_knee is untracked" in said[0]
+    assert "(and 1 more such gap(s))" in said[0]
 
 
 def test_a_body_read_in_the_wrong_length_unit_is_flagged() -> None:

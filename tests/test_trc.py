@@ -321,7 +321,10 @@ def test_markerless_keypoints_as_pose2sim_writes_them_make_the_body(tmp_path) ->
         halpe[s + "Heel"] = j[f"{c}_ankle"] - np.array([0.05, 0.0, 0.05])
     body25 = {k: v for k, v in halpe.items() if k not in ("Hip", "Head")}
     body25 |= {"MidHip": j["base"], "LEar": j["head"] + side, "REar": j["head"] - side}
-    for name, keypoints in (("halpe", halpe), ("body25", body25)):
+    # a set without the small toes: the big toe alone is the toe
+    big = {k: v for k, v in body25.items() if "SmallToe" not in k}
+    big |= {"LBigToe": j["l_toe"], "RBigToe": j["r_toe"]}
+    for name, keypoints in (("halpe", halpe), ("body25", body25), ("big toes", big)):
         motion = TrcSource(
             TrcConfig(file=_keypoint_trc(tmp_path / f"{name}.trc", keypoints, 60.0))
         ).load()
@@ -345,6 +348,24 @@ def test_rows_left_out_and_renumbered_are_named_as_such(tmp_path, lines) -> None
         "Frame# / DataRate, so number the frames as Time says (motion.frame_rate would read the "
         "motion without the gap)"
     )
+
+
+def test_one_row_left_out_and_renumbered_is_named_too(tmp_path, lines) -> None:
+    """A single row left out (a step of two frames, more than 1.5 median steps) is a jump as
+    well; a Frame# that also jumps, by other than Time does, is no renumbering: that file's
+    Time and Frame# disagree, as a wrong DataRate's do."""
+    data = lines[6:66] + lines[67:]
+    renumbered = [f"{k + 1}\t" + row.split("\t", 1)[1] for k, row in enumerate(data)]
+    path = _write(tmp_path, _header([*lines[:6], *renumbered], "NumFrames", str(len(data))))
+    with pytest.raises(DataFileError, match=r":67: Time jumps 0.034 s from the row before"):
+        read_trc(path)
+    data = lines[6:66] + lines[96:]
+    skipped = [
+        f"{k + 1 + (10 if k >= 60 else 0)}\t" + row.split("\t", 1)[1] for k, row in enumerate(data)
+    ]
+    path = _write(tmp_path, _header([*lines[:6], *skipped], "NumFrames", str(len(data))))
+    with pytest.raises(DataFileError, match=r":67: Time 1.5 s disagrees with Frame# 71"):
+        read_trc(path)
 
 
 def test_units_and_frame_rate_overrides(tmp_path, lines) -> None:
