@@ -382,6 +382,19 @@ FAILING_METHOD = {
         "scatterers plugin 'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug); check it with "
         "mdframework.testing.check_scatterer_model",
     ),
+    "radar config validator": (
+        "from mdf_lfm.waveform import LfmPulseDoppler as Base\n"
+        "from pydantic import model_validator\n",
+        "radar_waveforms",
+        "    class Config(XyzzyConfig):\n"
+        "        @model_validator(mode='after')\n"
+        "        def _bug(self):\n"
+        "            raise TypeError('not a ValueError')\n",
+        ('kind = "lfm"', 'kind = "xyzzy_bug"'),
+        "TypeError: not a ValueError (in Config.model_validate() of the radar plugin "
+        "'xyzzy_bug' (mdf_test_xyzzy.XyzzyBug); check it with "
+        "mdframework.testing.check_radar_waveform",
+    ),
     "motion source": (
         "from mdf_point_targets.source import PointTargets as Base\n",
         "motion_sources",
@@ -414,7 +427,8 @@ def test_a_plugin_method_that_fails_is_an_internal_error_naming_the_plugin(
 ) -> None:
     """A third party's motion source, scatterer model or radar whose method raises is that
     plugin's bug: the internal error names it and its contract check (it named nobody, as if
-    mdframework had failed; only effects were named)."""
+    mdframework had failed; only effects were named); so is a radar config validator raising
+    an exception other than pydantic's (the run config is validated whole: it named nobody)."""
     base, hook, method, (old, new), why = FAILING_METHOD[case]
     install_broken(installed, base, hook, method)
     config = tmp_path / "bug.toml"

@@ -27,9 +27,9 @@ from typing import Annotated, Any, Union, get_args
 from pydantic import BaseModel, Field, ValidationError, create_model, model_validator
 
 from . import limits
-from .errors import ConfigError, SceneError, unnameable
+from .errors import ConfigError, MdfError, SceneError, unnameable
 from .interfaces import PluginConfig, RadarConfig
-from .plugins import Registry, default_registry, suggest
+from .plugins import Registry, blame, default_registry, suggest
 from .settings import MotionConfig, RunConfigBase
 from .skeleton import CANONICAL_JOINTS
 
@@ -717,9 +717,35 @@ def validate_run_config(
         config = model.model_validate(data, context={"base_dir": base_dir})
     except ValidationError as exc:
         raise ConfigError(format_validation_error(exc, source, data, model)) from None
+    except MdfError:
+        raise
+    except Exception:  # a plugin's validator failed otherwise than pydantic expects: its bug
+        _name_failing_validator(data, reg, base_dir)
+        raise
     _check_saveable(config)
     _check_pulse_budget(config, source)
     return config
+
+
+def _name_failing_validator(data: dict[str, Any], reg: Registry, base_dir: Path | None) -> None:
+    """Validate each plugin section of ``data`` alone, in its plugin's own config model: the
+    one whose validator raises an exception other than pydantic's raises it again with a note
+    naming the plugin (:func:`~mdframework.plugins.blame`); the whole run config names nobody."""
+    sections = [(name, data.get(name)) for name in ("motion", "scatterers", "radar")]
+    effects = data.get("effects")
+    sections += [("effects", e) for e in effects] if isinstance(effects, list) else []
+    for interface, section in sections:
+        if not isinstance(section, dict) or not isinstance(section.get("kind"), str):
+            continue
+        try:
+            cls = reg.get(interface, section["kind"])
+        except KeyError:
+            continue
+        with blame(cls, "Config.model_validate"):
+            try:
+                cls.Config.model_validate(section, context={"base_dir": base_dir})
+            except ValidationError:
+                pass  # the user's error, which the whole config reports
 
 
 def _check_saveable(config: RunConfigBase) -> None:
