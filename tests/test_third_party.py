@@ -62,6 +62,10 @@ BROKEN = {
         'import sys\nsys.exit("no GPU here")\n',
         "failed to load: SystemExit: no GPU here",
     ),
+    "exits in its hook": (
+        EFFECT + "import sys\n" + registering('sys.exit("no GPU here")'),
+        "mdframework_register_effects raised SystemExit: no GPU here",
+    ),
     "kind of another plugin": (
         EFFECT.replace('Literal["xyzzy_fx"] = "xyzzy_fx"', 'Literal["noise"] = "noise"')
         + registering("[XyzzyFx]"),

@@ -437,7 +437,7 @@ def _hook_classes(
                 problem = f"{hook_name} returned {classes!r}, not a list of classes"
             else:
                 found, problem = list(classes or []), ""
-        except Exception as exc:  # in the hook, or in a generator it returned
+        except (Exception, SystemExit) as exc:  # in the hook, or a generator it returned
             _reraise_interrupt(exc)
             problem = f"{hook_name} raised {type(exc).__name__}: {exc}"
         if problem:
