@@ -506,15 +506,19 @@ def test_mdf_plugins_names_a_plugin_that_is_slow_to_import(
     assert 0.2 <= float(mine[0][3]) < 5 and mine[0][4] == "s"
 
 
+@pytest.mark.parametrize("where", ["import", "hook"])
 def test_what_a_plugin_prints_when_imported_stays_out_of_a_commands_output(
-    installed: Path, capsys: pytest.CaptureFixture[str]
+    where: str, installed: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """A third party's plugin that prints a banner when imported: `mdf config schema >
-    schema.json` wrote the banner into the JSON, which no JSON reader then took; it goes to
-    stderr."""
+    """A third party's plugin that prints a banner when imported, or when its registration
+    hook runs: `mdf config schema > schema.json` wrote the banner into the JSON, which no JSON
+    reader then took; it goes to stderr."""
     import json
 
-    body = 'print("xyzzy: hello")\n' + HEADER + EFFECT + registering("[XyzzyFx]")
+    if where == "import":
+        body = 'print("xyzzy: hello")\n' + HEADER + EFFECT + registering("[XyzzyFx]")
+    else:
+        body = HEADER + EFFECT + registering('print("xyzzy: hello") or [XyzzyFx]')
     _make_distribution(installed, "xyzzy-fx", "mdf_test_xyzzy", body, "xyzzy_fx")
     capsys.readouterr()
     assert cli.main(["config", "schema"]) == 0

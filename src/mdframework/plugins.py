@@ -430,13 +430,16 @@ def _hook_classes(
         provider = _provider_name(pm, impl.plugin)
         name = pm.get_name(impl.plugin) or provider
         try:
-            classes = impl.function()
-            # a list, or any other collection of classes (a set, a generator), but not one
-            # class or text, whose items are no classes
-            if isinstance(classes, str | bytes | type) or not isinstance(classes, Iterable | None):
-                problem = f"{hook_name} returned {classes!r}, not a list of classes"
-            else:
-                found, problem = list(classes or []), ""
+            with redirect_stdout(sys.stderr):  # what it prints stays out of a command's output
+                classes = impl.function()
+                # a list, or any other collection of classes (a set, a generator), but not one
+                # class or text, whose items are no classes
+                if isinstance(classes, str | bytes | type) or not isinstance(
+                    classes, Iterable | None
+                ):
+                    problem = f"{hook_name} returned {classes!r}, not a list of classes"
+                else:
+                    found, problem = list(classes or []), ""
         except (Exception, SystemExit) as exc:  # in the hook, or a generator it returned
             _reraise_interrupt(exc)
             problem = f"{hook_name} raised {type(exc).__name__}: {exc}"
