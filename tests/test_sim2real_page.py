@@ -88,6 +88,54 @@ def test_the_goal_sentence_follows_the_numbers() -> None:
     assert bench.goal_line(results).endswith("met for `a`; not met for `b`, `c`.")
 
 
+def test_the_goal_margins_and_the_ablation_differences_carry_their_standard_errors() -> None:
+    """How narrowly the goal is met, and each ablation difference, are computed with their
+    standard error over the seeds; the differences are taken seed by seed (the variants of one
+    seed share most of their draws), so a shift that every seed shows is told from the spread
+    of the seeds."""
+    import numpy as np
+
+    bench = _bench()
+    full = [0.80, 0.90, 0.70, 0.84]
+    results = {
+        "real_to_real": {"a": {"mean": 0.95}, "b": {"mean": 0.85}},
+        "sim_to_real": {
+            "full": {
+                "a": {"mean": float(np.mean(full)), "scores": full},
+                "b": {"mean": 0.81, "scores": [0.81]},
+            }
+        },
+    }
+    margin, se = bench.goal_margins(results)["a"]
+    # the bound is the stricter of 0.80 and 10 points below real-to-real: 0.85
+    assert margin == pytest.approx(100 * (np.mean(full) - 0.85))
+    assert se == pytest.approx(100 * np.std(full, ddof=1) / 2)
+    assert bench.goal_margins(results)["b"] == (pytest.approx(1.0), None)  # one seed: no error
+    assert "`a` -4.0 ± 4.2" in bench.margins_line(results)
+    # every seed 2 points lower: -2.0 with no error, though the seeds spread by 8 points
+    variant = {"mean": float(np.mean(full)) - 0.02, "scores": [v - 0.02 for v in full]}
+    diff, diff_se = bench.paired_difference(variant, results["sim_to_real"]["full"]["a"])
+    assert diff == pytest.approx(-2.0)
+    assert diff_se == pytest.approx(0.0, abs=1e-9)
+
+
+def test_a_variant_that_drops_the_room_says_so() -> None:
+    """An ablation row's words name what its change does to the room (the static reflectors):
+    a variant that removes them says 'room'."""
+    import copy
+
+    from mdframework.config import read_config_file
+
+    bench = _bench()
+    base = read_config_file(bench.CONFIG)
+    for name, (what, change) in bench.VARIANTS.items():
+        cfg = copy.deepcopy(base)
+        change(cfg)
+        kinds = [e.get("kind") for e in cfg["base"]["effects"]]
+        if "static_scene" not in kinds:
+            assert "room" in what, (name, what)
+
+
 def test_the_prose_figures_derived_from_the_results() -> None:
     """Figures of the prose that the script does not print as such: the walks' per-class rates
     on the histogram input (two decimals, which the test above does not look at), how many
@@ -130,6 +178,15 @@ def test_the_prose_figures_derived_from_the_results() -> None:
     ratios = [points["full"][a]["points"] / points["real"][a]["points"] for a in points["real"]]
     low, high = (float(t) for t in times.groups())
     assert low - 0.05 <= min(ratios) and max(ratios) <= high + 0.05, ratios
+    # the moving points per frame of the lively, the real and the shipped jumps
+    jumps = re.search(
+        r"have (\d\.\d\d) moving points per frame against the real jumps' (\d\.\d\d) \(the "
+        r"points table; the shipped slow jumps still have (\d\.\d\d)\)",
+        prose,
+    )
+    assert jumps is not None
+    moving = [points[v]["jump"]["moving"] for v in ("lively_jumps", "real", "full")]
+    assert list(jumps.groups()) == [f"{m:.2f}" for m in moving]
 
 
 def test_the_real_to_real_split_words_count_the_shipped_recordings() -> None:
