@@ -77,6 +77,35 @@ def test_velocities_are_the_sensor_bins_with_the_project_sign() -> None:
     assert cloud.velocity.max() == pytest.approx(5 * IWR1443_BIN_WIDTH, rel=1e-6)
 
 
+def test_walkers_range_changes_as_their_doppler_says() -> None:
+    """Physics, not the driver's word: in every shipped walk the range of the moving points
+    (the walker) shrinks while their radial velocity is positive (approaching) and grows while
+    it is negative, and at about the rate the velocity gives with frames 1/30 s apart (a wrong
+    sign, or a frame period off by half, fails this)."""
+    slopes = []
+    for name, cloud in npz_recordings(DATA / "radhar_walk_subset.npz"):
+        r = cloud.ranges
+        moving = (cloud.velocity != 0) & (r > 0.5) & (r < 3.0)
+        block = 15  # frames: 0.5 s
+        centre, velocity = [], []
+        for first in range(0, cloud.n_frames - block, block):
+            pick = moving & (cloud.frame >= first) & (cloud.frame < first + block)
+            if np.sum(pick) >= 5:
+                centre.append(np.median(r[pick]))
+                velocity.append(np.mean(cloud.velocity[pick]))
+            else:
+                centre.append(np.nan)
+                velocity.append(np.nan)
+        approach = -np.gradient(np.array(centre)) / (block * cloud.frame_period)  # m/s
+        v = np.array(velocity)
+        ok = np.isfinite(approach) & np.isfinite(v)
+        assert np.sum(ok) >= 10, name
+        assert np.corrcoef(approach[ok], v[ok])[0, 1] > 0.8, name
+        slopes.append(np.polyfit(v[ok], approach[ok], 1)[0])
+    # the moving points' mean Doppler (legs and arms included) exceeds the walker's own speed
+    assert 0.5 < np.median(slopes) < 1.0, slopes
+
+
 def test_people_stand_in_front_of_the_sensor() -> None:
     """ROS axes (x forward) become sensor axes (y boresight): the moving points near the person
     lie ahead of the sensor, about 1-2 m along y."""
