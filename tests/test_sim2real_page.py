@@ -204,3 +204,16 @@ def test_the_real_to_real_split_words_count_the_shipped_recordings() -> None:
     held = recordings_held_out(bench.REAL_RECORDINGS, bench.TEST_FRACTION)
     assert (held, bench.REAL_RECORDINGS) == (5, 12)
     assert "holding out 5 of the 12 recordings of every class" in PAGE.read_text()
+
+
+def test_the_reproduce_section_says_the_experiment_is_one_seed() -> None:
+    """`mdf experiment examples/experiment_sim2real.toml` builds one dataset seed: the page says
+    which, and that its score is the benchmark's first seed's, not the table's mean."""
+    import tomllib
+
+    results = _results()
+    config = tomllib.loads((ROOT / "examples" / "datasets" / "sim2real.toml").read_text())
+    reproduce = " ".join(PAGE.read_text().split("## Reproduce", 1)[1].split())
+    assert f"one dataset seed (the config's `seed = {config['seed']}`)" in reproduce
+    assert results["seeds"][0] == config["seed"]
+    assert "the first of the benchmark's k-NN histogram scores, not their mean" in reproduce
