@@ -1689,10 +1689,12 @@ def check_scheduler_address(address: str | None) -> None:
         return
     try:
         from distributed.comm.addressing import parse_address, parse_host_port
+        from distributed.comm.registry import get_backend
     except ImportError:
         raise SettingError("a Dask scheduler needs `pip install mdframework[dask]`") from None
     try:
         scheme, location = parse_address(address)
+        get_backend(scheme)  # a scheme misspelt (tpc://) was found out after planning
         if scheme != "inproc":
             parse_host_port(location)
     except ValueError as exc:
