@@ -199,3 +199,33 @@ def test_a_file_left_by_a_killed_worker_is_removed_when_the_build_ends(
     build_dataset(config, base, out, workers=1, progress=False)
     assert sorted(p.name for p in (out / RECORDS).iterdir() if not p.name.endswith(".npz")) == []
     assert len(list((out / RECORDS).iterdir())) == 8
+
+
+def test_a_scheduler_lost_mid_build_is_one_line(
+    cluster: Any, tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """The scheduler gone mid-build (killed, its machine down): Dask cancels every task, and
+    the build ended as an internal error (`FutureCancelledError: ... scheduler-connection-lost`)
+    after Dask's client logged a traceback. Now one line naming the scheduler and saying how
+    to resume; the records finished stay."""
+    config = write_relative_config(tmp_path / "cfg", walks=20, aspects="[0.0, 10.0, 20.0, 30.0]")
+    out = tmp_path / "out"
+    address = cluster.scheduler_address
+
+    def stop_the_scheduler_after_a_record() -> None:
+        while not list((out / RECORDS).glob("*.npz")) and build.is_alive():
+            threading.Event().wait(0.02)
+        cluster.close()  # its workers, then its scheduler
+
+    args = ["dataset", "build", str(config), "--out", str(out), "--no-progress"]
+    done: list[int] = []
+    build = threading.Thread(target=lambda: done.append(cli.main([*args, "--scheduler", address])))
+    build.start()
+    stop_the_scheduler_after_a_record()
+    build.join(60)
+    assert done == [2]
+    err = capfd.readouterr().err
+    assert "Traceback" not in err
+    assert err.splitlines()[-1].startswith(f"mdf: error: lost the Dask scheduler {address!r} ")
+    assert err.splitlines()[-1].endswith("the same command, run again, resumes from them")
+    assert list((out / RECORDS).glob("*.npz"))
