@@ -17,6 +17,7 @@ from test_dataset import assert_same
 
 from mdframework import cli, dataset
 from mdframework.dataset import RECORDS, build_dataset, load_dataset_config
+from mdframework.errors import SettingError
 
 pytest.importorskip("distributed")
 
@@ -229,3 +230,28 @@ def test_a_scheduler_lost_mid_build_is_one_line(
     assert err.splitlines()[-1].startswith(f"mdf: error: lost the Dask scheduler {address!r} ")
     assert err.splitlines()[-1].endswith("the same command, run again, resumes from them")
     assert list((out / RECORDS).glob("*.npz"))
+
+
+def test_a_worker_that_does_not_see_the_data_or_out_is_named(cluster: Any, tmp_path: Path) -> None:
+    """A worker on a machine without the build's file system (its data files, --out) is
+    named before any record, with the first path it does not see (such a worker failed every
+    record, as the config's error 'motion.file: file not found', or, writing, as an internal
+    error). Here a path no worker sees stands for one; checked for real with a worker in a
+    mount namespace where the config's folder was an empty tmpfs."""
+    from distributed import Client
+
+    config, base = load_dataset_config(write_relative_config(tmp_path / "cfg"))
+    files = dataset._data_files(dataset.plan_records(config, base))
+    assert sorted(Path(f).name for f in files) == ["02_01.amc", "80_10.bvh"]
+    assert all(Path(f).is_absolute() and Path(f).is_file() for f in files)
+    gone = str(tmp_path / "elsewhere" / "records")
+    with Client(cluster) as client:
+        dataset._check_paths(client, files)  # every worker sees them
+        with pytest.raises(SettingError) as err:
+            dataset._check_paths(client, [*files, gone, gone + "2"])
+    (worker,) = cluster.scheduler.workers
+    assert str(err.value) == (
+        f"Dask worker {worker} does not see {gone} (and 1 more): the workers read the data "
+        "files and write the records by the paths of this machine, so the data and --out must "
+        "be on a file system they share, at the same paths"
+    )

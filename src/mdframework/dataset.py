@@ -1858,6 +1858,8 @@ def _executor(
             client.run(_receive_motions, dict(_MOTIONS), on_error="ignore")
 
             def run_dask(specs: list[RecordSpec], out: str) -> Iterator[dict[str, Any]]:
+                if cluster is None:  # workers of one's own: on other machines, maybe
+                    _check_paths(client, [str(Path(out) / RECORDS), *_data_files(specs)])
                 threads = sum(client.nthreads().values()) or n
                 chunks = record_chunks(specs, threads)
                 futures = client.map(build_records, chunks, out_dir=out, pure=False)
@@ -1971,6 +1973,39 @@ class _Workerless(threading.Thread):
     def stop(self) -> None:
         self._done.set()
         self.join()
+
+
+def _data_files(specs: list[RecordSpec]) -> list[str]:
+    """The motion and recording files the ``specs`` read, by the absolute paths the workers
+    open."""
+    files: dict[str, None] = {}
+    for spec in specs:
+        section = spec.run_config.get("recording") or spec.run_config.get("motion") or {}
+        if isinstance(section.get("file"), str):
+            given = Path(section["file"]).expanduser()
+            files[os.path.abspath(Path(spec.base_dir) / given)] = None
+    return list(files)
+
+
+def _missing_paths(paths: list[str]) -> list[str]:
+    """Those of ``paths`` that this process (a Dask worker) does not see."""
+    return [path for path in paths if not os.path.exists(path)]
+
+
+def _check_paths(client: Any, paths: list[str]) -> None:
+    """:class:`SettingError` naming a Dask worker that does not see one of ``paths``, the
+    records folder and the data files, before any record: the workers read the data and write
+    the records themselves (a worker on a machine without them failed every record, as the
+    config's error 'file not found' or an internal error)."""
+    for worker, missing in sorted(client.run(_missing_paths, paths, on_error="return").items()):
+        if isinstance(missing, BaseException) or not missing:
+            continue  # a worker that left meanwhile: Dask does without it
+        more = f" (and {len(missing) - 1} more)" if len(missing) > 1 else ""
+        raise SettingError(
+            f"Dask worker {worker} does not see {missing[0]}{more}: the workers read the "
+            "data files and write the records by the paths of this machine, so the data and "
+            "--out must be on a file system they share, at the same paths"
+        )
 
 
 def _cluster_failure(exc: BaseException, address: str, record: str, out: str) -> SettingError:
