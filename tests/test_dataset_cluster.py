@@ -255,3 +255,38 @@ def test_a_worker_that_does_not_see_the_data_or_out_is_named(cluster: Any, tmp_p
         "files and write the records by the paths of this machine, so the data and --out must "
         "be on a file system they share, at the same paths"
     )
+
+
+def test_a_worker_without_mdframework_is_named_one_that_left_is_not() -> None:
+    """A worker without mdframework cannot unpickle the version check: Dask returns
+    ``Exception('ModuleNotFoundError(...)')`` for it (seen with a worker whose Python had no
+    mdframework; its build went on without the worker, which Dask removed). One that died
+    meanwhile (a comm error) is left to Dask."""
+    from distributed.comm.core import CommClosedError
+
+    from mdframework.plugins import versions
+
+    class Client:
+        def __init__(self, answers: dict[str, Any]) -> None:
+            self.answers = answers
+
+        def wait_for_workers(self, n: int, timeout: float) -> None:
+            pass
+
+        def run(self, function: Any, on_error: str) -> dict[str, Any]:
+            assert on_error == "return"
+            return self.answers
+
+    ours = versions()
+    left = CommClosedError("in <TCP (closed)>: Stream is closed")
+    dataset._check_workers(Client({"tcp://a:1": ours, "tcp://b:2": left}), "tcp://s:8786")
+    lacking = Exception("ModuleNotFoundError(\"No module named 'mdframework'\")")
+    with pytest.raises(SettingError) as err:
+        dataset._check_workers(Client({"tcp://a:1": ours, "tcp://b:2": lacking}), "tcp://s:8786")
+    assert str(err.value) == (
+        'Dask worker tcp://b:2 cannot run mdframework (ModuleNotFoundError("No module named '
+        "'mdframework'\")); every worker needs the build's mdframework and plugins installed"
+    )
+    older = {**ours, "mdframework": "0.2.0"}
+    with pytest.raises(SettingError, match=r"^Dask worker tcp://a:1 has mdframework '0.2.0', "):
+        dataset._check_workers(Client({"tcp://a:1": older}), "tcp://s:8786")

@@ -1907,10 +1907,14 @@ def _check_workers(client: Any, address: str) -> None:
     numeric = ("python", "numpy", "scipy", "scikit-learn")
     others: set[str] = set()
     for worker, theirs in sorted(client.run(versions, on_error="return").items()):
-        if isinstance(theirs, BaseException) and not isinstance(theirs, ImportError):
+        if isinstance(theirs, (OSError, TimeoutError)):
             continue  # a worker that left meanwhile (killed, restarting): Dask does without it
         if isinstance(theirs, BaseException):  # no mdframework there, or one without versions
-            reason = f"{type(theirs).__name__}: {' '.join(str(theirs).split())}"[:200]
+            reason = " ".join(str(theirs).split())  # a function it cannot unpickle: Dask's
+            # Exception('ModuleNotFoundError(...)'), not the error itself
+            if type(theirs) is not Exception:
+                reason = f"{type(theirs).__name__}: {reason}"
+            reason = reason[:200]
             raise SettingError(
                 f"Dask worker {worker} cannot run mdframework ({reason}); every worker needs "
                 "the build's mdframework and plugins installed"
