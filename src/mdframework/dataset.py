@@ -2158,6 +2158,28 @@ def _used_plugins(meta: dict[str, Any]) -> list[tuple[str, str]]:
     ]
 
 
+def _warn_other_ids(out: Path, specs: list[RecordSpec], kept: int) -> None:
+    """Warn once when a folder resumed with its own config holds records of other ids than
+    the build's (``kept`` of its records are the build's): an earlier version of mdframework
+    whose records had other ids (0.2.0's seeds came from the records' numbers), or motion
+    files changed since; every record of the folder was computed afresh without a word, and
+    a dataset of days of compute looked resumed."""
+    ours = {f"{s.record_id}.npz" for s in specs}
+    others = [p.name for p in (out / RECORDS).glob("*.npz") if p.name not in ours]
+    others = sorted(name for name in others if _RECORD_NAME.fullmatch(name))
+    if not others:
+        return
+    warnings.warn(
+        f"{len(others)} records in {out / RECORDS} (e.g. {others[0][:-4]}) are not records of "
+        f"this config as this version computes it (an earlier version of mdframework gave "
+        f"records other ids and seeds, or their motion files changed since): {kept} of the "
+        f"build's {len(specs)} records are there, the others are computed afresh, and those "
+        "of other ids are removed when the build ends",
+        DatasetWarning,
+        stacklevel=3,
+    )
+
+
 def _warn_other_versions(made_by: dict[str, Any], n_records: int) -> None:
     """Warn once when records kept from the folder were computed by other software versions
     (``made_by``: record id -> its ``versions``, ``None`` for a record written before records
@@ -2256,6 +2278,8 @@ def build_dataset(
             else:
                 rows[spec.record_id] = row
         _warn_other_versions(other_versions, len(specs))
+        if built == wanted and all(c == wanted for c in indexed):
+            _warn_other_ids(out, specs, len(rows))
         printed()
         bar = tqdm_bar(
             total=len(specs),
