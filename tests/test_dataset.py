@@ -1141,6 +1141,46 @@ def test_dataset_json_and_run_metadata_name_the_software_versions(tmp_path: Path
             assert f"{dist} {importlib.metadata.version(dist)}" in versions["plugins"], written
 
 
+def five_records(tmp_path: Path) -> tuple[Any, Path, Path]:
+    """A dataset of five records of 0.5 s from a 2.5 s motion, built into ``tmp_path / "ds"``:
+    its config, base folder and folder."""
+    config = point_dataset(tmp_path / "d.toml")
+    text = config.read_text().replace("length = 0.5", "length = 2.5")
+    config.write_text(text + "[record_lengths]\nrecede = 0.5\n")
+    cfg, base = load_dataset_config(config)
+    out = tmp_path / "ds"
+    build_dataset(cfg, base, out, workers=1, progress=False)
+    assert len(list((out / RECORDS).glob("*.npz"))) == 5
+    return cfg, base, out
+
+
+def test_a_folder_of_records_of_other_ids_is_said_to_be_computed_afresh(tmp_path: Path) -> None:
+    """A folder built by an earlier version whose records had other ids (0.2.0: seeds from the
+    records' numbers, and the seed is in the id) and resumed with the same config: every
+    record is computed afresh and the old files removed at the end, which the build did
+    without a word (a dataset of days of compute looked resumed). It warns once, saying how
+    many of the build's records are there; a folder of the build's own records says nothing."""
+    cfg, base, out = five_records(tmp_path)
+    files = sorted((out / RECORDS).glob("*.npz"))
+    old = [f.with_name(f"{f.name[:6]}0123456789.npz") for f in files[1:]]  # other digests
+    for file, renamed in zip(files[1:], old, strict=True):
+        file.rename(renamed)
+    with pytest.warns(dataset.DatasetWarning) as caught:
+        build_dataset(cfg, base, out, workers=1, progress=False)
+    said = [str(w.message) for w in caught if "not records of this config" in str(w.message)]
+    assert said == [
+        f"4 records in {out / RECORDS} (e.g. {old[0].stem}) are not records of this config as "
+        "this version computes it (an earlier version of mdframework gave records other ids "
+        "and seeds, or their motion files changed since): 1 of the build's 5 records are "
+        "there, the others are computed afresh, and those of other ids are removed when the "
+        "build ends"
+    ]
+    assert sorted((out / RECORDS).glob("*.npz")) == files
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", dataset.DatasetWarning)
+        build_dataset(cfg, base, out, workers=1, progress=False)
+
+
 def test_a_record_kept_from_other_software_versions_is_said(tmp_path: Path) -> None:
     """Each record names the versions that computed it; a build that keeps records computed
     by other versions (their id covers the config, not the software), or by a version before
@@ -1148,14 +1188,8 @@ def test_a_record_kept_from_other_software_versions_is_said(tmp_path: Path) -> N
     versions is never silent."""
     from mdframework.plugins import versions
 
-    config = point_dataset(tmp_path / "d.toml")  # five records of 0.5 s from a 2.5 s motion
-    text = config.read_text().replace("length = 0.5", "length = 2.5")
-    config.write_text(text + "[record_lengths]\nrecede = 0.5\n")
-    cfg, base = load_dataset_config(config)
-    out = tmp_path / "ds"
-    build_dataset(cfg, base, out, workers=1, progress=False)
+    cfg, base, out = five_records(tmp_path)
     files = sorted((out / RECORDS).glob("*.npz"))
-    assert len(files) == 5
     arrays, meta = read_record(files[1])
     ran = ("mdf-lfm", "mdf-point-targets")  # only the plugins the record ran
     assert meta["versions"] == {

@@ -322,7 +322,7 @@ def test_a_malformed_scheduler_address_is_refused_before_any_connection(
     before = set(threading.enumerate())
     for good in (None, "local", "tcp://10.0.0.1:8786", "10.0.0.1:8786", "tcp://[::1]:8786"):
         check_scheduler_address(good)
-    for bad in ("nonsense", "tcp://host", "tls://:x"):
+    for bad in ("nonsense", "tcp://host", "tls://:x", "tpc://10.0.0.1:8786"):
         with pytest.raises(MdfError, match="not an address"):
             check_scheduler_address(bad)
     assert set(threading.enumerate()) == before  # nothing was started

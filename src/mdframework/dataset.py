@@ -46,10 +46,12 @@ import itertools
 import json
 import os
 import re
+import threading
+import time
 import warnings
 from collections.abc import Callable, Generator, Iterable, Iterator, Mapping, Sequence
-from concurrent.futures import as_completed
-from contextlib import AbstractContextManager, closing, contextmanager, nullcontext
+from concurrent.futures import CancelledError, as_completed
+from contextlib import AbstractContextManager, closing, contextmanager
 from dataclasses import dataclass, replace
 from functools import lru_cache
 from pathlib import Path
@@ -1687,10 +1689,12 @@ def check_scheduler_address(address: str | None) -> None:
         return
     try:
         from distributed.comm.addressing import parse_address, parse_host_port
+        from distributed.comm.registry import get_backend
     except ImportError:
         raise SettingError("a Dask scheduler needs `pip install mdframework[dask]`") from None
     try:
         scheme, location = parse_address(address)
+        get_backend(scheme)  # a scheme misspelt (tpc://) was found out after planning
         if scheme != "inproc":
             parse_host_port(location)
     except ValueError as exc:
@@ -1822,11 +1826,12 @@ def _executor(
     try:
         from distributed import Client, LocalCluster
         from distributed import as_completed as dask_completed
+        from distributed.scheduler import KilledWorker
     except ImportError:
         raise SettingError("a Dask scheduler needs `pip install mdframework[dask]`") from None
     import dask
 
-    with _quiet_dask_logs() if address == "local" else nullcontext():
+    with _quiet_dask_logs():  # Dask's log of a failure or Ctrl-C would surround the line
         with dask.config.set(LOCAL_DASK_CONFIG):
             # no dashboard; the scheduler's HTTP server (health and metrics routes) still
             # starts, by default on port 8787 (and warns when another cluster has it): on a free
@@ -1846,14 +1851,35 @@ def _executor(
         try:
             if cluster is not None:
                 client.run(_quiet_dask_worker, warnings.showwarning, warning_filters())
-            client.run(_receive_motions, dict(_MOTIONS))  # each worker gets what planning loaded
+            else:
+                _check_workers(client, address)
+            # each worker gets what planning loaded; one that left meanwhile (killed,
+            # restarting) does without: a worker loads what it was not given itself
+            client.run(_receive_motions, dict(_MOTIONS), on_error="ignore")
 
             def run_dask(specs: list[RecordSpec], out: str) -> Iterator[dict[str, Any]]:
+                if cluster is None:  # workers of one's own: on other machines, maybe
+                    _check_paths(client, [str(Path(out) / RECORDS), *_data_files(specs)])
                 threads = sum(client.nthreads().values()) or n
                 chunks = record_chunks(specs, threads)
                 futures = client.map(build_records, chunks, out_dir=out, pure=False)
-                for fut in dask_completed(futures):
-                    yield from fut.result()
+                first = {
+                    fut.key: chunk[0].record_id for fut, chunk in zip(futures, chunks, strict=True)
+                }
+                watch = _Workerless(client, futures, address)
+                watch.start()
+                try:
+                    for fut in dask_completed(futures):
+                        try:
+                            rows = fut.result()
+                        except (CancelledError, KilledWorker) as exc:
+                            error = watch.error or _cluster_failure(
+                                exc, address, first[fut.key], out
+                            )
+                            raise error from None
+                        yield from rows
+                finally:
+                    watch.stop()
 
             yield run_dask
         finally:
@@ -1862,17 +1888,160 @@ def _executor(
                 cluster.close()
 
 
+def _check_workers(client: Any, address: str) -> None:
+    """:class:`SettingError` unless the cluster at ``address`` has a worker within the
+    connection timeout (a build on a scheduler without workers waited forever, silently), and
+    every worker runs this mdframework and these plugins (a worker without a plugin failed
+    every record of it as the config's error; one of another version computed records that
+    a local build would not). Other versions of Python, NumPy or SciPy are a warning: records
+    may differ from a local build's in the last bits, and each names the versions it ran."""
+    timeout = scheduler_timeout()
+    try:
+        client.wait_for_workers(1, timeout=timeout)
+    except TimeoutError:
+        raise SettingError(
+            f"the Dask scheduler {address!r} has no workers (waited {timeout:g} s for one); "
+            f"start them (`dask worker {address}`), or set {SCHEDULER_TIMEOUT_ENV}"
+        ) from None
+    ours = versions()
+    numeric = ("python", "numpy", "scipy", "scikit-learn")
+    others: set[str] = set()
+    for worker, theirs in sorted(client.run(versions, on_error="return").items()):
+        if isinstance(theirs, (OSError, TimeoutError)):
+            continue  # a worker that left meanwhile (killed, restarting): Dask does without it
+        if isinstance(theirs, BaseException):  # no mdframework there, or one without versions
+            reason = " ".join(str(theirs).split())  # a function it cannot unpickle: Dask's
+            # Exception('ModuleNotFoundError(...)'), not the error itself
+            if type(theirs) is not Exception:
+                reason = f"{type(theirs).__name__}: {reason}"
+            reason = reason[:200]
+            raise SettingError(
+                f"Dask worker {worker} cannot run mdframework ({reason}); every worker needs "
+                "the build's mdframework and plugins installed"
+            )
+        missing = sorted(set(ours["plugins"]) - set(theirs.get("plugins", ())))
+        diff = [f"mdframework {theirs.get('mdframework')!r}, not {ours['mdframework']!r}"] * (
+            theirs.get("mdframework") != ours["mdframework"]
+        )
+        diff += [f"no {', '.join(missing)}"] * bool(missing)
+        if diff:
+            raise SettingError(
+                f"Dask worker {worker} has {'; '.join(diff)}: every worker needs the build's "
+                "mdframework and plugins, of the same versions"
+            )
+        others |= {f"{k} {theirs.get(k)!r}" for k in numeric if theirs.get(k) != ours[k]}
+    if others:
+        warnings.warn(
+            f"Dask workers run {', '.join(sorted(others))}, not this process's versions: their "
+            "records may differ in the last bits from a local build's",
+            DatasetWarning,
+            stacklevel=2,
+        )
+
+
+class _Workerless(threading.Thread):
+    """Watches a Dask build's cluster for the connection timeout without a worker (every
+    worker killed: Dask waits for new ones, and the build waited forever, silently); then
+    cancels the build's ``futures``, and :attr:`error` says why. Stopped by :meth:`stop`.
+    A thread of the build's process (Dask's own loop runs in another): a loop waiting on the
+    futures with a timeout cost the build's process 0.7 s of CPU more for 1260 records."""
+
+    def __init__(self, client: Any, futures: list[Any], address: str) -> None:
+        super().__init__(name="mdf-dask-workers", daemon=True)
+        self.client, self.futures, self.address = client, futures, address
+        self.timeout = scheduler_timeout()
+        self.error: SettingError | None = None
+        self._done = threading.Event()
+
+    def run(self) -> None:
+        alone_since = None
+        while not self._done.wait(1.0):
+            try:
+                workers = bool(self.client.nthreads())
+            except Exception:  # the scheduler lost: the futures are cancelled by Dask
+                return
+            if workers:
+                alone_since = None
+            elif alone_since is None:
+                alone_since = time.monotonic()
+            elif time.monotonic() - alone_since > self.timeout:
+                self.error = SettingError(
+                    f"the Dask scheduler {self.address!r} has had no workers for "
+                    f"{self.timeout:g} s (they were killed, or left); the records finished "
+                    "stay, and the same command, run again when it has workers, resumes from "
+                    f"them (or set {SCHEDULER_TIMEOUT_ENV} to wait longer)"
+                )
+                self.client.cancel(self.futures)
+                return
+
+    def stop(self) -> None:
+        self._done.set()
+        self.join()
+
+
+def _data_files(specs: list[RecordSpec]) -> list[str]:
+    """The motion and recording files the ``specs`` read, by the absolute paths the workers
+    open."""
+    files: dict[str, None] = {}
+    for spec in specs:
+        section = spec.run_config.get("recording") or spec.run_config.get("motion") or {}
+        if isinstance(section.get("file"), str):
+            given = Path(section["file"]).expanduser()
+            files[os.path.abspath(Path(spec.base_dir) / given)] = None
+    return list(files)
+
+
+def _missing_paths(paths: list[str]) -> list[str]:
+    """Those of ``paths`` that this process (a Dask worker) does not see."""
+    return [path for path in paths if not os.path.exists(path)]
+
+
+def _check_paths(client: Any, paths: list[str]) -> None:
+    """:class:`SettingError` naming a Dask worker that does not see one of ``paths``, the
+    records folder and the data files, before any record: the workers read the data and write
+    the records themselves (a worker on a machine without them failed every record, as the
+    config's error 'file not found' or an internal error)."""
+    for worker, missing in sorted(client.run(_missing_paths, paths, on_error="return").items()):
+        if isinstance(missing, BaseException) or not missing:
+            continue  # a worker that left meanwhile: Dask does without it
+        more = f" (and {len(missing) - 1} more)" if len(missing) > 1 else ""
+        raise SettingError(
+            f"Dask worker {worker} does not see {missing[0]}{more}: the workers read the "
+            "data files and write the records by the paths of this machine, so the data and "
+            "--out must be on a file system they share, at the same paths"
+        )
+
+
+def _cluster_failure(exc: BaseException, address: str, record: str, out: str) -> SettingError:
+    """The one line for a Dask cluster that failed under a build: the scheduler lost, or
+    the workers running a task all died (killed, out of memory); the records finished stay."""
+    if isinstance(exc, CancelledError):  # Dask cancels every task when the scheduler is lost
+        what = f"lost the Dask scheduler {address!r} (record {record} and others cancelled)"
+    else:
+        what = (
+            f"Dask workers died while building record {record} and the records after it in "
+            f"its task, on every worker Dask tried (killed, or out of memory: see the workers' "
+            "logs)"
+        )
+    return SettingError(
+        f"{what}; the records finished stay in {out}, and the same command, run again, "
+        "resumes from them"
+    )
+
+
 @contextmanager
 def _quiet_dask_logs() -> Iterator[None]:
-    """Silence Dask's own log in this process (the local cluster's nannies and scheduler live
-    here) while a local cluster runs: a record's error reaches the user as one line, and
-    Dask's log of it, of the tasks cancelled after it or of Ctrl-C would only surround it.
+    """Silence Dask's own log in this process (a local cluster's nannies and scheduler live
+    here; the client of a cluster of one's own too) while a build runs on Dask: a record's
+    error, or the cluster's failure, reaches the user as one line, and Dask's log of it (the
+    client's traceback of a lost scheduler), of the tasks cancelled after it or of Ctrl-C
+    would only surround it.
     Tornado's too, whose event loop runs Dask's: a Ctrl-C that lands while the client waits
     on the loop can make Dask's cancelling callback fail there, and tornado logged that with
     its traceback (now and then, on a busy machine)."""
     import logging
 
-    logs = [logging.getLogger(name) for name in ("distributed", "tornado")]
+    logs = [logging.getLogger(name) for name in ("distributed", "distributed.client", "tornado")]
     levels = [log.level for log in logs]
     for log in logs:
         log.setLevel(logging.CRITICAL)
@@ -1989,6 +2158,28 @@ def _used_plugins(meta: dict[str, Any]) -> list[tuple[str, str]]:
     ]
 
 
+def _warn_other_ids(out: Path, specs: list[RecordSpec], kept: int) -> None:
+    """Warn once when a folder resumed with its own config holds records of other ids than
+    the build's (``kept`` of its records are the build's): an earlier version of mdframework
+    whose records had other ids (0.2.0's seeds came from the records' numbers), or motion
+    files changed since; every record of the folder was computed afresh without a word, and
+    a dataset of days of compute looked resumed."""
+    ours = {f"{s.record_id}.npz" for s in specs}
+    others = [p.name for p in (out / RECORDS).glob("*.npz") if p.name not in ours]
+    others = sorted(name for name in others if _RECORD_NAME.fullmatch(name))
+    if not others:
+        return
+    warnings.warn(
+        f"{len(others)} records in {out / RECORDS} (e.g. {others[0][:-4]}) are not records of "
+        f"this config as this version computes it (an earlier version of mdframework gave "
+        f"records other ids and seeds, or their motion files changed since): {kept} of the "
+        f"build's {len(specs)} records are there, the others are computed afresh, and those "
+        "of other ids are removed when the build ends",
+        DatasetWarning,
+        stacklevel=3,
+    )
+
+
 def _warn_other_versions(made_by: dict[str, Any], n_records: int) -> None:
     """Warn once when records kept from the folder were computed by other software versions
     (``made_by``: record id -> its ``versions``, ``None`` for a record written before records
@@ -2053,7 +2244,9 @@ def build_dataset(
         _refuse_names_in_the_way(folder.path)
         note("planning the records (reading each recording once)", progress)
         _forget_loaded()  # every file is read afresh: one changed since is seen
-        # errors in the config stop before any file
+        # errors in the config stop before any file. Records name their files, and are
+        # written, by absolute paths: a Dask cluster's workers have working folders of their own
+        base_dir = Path(os.path.abspath(base_dir))
         specs = plan_records(config, base_dir, workers=build_workers(config, workers))
         out = folder.path
         wanted = _comparable(config)
@@ -2085,6 +2278,8 @@ def build_dataset(
             else:
                 rows[spec.record_id] = row
         _warn_other_versions(other_versions, len(specs))
+        if built == wanted and all(c == wanted for c in indexed):
+            _warn_other_ids(out, specs, len(rows))
         printed()
         bar = tqdm_bar(
             total=len(specs),
@@ -2098,7 +2293,7 @@ def build_dataset(
         try:
             with closing(executor), bar:  # closing: workers stop at once on Ctrl-C or an error
                 for run in executor:
-                    for row in run(todo, str(out)):
+                    for row in run(todo, os.path.abspath(out)):
                         if "skipped" in row:
                             skipped[row["id"]] = row
                             warnings.warn(
@@ -2114,6 +2309,7 @@ def build_dataset(
         except BaseException:
             _remove_partials(out)  # of records that stopped workers were writing
             raise
+        _remove_partials(out)  # of Dask workers killed while writing (their tasks ran again)
         ordered = [rows[s.record_id] for s in specs if s.record_id in rows]
         if not ordered:
             first = next(iter(skipped.values()))["skipped"]
