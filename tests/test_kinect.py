@@ -774,7 +774,7 @@ def fake_nite(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> Path:
     NiTE2/s.dat (returned); the device's closing is recorded in FakeUserTracker.events."""
     from types import SimpleNamespace
 
-    import mdf_kinect.cli as kcli
+    import mdf_kinect.device as kdevice  # mdf capture imports its device layer when it runs
     from mdf_kinect.device import _task_ids
     from openni import openni2
 
@@ -782,8 +782,8 @@ def fake_nite(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> Path:
     (redist / "NiTE2").mkdir(parents=True)
     (redist / "NiTE2" / "s.dat").write_bytes(b"fake")
     fake = SimpleNamespace(UserTracker=FakeUserTracker, get_version=lambda: "2.2 (fake)")
-    monkeypatch.setattr(kcli, "initialize_nite", lambda redist=None: fake)
-    real_open = kcli.open_device
+    monkeypatch.setattr(kdevice, "initialize_nite", lambda redist=None: fake)
+    real_open = kdevice.open_device
 
     def open_device(o, uri=None):
         before = _task_ids()
@@ -791,7 +791,7 @@ def fake_nite(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> Path:
         FakeUserTracker.player = _task_ids() - before
         return dev
 
-    monkeypatch.setattr(kcli, "open_device", open_device)
+    monkeypatch.setattr(kdevice, "open_device", open_device)
     real_close = openni2.Device.close
 
     def close(self):

@@ -37,3 +37,29 @@ def test_console_script_runs_the_cli() -> None:
         timeout=60,
     )
     assert done.returncode == 0 and done.stdout.startswith("mdf (mdframework)")
+
+
+GC_DURING_COMMAND = r"""
+import gc
+import sys
+
+import mdframework.cli
+
+def main():
+    print(gc.isenabled(), gc.get_freeze_count() > 0)
+    return 3
+
+mdframework.cli.main = main
+from mdframework.launch import run
+run()
+"""
+
+
+def test_the_command_runs_with_the_garbage_collector_on() -> None:
+    # the collector is off only while the command line is imported (what the imports made is
+    # then frozen): a long dataset build still frees its cycles; the command's exit code holds
+    done = subprocess.run(
+        [sys.executable, "-c", GC_DURING_COMMAND], capture_output=True, text=True, timeout=60
+    )
+    assert done.returncode == 3, done.stderr
+    assert done.stdout == "True True\n"

@@ -148,5 +148,11 @@ def test_a_run_without_figures_imports_no_heavy_library(tmp_path: Path) -> None:
     assert written == {"result.npz", "features.json", "config.resolved.json", "metadata.json"}
     assert heavy(modules) == {}
     assert "yaml" not in modules  # PyYAML only for a YAML config
+    # the file readers of the motion formats the run does not read stay unimported (their
+    # packages export them on first use; loading a plugin imports its source classes only)
+    readers = {"mdf_c3d.reader", "mdf_c3d.trc", "mdf_table.reader", "mdf_deepmimic.reader"}
+    readers |= {"mdf_cmu.bvh", "mdf_cmu.asfamc", "mdf_cmu.rigs"}
+    readers |= {"mdf_kinect.formats", "mdf_kinect.nitefile", "mdf_kinect.device"}
+    assert "mdf_c3d.source" in modules and not readers & modules.keys()
     resolved = json.loads((tmp_path / "o" / "config.resolved.json").read_text())
     assert resolved["figures"]["enabled"] is False  # recorded with the run

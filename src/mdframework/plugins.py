@@ -362,8 +362,15 @@ def installed_names() -> set[str]:
     for ep in _entry_points():
         names.add(ep.name)
         if ep.dist is not None:
-            names.add(ep.dist.name)
+            names.add(_name_and_version(ep.dist)[0])
     return names
+
+
+def _name_and_version(dist: importlib.metadata.Distribution) -> tuple[str, str]:
+    """A distribution's name and version from one reading of its metadata (``dist.name`` and
+    ``dist.version`` each read and parse the whole file again)."""
+    meta = dist.metadata
+    return meta["Name"], meta["Version"]
 
 
 def _unknown_hooks(plugin: object) -> list[str]:
@@ -387,8 +394,10 @@ def _load_entry_points(
             continue
         if select is not None and not select(ep):
             continue
-        dist_name = ep.dist.name if ep.dist else ep.name
-        dist = f"{dist_name} {ep.dist.version}" if ep.dist else ep.name
+        dist_name, dist = ep.name, ep.name
+        if ep.dist is not None:
+            dist_name, version = _name_and_version(ep.dist)
+            dist = f"{dist_name} {version}"
         if {ep.name, dist_name} & off:
             _disabled(pm)[ep.name] = f"{dist}, disabled by {DISABLE_PLUGINS_ENV}"
             continue

@@ -28,7 +28,7 @@ from __future__ import annotations
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -44,8 +44,8 @@ from mdframework import (
 from mdframework.settings import FrameRate, MotionAxes, OrientedMotionConfig
 from mdframework.skeleton import Axis, check_canonical_keys, reorient
 
-from .bvh import bvh_forward_kinematics, read_bvh
-from .rigs import RIGS, Rig, RigMismatch, detect_rig, resolve
+if TYPE_CHECKING:
+    from .rigs import Rig
 
 
 class FrameRateWarning(UserWarning):
@@ -135,6 +135,11 @@ def load_any_bvh(
         its other joints there or in ``joint_map``), or two are as likely, and no complete joint
         map is given (see :func:`mdf_cmu.rigs.detect_rig`); a mapped joint is not in the file.
     """
+    # the BVH reader and the rigs are imported here: loading the plugin (every mdf command
+    # loads every plugin) needs only the source classes
+    from .bvh import bvh_forward_kinematics, read_bvh
+    from .rigs import RIGS, RigMismatch, detect_rig, resolve
+
     bvh = read_bvh(path)
     names = bvh.joint_names
     rig: Rig | None = None

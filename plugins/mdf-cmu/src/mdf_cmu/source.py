@@ -80,8 +80,6 @@ from mdframework import (
 from mdframework.settings import FrameRate
 
 from .anybvh import FrameRateWarning, choose_rate, load_any_bvh
-from .asfamc import asf_forward_kinematics, read_amc, read_asf
-from .kinematics import to_project_frame
 
 #: CMU's requested acknowledgement, recorded in every motion's metadata.
 ACKNOWLEDGEMENT = (
@@ -376,6 +374,10 @@ class CmuSource(MotionSource):
                     f"{path}: its skeleton {asf_path.name} is not next to it; "
                     "give the ASF file as motion.asf"
                 )
+        # the ASF/AMC reader when used (loading the plugin needs only the source classes)
+        from .asfamc import asf_forward_kinematics, read_amc, read_asf
+        from .kinematics import to_project_frame
+
         asf = read_asf(asf_path)
         amc = read_amc(path, asf)
         names, pos = asf_forward_kinematics(asf, amc)

@@ -18,17 +18,6 @@ from mdframework import DataFileError
 from mdframework.cli import add_command
 from mdframework.outdir import atomic_write_text, check_output_file
 
-from .device import (
-    DeviceError,
-    initialize_nite,
-    initialize_openni,
-    nite_redist,
-    oni_info_isolated,
-    open_device,
-    scan_oni,
-)
-from .nitefile import nite_frames_to_arrays, write_nite
-
 
 def add_commands(subparsers: argparse._SubParsersAction[Any]) -> None:
     """Register ``kinect info`` and ``capture``."""
@@ -96,6 +85,8 @@ def _seconds(text: str) -> float:
 
 def cmd_info(args: argparse.Namespace) -> int:
     """Print what an .oni recording holds."""
+    from .device import oni_info_isolated  # when used: loading the plugin adds the commands
+
     path = Path(args.file)
     if not path.exists():
         raise DataFileError(path, "file not found")
@@ -117,6 +108,16 @@ def cmd_info(args: argparse.Namespace) -> int:
 def cmd_capture(args: argparse.Namespace) -> int:
     """Record skeletons until the duration is over, Ctrl-C, or the end of an ``.oni`` file;
     write the NiTE file (checked before the device starts, written whole or not at all)."""
+    from .device import (
+        DeviceError,
+        initialize_nite,
+        initialize_openni,
+        nite_redist,
+        open_device,
+        scan_oni,
+    )
+    from .nitefile import nite_frames_to_arrays, write_nite
+
     # absolute first: the user tracker is created inside NiTE2's Redist folder
     out = check_output_file(Path(args.out).absolute())
     device = args.device

@@ -24,7 +24,7 @@ from __future__ import annotations
 import re
 import warnings
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -40,20 +40,8 @@ from mdframework import (
 )
 from mdframework.settings import FrameRate, Seconds
 
-from .formats import (
-    MSR_RATE_HZ,
-    NTU_RATE_HZ,
-    PRECOG_RATE_HZ,
-    UTKINECT_RATE_HZ,
-    Recording,
-    read_msr,
-    read_ntu,
-    read_precog,
-    read_utkinect,
-    read_utkinect_labels,
-    to_project_frame,
-)
-from .nitefile import read_nite
+if TYPE_CHECKING:
+    from .formats import Recording
 
 
 class TrackingWarning(UserWarning):
@@ -163,6 +151,19 @@ class KinectSource(MotionSource):
 
     def read(self) -> Recording:
         """The recording in Kinect axes, before segment selection."""
+        # the readers when used (loading the plugin needs only the source classes)
+        from .formats import (
+            MSR_RATE_HZ,
+            NTU_RATE_HZ,
+            PRECOG_RATE_HZ,
+            UTKINECT_RATE_HZ,
+            read_msr,
+            read_ntu,
+            read_precog,
+            read_utkinect,
+        )
+        from .nitefile import read_nite
+
         c = self.config
         path = Path(c.file)
         if c.format == "utkinect":
@@ -191,6 +192,8 @@ class KinectSource(MotionSource):
         mdframework.DataFileError
             Malformed file, or an unknown segment (names the file and line).
         """
+        from .formats import to_project_frame
+
         c = self.config
         path = Path(c.file)
         rec = self.read()
@@ -279,6 +282,8 @@ class KinectSource(MotionSource):
         labels = Path(c.labels) if c.labels is not None else path.with_name("actionLabel.txt")
         if not labels.exists():
             raise DataFileError(path, f"segment {c.segment!r}: no label file {labels}")
+        from .formats import read_utkinect_labels
+
         table = read_utkinect_labels(labels)
         seq = c.sequence
         if seq is None:
