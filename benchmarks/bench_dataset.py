@@ -118,7 +118,7 @@ def _idle_child(settings: str, workers: int, seconds: float) -> None:
     import dask
     from distributed import Client, LocalCluster
 
-    from mdframework.dataset import LOCAL_DASK_CONFIG
+    from mdframework.cluster import LOCAL_DASK_CONFIG
 
     config = dict(LOCAL_DASK_CONFIG)
     if settings == "dask":  # Dask's defaults, but for the profiler and the malloc setting

@@ -16,6 +16,7 @@ from conftest import EXAMPLES
 from test_dataset import assert_same
 
 from mdframework import cli, dataset
+from mdframework.cluster import SCHEDULER_TIMEOUT_ENV, check_paths, check_workers
 from mdframework.dataset import RECORDS, build_dataset, load_dataset_config
 from mdframework.errors import SettingError
 
@@ -109,7 +110,7 @@ def test_a_scheduler_without_workers_is_one_line_after_the_timeout(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     """A build on a scheduler that has no workers waited forever, printing nothing."""
-    monkeypatch.setenv(dataset.SCHEDULER_TIMEOUT_ENV, "1")
+    monkeypatch.setenv(SCHEDULER_TIMEOUT_ENV, "1")
     config = write_relative_config(tmp_path / "cfg")
     address = cluster.scheduler_address
     args = ["dataset", "build", str(config), "--out", str(tmp_path / "out"), "--no-progress"]
@@ -158,7 +159,7 @@ def test_workers_gone_mid_build_end_it_with_one_line(
     """Every worker gone mid-build (killed, or the cluster scaled down): Dask waits for new
     ones, and the build waited forever. After the timeout without a worker it stops with one
     line; the records finished stay, and no file being written is left."""
-    monkeypatch.setenv(dataset.SCHEDULER_TIMEOUT_ENV, "1")
+    monkeypatch.setenv(SCHEDULER_TIMEOUT_ENV, "1")
     config = write_relative_config(tmp_path / "cfg", walks=20, aspects="[0.0, 10.0, 20.0, 30.0]")
     out = tmp_path / "out"
 
@@ -246,9 +247,9 @@ def test_a_worker_that_does_not_see_the_data_or_out_is_named(cluster: Any, tmp_p
     assert all(Path(f).is_absolute() and Path(f).is_file() for f in files)
     gone = str(tmp_path / "elsewhere" / "records")
     with Client(cluster) as client:
-        dataset._check_paths(client, files)  # every worker sees them
+        check_paths(client, files)  # every worker sees them
         with pytest.raises(SettingError) as err:
-            dataset._check_paths(client, [*files, gone, gone + "2"])
+            check_paths(client, [*files, gone, gone + "2"])
     (worker,) = cluster.scheduler.workers
     assert str(err.value) == (
         f"Dask worker {worker} does not see {gone} (and 1 more): the workers read the data "
@@ -279,14 +280,14 @@ def test_a_worker_without_mdframework_is_named_one_that_left_is_not() -> None:
 
     ours = versions()
     left = CommClosedError("in <TCP (closed)>: Stream is closed")
-    dataset._check_workers(Client({"tcp://a:1": ours, "tcp://b:2": left}), "tcp://s:8786")
+    check_workers(Client({"tcp://a:1": ours, "tcp://b:2": left}), "tcp://s:8786")
     lacking = Exception("ModuleNotFoundError(\"No module named 'mdframework'\")")
     with pytest.raises(SettingError) as err:
-        dataset._check_workers(Client({"tcp://a:1": ours, "tcp://b:2": lacking}), "tcp://s:8786")
+        check_workers(Client({"tcp://a:1": ours, "tcp://b:2": lacking}), "tcp://s:8786")
     assert str(err.value) == (
         'Dask worker tcp://b:2 cannot run mdframework (ModuleNotFoundError("No module named '
         "'mdframework'\")); every worker needs the build's mdframework and plugins installed"
     )
     older = {**ours, "mdframework": "0.2.0"}
     with pytest.raises(SettingError, match=r"^Dask worker tcp://a:1 has mdframework '0.2.0', "):
-        dataset._check_workers(Client({"tcp://a:1": older}), "tcp://s:8786")
+        check_workers(Client({"tcp://a:1": older}), "tcp://s:8786")

@@ -19,15 +19,15 @@ from conftest import EXAMPLES, project_distributions
 from pydantic import BaseModel
 
 from mdframework import ConfigError, DataFileError, MdfError, SceneError, limits
-from mdframework.config import read_config_file, run_config_model, validate_run_config
-from mdframework.dataset import (
+from mdframework.cluster import (
     SCHEDULER_ENV,
     SCHEDULER_TIMEOUT_ENV,
-    DatasetConfig,
-    _connect,
     check_scheduler_address,
+    connect,
     scheduler_address,
 )
+from mdframework.config import read_config_file, run_config_model, validate_run_config
+from mdframework.dataset import DatasetConfig
 from mdframework.docgen import numeric_ranges
 from mdframework.experiment import ExperimentConfig
 from mdframework.interfaces import PluginConfig
@@ -305,11 +305,11 @@ def test_an_unreachable_scheduler_is_a_clear_error_after_the_timeout(
     monkeypatch.setenv(SCHEDULER_TIMEOUT_ENV, "1.5")
     t0 = time.monotonic()
     with pytest.raises(MdfError, match=r"cannot connect to the Dask scheduler .* within 1\.5 s"):
-        _connect(Client, None, f"tcp://127.0.0.1:{port}")
+        connect(Client, None, f"tcp://127.0.0.1:{port}")
     assert time.monotonic() - t0 < 20  # not the 30 s default
     monkeypatch.setenv(SCHEDULER_TIMEOUT_ENV, "soon")
     with pytest.raises(MdfError, match=SCHEDULER_TIMEOUT_ENV):
-        _connect(Client, None, f"tcp://127.0.0.1:{port}")
+        connect(Client, None, f"tcp://127.0.0.1:{port}")
 
 
 def test_a_malformed_scheduler_address_is_refused_before_any_connection(
@@ -360,7 +360,7 @@ def test_a_server_that_is_not_a_dask_scheduler_is_a_clear_error(
     monkeypatch.setenv(SCHEDULER_TIMEOUT_ENV, "3")
     try:
         with pytest.raises(MdfError, match=rf"127\.0\.0\.1:{port}"):
-            _connect(Client, None, f"tcp://127.0.0.1:{port}")
+            connect(Client, None, f"tcp://127.0.0.1:{port}")
     finally:
         server.close()
 
@@ -479,7 +479,7 @@ def test_the_documented_limits_are_the_code_s() -> None:
 
     from conftest import ROOT
 
-    from mdframework.dataset import SCHEDULER_TIMEOUT_S, scheduler_timeout
+    from mdframework.cluster import SCHEDULER_TIMEOUT_S, scheduler_timeout
 
     page = (ROOT / "docs" / "input-rules.md").read_text()
     rows = re.findall(r"^\| `([A-Z0-9_]+)` \| ([0-9.e+]+) \|", page, flags=re.M)

@@ -327,7 +327,7 @@ def _check_build_environment(args: argparse.Namespace) -> None:
     """How a build's records are computed (``--scheduler``, ``MDF_DASK_SCHEDULER``,
     ``MDF_START_METHOD``), checked before any folder is made, outside :func:`_naming`: a bad
     setting is not the config's fault."""
-    from .dataset import check_scheduler_address, scheduler_address
+    from .cluster import check_scheduler_address, scheduler_address
     from .workers import start_method
 
     check_scheduler_address(scheduler_address(args.scheduler))
