@@ -15,7 +15,7 @@ venv: $(STAMP)
 $(STAMP): pyproject.toml $(PLUGINS)
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	@echo "Installing mdframework and $(words $(PLUGINS)) plugins into $(VENV)"
-	$(BIN)/python -m pip install --progress-bar on "setuptools>=70.1"
+	$(BIN)/python -m pip install --progress-bar on "setuptools>=77"
 	@# uv installs every distribution in one call, downloading and building the editable ones in
 	@# parallel with the setuptools just installed, and compiles their bytecode as pip does (else
 	@# the examples that make demo runs side by side would each compile it on first import);

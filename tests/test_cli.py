@@ -1234,3 +1234,48 @@ def test_a_record_past_a_lost_joints_track_is_the_users_error(
         code, _, err = run_cli([command[0], str(config), *command[1:]], capsys)
         lines = [line for line in err.splitlines() if "warning" not in line]
         assert code == 2 and len(lines) == 1 and re.search(said, lines[0]), err
+
+
+def test_a_missing_optional_package_is_one_line_naming_it_and_the_install(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """mdf-mujoco installed without mujoco (`pip install --no-deps`, or mujoco uninstalled
+    since): the Boulic walker says which package is missing, which distribution needs it and
+    how to install it, exit 2; it was `mdf: internal error: ModuleNotFoundError: No module
+    named 'mujoco' (in load() of the motion plugin 'boulic' ...; check it with
+    mdframework.testing.check_motion_source ...)`, blaming the plugin. The same for the core's
+    figures without matplotlib; a module missing from a package that is there stays an
+    internal error."""
+    monkeypatch.setitem(sys.modules, "mujoco", None)  # import mujoco: ModuleNotFoundError
+    out = tmp_path / "boulic"
+    code, _, err = run_cli(["run", str(EXAMPLES / "boulic_walk.toml"), "--out", str(out)], capsys)
+    assert (code, err) == (
+        2,
+        "mdf: error: mdf-mujoco needs the Python package 'mujoco', which is not installed: "
+        "pip install mujoco\n",
+    )
+    assert not out.exists()
+
+    monkeypatch.setitem(sys.modules, "matplotlib", None)
+    out = tmp_path / "pt"
+    code, _, err = run_cli(["run", str(EXAMPLES / "point_target.toml"), "--out", str(out)], capsys)
+    assert (code, err) == (
+        2,
+        "mdf: error: mdframework needs the Python package 'matplotlib', which is not "
+        "installed: pip install matplotlib\n",
+    )
+    assert not out.exists()
+    monkeypatch.undo()
+
+    from mdf_lfm import LfmPulseDoppler
+
+    def broken_init(self: Any, config: Any) -> None:
+        import numpy.no_such_part  # noqa: F401
+
+    monkeypatch.setattr(LfmPulseDoppler, "__init__", broken_init)
+    code, _, err = run_cli(["check", str(EXAMPLES / "point_target.toml")], capsys)
+    assert code == 1, err
+    assert err.startswith(
+        "mdf: internal error: ModuleNotFoundError: No module named 'numpy.no_such_part' (in the "
+        "radar plugin 'lfm'"
+    ), err

@@ -303,6 +303,24 @@ def test_config_reference_is_current() -> None:
     )
 
 
+def test_the_reference_of_an_installed_mdframework_is_refused(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`python -m mdframework.docgen` run on an installed (not editable) mdframework has no
+    plugins/ folder to document: it says so, where it wrote the reference without a single
+    plugin section."""
+    from mdframework import docgen
+
+    installed = tmp_path / "lib" / "python3.11" / "site-packages" / "mdframework" / "docgen.py"
+    monkeypatch.setattr(docgen, "__file__", str(installed))
+    docgen.project_registry.cache_clear()
+    try:
+        with pytest.raises(RuntimeError, match=r"^no plugins/ folder beside this mdframework"):
+            docgen.project_registry()
+    finally:
+        docgen.project_registry.cache_clear()
+
+
 def test_config_reference_covers_every_section() -> None:
     from mdframework.docgen import project_registry
 

@@ -1048,3 +1048,28 @@ def test_the_largest_experiment_seed_runs_and_a_larger_one_is_a_config_error(
     p.write_text('seed = -1\n[dataset]\npath = "x"\n')  # nor a negative one
     with pytest.raises(ConfigError, match=r"e\.toml: seed: must be at least 0 \(got -1\)"):
         exp.load_experiment_config(p)
+
+
+def test_an_error_in_the_dataset_config_names_that_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A motion kind that is not installed (mdf-cmu uninstalled) in the dataset config an
+    experiment builds is named in that file, as its field errors are: it was
+    `mdf: error: e.toml: sources[0].motion.kind: no motion plugin named 'cmux' ...`, which sent
+    the user looking in the experiment's config for a `sources` it does not have."""
+    from mdframework import cli
+
+    data = EXAMPLES / "data" / "cmu" / "asf-amc" / "02_01.amc"
+    (tmp_path / "d.toml").write_text(
+        f'[[sources]]\nlabel = "walk"\nmotion = {{ kind = "cmux", file = "{data}" }}\n'
+        '[record_lengths]\nwalk = 1.0\n[base.radar]\nkind = "lfm"\n'
+        '[base.scatterers]\nkind = "ellipsoid"\nplacement = "joints17"\n'
+    )
+    (tmp_path / "e.toml").write_text('[dataset]\nconfig = "d.toml"\n[classifier]\nkind = "knn"\n')
+    code = cli.main(["experiment", str(tmp_path / "e.toml"), "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert err.startswith(
+        f"mdf: error: {tmp_path / 'e.toml'}: {tmp_path / 'd.toml'}: sources[0].motion.kind: no "
+        "motion plugin named 'cmux' (did you mean 'cmu'?)"
+    ), err

@@ -202,6 +202,49 @@ _WRITE_ERRNOS = (
 _NO_ROOM = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)
 
 
+#: import name -> the name pip installs it by, where the two differ
+_PIP_NAMES = {
+    "sklearn": "scikit-learn",
+    "yaml": "pyyaml",
+    "PIL": "pillow",
+    "imageio_ffmpeg": "imageio-ffmpeg",
+    "dask": "mdframework[dask]",
+    "distributed": "mdframework[dask]",
+}
+
+
+def _missing_package(exc: BaseException) -> str | None:
+    """One line for a Python package that is not installed where a feature imports it (an
+    optional dependency such as mujoco, ezc3d or scikit-learn, left out or uninstalled): the
+    package, the distribution that imports it (that of the innermost frame of the traceback)
+    and the command that installs it; ``None`` for any other error, and for a module missing
+    from a package that is installed (a bug, or a broken install: an internal error)."""
+    import importlib.metadata
+    import importlib.util
+
+    if not isinstance(exc, ModuleNotFoundError) or not exc.name:
+        return None
+    top = exc.name.partition(".")[0]
+    try:
+        if importlib.util.find_spec(top) is not None:
+            return None
+    except (ImportError, ValueError):
+        return None
+    importer = ""
+    tb = exc.__traceback__
+    while tb is not None:
+        module = str(tb.tb_frame.f_globals.get("__name__", "")).partition(".")[0]
+        if module not in ("", "__main__", "importlib", top):
+            importer = module
+        tb = tb.tb_next
+    dists = importlib.metadata.packages_distributions().get(importer, []) if importer else []
+    who = f"{dists[0]} needs" if dists else "this command needs"
+    return (
+        f"{who} the Python package {top!r}, which is not installed: "
+        f"pip install {_PIP_NAMES.get(top, top)}"
+    )
+
+
 def _write_failure(exc: OSError, args: argparse.Namespace) -> str:
     """One line for a file-system error (:data:`_WRITE_ERRNOS`): the file being written (the
     note ``while writing PATH`` that mdframework's writers add, else the error's own file name;
@@ -403,7 +446,8 @@ STAGING_HELP = (
 EXIT_CODES_HELP = (
     "exit codes: 0 done; 1 internal error (a bug, in mdf or a plugin: --debug shows the "
     "traceback); 2 bad input (a config, a data file, a scene that cannot be simulated, the "
-    "command line, --out); 130 interrupted (Ctrl-C); 143 terminated (SIGTERM)."
+    "command line, --out, a Python package a feature needs that is not installed); 130 "
+    "interrupted (Ctrl-C); 143 terminated (SIGTERM)."
 )
 
 
@@ -901,6 +945,10 @@ def _main(argv: list[str], debug: bool) -> int:
         retract()
         if isinstance(exc, OSError) and exc.errno in _WRITE_ERRNOS:
             say(f"mdf: error: {_write_failure(exc, args)}")
+            return EXIT_USAGE
+        missing = _missing_package(exc)
+        if missing is not None:
+            say(f"mdf: error: {missing}")
             return EXIT_USAGE
         notes = "".join(f"{_one_line(note)}; " for note in getattr(exc, "__notes__", ()))
         say(

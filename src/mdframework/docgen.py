@@ -249,6 +249,12 @@ def project_registry() -> Registry:
     from .plugins import build_registry
 
     root = Path(__file__).resolve().parents[2] / "plugins"
+    if not root.is_dir():  # an installed mdframework: the reference would lack every plugin
+        raise RuntimeError(
+            f"no plugins/ folder beside this mdframework ({root.parent}): the reference "
+            "documents the plugins of a source tree; run python -m mdframework.docgen in a "
+            "clone of the repository"
+        )
 
     def ours(ep: importlib.metadata.EntryPoint) -> bool:
         spec = importlib.util.find_spec(ep.module.split(".")[0])  # imports nothing
@@ -259,4 +265,8 @@ def project_registry() -> Registry:
 
 
 if __name__ == "__main__":
-    sys.stdout.write(render(project_registry()))
+    try:
+        registry = project_registry()
+    except RuntimeError as exc:
+        sys.exit(f"mdframework.docgen: {exc}")
+    sys.stdout.write(render(registry))

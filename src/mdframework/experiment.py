@@ -962,15 +962,21 @@ def run_experiment(
             data_dir = folder.path / "dataset"
             if not folder.previous:  # a rerun after a stop (a full disk, a time limit) is ours
                 folder.write_marker()  # and resumes the build; the report's files come later
-            build_dataset(
-                dcfg,
-                base,
-                data_dir,
-                workers=cfg.workers,
-                scheduler=scheduler,
-                progress=progress,
-                force=force,
-            )
+            try:
+                build_dataset(
+                    dcfg,
+                    base,
+                    data_dir,
+                    workers=cfg.workers,
+                    scheduler=scheduler,
+                    progress=progress,
+                    force=force,
+                )
+            except ConfigError as exc:  # a field of the dataset config: named in its file
+                named = str(cfg.dataset.config)
+                if str(exc).startswith(named):
+                    raise
+                raise ConfigError(f"{named}: {exc}") from exc
         else:
             assert cfg.dataset.path is not None
             data_dir = cfg.dataset.path

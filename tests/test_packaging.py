@@ -1,0 +1,85 @@
+"""The distributions as a packager builds them (sdist and wheel, not the editable install of the
+development set-up): each carries its licence, the core's wheel its ``py.typed``, and the core's
+sdist no half of the test suite. ``.ci/check_dists.sh`` builds every distribution, installs the
+wheels into a fresh environment and runs ``mdf`` from outside the repository."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+import tarfile
+import tomllib
+import zipfile
+from pathlib import Path
+
+import pytest
+from conftest import ROOT
+
+DISTRIBUTIONS = [ROOT, *sorted(p.parent for p in (ROOT / "plugins").glob("*/pyproject.toml"))]
+
+
+@pytest.mark.parametrize("folder", DISTRIBUTIONS, ids=[p.name for p in DISTRIBUTIONS])
+def test_every_distribution_declares_and_ships_the_licence(folder: Path) -> None:
+    """Every distribution says MIT and ships the licence text beside its pyproject (a plugin's
+    sdist and wheel hold only its own folder); setuptools reads the SPDX form from 77 on."""
+    project = tomllib.loads((folder / "pyproject.toml").read_text(encoding="utf-8"))
+    assert project["project"]["license"] == "MIT"
+    assert project["project"]["license-files"] == ["LICENSE"]
+    assert (folder / "LICENSE").read_bytes() == (ROOT / "LICENSE").read_bytes()
+    assert project["build-system"]["requires"] == ["setuptools>=77"]
+
+
+def _build(src: Path, out: Path) -> tuple[list[str], list[str]]:
+    """The names in the sdist and in the wheel that setuptools builds from a copy of ``src``
+    (the build writes into its source folder), with the setuptools of this environment."""
+    copy = out / "src"
+    shutil.copytree(src, copy, ignore=shutil.ignore_patterns("*.egg-info", "__pycache__", "build"))
+    names = []
+    for hook in ("build_sdist", "build_wheel"):  # one process each (both in one misplace one)
+        done = subprocess.run(
+            [
+                sys.executable,
+                "-c",
+                f"from setuptools import build_meta as b; import sys; print(b.{hook}(sys.argv[1]))",
+                str(out),
+            ],
+            cwd=copy,
+            capture_output=True,
+            text=True,
+        )
+        assert done.returncode == 0, done.stderr[-2000:]
+        names.append(done.stdout.splitlines()[-1])  # after setuptools' log
+    sdist, wheel = names
+    with tarfile.open(out / sdist) as tar:
+        sdist_names = [m.name.partition("/")[2] for m in tar.getmembers()]
+    with zipfile.ZipFile(out / wheel) as zf:
+        wheel_names = zf.namelist()
+        metadata = next(n for n in wheel_names if n.endswith(".dist-info/METADATA"))
+        assert "License-Expression: MIT" in zf.read(metadata).decode()
+    return sdist_names, wheel_names
+
+
+def test_the_core_sdist_and_wheel(tmp_path: Path) -> None:
+    """The core's sdist holds what building it needs (pyproject, README, LICENSE, the sources)
+    and not the test files setuptools picks up by default (without conftest.py, helpers and the
+    examples, none of them ran); its wheel holds the licence and ``py.typed``."""
+    src = tmp_path / "core"
+    src.mkdir()
+    for name in ("pyproject.toml", "README.md", "LICENSE", "MANIFEST.in"):
+        shutil.copy(ROOT / name, src / name)
+    shutil.copytree(ROOT / "src", src / "src", ignore=shutil.ignore_patterns("*.egg-info"))
+    shutil.copytree(ROOT / "tests", src / "tests", ignore=shutil.ignore_patterns("__pycache__"))
+    sdist, wheel = _build(src, tmp_path)
+    assert {"pyproject.toml", "README.md", "LICENSE", "src/mdframework/py.typed"} <= set(sdist)
+    assert not [n for n in sdist if n.startswith("tests")]
+    assert "mdframework/py.typed" in wheel
+    assert any(n.endswith(".dist-info/licenses/LICENSE") for n in wheel)
+
+
+def test_a_plugin_sdist_and_wheel(tmp_path: Path) -> None:
+    """A plugin's sdist and wheel carry the licence (they held none: no licence text, and no
+    licence in the metadata)."""
+    sdist, wheel = _build(ROOT / "plugins" / "mdf-cw", tmp_path)
+    assert "LICENSE" in sdist
+    assert any(n.endswith(".dist-info/licenses/LICENSE") for n in wheel)
