@@ -441,6 +441,8 @@ def test_a_build_forks_its_workers_from_a_process_of_one_thread(tmp_path: Path) 
     multi-threaded, use of fork() may lead to deadlocks in the child" once per worker."""
     script = (
         "import os, sys, threading\n"
+        "cpus = os.cpu_count() or 1\n"  # motions load in one process per CPU: 2 on one CPU
+        "os.cpu_count = lambda: max(2, cpus)\n"
         "seen = []\n"
         "os.register_at_fork(before=lambda: seen.append([t.name for t in threading.enumerate()]))\n"
         "from mdframework.cli import main\n"
@@ -660,6 +662,8 @@ def _plan_fresh(
     """Plan with an empty motion cache: specs, motions, warnings shown (category, text) and how
     many motions this process loaded itself."""
     monkeypatch.setattr(dataset, "_MOTIONS", {})
+    cpus = os.cpu_count() or 1  # motions load in one process per CPU: 2 on a machine of one
+    monkeypatch.setattr(os, "cpu_count", lambda: max(2, cpus))
     calls = []
     real = dataset.load_motion
     monkeypatch.setattr(dataset, "load_motion", lambda src: calls.append(src) or real(src))
