@@ -18,6 +18,17 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
+from mdframework.dataset import SCHEDULER_ENV, SCHEDULER_TIMEOUT_ENV  # noqa: E402
+from mdframework.progress import PROGRESS_ENV  # noqa: E402
+
+# How commands print and where builds run, as the environment of whoever runs the tests may set
+# it (MDF_PROGRESS=1 in a shell's profile failed 49 tests of five files on a command's stderr,
+# MDF_DASK_TIMEOUT the test of its default, and MDF_DASK_SCHEDULER would send the tests' builds
+# to that cluster): the tests' commands, here and in the processes they start, run without it;
+# a test that needs one sets it itself.
+for _var in (PROGRESS_ENV, SCHEDULER_ENV, SCHEDULER_TIMEOUT_ENV):
+    os.environ.pop(_var, None)
+
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
 

@@ -535,8 +535,11 @@ def test_split_global_options_stops_at_double_dash() -> None:
     assert rest == ["run", "--", "--debug"] and not debug and off == []
 
 
-def test_check_output_in_the_docs_is_current(capsys: pytest.CaptureFixture[str]) -> None:
+def test_check_output_in_the_docs_is_current(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
     guide = (EXAMPLES.parent / "docs" / "getting-started.md").read_text()
+    monkeypatch.chdir(EXAMPLES.parent)  # the guide's path, from the repository root
     code, out, _ = run_cli(["check", "examples/point_target.toml"], capsys)
     assert code == 0
     assert f"```text\n{out}```" in guide

@@ -216,7 +216,7 @@ def test_sigterm_cleans_up_like_ctrl_c(tmp_path: Path) -> None:
     cfg.write_text(
         (EXAMPLES / "point_target.toml")
         .read_text(encoding="utf-8")
-        .replace("length = 2.0", "length = 30.0")
+        .replace("length = 2.0", "length = 120.0")  # 10 s of CPU: not ended before the signal
         .replace('kind = "lfm"', 'kind = "lfm"\npath = "raw"'),
         encoding="utf-8",
     )

@@ -53,6 +53,9 @@ SOURCE_EXAMPLES = {
 #: others that they can map onto the whole body is shipped: the one public C3D file in
 #: examples/data/c3d has no arm or head markers (tests/test_c3d.py checks physics on it)
 WRITTEN_SOURCE_FILES = {"c3d": lambda folder: walking_c3d(folder / "walk.c3d")}
+#: where those files are written (at collection, before any fixture); removed when the process
+#: ends (a folder per collection was left in the temporary folder, hundreds of them by now)
+WRITTEN_FILES_FOLDER = tempfile.TemporaryDirectory(prefix="contract-")
 #: a recording each of the project's recording sources reads in its contract check
 RECORDING_EXAMPLES = {"radhar": {"file": "data/radhar/radhar_walk_subset.npz"}}
 #: configs for plugins whose default Config is not the one to check
@@ -67,7 +70,9 @@ def _instance(interface: str, name: str) -> Any:
     the others with their default config."""
     info = REGISTRY.plugins[interface][name]
     if interface == "motion" and name in WRITTEN_SOURCE_FILES:
-        path = WRITTEN_SOURCE_FILES[name](Path(tempfile.mkdtemp(prefix=f"contract-{name}-")))
+        folder = Path(WRITTEN_FILES_FOLDER.name) / name
+        folder.mkdir(exist_ok=True)
+        path = WRITTEN_SOURCE_FILES[name](folder)
         cls0: Any = info.cls
         return cls0(cls0.Config(file=path))
     if interface == "motion":

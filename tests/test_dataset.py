@@ -441,6 +441,8 @@ def test_a_build_forks_its_workers_from_a_process_of_one_thread(tmp_path: Path) 
     multi-threaded, use of fork() may lead to deadlocks in the child" once per worker."""
     script = (
         "import os, sys, threading\n"
+        "cpus = os.cpu_count() or 1\n"  # motions load in one process per CPU: 2 on one CPU
+        "os.cpu_count = lambda: max(2, cpus)\n"
         "seen = []\n"
         "os.register_at_fork(before=lambda: seen.append([t.name for t in threading.enumerate()]))\n"
         "from mdframework.cli import main\n"
@@ -602,22 +604,31 @@ print(resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before)
     assert faults[0] >= 20 and faults[1] <= faults[0] / 10, faults
 
 
-def _blas_threads() -> list[int]:
-    from threadpoolctl import threadpool_info
+def _blas_threads() -> list[tuple[int, int]]:
+    """(threads, the most threads the library runs) of each BLAS library of this process."""
+    from threadpoolctl import threadpool_info, threadpool_limits
 
-    return [int(lib["num_threads"]) for lib in threadpool_info() if lib["user_api"] == "blas"]
+    def threads() -> list[int]:
+        return [int(lib["num_threads"]) for lib in threadpool_info() if lib["user_api"] == "blas"]
+
+    now = threads()
+    with threadpool_limits(1 << 16):  # as many as each library allows (OpenBLAS: 64)
+        most = threads()
+    return list(zip(now, most, strict=True))
 
 
 def test_pool_workers_share_the_cpus_blas_threads() -> None:
-    """Each of n local workers runs its BLAS with cpu_count // n threads (at least one), so
-    that n workers side by side never start more BLAS threads than there are CPUs."""
+    """Each of n local workers runs its BLAS with cpu_count // n threads (at least one, at most
+    what the library allows: OpenBLAS runs 64 on a machine of 128 CPUs), so that n workers side
+    by side never start more BLAS threads than there are CPUs."""
     from mdframework.workers import worker_pool
 
     n_cpu = os.cpu_count() or 1
     for n in (1, 2, n_cpu + 1):
         with worker_pool(n) as pool:
             threads = pool.submit(_blas_threads).result()
-        assert threads and all(t == max(1, n_cpu // n) for t in threads), (n, threads)
+        share = max(1, n_cpu // n)
+        assert threads and all(t == min(share, most) for t, most in threads), (n, threads)
 
 
 def _mixed_sources(tmp_path: Path, *extra: str) -> Path:
@@ -651,6 +662,8 @@ def _plan_fresh(
     """Plan with an empty motion cache: specs, motions, warnings shown (category, text) and how
     many motions this process loaded itself."""
     monkeypatch.setattr(dataset, "_MOTIONS", {})
+    cpus = os.cpu_count() or 1  # motions load in one process per CPU: 2 on a machine of one
+    monkeypatch.setattr(os, "cpu_count", lambda: max(2, cpus))
     calls = []
     real = dataset.load_motion
     monkeypatch.setattr(dataset, "load_motion", lambda src: calls.append(src) or real(src))
