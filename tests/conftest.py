@@ -18,7 +18,7 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from mdframework.dataset import SCHEDULER_ENV, SCHEDULER_TIMEOUT_ENV  # noqa: E402
+from mdframework.cluster import SCHEDULER_ENV, SCHEDULER_TIMEOUT_ENV  # noqa: E402
 from mdframework.progress import PROGRESS_ENV  # noqa: E402
 
 # How commands print and where builds run, as the environment of whoever runs the tests may set
