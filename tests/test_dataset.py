@@ -1179,6 +1179,10 @@ def test_a_folder_of_records_of_other_ids_is_said_to_be_computed_afresh(tmp_path
     with warnings.catch_warnings():
         warnings.simplefilter("error", dataset.DatasetWarning)
         build_dataset(cfg, base, out, workers=1, progress=False)
+        # a folder of another config's records, rebuilt with --force: of course other ids
+        other = cfg.model_copy(update={"seed": cfg.seed + 1})
+        build_dataset(other, base, out, workers=1, progress=False, force=True)
+    assert not set((out / RECORDS).glob("*.npz")) & set(files)
 
 
 def test_a_record_kept_from_other_software_versions_is_said(tmp_path: Path) -> None:
