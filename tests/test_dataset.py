@@ -1165,6 +1165,7 @@ def test_a_folder_of_records_of_other_ids_is_said_to_be_computed_afresh(tmp_path
     old = [f.with_name(f"{f.name[:6]}0123456789.npz") for f in files[1:]]  # other digests
     for file, renamed in zip(files[1:], old, strict=True):
         file.rename(renamed)
+    (out / RECORDS / "notes.npz").write_bytes(b"the user's, not a record")  # neither counted
     with pytest.warns(dataset.DatasetWarning) as caught:
         build_dataset(cfg, base, out, workers=1, progress=False)
     said = [str(w.message) for w in caught if "not records of this config" in str(w.message)]
@@ -1175,7 +1176,8 @@ def test_a_folder_of_records_of_other_ids_is_said_to_be_computed_afresh(tmp_path
         "there, the others are computed afresh, and those of other ids are removed when the "
         "build ends"
     ]
-    assert sorted((out / RECORDS).glob("*.npz")) == files
+    notes = out / RECORDS / "notes.npz"
+    assert sorted((out / RECORDS).glob("*.npz")) == sorted([*files, notes])  # notes stay
     with warnings.catch_warnings():
         warnings.simplefilter("error", dataset.DatasetWarning)
         build_dataset(cfg, base, out, workers=1, progress=False)
