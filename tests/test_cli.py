@@ -1282,3 +1282,31 @@ def test_a_missing_optional_package_is_one_line_naming_it_and_the_install(
         "mdf: internal error: ModuleNotFoundError: No module named 'numpy.no_such_part' (in the "
         "radar plugin 'lfm'"
     ), err
+
+
+@pytest.mark.parametrize(
+    ("module", "install"),
+    [
+        ("sklearn.neighbors", "scikit-learn"),
+        ("yaml", "pyyaml"),
+        ("distributed.client", "mdframework[dask]"),
+        ("ezc3d", "ezc3d"),
+    ],
+)
+def test_a_missing_package_is_installed_by_its_name_on_pypi(
+    module: str, install: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The pip install the line gives installs the package: scikit-learn, not `sklearn` (a
+    deprecated stub on PyPI that fails to install), PyYAML, not `yaml`; Dask through
+    mdframework's extra. Imported here, no distribution's module: 'this command needs'."""
+    import importlib
+
+    top = module.partition(".")[0]
+    for name in {top, module}:  # import: ModuleNotFoundError, whatever was imported before
+        monkeypatch.setitem(sys.modules, name, None)
+    with pytest.raises(ModuleNotFoundError) as caught:
+        importlib.import_module(module)
+    assert cli._missing_package(caught.value) == (
+        f"this command needs the Python package {top!r}, which is not installed: "
+        f"pip install {install}"
+    )

@@ -1178,6 +1178,7 @@ def test_a_folder_of_records_of_other_ids_is_said_to_be_computed_afresh(tmp_path
     old = [f.with_name(f"{f.name[:6]}0123456789.npz") for f in files[1:]]  # other digests
     for file, renamed in zip(files[1:], old, strict=True):
         file.rename(renamed)
+    (out / RECORDS / "notes.npz").write_bytes(b"the user's, not a record")  # neither counted
     with pytest.warns(dataset.DatasetWarning) as caught:
         build_dataset(cfg, base, out, workers=1, progress=False)
     said = [str(w.message) for w in caught if "not records of this config" in str(w.message)]
@@ -1188,10 +1189,42 @@ def test_a_folder_of_records_of_other_ids_is_said_to_be_computed_afresh(tmp_path
         "there, the others are computed afresh, and those of other ids are removed when the "
         "build ends"
     ]
-    assert sorted((out / RECORDS).glob("*.npz")) == files
+    notes = out / RECORDS / "notes.npz"
+    assert sorted((out / RECORDS).glob("*.npz")) == sorted([*files, notes])  # notes stay
     with warnings.catch_warnings():
         warnings.simplefilter("error", dataset.DatasetWarning)
         build_dataset(cfg, base, out, workers=1, progress=False)
+        # a folder of another config's records, rebuilt with --force: of course other ids
+        other = cfg.model_copy(update={"seed": cfg.seed + 1})
+        build_dataset(other, base, out, workers=1, progress=False, force=True)
+    assert not set((out / RECORDS).glob("*.npz")) & set(files)
+
+
+def test_a_stopped_rebuild_with_another_config_resumes_without_the_other_ids_warning(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A --force rebuild with another config, stopped before any record, leaves the complete
+    dataset of the first config in place (its index and records): resumed, the folder's other
+    records are that dataset's, not an earlier version's, and nothing is said of them."""
+    cfg, base, out = five_records(tmp_path)
+    other = cfg.model_copy(update={"seed": cfg.seed + 1})
+
+    def stopped(config: object, workers: object, scheduler: object) -> Any:
+        def run(specs: list[Any], out_dir: str) -> Any:
+            raise KeyboardInterrupt
+            yield
+
+        yield run
+
+    with monkeypatch.context() as patched:
+        patched.setattr(dataset, "_executor", stopped)
+        with pytest.raises(KeyboardInterrupt):
+            build_dataset(other, base, out, workers=1, progress=False, force=True)
+    assert len(list((out / RECORDS).glob("*.npz"))) == 5  # the first config's, indexed
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", dataset.DatasetWarning)
+        build_dataset(other, base, out, workers=1, progress=False)
+    assert len(list((out / RECORDS).glob("*.npz"))) == 5  # now the other config's
 
 
 def test_a_record_kept_from_other_software_versions_is_said(tmp_path: Path) -> None:

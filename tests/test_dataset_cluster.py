@@ -6,9 +6,12 @@ cluster."""
 from __future__ import annotations
 
 import os
+import re
 import threading
+import warnings
 from collections.abc import Iterator
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import pytest
@@ -16,7 +19,7 @@ from conftest import EXAMPLES
 from test_dataset import assert_same
 
 from mdframework import cli, dataset
-from mdframework.cluster import SCHEDULER_TIMEOUT_ENV, check_paths, check_workers
+from mdframework.cluster import SCHEDULER_TIMEOUT_ENV, Workerless, check_paths, check_workers
 from mdframework.dataset import RECORDS, build_dataset, load_dataset_config
 from mdframework.errors import SettingError
 
@@ -68,6 +71,11 @@ def cluster(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[Any]:
     where.mkdir()
     kwargs = {"n_workers": 1, **getattr(request, "param", {})}
     before = Path.cwd()
+    # Dask's nannies set MALLOC_TRIM_THRESHOLD_ in this process's environment for the workers
+    # they spawn (a user's cluster does; a build's local cluster does not) and leave it there:
+    # a later test's workers or subprocesses would run with it
+    trim = "MALLOC_TRIM_THRESHOLD_"
+    trim_before = os.environ.get(trim)
     os.chdir(where)
     try:
         cluster = LocalCluster(
@@ -79,8 +87,14 @@ def cluster(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[Any]:
         )
     finally:
         os.chdir(before)
-    with cluster:
-        yield cluster
+    try:
+        with cluster:
+            yield cluster
+    finally:
+        if trim_before is None:
+            os.environ.pop(trim, None)
+        else:
+            os.environ[trim] = trim_before
 
 
 def test_relative_paths_resolve_on_workers_of_another_folder(
@@ -96,10 +110,26 @@ def test_relative_paths_resolve_on_workers_of_another_folder(
     config, base = load_dataset_config("d.toml")
     assert not base.is_absolute()
     build_dataset(config, base, Path("local"), workers=1, progress=False)
+    checked: list[list[str]] = []
+    check = dataset.check_paths
+
+    def and_note_them(client: Any, paths: list[str]) -> None:
+        checked.append(paths)
+        check(client, paths)
+
+    monkeypatch.setattr(dataset, "check_paths", and_note_them)
     args = ["dataset", "build", "d.toml", "--out", "out", "--no-progress"]
     assert cli.main([*args, "--scheduler", cluster.scheduler_address]) == 0
     assert_same(tmp_path / "cfg" / "local", tmp_path / "cfg" / "out")
     assert not (tmp_path / "workers" / "out").exists()
+    # the workers were asked, before any record, whether they see the records folder and the
+    # motion files, by the absolute paths they use
+    cmu = EXAMPLES.resolve() / "data" / "cmu"
+    records = str(tmp_path / "cfg" / "out" / RECORDS)
+    motions = [cmu / "asf-amc" / "02_01.amc", cmu / "bvh" / "80_10.bvh"]
+    assert [[p[0], *sorted(str(Path(f).resolve()) for f in p[1:])] for p in checked] == [
+        [records, *map(str, motions)]
+    ]
 
 
 @pytest.mark.parametrize("cluster", [{"n_workers": 0}], indirect=True)
@@ -204,7 +234,10 @@ def test_a_file_left_by_a_killed_worker_is_removed_when_the_build_ends(
 
 
 def test_a_scheduler_lost_mid_build_is_one_line(
-    cluster: Any, tmp_path: Path, capfd: pytest.CaptureFixture[str]
+    cluster: Any,
+    tmp_path: Path,
+    capfd: pytest.CaptureFixture[str],
+    caplog: pytest.LogCaptureFixture,
 ) -> None:
     """The scheduler gone mid-build (killed, its machine down): Dask cancels every task, and
     the build ended as an internal error (`FutureCancelledError: ... scheduler-connection-lost`)
@@ -231,6 +264,8 @@ def test_a_scheduler_lost_mid_build_is_one_line(
     assert err.splitlines()[-1].startswith(f"mdf: error: lost the Dask scheduler {address!r} ")
     assert err.splitlines()[-1].endswith("the same command, run again, resumes from them")
     assert list((out / RECORDS).glob("*.npz"))
+    # nor logged (Dask's client logs the lost connection with its traceback, at its own level)
+    assert [r.getMessage() for r in caplog.records if r.name.startswith("distributed")] == []
 
 
 def test_a_worker_that_does_not_see_the_data_or_out_is_named(cluster: Any, tmp_path: Path) -> None:
@@ -291,3 +326,141 @@ def test_a_worker_without_mdframework_is_named_one_that_left_is_not() -> None:
     older = {**ours, "mdframework": "0.2.0"}
     with pytest.raises(SettingError, match=r"^Dask worker tcp://a:1 has mdframework '0.2.0', "):
         check_workers(Client({"tcp://a:1": older}), "tcp://s:8786")
+
+
+def test_workers_of_other_numeric_versions_are_a_dataset_warning() -> None:
+    """Workers of another NumPy (or Python, SciPy, scikit-learn) than the build's compute
+    records that may differ in the last bits: the build goes on, with one warning naming the
+    versions, of the category the build gives (DatasetWarning); workers of the same versions
+    say nothing."""
+    from mdframework.plugins import versions
+
+    ours = versions()
+
+    class Client:
+        def __init__(self, theirs: dict[str, Any]) -> None:
+            self.theirs = theirs
+
+        def wait_for_workers(self, n: int, timeout: float) -> None:
+            pass
+
+        def run(self, function: Any, on_error: str) -> dict[str, Any]:
+            return {"tcp://a:1": ours, "tcp://b:2": self.theirs}
+
+    with pytest.warns(dataset.DatasetWarning) as caught:
+        check_workers(Client({**ours, "numpy": "1.0.0"}), "tcp://s:8786", dataset.DatasetWarning)
+    assert [str(w.message) for w in caught] == [
+        "Dask workers run numpy '1.0.0', not this process's versions: their records may "
+        "differ in the last bits from a local build's"
+    ]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_workers(Client(ours), "tcp://s:8786", dataset.DatasetWarning)
+
+
+def test_the_build_is_stopped_after_the_timeout_without_a_worker_not_before(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The watch of a build on a cluster of one's own cancels the build's tasks once the
+    scheduler has had no worker for MDF_DASK_TIMEOUT: a worker seen meanwhile starts the wait
+    afresh (workers restarting one by one are not a cluster without workers), and a scheduler
+    lost is left to Dask. Driven poll by poll, each a second of a clock of its own."""
+    from mdframework import cluster as dask_cluster
+
+    monkeypatch.setenv(SCHEDULER_TIMEOUT_ENV, "1.5")
+    clock = [0.0]
+    monkeypatch.setattr(dask_cluster, "time", SimpleNamespace(monotonic=lambda: clock[0]))
+
+    class Client:
+        def __init__(self, answers: list[Any]) -> None:
+            self.answers, self.polls = answers, 0
+            self.cancelled: tuple[int, list[str]] | None = None
+
+        def nthreads(self) -> dict[str, int]:
+            self.polls += 1
+            clock[0] += 1.0
+            answer = self.answers.pop(0) if self.answers else {}
+            if isinstance(answer, Exception):
+                raise answer
+            return dict(answer)
+
+        def cancel(self, futures: list[str]) -> None:
+            self.cancelled = (self.polls, futures)
+
+    class AtOnce:  # the watch's wait of a second between polls, without waiting
+        def wait(self, timeout: float) -> bool:
+            return False
+
+    one = {"tcp://w:1": 1}
+    client = Client([{}, one, {}, one])  # alone from poll 5: 1 s at poll 6, 2 s at poll 7
+    watch = Workerless(client, ["f1", "f2"], "tcp://s:8786")
+    watch._done = AtOnce()  # type: ignore[assignment]
+    watch.run()
+    assert client.cancelled == (7, ["f1", "f2"])
+    assert str(watch.error).startswith(
+        "the Dask scheduler 'tcp://s:8786' has had no workers for 1.5 s (they were killed, or "
+        "left); the records finished stay, and the same command, run again when it has "
+        "workers, resumes from them"
+    )
+    client = Client([one, {}, OSError("scheduler lost")])
+    watch = Workerless(client, ["f1"], "tcp://s:8786")
+    watch._done = AtOnce()  # type: ignore[assignment]
+    watch.run()
+    assert (client.polls, client.cancelled, watch.error) == (3, None, None)
+
+
+def test_a_task_whose_workers_all_died_is_one_line_naming_its_first_record(
+    cluster: Any,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capfd: pytest.CaptureFixture[str],
+) -> None:
+    """Every worker that ran a task died (killed, out of memory; here the task ends its
+    worker's process): Dask gives up on the task (KilledWorker), and the build ended as an
+    internal error. Now one line naming the task's first record and how to resume."""
+    cluster.scheduler.allowed_failures = 0  # Dask's three retries would take a restart each
+    config_file = write_relative_config(tmp_path / "cfg")
+    config, base = load_dataset_config(config_file)
+    specs = dataset.plan_records(config, base)
+    firsts = {chunk[0].record_id for chunk in dataset.record_chunks(specs, 1)}
+    assert len(firsts) < len(specs)
+    monkeypatch.setattr(dataset, "build_records", lambda specs, out_dir: os._exit(1))
+    out = tmp_path / "out"
+    args = ["dataset", "build", str(config_file), "--out", str(out), "--no-progress"]
+    assert cli.main([*args, "--scheduler", cluster.scheduler_address]) == 2
+    err = capfd.readouterr().err
+    assert "Traceback" not in err
+    said = re.fullmatch(
+        r"mdf: error: Dask workers died while building record (\S+) and the records after it "
+        r"in its task, on every worker Dask tried \(killed, or out of memory: see the workers' "
+        r"logs\); the records finished stay in (.+), and the same command, run again, resumes "
+        r"from them",
+        err.splitlines()[-1],
+    )
+    assert said and said[1] in firsts and said[2] == str(out), err
+
+
+def test_the_files_the_workers_must_see_are_recordings_and_motions_by_absolute_path(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The files a cluster's workers are checked for: a real radar's recordings too, and a
+    motion file given from the home folder (`~/...`) by its path there, not under the config's
+    folder (a worker would be named for not seeing a path that does not exist)."""
+    radhar = EXAMPLES / "datasets" / "radhar.toml"
+    config, base = load_dataset_config(radhar)
+    files = dataset._data_files(dataset.plan_records(config, base))
+    assert sorted(files) == [
+        os.path.abspath(EXAMPLES / "data" / "radhar" / f"radhar_{a}_subset.npz")
+        for a in ("boxing", "jump", "walk")
+    ]
+    home = tmp_path / "home"
+    home.mkdir()
+    for name in ("02.asf", "02_01.amc"):
+        (home / name).write_bytes((EXAMPLES / "data" / "cmu" / "asf-amc" / name).read_bytes())
+    monkeypatch.setenv("HOME", str(home))
+    (tmp_path / "d.toml").write_text(
+        '[[sources]]\nlabel = "walk"\nmotion = { kind = "cmu", file = "~/02_01.amc" }\n'
+        "max_records = 1\n[record_lengths]\nwalk = 1.0\n"
+    )
+    config, base = load_dataset_config(tmp_path / "d.toml")
+    assert dataset._data_files(dataset.plan_records(config, base)) == [str(home / "02_01.amc")]

@@ -320,6 +320,30 @@ def test_the_reference_of_an_installed_mdframework_is_refused(
     finally:
         docgen.project_registry.cache_clear()
 
+    # the command itself, on a copy of the package where pip puts it: one line, exit 1
+    import shutil
+
+    site = tmp_path / "site-packages"
+    shutil.copytree(
+        ROOT / "src" / "mdframework",
+        site / "mdframework",
+        ignore=shutil.ignore_patterns("__pycache__"),
+    )
+    done = subprocess.run(
+        [sys.executable, "-m", "mdframework.docgen"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        env={**os.environ, "PYTHONPATH": str(site)},
+        timeout=60,
+    )
+    assert (done.returncode, done.stdout) == (1, "")
+    assert done.stderr == (
+        f"mdframework.docgen: no plugins/ folder beside this mdframework ({tmp_path}): the "
+        "reference documents the plugins of a source tree; run python -m mdframework.docgen "
+        "in a clone of the repository\n"
+    )
+
 
 def test_config_reference_covers_every_section() -> None:
     from mdframework.docgen import project_registry

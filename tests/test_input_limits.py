@@ -25,6 +25,7 @@ from mdframework.cluster import (
     check_scheduler_address,
     connect,
     scheduler_address,
+    scheduler_timeout,
 )
 from mdframework.config import read_config_file, run_config_model, validate_run_config
 from mdframework.dataset import DatasetConfig
@@ -310,6 +311,29 @@ def test_an_unreachable_scheduler_is_a_clear_error_after_the_timeout(
     monkeypatch.setenv(SCHEDULER_TIMEOUT_ENV, "soon")
     with pytest.raises(MdfError, match=SCHEDULER_TIMEOUT_ENV):
         connect(Client, None, f"tcp://127.0.0.1:{port}")
+
+
+@pytest.mark.parametrize(
+    ("text", "seconds"),
+    [(None, 10.0), ("0.5", 0.5), ("3600", 3600.0), ("0", None), ("3601", None), ("nan", None)],
+)
+def test_the_scheduler_timeout_is_a_positive_number_up_to_an_hour(
+    monkeypatch: pytest.MonkeyPatch, text: str | None, seconds: float | None
+) -> None:
+    """MDF_DASK_TIMEOUT: 0 < t <= 3600 s (0 would give up on every scheduler at once; the
+    default 10 s when it is not set)."""
+    if text is None:
+        monkeypatch.delenv(SCHEDULER_TIMEOUT_ENV, raising=False)
+    else:
+        monkeypatch.setenv(SCHEDULER_TIMEOUT_ENV, text)
+    if seconds is not None:
+        assert scheduler_timeout() == seconds
+        return
+    with pytest.raises(MdfError) as err:
+        scheduler_timeout()
+    assert str(err.value) == (
+        f"MDF_DASK_TIMEOUT={text!r}: give a timeout in seconds, 0 < t <= 3600"
+    )
 
 
 def test_a_malformed_scheduler_address_is_refused_before_any_connection(

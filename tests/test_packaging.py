@@ -83,3 +83,49 @@ def test_a_plugin_sdist_and_wheel(tmp_path: Path) -> None:
     sdist, wheel = _build(ROOT / "plugins" / "mdf-cw", tmp_path)
     assert "LICENSE" in sdist
     assert any(n.endswith(".dist-info/licenses/LICENSE") for n in wheel)
+
+
+PLUGINS = DISTRIBUTIONS[1:]
+
+
+@pytest.mark.parametrize("folder", PLUGINS, ids=[p.name for p in PLUGINS])
+def test_a_plugin_declares_the_installed_packages_its_modules_import(folder: Path) -> None:
+    """A plugin installed alone gets what it imports (mdf-clutter imported scipy, which came
+    only through mdframework's own dependencies): every installed distribution that a module
+    of the plugin imports is one of its dependencies (optional ones included); the standard
+    library, the plugin's own package and packages that are not installed here are left out."""
+    import ast
+    import importlib.metadata
+    import re
+
+    project = tomllib.loads((folder / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    requirements = [*project.get("dependencies", [])]
+    for extra in project.get("optional-dependencies", {}).values():
+        requirements += extra
+    declared = {re.split(r"[\s<>=!~\[;]", r, maxsplit=1)[0].lower() for r in requirements}
+    declared = {name.replace("_", "-") for name in declared}
+    owners = importlib.metadata.packages_distributions()
+    imported: dict[str, str] = {}
+    for source in sorted((folder / "src").rglob("*.py")):
+        for node in ast.walk(ast.parse(source.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                tops = [alias.name.partition(".")[0] for alias in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                tops = [node.module.partition(".")[0]]
+            else:
+                continue
+            for top in tops:
+                if (
+                    top in sys.stdlib_module_names
+                    or top == source.relative_to(folder / "src").parts[0]
+                ):
+                    continue
+                for dist in owners.get(top, []):
+                    imported.setdefault(
+                        dist.lower().replace("_", "-"), str(source.relative_to(folder))
+                    )
+    # pydantic is mdframework's plugin interface (a plugin's config is a PluginConfig, one of
+    # mdframework's pydantic models): the plugin has it, of the version mdframework needs
+    declared.add("pydantic")
+    undeclared = {dist: where for dist, where in imported.items() if dist not in declared}
+    assert undeclared == {}, f"imported but not declared in {folder.name}'s pyproject"

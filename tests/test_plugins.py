@@ -751,3 +751,26 @@ def test_a_plugin_using_what_mdframework_0_2_added_requires_0_2() -> None:
         if used and pin != "mdframework>=0.2":
             wrong.append(f"{project['name']} ({pin}) uses {', '.join(used)}")
     assert wrong == []
+
+
+@pytest.mark.parametrize(
+    "package", ["mdf_c3d", "mdf_table", "mdf_deepmimic", "mdf_cmu", "mdf_kinect"]
+)
+def test_a_plugin_package_exports_its_readers_on_first_use(package: str) -> None:
+    """The packages that import their readers only when used still export every public name:
+    each resolves (to the object of the module that defines it), dir() lists it, and a name
+    the package does not have is an AttributeError (hasattr() is False, as before)."""
+    import importlib
+
+    fresh = f"import {package} as m; print(sorted(set(m.__all__) - set(dir(m))))"
+    listed = subprocess.run([sys.executable, "-c", fresh], capture_output=True, text=True)
+    assert listed.stdout == "[]\n", listed.stderr  # before any is imported
+    module = importlib.import_module(package)
+    for name in module.__all__:
+        value = getattr(module, name)
+        defined = getattr(value, "__module__", None)
+        if defined is not None and defined.startswith(f"{package}."):
+            assert getattr(importlib.import_module(defined), name) is value, name
+    assert not hasattr(module, "no_such_name")
+    with pytest.raises(AttributeError, match=rf"^module '{package}' has no attribute 'read_x'$"):
+        module.read_x  # noqa: B018
