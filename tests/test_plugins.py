@@ -538,8 +538,19 @@ def test_an_interrupt_python_could_not_raise_ends_the_command_as_interrupted(
     assert passed_on == [other] and not errors.interrupt_seen()
     handle(Unraisable(KeyboardInterrupt()))
     assert passed_on == [other] and errors.interrupt_seen()
+    # in a command: the hook that main installs records it while the command runs
+    registry = cli.default_registry
+
+    def interrupted_in_a_finaliser() -> Any:
+        sys.unraisablehook(Unraisable(KeyboardInterrupt()))  # type: ignore[arg-type]
+        return registry()
+
+    monkeypatch.setattr(cli, "default_registry", interrupted_in_a_finaliser)
     assert cli.main(["plugins"]) == 130
     assert capsys.readouterr().err.strip().splitlines()[-1] == "mdf: interrupted"
+    # a Ctrl-C of an earlier command in the process is not the next one's
+    monkeypatch.setattr(cli, "default_registry", registry)
+    assert cli.main(["plugins"]) == 0
 
 
 def _radar_module(declared: bool) -> ModuleType:

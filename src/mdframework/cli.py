@@ -791,6 +791,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     one line and returns 130."""
     try:
         _ENDED_BY.clear()
+        note_interrupt(False)  # a Ctrl-C of an earlier command in this process is not ours
         previous = _catch_interrupts()
         hook = sys.unraisablehook
         sys.unraisablehook = _quiet_unraisable_interrupt(hook)

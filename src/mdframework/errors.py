@@ -65,10 +65,21 @@ class OutputError(MdfError):
 _interrupt_seen = False
 
 
-def note_interrupt() -> None:
-    """Record that Ctrl-C reached this process (the CLI's SIGINT handler calls it)."""
+def note_interrupt(seen: bool = True) -> None:
+    """Record that Ctrl-C reached this process (the CLI's SIGINT handler calls it; each
+    command starts with ``seen=False``)."""
     global _interrupt_seen
-    _interrupt_seen = True
+    _interrupt_seen = seen
+
+
+def stop_if_interrupted() -> None:
+    """Raise KeyboardInterrupt if Ctrl-C reached this process and was swallowed on its way:
+    raised in a finaliser (Python then reports it as unraisable and goes on), or caught by a
+    library as an exception (Python wraps one raised while a class is being created). The
+    command's progress reports call this at every step and block, so such a Ctrl-C stops the
+    command at its next step instead of at its end."""
+    if _interrupt_seen:
+        raise KeyboardInterrupt
 
 
 def interrupt_seen() -> bool:

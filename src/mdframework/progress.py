@@ -29,6 +29,8 @@ from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from typing import Any
 
+from .errors import stop_if_interrupted
+
 #: Environment variable: ``1`` forces progress on (every step, no delay), ``0`` off (also
 #: ``true``/``yes``/``on`` and ``false``/``no``/``off``, in any case; empty is unset; anything
 #: else is refused by the ``mdf`` commands that report progress, :func:`check_progress_setting`,
@@ -197,8 +199,11 @@ class Progress:
 
     def stage(self, message: str) -> None:
         """Start a step (ending the previous one): ``mdf: MESSAGE ...`` appears if it lasts
-        :attr:`delay` seconds, i.e. if :meth:`stage` or :meth:`end` is not called sooner."""
+        :attr:`delay` seconds, i.e. if :meth:`stage` or :meth:`end` is not called sooner.
+        A Ctrl-C that a library swallowed stops the command here
+        (:func:`~mdframework.errors.stop_if_interrupted`), as at every block of :meth:`counted`."""
         self.end()
+        stop_if_interrupted()
         if not self.enabled:
             return
         if self.delay <= 0:
@@ -230,6 +235,7 @@ class Progress:
         that advances by ``hi - lo`` as each block is done."""
         with self.bar(total, label, unit) as advance:
             for lo, hi in blocks:
+                stop_if_interrupted()
                 yield lo, hi
                 advance(hi - lo)
 
