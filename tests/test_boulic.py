@@ -265,7 +265,9 @@ def test_the_source_keeps_only_the_joints_of_a_long_walk(chen: bool) -> None:
     10-minute walk peaked at 1 GB while it loaded."""
     cfg = BoulicConfig(height=H, duration=60.0, chen_compatible=chen)
     source = BoulicWalker(cfg)
-    motion, peak = traced_peak(source.load)
+    # a short walk first: the first load imports 15 MB of scipy (the test failed run alone)
+    short = BoulicWalker(BoulicConfig(height=H, duration=1.0, chen_compatible=chen))
+    motion, peak = traced_peak(source.load, warm_up=short.load)
     joints = motion.skeleton.positions
     assert joints.shape[0] > 60 * 380
     assert peak < 3 * joints.nbytes

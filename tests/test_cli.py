@@ -865,27 +865,29 @@ def test_check_counts_the_raw_paths_fast_time_arrays(bandwidth: float) -> None:
     FFTs) are most of its memory and were left out of `mdf check`'s estimate (13 MiB for the
     raw walk, which peaks 40 MiB above the analytic path): the radar's own term is now within
     15 % of what tracemalloc measures the raw path to add, at two bandwidths (the fast-time
-    samples and the filter grow with it)."""
-    import tracemalloc
+    samples and the filter grow with it). Each peak is the lower of two runs after a short one
+    (the first run's imports, and a resize of the interned strings' table, which the run's
+    paths feed: 3.7 MB in the analytic run's peak put the term 16 % above)."""
+    from helpers import traced_peak
 
     from mdframework.check import MIB, plan_run
     from mdframework.pipeline import simulate
 
-    sets = ["motion.duration=1.0", f"radar.bandwidth={bandwidth}", "figures.enabled=false"]
-    raw = load_run_config(EXAMPLES / "cmu_walk_raw.toml", overrides=sets)
-    analytic = load_run_config(
-        EXAMPLES / "cmu_walk_raw.toml", overrides=[*sets, 'radar.path="analytic"']
-    )
-    for config in (analytic, raw):  # the first runs' one-time allocations out of the way
-        simulate(config)
-    peaks = []
-    for config in (analytic, raw):
-        tracemalloc.start()
-        try:
-            simulate(config)
-            peaks.append(tracemalloc.get_traced_memory()[1])
-        finally:
-            tracemalloc.stop()
+    def configs(duration: float) -> tuple[Any, Any]:
+        sets = [f"motion.duration={duration}", f"radar.bandwidth={bandwidth}"]
+        sets.append("figures.enabled=false")
+        return (
+            load_run_config(
+                EXAMPLES / "cmu_walk_raw.toml", overrides=[*sets, 'radar.path="analytic"']
+            ),
+            load_run_config(EXAMPLES / "cmu_walk_raw.toml", overrides=sets),
+        )
+
+    def peak(config: Any, short: Any) -> int:
+        return traced_peak(lambda: simulate(config), warm_up=lambda: simulate(short), runs=2)[1]
+
+    analytic, raw = configs(1.0)
+    peaks = [peak(*pair) for pair in zip((analytic, raw), configs(0.2), strict=True)]
     term = plan_run(raw).memory_terms_mib["fast time"] * MIB
     assert term == pytest.approx(peaks[1] - peaks[0], rel=0.15)
     assert "fast time" not in plan_run(analytic).memory_terms_mib
