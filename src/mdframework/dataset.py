@@ -1158,6 +1158,17 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
     return _distinct_recordings(specs)
 
 
+def _record_file_of(spec: RecordSpec) -> tuple[str, Path] | None:
+    """The motion or recording file a record is cut from: as its config gives it, and joined
+    to the config's folder as the config's paths are (``~`` expanded, as
+    :data:`~mdframework.settings.DataPath` does); ``None`` for a motion read from no file."""
+    run = spec.run_config
+    given = (run.get("recording") or run.get("motion") or {}).get("file")
+    if given is None:
+        return None
+    return str(given), Path(spec.base_dir) / Path(str(given)).expanduser()
+
+
 def _distinct_recordings(specs: list[RecordSpec]) -> list[RecordSpec]:
     """Records named by distinct recordings: where two different motion files share a name
     (``alice/walk.bvh``, ``bob/walk.bvh``), their records' ``recording`` is the file as the
@@ -1168,12 +1179,12 @@ def _distinct_recordings(specs: list[RecordSpec]) -> list[RecordSpec]:
     files: dict[str, set[Path]] = {}
     paths: list[Path | None] = []  # each record's file
     for spec in specs:
-        run = spec.run_config
-        given = run["recording"].get("file") if "recording" in run else run["motion"].get("file")
+        read = _record_file_of(spec)
         path = None
-        if given is not None:
-            path = (Path(spec.base_dir) / Path(str(given)).expanduser()).resolve()  # as DataPath
-            first.setdefault(path, str(given))
+        if read is not None:
+            given, joined = read
+            path = joined.resolve()
+            first.setdefault(path, given)
             files.setdefault(spec.recording, set()).add(path)
         paths.append(path)
     shared = {name for name, held in files.items() if len(held) > 1}
@@ -1805,10 +1816,9 @@ def _data_files(specs: list[RecordSpec]) -> list[str]:
     open."""
     files: dict[str, None] = {}
     for spec in specs:
-        section = spec.run_config.get("recording") or spec.run_config.get("motion") or {}
-        if isinstance(section.get("file"), str):
-            given = Path(section["file"]).expanduser()
-            files[os.path.abspath(Path(spec.base_dir) / given)] = None
+        read = _record_file_of(spec)
+        if read is not None:
+            files[os.path.abspath(read[1])] = None
     return list(files)
 
 
