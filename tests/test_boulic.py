@@ -453,3 +453,45 @@ def test_closed_form_tracks_follow_the_pages_formulas(rv: float, chen: bool) -> 
     }
     for name, want in expected.items():
         np.testing.assert_allclose(got[name], want, rtol=0, atol=1e-12, err_msg=name)
+
+
+# ---------------------------------------------------------------------------- parameter range
+
+
+def test_too_few_samples_per_cycle_are_refused_not_crashed(registry: Registry) -> None:
+    """``nt`` below 32 left the pipeline's spline of the walker's samples more than 5 mm off
+    the exact kinematics, and ``mujoco_body`` (the examples' model) then stopped ``mdf run``
+    with an internal error blaming itself after ``mdf check`` had passed the config. It is
+    refused as a config error; the smallest allowed ``nt`` runs at the worst corner of the
+    range (tallest walker, fastest rv, record to both ends of the walk)."""
+    with pytest.raises(ConfigError, match=r"motion\.nt: must be at least 32 \(got 16\)"):
+        validate_run_config({"motion": {"kind": "boulic", "nt": 16}}, registry=registry)
+    res = run(
+        registry,
+        motion={"kind": "boulic", "height": 2.49, "rv": 3.0, "nt": 32, "n_cycles": 2},
+        radar={"kind": "lfm", "prf": 3000.0},
+    )
+    assert res.scatterers is not None and res.scatterers.positions.shape[1] == 16
+
+
+@pytest.mark.parametrize(("rv", "height"), [(0.3, 1.8), (3.0, 1.8), (1.0, 0.6)])
+def test_walker_is_not_blamed_for_its_time_base_or_unit(
+    registry: Registry, rv: float, height: float
+) -> None:
+    """Boulic's cadence is the model's own, 120 sqrt(rv) / 1.346 steps a minute at an exact time
+    base: 49 at rv = 0.3, 154 at rv = 3, both inside the model's 0 < rv <= 3; its legs are
+    0.491 H long, 0.29 m at the allowed height 0.6 m. The sanity checks warned 'check the frame
+    rate or time base' outside rv 0.62-2.8 and 'check its unit (motion.unit_m ...)' (a field the
+    walker lacks) below 0.82 m; both are off for the walker unless asked for."""
+    import warnings
+
+    from mdframework.sanity import MotionSanityWarning
+
+    motion = {"kind": "boulic", "rv": rv, "height": height, "duration": 1.0}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", MotionSanityWarning)
+        run(registry, motion=motion)
+        run(registry, motion=motion | {"sanity": {"glitches": "error"}})
+    asked = motion | {"sanity": {"cadence": True, "size": "warn"}}
+    with pytest.warns(MotionSanityWarning, match="times a minute|legs are"):
+        run(registry, motion=asked)

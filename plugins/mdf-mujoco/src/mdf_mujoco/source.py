@@ -17,16 +17,20 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
 
 from mdframework import CANONICAL_JOINTS, Motion, MotionConfig, MotionSource, Skeleton, limits
 from mdframework.physics.body import LEG_FRACTION
+from mdframework.settings import SanityConfig
 
 from .body_model import WalkerBody
 from .gait import Gait
+
+#: Sanity options the walker sets unless the config gives them (see ``BoulicConfig``).
+_WALKER_SANITY: dict[str, Any] = {"cadence": False, "size": "ignore"}
 
 
 class BoulicConfig(MotionConfig):
@@ -54,7 +58,13 @@ class BoulicConfig(MotionConfig):
         le=10_000,
         description="Gait cycles to generate; default: enough for start + duration, else 3.",
     )
-    nt: int = Field(512, ge=4, le=65536, description="Samples per gait cycle (even).")
+    nt: int = Field(
+        512,
+        ge=32,
+        le=65536,
+        description="Samples per gait cycle (even); at least 32: fewer leave the pipeline's "
+        "spline of the samples millimetres to centimetres off the walker's kinematics.",
+    )
     chen_compatible: bool = Field(
         False,
         description="Reproduce the quirks of Chen's MATLAB code (speed scale, gait-a sign flip, "
@@ -62,6 +72,25 @@ class BoulicConfig(MotionConfig):
         "lower-leg ellipsoid) for side-by-side comparison.",
     )
     activity: str = Field("walk", description="Activity label recorded with the run.")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _walker_sanity(cls, data: Any) -> Any:
+        """The cadence and size sanity checks are off unless asked for: made to expose a wrong
+        frame rate or length unit, they blamed the walker's exact time base outside rv
+        0.62-2.8 (its cadence is the model's, 120 sqrt(rv) / 1.346 steps a minute) and its
+        unit below a height of 0.82 m (its legs are 0.491 H long)."""
+        if not isinstance(data, dict):
+            return data
+        given = data.get("sanity")
+        if given is None:
+            return {**data, "sanity": dict(_WALKER_SANITY)}
+        if isinstance(given, dict):
+            return {**data, "sanity": _WALKER_SANITY | given}
+        if isinstance(given, SanityConfig):
+            off = {k: v for k, v in _WALKER_SANITY.items() if k not in given.model_fields_set}
+            return {**data, "sanity": given.model_copy(update=off)}
+        return data
 
     @model_validator(mode="after")
     def _check(self) -> BoulicConfig:
