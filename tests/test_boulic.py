@@ -495,3 +495,23 @@ def test_walker_is_not_blamed_for_its_time_base_or_unit(
     asked = motion | {"sanity": {"cadence": True, "size": "warn"}}
     with pytest.warns(MotionSanityWarning, match="times a minute|legs are"):
         run(registry, motion=asked)
+
+
+@pytest.mark.parametrize(
+    ("motion", "what"),
+    [
+        ({"n_cycles": 10_000, "nt": 65536}, "655,360,001 frames"),  # 200 GiB of joints
+        ({"rv": 5e-324}, r"of 6\.0\d+e\+161 s"),  # an overflow, reported as an internal error
+        ({"rv": 1e-9}, r"3 cycle\(s\) of 4\.256e\+04 s"),  # 3 cycles of 11.8 h
+    ],
+)
+def test_walks_beyond_the_limits_are_refused_before_loading(
+    registry: Registry, motion: dict[str, Any], what: str
+) -> None:
+    """The walker computes every frame from its start: a walk beyond the project's limits (a
+    day, 10 million frames) is refused as a config error, as the deepmimic source's repeated
+    clips are, instead of exhausting memory or overflowing in ``mdf check``."""
+    with pytest.raises(ConfigError, match=rf"motion: the walk is .*{what}.*beyond the limits"):
+        validate_run_config({"motion": {"kind": "boulic", **motion}}, registry=registry)
+    slow = BoulicConfig(rv=1e-9, duration=1.0)  # one cycle: within the limits
+    assert BoulicWalker(slow).n_cycles(BoulicWalker(slow).gait()) == 1

@@ -56,7 +56,8 @@ class BoulicConfig(MotionConfig):
         None,
         ge=1,
         le=10_000,
-        description="Gait cycles to generate; default: enough for start + duration, else 3.",
+        description="Gait cycles to generate; default: enough for start + duration, else 3. "
+        "The walk, from its start, is at most a day and 10 million frames (n_cycles nt).",
     )
     nt: int = Field(
         512,
@@ -105,7 +106,26 @@ class BoulicConfig(MotionConfig):
                 f"speed {self.speed} m/s gives rv = {rv:.4g}, outside Boulic's 0 < rv <= 3 "
                 f"(H_t = {LEG_FRACTION * self.height:.4g} m)"
             )
+        dc = 1.346 / math.sqrt(rv)  # Gait.cycle_duration
+        n = self.cycles(dc)
+        if n * dc > limits.MAX_DURATION_S or n * self.nt + 1 > limits.MAX_FRAMES:
+            raise ValueError(
+                f"the walk is {n} cycle(s) of {dc:.4g} s (rv = {rv:.4g}) from its start, "
+                f"{n * dc:.4g} s and {n * self.nt + 1:,} frames (nt = {self.nt} per cycle), "
+                f"beyond the limits of {limits.MAX_DURATION_S:g} s and {limits.MAX_FRAMES:,} "
+                "frames: walk fewer cycles (n_cycles, or an earlier start + duration), a smaller "
+                "nt or a larger rv"
+            )
         return self
+
+    def cycles(self, cycle_duration: float) -> int:
+        """Gait cycles to generate for a cycle of ``cycle_duration`` [s]: ``n_cycles``, else
+        enough for ``start + duration``, else 3."""
+        if self.n_cycles is not None:
+            return self.n_cycles
+        if self.duration is None:
+            return 3
+        return max(1, math.ceil((self.start + self.duration) / cycle_duration - 1e-9))
 
     @property
     def relative_velocity(self) -> float:
@@ -137,12 +157,7 @@ class BoulicWalker(MotionSource):
 
     def n_cycles(self, gait: Gait) -> int:
         """Number of cycles to generate."""
-        c = self.config
-        if c.n_cycles is not None:
-            return c.n_cycles
-        if c.duration is None:
-            return 3
-        return max(1, math.ceil((c.start + c.duration) / gait.cycle_duration - 1e-9))
+        return self.config.cycles(gait.cycle_duration)
 
     def load(self) -> Motion:
         """Canonical joints at ``k Dc / nt`` s, ``k = 0 .. n_cycles nt`` (both ends)."""
