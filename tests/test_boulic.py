@@ -515,3 +515,24 @@ def test_walks_beyond_the_limits_are_refused_before_loading(
         validate_run_config({"motion": {"kind": "boulic", **motion}}, registry=registry)
     slow = BoulicConfig(rv=1e-9, duration=1.0)  # one cycle: within the limits
     assert BoulicWalker(slow).n_cycles(BoulicWalker(slow).gait()) == 1
+
+
+def test_the_ground_as_the_page_states_it() -> None:
+    """docs/validation.md (the ground in the corrected mode), H = 1.8 m over 0 < rv <= 3: the
+    ankles at z = 0 (no lower than -3 mm up to rv = 2, -19 mm at rv = 3); the toes below it for
+    58-100 % of each cycle, down to -0.092 m at rv = 1 and -0.198 m at rv = 3."""
+    ankle_min, toe_min, below = {}, {}, []
+    for rv in np.linspace(0.01, 3.0, 300):
+        g = Gait(H, float(rv), 512)
+        p = chain_positions(g, np.arange(512) * g.cycle_duration / 512)
+        toes = p[:, [J["l_toe"], J["r_toe"]], 2]
+        ankle_min[float(rv)] = p[:, [J["l_ankle"], J["r_ankle"]], 2].min()
+        toe_min[float(rv)] = toes.min()
+        below.append(np.mean(toes < 0))
+    assert min(v for rv, v in ankle_min.items() if rv <= 2) == pytest.approx(-0.003, abs=5e-4)
+    assert ankle_min[3.0] == pytest.approx(-0.019, abs=5e-4)
+    assert (min(below), max(below)) == pytest.approx((0.58, 1.0), abs=0.005)
+    assert min(toe_min.values()) == toe_min[3.0] == pytest.approx(-0.198, abs=5e-4)
+    g1 = Gait(H, 1.0, 512)
+    p1 = chain_positions(g1, np.arange(512) * g1.cycle_duration / 512)
+    assert p1[:, [J["l_toe"], J["r_toe"]], 2].min() == pytest.approx(-0.092, abs=5e-4)

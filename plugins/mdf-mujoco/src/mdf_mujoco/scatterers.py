@@ -71,7 +71,8 @@ class MujocoBodyConfig(PluginConfig):
         None,
         description="Semi-axes (a, b) [m] per segment (head, torso, shoulder, upper_arm, "
         "lower_arm, hip, upper_leg, lower_leg, foot); a is forward (up for the feet). "
-        "Default: Chen's a = b.",
+        "Default: Chen's a = b (0.05-0.15 m), the same at every height: only c (half the "
+        "segment's length) scales with the height.",
     )
     height: float | None = Field(
         None, gt=0.5, lt=2.5, description="Height [m] for non-Boulic motions; default estimated."
