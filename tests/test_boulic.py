@@ -536,3 +536,13 @@ def test_the_ground_as_the_page_states_it() -> None:
     g1 = Gait(H, 1.0, 512)
     p1 = chain_positions(g1, np.arange(512) * g1.cycle_duration / 512)
     assert p1[:, [J["l_toe"], J["r_toe"]], 2].min() == pytest.approx(-0.092, abs=5e-4)
+
+
+def test_a_window_beyond_the_cycles_names_n_cycles(registry: Registry) -> None:
+    """n_cycles = 1 at rv = 1 is 1.346 s: a 3 s window was refused as 'motion.duration: the
+    window 0..3 s ends after the recording', not naming the field that set the walk's length."""
+    cfg = {"motion": {"kind": "boulic", "n_cycles": 1, "start": 1.0, "duration": 2.0}}
+    with pytest.raises(ConfigError, match=r"n_cycles = 1 .* set n_cycles to at least 3"):
+        validate_run_config(cfg, registry=registry)
+    cfg["motion"]["n_cycles"] = 3
+    validate_run_config(cfg, registry=registry)

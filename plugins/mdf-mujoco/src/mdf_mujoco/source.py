@@ -108,6 +108,14 @@ class BoulicConfig(MotionConfig):
             )
         dc = 1.346 / math.sqrt(rv)  # Gait.cycle_duration
         n = self.cycles(dc)
+        end = self.start + (self.duration or 0.0)
+        if self.n_cycles is not None and end > n * dc + 1e-9:
+            raise ValueError(
+                f"start + duration = {end:g} s is longer than the walk of n_cycles = {n} "
+                f"cycle(s) of {dc:.4g} s (rv = {rv:.4g}): {n * dc:.4g} s; set n_cycles to at "
+                f"least {math.ceil(end / dc - 1e-9)}, or leave it out (enough cycles for the "
+                "window)"
+            )
         if n * dc > limits.MAX_DURATION_S or n * self.nt + 1 > limits.MAX_FRAMES:
             raise ValueError(
                 f"the walk is {n} cycle(s) of {dc:.4g} s (rv = {rv:.4g}) from its start, "
