@@ -100,7 +100,9 @@ def _gate_advice(losses: Losses, fixed_gate: bool) -> str:
         )
     return (
         f"the range gate (tracking the body) is narrower than the body's spread in range "
-        f"({lo:.4g}-{hi:.4g} m): lengthen the radar's pulse, or choose a wider gate response"
+        f"({lo:.4g}-{hi:.4g} m), or beyond the radar's maximum range: lengthen the radar's "
+        "pulse, choose a wider gate response or gate (an FMCW radar's radar.gate_width), or "
+        "bring the body within the maximum range"
     )
 
 
