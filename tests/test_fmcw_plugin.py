@@ -1094,3 +1094,17 @@ def test_a_fixed_gate_that_misses_the_target_is_an_empty_result(gate: float) -> 
     with warnings.catch_warnings():
         warnings.simplefilter("error", EmptyResultWarning)
         assert np.abs(run(4.5).received.signal).min() > 0
+
+
+def test_a_target_beyond_the_unambiguous_range_of_the_prf_is_warned_about() -> None:
+    """An X-band pulse-Doppler radar at PRF 1 MHz has the unambiguous range
+    c / (2 PRF) = 149.9 m: a target at 300 m returns after the next pulse has gone out (a real
+    radar sees it at 150 m). The run warns naming radar.prf, the range and the PRF that
+    reaches it; at PRF 10 kHz (14.99 km) it does not."""
+    target = [{"position": [300.0, 0.0, 0.0], "velocity": [-2.0, 0.0, 0.0]}]
+    radar_ = {"kind": "lfm", "carrier_frequency": 10e9, "bandwidth": 1e6, "pulse_width": 1e-6}
+    with pytest.warns(UserWarning, match=r"radar\.prf: .* 300(\.0)? m .* 149\.9 m .* 499\.7 kHz"):
+        point_run(target, duration=0.05, radar={**radar_, "prf": 1e6})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        point_run(target, duration=0.05, radar={**radar_, "prf": 1e4})

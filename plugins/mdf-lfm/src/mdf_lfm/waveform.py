@@ -20,6 +20,7 @@ result is returned as complex128.
 
 from __future__ import annotations
 
+import warnings
 from typing import Literal
 
 import numpy as np
@@ -122,8 +123,22 @@ class LfmPulseDoppler(RadarWaveform):
 
     def start_record(self, times: np.ndarray, range_span: tuple[float, float]) -> None:
         """Fix the raw path's range-time window for the record: the joints' range span plus
-        ``range_margin`` on either side."""
+        ``range_margin`` on either side. Warn, naming ``radar.prf``, when the farthest joint
+        is beyond the unambiguous range ``c / (2 prf)``: its echo arrives after the next
+        pulse has gone out (a real radar sees it nearer, at its range modulo that one)."""
         self._span = range_span
+        prf, far = self.config.prf, range_span[1]
+        unambiguous = SPEED_OF_LIGHT / (2.0 * prf)
+        if far > unambiguous:
+            warnings.warn(
+                f"radar.prf: the farthest joint at {far:.4g} m is beyond the unambiguous range "
+                f"c / (2 prf) = {unambiguous:.4g} m of the {prf / 1e3:.4g} kHz PRF: its echo "
+                "arrives after the next pulse has gone out, where a real radar sees it at "
+                f"{far % unambiguous:.4g} m (the simulation gates it at its true range); lower "
+                f"prf to at most {SPEED_OF_LIGHT / (2.0 * far) / 1e3:.4g} kHz",
+                UserWarning,
+                stacklevel=2,
+            )
 
     def working_memory(self) -> dict[str, int]:
         """The raw path's fast-time arrays of :data:`RAW_BLOCK` pulses: the sampled echoes, the
