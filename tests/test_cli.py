@@ -1312,3 +1312,29 @@ def test_a_missing_package_is_installed_by_its_name_on_pypi(
         f"this command needs the Python package {top!r}, which is not installed: "
         f"pip install {install}"
     )
+
+
+@pytest.mark.parametrize("kind", ["fmcw", "lfm", "cw"])
+def test_check_of_a_target_that_does_not_move_radially(kind: str) -> None:
+    """A sensor pointed at a fixed corner reflector (no radial motion): `mdf check` of the
+    FMCW radar ended in an internal error (the advice for the loop rate reaching 0 Hz divided
+    by it); now every radar reports no aliasing and no advice (there is no rate to reach)."""
+    from mdframework.check import format_plan, plan_run
+    from mdframework.config import validate_run_config
+
+    config = validate_run_config(
+        {
+            "motion": {
+                "kind": "point_targets",
+                "length": 0.5,
+                "targets": [{"position": [5, 0, 0]}],
+            },
+            "scatterers": {"kind": "points"},
+            "radar": {"kind": kind},
+            "scene": {"radar_position": [0.0, 0.0, 0.0]},
+        }
+    )
+    plan = plan_run(config)
+    assert plan.max_joint_radial_speed_mps == 0.0 and not plan.aliasing
+    assert plan.prf_needed_hz == 0.0 and plan.faster_sampling == ""
+    assert "aliasing    none expected: fastest joint 0 m/s radially" in format_plan(plan, "x")

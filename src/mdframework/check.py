@@ -290,7 +290,8 @@ def plan_run(
         max_joint_radial_speed_mps=speed,
         aliasing=speed > v_max,
         prf_needed_hz=prf * speed / v_max,  # v_max grows in proportion to the PRF
-        faster_sampling=wf.faster_sampling(prf * speed / v_max),
+        # nothing to reach when nothing moves radially (a rate of 0 Hz has no chirp period)
+        faster_sampling=wf.faster_sampling(prf * speed / v_max) if speed > 0 else "",
         memory_mib=sum(terms.values()),
         memory_terms_mib=terms,
     )
