@@ -349,6 +349,11 @@ class FmcwRadar(RadarWaveform):
         """Slow-time rate of one virtual channel [Hz]: one chirp per loop, ``1 / (n_tx T_c)``."""
         return 1.0 / self.sequence.loop_period
 
+    def unambiguous_range(self) -> float:
+        """The maximum range ``c sample_rate / (2 slope)`` [m]: a farther scatterer's beat
+        frequency is above the complex ADC's rate."""
+        return self.sequence.max_range
+
     @property
     def n_range(self) -> int:
         """Range bins."""
