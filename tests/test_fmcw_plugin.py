@@ -1108,3 +1108,32 @@ def test_a_target_beyond_the_unambiguous_range_of_the_prf_is_warned_about() -> N
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         point_run(target, duration=0.05, radar={**radar_, "prf": 1e4})
+
+
+@pytest.mark.parametrize(
+    ("radar_", "start"),
+    [
+        ({"kind": "lfm", "prf": 1e4, "pulse_width": 2e-4}, "radar.pulse_width: 0.0002 s is "),
+        ({"kind": "lfm", "carrier_frequency": 1e9, "bandwidth": 3e9}, "radar.bandwidth: 3e+09 Hz"),
+        ({"kind": "lfm", "bandwidth": 1e5}, "radar.bandwidth: bandwidth x pulse_width"),
+        ({"kind": "lfm", "path": "raw", "sample_rate": 1e8}, "radar.sample_rate: 1e+08 Hz is "),
+        ({"kind": "fmcw", "range_fft_size": 100}, "radar.range_fft_size: 100 is below n_samples"),
+        ({"kind": "fmcw", "n_loops": 16, "doppler_fft_size": 8}, "radar.doppler_fft_size: 8 is "),
+    ],
+)
+def test_inconsistent_pulse_and_fft_settings_name_their_field(
+    radar_: dict[str, Any], start: str
+) -> None:
+    """A pulse longer than its interval, a band reaching 0 Hz, and the other checks across a
+    radar's fields read 'radar: pulse_width (...) must ...' without the field in the
+    location; they now name it as every other field error does ('radar.pulse_width: ...')."""
+    cfg = {
+        "motion": {"kind": "point_targets", "length": 1.0, "targets": [{"position": [3, 0, 0]}]},
+        "scatterers": {"kind": "points"},
+        "radar": radar_,
+    }
+    with pytest.raises(ConfigError) as err:
+        validate_run_config(cfg, source="run.toml")
+    msg = str(err.value)
+    assert msg.startswith(f"run.toml: {start}"), msg
+    assert "\n" not in msg

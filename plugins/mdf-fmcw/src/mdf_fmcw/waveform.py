@@ -257,9 +257,13 @@ class FmcwConfig(RadarPowerConfig):
         if len(set(self.tdm_order)) != len(self.tdm_order):
             raise ValueError("tdm_order: each TX may appear once per loop")
         if self.range_fft_size is not None and self.range_fft_size < self.n_samples:
-            raise ValueError(f"range_fft_size must be >= n_samples ({self.n_samples})")
+            raise ValueError(
+                f"range_fft_size: {self.range_fft_size} is below n_samples ({self.n_samples})"
+            )
         if self.doppler_fft_size is not None and self.doppler_fft_size < self.n_loops:
-            raise ValueError(f"doppler_fft_size must be >= n_loops ({self.n_loops})")
+            raise ValueError(
+                f"doppler_fft_size: {self.doppler_fft_size} is below n_loops ({self.n_loops})"
+            )
         for field, what, shape in self.frame_arrays():
             limits.check_frame_cells(shape, what, field)
         return self

@@ -84,18 +84,24 @@ class LfmConfig(RadarPowerConfig):
     def _check(self) -> LfmConfig:
         if self.bandwidth >= 2 * self.carrier_frequency:
             raise ValueError(
-                f"bandwidth ({self.bandwidth:g} Hz) must be below twice the carrier frequency "
+                f"bandwidth: {self.bandwidth:g} Hz must be below twice the carrier frequency "
                 f"({self.carrier_frequency:g} Hz): the band cannot reach 0 Hz"
             )
         if self.pulse_width * self.prf > 1.0:
             raise ValueError(
-                f"pulse_width ({self.pulse_width:g} s) must not exceed the pulse interval "
-                f"1/prf ({1.0 / self.prf:g} s)"
+                f"pulse_width: {self.pulse_width:g} s is longer than the pulse interval "
+                f"1/prf ({1.0 / self.prf:g} s): shorten it or lower prf"
             )
         if self.bandwidth * self.pulse_width < 1.0:
-            raise ValueError("bandwidth x pulse_width must be >= 1 for a pulse-compression radar")
+            raise ValueError(
+                f"bandwidth: bandwidth x pulse_width is {self.bandwidth * self.pulse_width:g}, "
+                "below 1: a pulse-compression radar needs at least 1"
+            )
         if self.sample_rate is not None and self.sample_rate < self.bandwidth:
-            raise ValueError("sample_rate must be >= bandwidth (complex sampling)")
+            raise ValueError(
+                f"sample_rate: {self.sample_rate:g} Hz is below the bandwidth "
+                f"({self.bandwidth:g} Hz; complex sampling needs at least that)"
+            )
         return self
 
 
