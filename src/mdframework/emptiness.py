@@ -12,8 +12,9 @@ The checks, in order:
 2. **no power**: the echo's mean power is below :data:`MIN_POWER_W` (float64's smallest normal
    number: the echoes underflowed);
 3. **lost scatterers**: more than ``max_lost_fraction`` of the scatterer returns (one per
-   scatterer and pulse, counted on every :data:`SAMPLE_EVERY`-th pulse) are lost, i.e. weighted
-   by :data:`LOST_GAIN` or less (-20 dB) by the range gate, or cut to that by the
+   scatterer of the scatterer model and pulse, counted on every :data:`SAMPLE_EVERY`-th pulse;
+   the static reflectors and multipath images that effects add are not counted) are lost, i.e.
+   weighted by :data:`LOST_GAIN` or less (-20 dB) by the range gate, or cut to that by the
    scatterer-stage effects (shadowing, attenuation, antenna pattern).
 """
 

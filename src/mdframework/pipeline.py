@@ -517,13 +517,17 @@ def _simulate_motion(
         )
         if early_effects:  # the body itself within scene.min_range: refused before any effect
             stream.check_near(lo, scat, scat.ranges(radar_pos))
+        modelled = scat
         scat = apply_effects(stages, "scatterers", scat, context, generators)
         ranges = scat.ranges(radar_pos)
         stream.check(lo, scat, ranges)
         s = slice(None, None, emptiness.SAMPLE_EVERY)
+        # the body's own returns count, not those an effect adds (static reflectors, multipath
+        # images): a reflector away from the gate is no target lost
+        own = ranges if scat.rcs.shape == rcs_model.shape else modelled.ranges(radar_pos)
         with blame(wf, "gate_gain"):
-            gain = wf.gate_gain(ranges[s], gate[s])
-        losses += emptiness.count_losses(ranges[s], gate[s], rcs_model[s], scat.rcs[s], gain)
+            gain = wf.gate_gain(own[s], gate[s])
+        losses += emptiness.count_losses(own[s], gate[s], rcs_model[s], scat.rcs[s], gain)
         timings["scatterers"] = timings.get("scatterers", 0.0) + time.perf_counter() - clock
 
         clock = time.perf_counter()
