@@ -1373,3 +1373,42 @@ def test_check_reports_the_range_resolution_and_unambiguous_range(
     assert plan.range_resolution_m == pytest.approx(resolution, rel=1e-3)
     assert plan.max_range_m == pytest.approx(max_range, rel=1e-3)
     assert re.search(r"\n  range +resolution [0-9.]+ m, unambiguous to [0-9.]+ k?m\n", text)
+
+
+@pytest.mark.parametrize(
+    ("radar_", "gate", "limit"),
+    [
+        ({"kind": "fmcw", "slope": 60e12, "sample_rate": 5e6}, 20.0, "12.49 m"),
+        ({"kind": "lfm", "prf": 1e5}, 2000.0, "1499 m"),
+    ],
+)
+def test_a_fixed_gate_beyond_the_unambiguous_range_is_warned_about_by_check_and_run(
+    radar_: dict[str, Any], gate: float, limit: str
+) -> None:
+    """A fixed scene.gate beyond the sensor's unambiguous range (an FMCW radar's maximum range
+    c fs / (2 S), a pulse radar's c / (2 PRF)) is no gate the sensor has: `mdf check` said the
+    config was valid without a word, and the run found only an empty result. Both now warn
+    before the first pulse, naming scene.gate and the range; a gate within it is not warned
+    about."""
+    import warnings
+
+    from mdframework.check import plan_run
+    from mdframework.config import validate_run_config
+    from mdframework.pipeline import simulate
+
+    def config(at: float) -> Any:
+        motion = {"kind": "point_targets", "length": 0.5, "targets": [{"position": [5, 0, 0]}]}
+        scene = {"radar_position": [0.0, 0.0, 0.0], "gate": at}
+        return validate_run_config(
+            {"motion": motion, "scatterers": {"kind": "points"}, "radar": radar_, "scene": scene}
+        )
+
+    match = rf"scene\.gate: the fixed range gate at {gate:g} m is beyond .* range {limit}"
+    with pytest.warns(UserWarning, match=match):
+        plan_run(config(gate))
+    with pytest.warns(UserWarning, match=match):
+        simulate(config(gate))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        plan_run(config(5.0))
+        simulate(config(5.0))

@@ -235,7 +235,8 @@ def plan_run(
     n_pulses = int(t.shape[0])
     geometry = spectrogram_geometry(wf, n_pulses, proc)
     record_body = body.select_frames(frames_inside(body.time, t_start, t_end))
-    start_record(stages, record_body, t, radar_pos)  # what the radar refuses before a pulse
+    # what the radar refuses (or warns about) before a pulse
+    start_record(stages, record_body, t, radar_pos, config.scene.gate)
 
     inside = (body.time >= t_start - 1e-9) & (body.time <= t_end + 1e-9)
     # a joint nearer than scene.min_range: refused as the run refuses the scatterer there
