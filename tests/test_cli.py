@@ -1312,3 +1312,103 @@ def test_a_missing_package_is_installed_by_its_name_on_pypi(
         f"this command needs the Python package {top!r}, which is not installed: "
         f"pip install {install}"
     )
+
+
+def _plan_of_a_fixed_point(radar_: dict[str, Any]) -> Any:
+    """`mdf check`'s plan of a fixed 1 m^2 point 5 m from ``radar_`` at the origin."""
+    from mdframework.check import plan_run
+    from mdframework.config import validate_run_config
+
+    motion = {"kind": "point_targets", "length": 0.5, "targets": [{"position": [5, 0, 0]}]}
+    scene = {"radar_position": [0.0, 0.0, 0.0]}
+    return plan_run(
+        validate_run_config(
+            {"motion": motion, "scatterers": {"kind": "points"}, "radar": radar_, "scene": scene}
+        )
+    )
+
+
+@pytest.mark.parametrize("kind", ["fmcw", "lfm", "cw"])
+def test_check_of_a_target_that_does_not_move_radially(kind: str) -> None:
+    """A sensor pointed at a fixed corner reflector (no radial motion): `mdf check` of the
+    FMCW radar ended in an internal error (the advice for the loop rate reaching 0 Hz divided
+    by it); now every radar reports no aliasing and no advice (there is no rate to reach)."""
+    from mdframework.check import format_plan
+
+    plan = _plan_of_a_fixed_point({"kind": kind})
+    assert plan.max_joint_radial_speed_mps == 0.0 and not plan.aliasing
+    assert plan.prf_needed_hz == 0.0 and plan.faster_sampling == ""
+    assert "aliasing    none expected: fastest joint 0 m/s radially" in format_plan(plan, "x")
+
+
+@pytest.mark.parametrize(
+    ("radar_", "resolution", "max_range"),
+    [
+        # c / (2 B) = 149.9 m for 1 MHz; c / (2 PRF) = 14.99 km at 10 kHz
+        ({"kind": "lfm", "carrier_frequency": 10e9, "bandwidth": 1e6, "prf": 1e4}, 149.9, 14990),
+        # AWR1843-like: B = S n / fs = 3.072 GHz, c / (2 B) = 0.0488 m; c fs / (2 S) = 12.49 m
+        (
+            {"kind": "fmcw", "slope": 60e12, "sample_rate": 5e6, "n_samples": 256},
+            0.0488,
+            12.49,
+        ),
+        ({"kind": "cw"}, None, None),
+    ],
+)
+def test_check_reports_the_range_resolution_and_unambiguous_range(
+    radar_: dict[str, Any], resolution: float | None, max_range: float | None
+) -> None:
+    """A sensor modelled from its data sheet: `mdf check` states the range resolution and the
+    largest unambiguous range it implies (it stated neither: a pulse radar's c / (2 PRF) and an
+    FMCW radar's maximum range c fs / (2 S) were nowhere to be seen before a run refused or
+    folded a target), and no range line for a CW radar."""
+    from mdframework.check import format_plan
+
+    plan = _plan_of_a_fixed_point(radar_)
+    text = format_plan(plan, "sensor.toml")
+    if resolution is None:
+        assert plan.range_resolution_m is None and plan.max_range_m is None
+        assert "\n  range " not in text
+        return
+    assert plan.range_resolution_m == pytest.approx(resolution, rel=1e-3)
+    assert plan.max_range_m == pytest.approx(max_range, rel=1e-3)
+    assert re.search(r"\n  range +resolution [0-9.]+ m, unambiguous to [0-9.]+ k?m\n", text)
+
+
+@pytest.mark.parametrize(
+    ("radar_", "gate", "limit"),
+    [
+        ({"kind": "fmcw", "slope": 60e12, "sample_rate": 5e6}, 20.0, "12.49 m"),
+        ({"kind": "lfm", "prf": 1e5}, 2000.0, "1499 m"),
+    ],
+)
+def test_a_fixed_gate_beyond_the_unambiguous_range_is_warned_about_by_check_and_run(
+    radar_: dict[str, Any], gate: float, limit: str
+) -> None:
+    """A fixed scene.gate beyond the sensor's unambiguous range (an FMCW radar's maximum range
+    c fs / (2 S), a pulse radar's c / (2 PRF)) is no gate the sensor has: `mdf check` said the
+    config was valid without a word, and the run found only an empty result. Both now warn
+    before the first pulse, naming scene.gate and the range; a gate within it is not warned
+    about."""
+    import warnings
+
+    from mdframework.check import plan_run
+    from mdframework.config import validate_run_config
+    from mdframework.pipeline import simulate
+
+    def config(at: float) -> Any:
+        motion = {"kind": "point_targets", "length": 0.5, "targets": [{"position": [5, 0, 0]}]}
+        scene = {"radar_position": [0.0, 0.0, 0.0], "gate": at}
+        return validate_run_config(
+            {"motion": motion, "scatterers": {"kind": "points"}, "radar": radar_, "scene": scene}
+        )
+
+    match = rf"scene\.gate: the fixed range gate at {gate:g} m is beyond .* range {limit}"
+    with pytest.warns(UserWarning, match=match):
+        plan_run(config(gate))
+    with pytest.warns(UserWarning, match=match):
+        simulate(config(gate))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        plan_run(config(5.0))
+        simulate(config(5.0))

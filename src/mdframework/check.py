@@ -91,6 +91,10 @@ class RunPlan:
     faster_sampling: str
     memory_mib: float
     memory_terms_mib: dict[str, float] = field(default_factory=dict)
+    #: ``c / (2 B)`` and the largest unambiguous range (a pulse radar's ``c / (2 prf)``, an
+    #: FMCW radar's maximum range); None for a radar without range (CW)
+    range_resolution_m: float | None = None
+    max_range_m: float | None = None
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-serialisable view."""
@@ -231,7 +235,8 @@ def plan_run(
     n_pulses = int(t.shape[0])
     geometry = spectrogram_geometry(wf, n_pulses, proc)
     record_body = body.select_frames(frames_inside(body.time, t_start, t_end))
-    start_record(stages, record_body, t, radar_pos)  # what the radar refuses before a pulse
+    # what the radar refuses (or warns about) before a pulse
+    start_record(stages, record_body, t, radar_pos, config.scene.gate)
 
     inside = (body.time >= t_start - 1e-9) & (body.time <= t_end + 1e-9)
     # a joint nearer than scene.min_range: refused as the run refuses the scatterer there
@@ -290,9 +295,12 @@ def plan_run(
         max_joint_radial_speed_mps=speed,
         aliasing=speed > v_max,
         prf_needed_hz=prf * speed / v_max,  # v_max grows in proportion to the PRF
-        faster_sampling=wf.faster_sampling(prf * speed / v_max),
+        # nothing to reach when nothing moves radially (a rate of 0 Hz has no chirp period)
+        faster_sampling=wf.faster_sampling(prf * speed / v_max) if speed > 0 else "",
         memory_mib=sum(terms.values()),
         memory_terms_mib=terms,
+        range_resolution_m=wf.range_resolution,
+        max_range_m=wf.unambiguous_range(),
     )
 
 
@@ -301,6 +309,10 @@ def _hz(value: float) -> str:
         if abs(value) >= scale:
             return f"{value / scale:.4g} {unit}"
     return f"{value:.4g} Hz"
+
+
+def _metres(value: float, digits: int) -> str:
+    return f"{value / 1e3:.{digits}g} km" if value >= 1e3 else f"{value:.{digits}g} m"
 
 
 def _mib(value: float) -> str:
@@ -337,6 +349,11 @@ def format_plan(plan: RunPlan, source: str) -> str:
         f"  {'unambiguous':<12}+-{p.max_unambiguous_velocity_mps:.3g} m/s "
         f"(+-{p.prf_hz / 2:.4g} Hz)",
     ]
+    if p.range_resolution_m is not None and p.max_range_m is not None:
+        lines.append(
+            f"  {'range':<12}resolution {_metres(p.range_resolution_m, 3)}, unambiguous to "
+            f"{_metres(p.max_range_m, 4)}"
+        )
     speed = f"fastest joint {p.max_joint_radial_speed_mps:.3g} m/s radially"
     if p.aliasing:
         lines.append(f"  {'aliasing':<12}LIKELY: {speed}; {p.faster_sampling}")

@@ -12,8 +12,9 @@ The checks, in order:
 2. **no power**: the echo's mean power is below :data:`MIN_POWER_W` (float64's smallest normal
    number: the echoes underflowed);
 3. **lost scatterers**: more than ``max_lost_fraction`` of the scatterer returns (one per
-   scatterer and pulse, counted on every :data:`SAMPLE_EVERY`-th pulse) are lost, i.e. weighted
-   by :data:`LOST_GAIN` or less (-20 dB) by the range gate, or cut to that by the
+   scatterer of the scatterer model and pulse, counted on every :data:`SAMPLE_EVERY`-th pulse;
+   the static reflectors and multipath images that effects add are not counted) are lost, i.e.
+   weighted by :data:`LOST_GAIN` or less (-20 dB) by the range gate, or cut to that by the
    scatterer-stage effects (shadowing, attenuation, antenna pattern).
 """
 
@@ -100,7 +101,9 @@ def _gate_advice(losses: Losses, fixed_gate: bool) -> str:
         )
     return (
         f"the range gate (tracking the body) is narrower than the body's spread in range "
-        f"({lo:.4g}-{hi:.4g} m): lengthen the radar's pulse, or choose a wider gate response"
+        f"({lo:.4g}-{hi:.4g} m), or beyond the radar's maximum range: lengthen the radar's "
+        "pulse, choose a wider gate response or gate (an FMCW radar's radar.gate_width), or "
+        "bring the body within the maximum range"
     )
 
 

@@ -535,6 +535,16 @@ class RadarWaveform(Plugin):
     def range_resolution(self, value: float | None) -> None:
         self.__dict__["range_resolution"] = value
 
+    def unambiguous_range(self) -> float | None:
+        """Largest range [m] the radar measures without ambiguity, or ``None`` for a radar
+        without range (CW): ``mdf check`` reports it. Default: ``c / (2 prf)`` when the
+        config has a ``prf`` (a pulse radar: an echo from farther arrives after the next
+        pulse), else ``None``; the FMCW radar's is its maximum range."""
+        from .constants import SPEED_OF_LIGHT
+
+        prf = getattr(self.config, "prf", None)
+        return None if prf is None else SPEED_OF_LIGHT / (2.0 * float(prf))
+
     @property
     def max_unambiguous_velocity(self) -> float:
         """Largest |radial velocity| [m/s] the slow-time sampling represents without aliasing.

@@ -483,7 +483,7 @@ def _simulate_motion(
         near = placed(near, where)
         resample = interpolation.TrackResampler(near.time, near.positions, near.valid, method)
     record_body = near.select_frames(frames_inside(near.time, t_start, t_end))
-    start_record(stages, record_body, t, radar_pos)
+    start_record(stages, record_body, t, radar_pos, sc.gate)
     timings["prepare"] = time.perf_counter() - clock
 
     n = t.shape[0]
@@ -517,13 +517,17 @@ def _simulate_motion(
         )
         if early_effects:  # the body itself within scene.min_range: refused before any effect
             stream.check_near(lo, scat, scat.ranges(radar_pos))
+        modelled = scat
         scat = apply_effects(stages, "scatterers", scat, context, generators)
         ranges = scat.ranges(radar_pos)
         stream.check(lo, scat, ranges)
         s = slice(None, None, emptiness.SAMPLE_EVERY)
+        # the body's own returns count, not those an effect adds (static reflectors, multipath
+        # images): a reflector away from the gate is no target lost
+        own = ranges if scat.rcs.shape == rcs_model.shape else modelled.ranges(radar_pos)
         with blame(wf, "gate_gain"):
-            gain = wf.gate_gain(ranges[s], gate[s])
-        losses += emptiness.count_losses(ranges[s], gate[s], rcs_model[s], scat.rcs[s], gain)
+            gain = wf.gate_gain(own[s], gate[s])
+        losses += emptiness.count_losses(own[s], gate[s], rcs_model[s], scat.rcs[s], gain)
         timings["scatterers"] = timings.get("scatterers", 0.0) + time.perf_counter() - clock
 
         clock = time.perf_counter()
@@ -593,16 +597,31 @@ def _simulate_motion(
 
 
 def start_record(
-    stages: Stages, record_body: Skeleton, t: FloatArray, radar_pos: FloatArray
+    stages: Stages,
+    record_body: Skeleton,
+    t: FloatArray,
+    radar_pos: FloatArray,
+    gate: float | str = "track",
 ) -> None:
     """Tell the scatterer model, the radar and the effects the record about to be simulated:
     the placed body at its frame times within the record, the pulse times ``t`` (n_pulses,) [s]
     and the radar position (3,) [m]. The radar refuses here what it cannot simulate (an FMCW
-    scatterer beyond its maximum range, range-Doppler maps over the product limit)."""
+    scatterer beyond its maximum range, range-Doppler maps over the product limit). A fixed
+    ``gate`` [m] (``scene.gate``) beyond the radar's unambiguous range is warned about."""
     with blame(stages.model, "start_record"):
         stages.model.start_record(record_body)
     with blame(stages.radar, "start_record"):
         stages.radar.start_record(t, _range_span(record_body, radar_pos))
+        farthest = stages.radar.unambiguous_range()
+    if not isinstance(gate, str) and farthest is not None and gate >= farthest:
+        warnings.warn(
+            f"scene.gate: the fixed range gate at {gate:g} m is beyond the radar's unambiguous "
+            f"range {farthest:.4g} m (an FMCW radar's maximum range, a pulse radar's "
+            "c / (2 prf)), which no gate of the real sensor reaches: set a gate within it, or "
+            "scene.gate = 'track'",
+            UserWarning,
+            stacklevel=2,
+        )
     for effect in stages.effects:
         with blame(effect, "start_record"):
             effect.start_record(record_body, radar_pos)

@@ -257,9 +257,13 @@ class FmcwConfig(RadarPowerConfig):
         if len(set(self.tdm_order)) != len(self.tdm_order):
             raise ValueError("tdm_order: each TX may appear once per loop")
         if self.range_fft_size is not None and self.range_fft_size < self.n_samples:
-            raise ValueError(f"range_fft_size must be >= n_samples ({self.n_samples})")
+            raise ValueError(
+                f"range_fft_size: {self.range_fft_size} is below n_samples ({self.n_samples})"
+            )
         if self.doppler_fft_size is not None and self.doppler_fft_size < self.n_loops:
-            raise ValueError(f"doppler_fft_size must be >= n_loops ({self.n_loops})")
+            raise ValueError(
+                f"doppler_fft_size: {self.doppler_fft_size} is below n_loops ({self.n_loops})"
+            )
         for field, what, shape in self.frame_arrays():
             limits.check_frame_cells(shape, what, field)
         return self
@@ -309,6 +313,11 @@ def _cfar(c: CfarConfig | None) -> fmcw.Cfar | None:
 #: Hann range window (the rectangular window's ripple is +-8 % even at eight).
 FLAT_GATE_RESOLUTIONS = 4.0
 
+#: A scatterer farther than this many range resolutions from the range bins the gate reads
+#: reaches the slow-time signal through the range window's sidelobes only (beyond the main
+#: lobe: 2 resolutions for Hann and Hamming, 3 for Blackman), at -20 dB or less.
+GATE_MARGIN_RESOLUTIONS = 3.0
+
 
 class FmcwRadar(RadarWaveform):
     """Chirp-sequence FMCW radar (TDM-MIMO): slow-time signal, range-Doppler maps, points."""
@@ -343,6 +352,11 @@ class FmcwRadar(RadarWaveform):
     def prf(self) -> float:
         """Slow-time rate of one virtual channel [Hz]: one chirp per loop, ``1 / (n_tx T_c)``."""
         return 1.0 / self.sequence.loop_period
+
+    def unambiguous_range(self) -> float:
+        """The maximum range ``c sample_rate / (2 slope)`` [m]: a farther scatterer's beat
+        frequency is above the complex ADC's rate."""
+        return self.sequence.max_range
 
     @property
     def n_range(self) -> int:
@@ -500,6 +514,28 @@ class FmcwRadar(RadarWaveform):
                 n_fft=self.n_range,
             )
         return out
+
+    def gate_gain(self, ranges: FloatArray, gate_range: FloatArray) -> FloatArray:
+        """Whether each scatterer reaches the slow-time signal's gate, (n_pulses, K): 1 when
+        its range (folded into ``[0, max_range)`` as its beat frequency is, cyclically as the
+        range FFT is) lies within :data:`GATE_MARGIN_RESOLUTIONS` range resolutions of the
+        range bins the gate reads (those within ``gate_width / 2`` of the gate, or the bin
+        nearest to it), else 0: beyond that only the range window's sidelobes reach the gate.
+        For the empty-result check (a fixed gate away from the target)."""
+        seq = self.sequence
+        raxis = fmcw.range_axis(seq, self.n_range)
+        gate = np.asarray(gate_range, np.float64)[:, None]
+        half = self.config.gate_width / 2.0
+        lo = np.maximum(gate - half, raxis[0])
+        hi = np.minimum(gate + half, raxis[-1])
+        nearest = np.clip(gate, raxis[0], raxis[-1])
+        lo, hi = np.where(lo > hi, nearest, lo), np.where(lo > hi, nearest, hi)
+        r = np.mod(np.asarray(ranges, np.float64), seq.max_range)
+        off = np.full(r.shape, np.inf)
+        for turn in (-seq.max_range, 0.0, seq.max_range):  # the range FFT is cyclic
+            off = np.minimum(off, np.maximum(np.maximum(lo - (r + turn), r + turn - hi), 0.0))
+        near = off <= GATE_MARGIN_RESOLUTIONS * seq.range_resolution
+        return np.asarray(near, dtype=np.float64)
 
     def _receive(self, block: PulseBlock, products: bool) -> Received:
         """:meth:`receive`, with the configured products or (``products`` False) none."""

@@ -20,6 +20,7 @@ result is returned as complex128.
 
 from __future__ import annotations
 
+import warnings
 from typing import Literal
 
 import numpy as np
@@ -83,18 +84,24 @@ class LfmConfig(RadarPowerConfig):
     def _check(self) -> LfmConfig:
         if self.bandwidth >= 2 * self.carrier_frequency:
             raise ValueError(
-                f"bandwidth ({self.bandwidth:g} Hz) must be below twice the carrier frequency "
+                f"bandwidth: {self.bandwidth:g} Hz must be below twice the carrier frequency "
                 f"({self.carrier_frequency:g} Hz): the band cannot reach 0 Hz"
             )
         if self.pulse_width * self.prf > 1.0:
             raise ValueError(
-                f"pulse_width ({self.pulse_width:g} s) must not exceed the pulse interval "
-                f"1/prf ({1.0 / self.prf:g} s)"
+                f"pulse_width: {self.pulse_width:g} s is longer than the pulse interval "
+                f"1/prf ({1.0 / self.prf:g} s): shorten it or lower prf"
             )
         if self.bandwidth * self.pulse_width < 1.0:
-            raise ValueError("bandwidth x pulse_width must be >= 1 for a pulse-compression radar")
+            raise ValueError(
+                f"bandwidth: bandwidth x pulse_width is {self.bandwidth * self.pulse_width:g}, "
+                "below 1: a pulse-compression radar needs at least 1"
+            )
         if self.sample_rate is not None and self.sample_rate < self.bandwidth:
-            raise ValueError("sample_rate must be >= bandwidth (complex sampling)")
+            raise ValueError(
+                f"sample_rate: {self.sample_rate:g} Hz is below the bandwidth "
+                f"({self.bandwidth:g} Hz; complex sampling needs at least that)"
+            )
         return self
 
 
@@ -122,8 +129,22 @@ class LfmPulseDoppler(RadarWaveform):
 
     def start_record(self, times: np.ndarray, range_span: tuple[float, float]) -> None:
         """Fix the raw path's range-time window for the record: the joints' range span plus
-        ``range_margin`` on either side."""
+        ``range_margin`` on either side. Warn, naming ``radar.prf``, when the farthest joint
+        is beyond the unambiguous range ``c / (2 prf)``: its echo arrives after the next
+        pulse has gone out (a real radar sees it nearer, at its range modulo that one)."""
         self._span = range_span
+        prf, far = self.config.prf, range_span[1]
+        unambiguous = SPEED_OF_LIGHT / (2.0 * prf)
+        if far > unambiguous:
+            warnings.warn(
+                f"radar.prf: the farthest joint at {far:.4g} m is beyond the unambiguous range "
+                f"c / (2 prf) = {unambiguous:.4g} m of the {prf / 1e3:.4g} kHz PRF: its echo "
+                "arrives after the next pulse has gone out, where a real radar sees it at "
+                f"{far % unambiguous:.4g} m (the simulation gates it at its true range); lower "
+                f"prf to at most {SPEED_OF_LIGHT / (2.0 * far) / 1e3:.4g} kHz",
+                UserWarning,
+                stacklevel=2,
+            )
 
     def working_memory(self) -> dict[str, int]:
         """The raw path's fast-time arrays of :data:`RAW_BLOCK` pulses: the sampled echoes, the
