@@ -129,3 +129,48 @@ def test_a_plugin_declares_the_installed_packages_its_modules_import(folder: Pat
     declared.add("pydantic")
     undeclared = {dist: where for dist, where in imported.items() if dist not in declared}
     assert undeclared == {}, f"imported but not declared in {folder.name}'s pyproject"
+
+
+#: what a distribution's code calls that a dependency added only in a later release than the
+#: oldest its pyproject once allowed: (pattern in its sources, dependency, lowest release that has
+#: it, what). Installed beside an older release the call fails, an internal TypeError, instead of
+#: pip refusing the install.
+NEWER_APIS = [
+    (r'method="makima"', "scipy", "1.13", "Akima1DInterpolator(method='makima')"),
+    (r"\bmj_multiRay\(", "mujoco", "3.5", "mj_multiRay's normal argument"),
+]
+
+
+@pytest.mark.parametrize("folder", DISTRIBUTIONS, ids=[p.name for p in DISTRIBUTIONS])
+def test_a_distribution_requires_the_releases_whose_api_it_calls(folder: Path) -> None:
+    """The lower bound of a dependency is a release that has what the code calls: with scipy
+    1.11 or 1.12 (``scipy>=1.11``) ``interpolation = "akima"`` was an internal TypeError
+    (``method`` came in 1.13), and with mujoco 3.0 to 3.4 (``mujoco>=3``) the shadowing effect
+    was one (``mj_multiRay`` took no ``normal`` before 3.5)."""
+    import re
+
+    from packaging.requirements import Requirement
+    from packaging.version import Version
+
+    project = tomllib.loads((folder / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    requirements = {r.name: r for r in map(Requirement, project.get("dependencies", []))}
+    code = "\n".join(p.read_text(encoding="utf-8") for p in sorted(folder.glob("src/**/*.py")))
+    wrong = []
+    for pattern, dist, release, what in NEWER_APIS:
+        if not re.search(pattern, code):
+            continue
+        lowest = [Version(s.version) for s in requirements[dist].specifier if s.operator == ">="]
+        if not lowest or max(lowest) < Version(release):
+            wrong.append(f"{what} needs {dist}>={release}, not {requirements[dist]}")
+    assert wrong == []
+
+
+def test_every_newer_api_is_still_called() -> None:
+    """Each pattern of :data:`NEWER_APIS` is found in some distribution's code (a pattern that
+    no longer matches checks nothing)."""
+    import re
+
+    code = "\n".join(
+        p.read_text(encoding="utf-8") for d in DISTRIBUTIONS for p in d.glob("src/**/*.py")
+    )
+    assert [what for pattern, _, _, what in NEWER_APIS if not re.search(pattern, code)] == []
