@@ -79,10 +79,17 @@ def test_the_core_sdist_and_wheel(tmp_path: Path) -> None:
 
 def test_a_plugin_sdist_and_wheel(tmp_path: Path) -> None:
     """A plugin's sdist and wheel carry the licence (they held none: no licence text, and no
-    licence in the metadata)."""
+    licence in the metadata), and its README as the long description of its package page, in
+    Markdown (they had none: an empty page)."""
     sdist, wheel = _build(ROOT / "plugins" / "mdf-cw", tmp_path)
-    assert "LICENSE" in sdist
+    assert {"LICENSE", "README.md"} <= set(sdist)
     assert any(n.endswith(".dist-info/licenses/LICENSE") for n in wheel)
+    [name] = [n for n in wheel if n.endswith(".dist-info/METADATA")]
+    [whl] = tmp_path.glob("*.whl")
+    with zipfile.ZipFile(whl) as zf:
+        headers, _, body = zf.read(name).decode().partition("\n\n")
+    assert "Description-Content-Type: text/markdown" in headers.splitlines()
+    assert body == (ROOT / "plugins" / "mdf-cw" / "README.md").read_text(encoding="utf-8")
 
 
 PLUGINS = DISTRIBUTIONS[1:]
@@ -174,3 +181,50 @@ def test_every_newer_api_is_still_called() -> None:
         p.read_text(encoding="utf-8") for d in DISTRIBUTIONS for p in d.glob("src/**/*.py")
     )
     assert [what for pattern, _, _, what in NEWER_APIS if not re.search(pattern, code)] == []
+
+
+@pytest.mark.parametrize("folder", PLUGINS, ids=[p.name for p in PLUGINS])
+def test_a_plugin_has_a_package_page(folder: Path) -> None:
+    """Each plugin distribution declares its README (a package index shows it; they had none,
+    so a plugin's page was empty), and the README says what a researcher needs before
+    installing: its name, every kind it registers and every field of each kind's config (a
+    field added to the code and not to the page fails here), its dependencies as the
+    pyproject declares them, and the licence; no relative link (a package page cannot follow
+    one)."""
+    import re
+
+    from mdframework.docgen import project_registry
+
+    project = tomllib.loads((folder / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    assert project["readme"] == "README.md"
+    readme = (folder / "README.md").read_text(encoding="utf-8")
+    assert readme.startswith(f"# {project['name']}\n\n")
+    flat = " ".join(readme.split())  # the page's text, as Markdown joins wrapped lines
+    registry = project_registry()
+    kinds = [
+        (name, info.cls.Config)
+        for plugins in registry.plugins.values()
+        for name, info in plugins.items()
+        if info.provider.split()[0] == project["name"]
+    ]
+    assert kinds, f"{project['name']} registers nothing here"
+    for name, config in kinds:
+        assert f'`kind = "{name}"`' in flat, name
+        missing = [f for f in config.model_fields if f != "kind" and f"`{f}`" not in flat]
+        assert missing == [], f"{name}: fields not on the page"
+    for requirement in project["dependencies"]:
+        assert f"`{requirement}`" in flat, requirement
+    assert f"Python {project['requires-python']}" in flat
+    assert "## Licence\n\nMIT" in readme
+    assert re.findall(r"\]\((?!https?://)[^)]*\)", readme) == []
+
+
+def test_the_core_package_page_has_no_relative_link() -> None:
+    """The core's README is its package page too, where a link to docs/... or examples/...
+    leads nowhere (it linked to docs/getting-started.md, docs/kinect.md and docs/index.md): it
+    names the documentation's pages instead, and says which distributions a run needs."""
+    import re
+
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert re.findall(r"\]\((?!https?://)[^)]*\)", readme) == []
+    assert "pip install mdframework mdf-cmu mdf-ellipsoid mdf-lfm" in readme
