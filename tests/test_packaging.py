@@ -228,3 +228,18 @@ def test_the_core_package_page_has_no_relative_link() -> None:
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
     assert re.findall(r"\]\((?!https?://)[^)]*\)", readme) == []
     assert "pip install mdframework mdf-cmu mdf-ellipsoid mdf-lfm" in readme
+
+
+@pytest.mark.parametrize("folder", DISTRIBUTIONS, ids=[p.name for p in DISTRIBUTIONS])
+def test_every_distribution_fills_its_package_page(folder: Path) -> None:
+    """What a package index and ``pip show`` show before installing: a README that exists and
+    is not empty, the authors the licence names, keywords, and classifiers of the Python
+    versions the project is tested with and of the one system it supports."""
+    project = tomllib.loads((folder / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    assert (folder / project["readme"]).read_text(encoding="utf-8").strip()
+    holder = (ROOT / "LICENSE").read_text(encoding="utf-8").splitlines()[2]
+    assert holder == "Copyright (c) 2026 the mdframework authors"
+    assert project["authors"] == [{"name": "the mdframework authors"}]
+    assert "radar" in project["keywords"]
+    versions = [f"Programming Language :: Python :: 3.{minor}" for minor in (11, 12, 13)]
+    assert set(versions) | {"Operating System :: POSIX :: Linux"} <= set(project["classifiers"])
