@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # What a packager, or a user who installs from wheels, gets: builds the sdist and the wheel of the
 # core and of every plugin under plugins/ (from the sdist, as `python -m build` does), checks what
-# they hold, installs the wheels (not editable) into a fresh virtual environment outside the
-# repository and runs mdf from a folder outside it on a copy of the examples; then uninstalls one
+# they hold and that their package pages render (twine check), installs the wheels (not
+# editable) into a fresh virtual environment outside the repository and runs mdf from a folder
+# outside it on a copy of the examples; then uninstalls one
 # plugin and one optional dependency and checks the rest still works and the feature that needs
 # it says so in one line. Needs the package index (build requirements, dependencies); a few
 # minutes, so not part of `make test` (tests/test_packaging.py checks the licence files and the
@@ -20,7 +21,7 @@ say "building from the working tree's files (tracked and untracked, not ignored)
 mkdir -p "$work/src" "$work/dist" "$work/run"
 (cd "$repo" && git ls-files -co --exclude-standard -z | tar --null -T - -c) | tar -x -C "$work/src"
 "$py" -m venv "$work/build-env"
-"$work/build-env/bin/pip" install -q build 2> /dev/null
+"$work/build-env/bin/pip" install -q build twine 2> /dev/null
 for d in "$work/src" "$work"/src/plugins/*/; do
     "$work/build-env/bin/python" -m build --outdir "$work/dist" "$d" > "$work/build.log" 2>&1 ||
         { tail -20 "$work/build.log"; echo "building $d failed"; exit 1; }
@@ -46,6 +47,11 @@ for wheel in sorted(dist.glob("*.whl")):
 print("\n".join(bad) or f"{len(list(dist.iterdir()))} files: sdists and wheels hold what they should")
 sys.exit(1 if bad else 0)
 EOF
+
+say "the package pages: each distribution's README renders as its long description"
+"$work/build-env/bin/twine" check --strict "$work"/dist/* > "$work/twine.log" 2>&1 ||
+    { grep -v PASSED "$work/twine.log"; echo "twine check failed"; exit 1; }
+echo "$(grep -c PASSED "$work/twine.log") files pass twine check --strict"
 
 say "installing the wheels into a fresh environment"
 "$py" -m venv "$work/venv"

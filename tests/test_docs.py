@@ -361,6 +361,98 @@ def test_config_reference_covers_every_section() -> None:
     assert "[classifier]" not in run_part  # classifiers belong to experiment configs
 
 
+def _config_models() -> dict[str, type[Any]]:
+    """Every config model the reference documents, by a name for messages: the run, dataset
+    and experiment configs, the motion sanity checks, each plugin kind's config of the
+    project's plugins, and every model their fields hold."""
+    from mdframework.dataset import DatasetConfig
+    from mdframework.docgen import project_registry
+    from mdframework.experiment import ExperimentConfig
+    from mdframework.settings import SanityConfig
+
+    roots: dict[str, type[Any]] = {
+        "run": RunConfigBase,
+        "motion.sanity": SanityConfig,
+        "dataset": DatasetConfig,
+        "experiment": ExperimentConfig,
+    }
+    registry = project_registry()
+    for interface, plugins in registry.plugins.items():
+        for name, info in plugins.items():
+            roots[f"{interface} {name}"] = info.cls.Config
+    found: dict[str, type[Any]] = {}
+    stack = list(roots.items())
+    while stack:
+        label, model = stack.pop()
+        if model in found.values():
+            continue
+        found[label] = model
+        for field, info in model.model_fields.items():
+            sub = _submodel(info.annotation)
+            if sub is not None:
+                stack.append((f"{label}.{field}", sub))
+    return found
+
+
+def test_the_reference_documents_every_field_of_every_config_model() -> None:
+    """Every field of every config model, nested ones included, has its row in the reference
+    (name, type, default, range, description): the fields of the models that plugin configs
+    hold (the point targets' ``targets``, the FMCW radar's ``cfar_range`` and the static
+    scene's ``reflectors``) were named nowhere, only the field that holds them, and the run's
+    ``seed`` had neither default nor range."""
+    from mdframework.docgen import model_table, project_registry
+
+    reference = render(project_registry())
+    missing = []
+    for label, model in _config_models().items():
+        rows = model_table(model).splitlines()[2:]
+        for name, row in zip(model.model_fields, rows, strict=True):
+            leaf = name != "kind" and _submodel(model.model_fields[name].annotation) is None
+            if leaf and model is RunConfigBase:  # the run's own fields: one table of their own
+                row = f"\n| `{name}` | {model.model_fields[name].description} Default `"
+            if leaf and row not in reference:
+                missing.append(f"{label}.{name}")
+    assert missing == []
+
+
+#: the float fields without a unit of their own: ratios, fractions, probabilities, positions in
+#: units of another field, a table's time range in its column's unit, a distribution's values
+#: (the drawn field's unit); any other float field names its unit in its description ([m],
+#: [dB] ...) or in its name (_deg)
+NO_UNIT = {
+    "max_lost_fraction", "glitch_ratio", "glitch_local_ratio", "glitch_return_ratio",
+    "speed_scale", "bone_tolerance", "mirror", "time_warp", "test_fraction", "min_confidence",
+    "rain_k", "rain_alpha", "path_fraction", "wind_fraction", "reflection_magnitude",
+    "multi_object_threshold", "tx_positions", "rx_positions", "time_range",
+    "uniform", "loguniform", "normal", "choice",
+}  # fmt: skip
+UNIT_NAME = re.compile(r"_(deg|db|dbi|m|m2|s|hz|mps|per_km|per_h)$")
+
+
+def test_every_config_field_has_a_description_and_every_float_field_a_unit() -> None:
+    """The reference's description column is never empty (a field holding a model takes the
+    model's docstring), and a float field says its unit (the features' ``percentiles`` said
+    "Percentile method.", the motion sources' ``start`` "s from the first frame" with no
+    unit in brackets)."""
+    from mdframework.docgen import _type_name
+
+    models = _config_models()
+    assert len(models) > 40
+    bare, unitless = [], []
+    for label, model in models.items():
+        for name, info in model.model_fields.items():
+            sub = _submodel(info.annotation)
+            text = info.description or (sub.__doc__ if sub is not None else "") or ""
+            if name != "kind" and not text.strip():
+                bare.append(f"{label}.{name}")
+            floats = re.search(r"\bfloat\b", _type_name(info.annotation))
+            has_unit = re.search(r"\[[^\],]*[A-Za-z%][^\],]*\]", info.description or "")
+            if floats and not (has_unit or UNIT_NAME.search(name) or name in NO_UNIT):
+                unitless.append(f"{label}.{name}")
+    assert bare == []
+    assert unitless == [], unitless
+
+
 def test_every_hook_is_documented_in_the_plugin_guide() -> None:
     guide = (ROOT / "docs" / "plugins.md").read_text()
     hooks = [

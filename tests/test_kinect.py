@@ -1062,3 +1062,44 @@ def test_ntu_tracking_state_threshold(tmp_path: Path) -> None:
     strict = read_ntu(path, min_tracking=2).valid[0]
     assert default[0] and not default[1] and default[2:].all()
     assert not strict[0] and not strict[1] and strict[2:].all()
+
+
+def _mdf_without(args: list[str], hide: str | None, env: dict[str, str]) -> tuple[int, str]:
+    """``mdf ARGS`` in a child process where the Python package ``hide`` cannot be imported (as
+    where it is not installed): exit status and stderr."""
+    import os
+
+    code = (
+        "import sys\n"
+        + (f"sys.modules[{hide!r}] = None\n" if hide is not None else "")
+        + "from mdframework import cli\n"
+        "sys.exit(cli.main(sys.argv[1:]))\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code, *args],
+        capture_output=True,
+        text=True,
+        env={**os.environ, **env},
+        timeout=120,
+    )
+    return done.returncode, done.stderr
+
+
+def test_a_missing_openni_package_says_what_to_pip_install() -> None:
+    """Without the ``openni`` binding, ``mdf kinect info`` is one line naming the package and
+    the command that installs it, exit 2 (it named the package and Python's import error only)."""
+    code, err = _mdf_without(["kinect", "info", str(ONI)], "openni", {})
+    assert code == 2
+    assert len(err.splitlines()) == 1, err
+    assert err.startswith("mdf: error: mdf-kinect needs the Python package 'openni'"), err
+    assert err.rstrip().endswith(": pip install openni"), err
+
+
+def test_a_missing_openni2_library_says_what_to_apt_get_install(tmp_path: Path) -> None:
+    """Where the system OpenNI2 library is not found, ``mdf kinect info`` is one line naming the
+    folder it looked in and the Debian packages that install it, exit 2."""
+    code, err = _mdf_without(["kinect", "info", str(ONI)], None, {"OPENNI2_REDIST": str(tmp_path)})
+    assert code == 2
+    assert len(err.splitlines()) == 1, err
+    assert err.startswith(f"mdf: error: OpenNI2 could not be loaded from {tmp_path} "), err
+    assert "apt-get install libopenni2-0 libopenni2-dev" in err, err

@@ -79,10 +79,17 @@ def test_the_core_sdist_and_wheel(tmp_path: Path) -> None:
 
 def test_a_plugin_sdist_and_wheel(tmp_path: Path) -> None:
     """A plugin's sdist and wheel carry the licence (they held none: no licence text, and no
-    licence in the metadata)."""
+    licence in the metadata), and its README as the long description of its package page, in
+    Markdown (they had none: an empty page)."""
     sdist, wheel = _build(ROOT / "plugins" / "mdf-cw", tmp_path)
-    assert "LICENSE" in sdist
+    assert {"LICENSE", "README.md"} <= set(sdist)
     assert any(n.endswith(".dist-info/licenses/LICENSE") for n in wheel)
+    [name] = [n for n in wheel if n.endswith(".dist-info/METADATA")]
+    [whl] = tmp_path.glob("*.whl")
+    with zipfile.ZipFile(whl) as zf:
+        headers, _, body = zf.read(name).decode().partition("\n\n")
+    assert "Description-Content-Type: text/markdown" in headers.splitlines()
+    assert body == (ROOT / "plugins" / "mdf-cw" / "README.md").read_text(encoding="utf-8")
 
 
 PLUGINS = DISTRIBUTIONS[1:]
@@ -129,3 +136,110 @@ def test_a_plugin_declares_the_installed_packages_its_modules_import(folder: Pat
     declared.add("pydantic")
     undeclared = {dist: where for dist, where in imported.items() if dist not in declared}
     assert undeclared == {}, f"imported but not declared in {folder.name}'s pyproject"
+
+
+#: what a distribution's code calls that a dependency added only in a later release than the
+#: oldest its pyproject once allowed: (pattern in its sources, dependency, lowest release that has
+#: it, what). Installed beside an older release the call fails, an internal TypeError, instead of
+#: pip refusing the install.
+NEWER_APIS = [
+    (r'method="makima"', "scipy", "1.13", "Akima1DInterpolator(method='makima')"),
+    (r"\bmj_multiRay\(", "mujoco", "3.5", "mj_multiRay's normal argument"),
+]
+
+
+@pytest.mark.parametrize("folder", DISTRIBUTIONS, ids=[p.name for p in DISTRIBUTIONS])
+def test_a_distribution_requires_the_releases_whose_api_it_calls(folder: Path) -> None:
+    """The lower bound of a dependency is a release that has what the code calls: with scipy
+    1.11 or 1.12 (``scipy>=1.11``) ``interpolation = "akima"`` was an internal TypeError
+    (``method`` came in 1.13), and with mujoco 3.0 to 3.4 (``mujoco>=3``) the shadowing effect
+    was one (``mj_multiRay`` took no ``normal`` before 3.5)."""
+    import re
+
+    from packaging.requirements import Requirement
+    from packaging.version import Version
+
+    project = tomllib.loads((folder / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    requirements = {r.name: r for r in map(Requirement, project.get("dependencies", []))}
+    code = "\n".join(p.read_text(encoding="utf-8") for p in sorted(folder.glob("src/**/*.py")))
+    wrong = []
+    for pattern, dist, release, what in NEWER_APIS:
+        if not re.search(pattern, code):
+            continue
+        lowest = [Version(s.version) for s in requirements[dist].specifier if s.operator == ">="]
+        if not lowest or max(lowest) < Version(release):
+            wrong.append(f"{what} needs {dist}>={release}, not {requirements[dist]}")
+    assert wrong == []
+
+
+def test_every_newer_api_is_still_called() -> None:
+    """Each pattern of :data:`NEWER_APIS` is found in some distribution's code (a pattern that
+    no longer matches checks nothing)."""
+    import re
+
+    code = "\n".join(
+        p.read_text(encoding="utf-8") for d in DISTRIBUTIONS for p in d.glob("src/**/*.py")
+    )
+    assert [what for pattern, _, _, what in NEWER_APIS if not re.search(pattern, code)] == []
+
+
+@pytest.mark.parametrize("folder", PLUGINS, ids=[p.name for p in PLUGINS])
+def test_a_plugin_has_a_package_page(folder: Path) -> None:
+    """Each plugin distribution declares its README (a package index shows it; they had none,
+    so a plugin's page was empty), and the README says what a researcher needs before
+    installing: its name, every kind it registers and every field of each kind's config (a
+    field added to the code and not to the page fails here), its dependencies as the
+    pyproject declares them, and the licence; no relative link (a package page cannot follow
+    one)."""
+    import re
+
+    from mdframework.docgen import project_registry
+
+    project = tomllib.loads((folder / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    assert project["readme"] == "README.md"
+    readme = (folder / "README.md").read_text(encoding="utf-8")
+    assert readme.startswith(f"# {project['name']}\n\n")
+    flat = " ".join(readme.split())  # the page's text, as Markdown joins wrapped lines
+    registry = project_registry()
+    kinds = [
+        (name, info.cls.Config)
+        for plugins in registry.plugins.values()
+        for name, info in plugins.items()
+        if info.provider.split()[0] == project["name"]
+    ]
+    assert kinds, f"{project['name']} registers nothing here"
+    for name, config in kinds:
+        assert f'`kind = "{name}"`' in flat, name
+        missing = [f for f in config.model_fields if f != "kind" and f"`{f}`" not in flat]
+        assert missing == [], f"{name}: fields not on the page"
+    for requirement in project["dependencies"]:
+        assert f"`{requirement}`" in flat, requirement
+    assert f"Python {project['requires-python']}" in flat
+    assert "## Licence\n\nMIT" in readme
+    assert re.findall(r"\]\((?!https?://)[^)]*\)", readme) == []
+
+
+def test_the_core_package_page_has_no_relative_link() -> None:
+    """The core's README is its package page too, where a link to docs/... or examples/...
+    leads nowhere (it linked to docs/getting-started.md, docs/kinect.md and docs/index.md): it
+    names the documentation's pages instead, and says which distributions a run needs."""
+    import re
+
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert re.findall(r"\]\((?!https?://)[^)]*\)", readme) == []
+    assert "pip install mdframework mdf-cmu mdf-ellipsoid mdf-lfm" in readme
+
+
+@pytest.mark.parametrize("folder", DISTRIBUTIONS, ids=[p.name for p in DISTRIBUTIONS])
+def test_every_distribution_fills_its_package_page(folder: Path) -> None:
+    """What a package index and ``pip show`` show before installing: a README that exists and
+    is not empty, the authors the licence names, keywords, and classifiers of the Python
+    versions the project is tested with and of the one system it supports."""
+    project = tomllib.loads((folder / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    assert (folder / project["readme"]).read_text(encoding="utf-8").strip()
+    holder = (ROOT / "LICENSE").read_text(encoding="utf-8").splitlines()[2]
+    assert holder == "Copyright (c) 2026 the mdframework authors"
+    assert project["authors"] == [{"name": "the mdframework authors"}]
+    assert "radar" in project["keywords"]
+    versions = [f"Programming Language :: Python :: 3.{minor}" for minor in (11, 12, 13)]
+    assert set(versions) | {"Operating System :: POSIX :: Linux"} <= set(project["classifiers"])

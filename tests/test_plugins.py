@@ -785,3 +785,45 @@ def test_a_plugin_package_exports_its_readers_on_first_use(package: str) -> None
     assert not hasattr(module, "no_such_name")
     with pytest.raises(AttributeError, match=rf"^module '{package}' has no attribute 'read_x'$"):
         module.read_x  # noqa: B018
+
+
+def test_the_built_in_kinds_are_those_the_project_plugins_register() -> None:
+    """``BUILT_IN_KINDS`` (what a config naming a kind of a distribution that is not installed is
+    told to install) names each kind of the project's plugins with its distribution."""
+    from mdframework.docgen import project_registry
+    from mdframework.plugins import BUILT_IN_KINDS
+
+    registry = project_registry()
+    registered = {
+        interface: {name: info.provider.split()[0] for name, info in plugins.items()}
+        for interface, plugins in registry.plugins.items()
+    }
+    assert registered == BUILT_IN_KINDS
+
+
+def test_a_kind_whose_distribution_is_not_installed_says_what_to_install(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """With the core and some plugins installed (pip install mdframework mdf-cmu ...), a config
+    naming the kind of another built-in distribution is told which one and how to install it
+    (it was told the kind is unknown, and the kinds installed); a kind no built-in distribution
+    has, or one whose distribution is installed (so disabled or broken), gets no such hint."""
+    import importlib.metadata
+
+    from mdframework.docgen import project_registry
+
+    real = importlib.metadata.distribution
+
+    def distribution(name: str) -> importlib.metadata.Distribution:
+        if name == "mdf-fmcw":
+            raise importlib.metadata.PackageNotFoundError(name)
+        return real(name)
+
+    monkeypatch.setattr(importlib.metadata, "distribution", distribution)
+    registry = project_registry().provided_by(["mdf-lfm", "mdf-cw"])
+    assert registry.unknown_kind_message("radar", "fmcw") == (
+        "no radar plugin named 'fmcw'; installed: cw, lfm; it comes with mdf-fmcw, which is not "
+        "installed: pip install mdf-fmcw"
+    )
+    assert "pip install" not in registry.unknown_kind_message("radar", "sonar")
+    assert "pip install" not in registry.unknown_kind_message("motion", "cmu")  # installed here

@@ -162,10 +162,23 @@ BUILD_OPTIONS = ("workers", "scheduler", "on_error")
 class FeatureConfig(StrictModel):
     """How the seven features are extracted (see :mod:`mdframework.features`)."""
 
-    method: Literal["threshold", "percentile"] = Field("threshold", description="Envelopes.")
-    threshold_db: BelowPeakDb = Field(-20.0, description="Threshold below each column's peak.")
-    floor_db: BelowPeakDb = Field(-40.0, description="Ignore bins this far below the peak.")
-    percentiles: tuple[Percent, Percent] = Field((3.0, 97.0), description="Percentile method.")
+    method: Literal["threshold", "percentile"] = Field(
+        "threshold",
+        description="How the upper and lower envelopes are found in each time column: "
+        "threshold (the highest and lowest bins within threshold_db of the column's peak) or "
+        "percentile (the velocities where the cumulative power reaches percentiles).",
+    )
+    threshold_db: BelowPeakDb = Field(
+        -20.0, description="method threshold: envelope bins are within this of the column's peak."
+    )
+    floor_db: BelowPeakDb = Field(
+        -40.0, description="Ignore bins this far below the whole spectrogram's peak."
+    )
+    percentiles: tuple[Percent, Percent] = Field(
+        (3.0, 97.0),
+        description="method percentile: the cumulative power [%] of the lower and the upper "
+        "envelope (van Dorp & Groen 2008).",
+    )
     torso: Literal["median", "peak"] = Field(
         "median", description="Torso track: the column's power median, or its peak bin."
     )

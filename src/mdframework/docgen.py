@@ -171,7 +171,9 @@ def _plugin_sections(reg: Registry, interface: str, title: str, section: str = "
         info = reg.plugins[interface][name]
         doc = (info.cls.__doc__ or "").strip().splitlines()[0]
         out += [f"### kind = `{name}` ({info.provider.split()[0]})", "", doc, ""]
-        out += [model_table(info.cls.Config, skip=("kind",), prefix=section), ""]
+        # the models its fields hold get subsections (the sanity checks' is documented once)
+        seen: dict[type[BaseModel], str] = {SanityConfig: "motion.sanity"}
+        out += model_sections(info.cls.Config, section, 4, skip=("kind",), seen=seen)
     if interface == "motion":
         out += [
             "### `[motion.sanity]` (every motion source)",
@@ -214,8 +216,13 @@ def render(registry: Registry | None = None) -> str:
         "| `radar` | the radar, default `lfm` |",
         "| `effects` | list of scene effects, default none |",
     ]
+    props = RunConfigBase.model_json_schema().get("properties", {})
     for name, field in RunConfigBase.model_fields.items():
-        out.append(f"| `{name}` | {field.description} |")
+        desc = field.description or ""
+        if _submodel(field.annotation) is None:  # a value, not a section: its default and range
+            ranges = " or ".join(numeric_ranges(props.get(field.alias or name, {})))
+            desc += f" Default {_default(field, name)}" + (f", range {ranges}." if ranges else ".")
+        out.append(f"| `{name}` | {desc} |")
     out.append("")
     for name, field in RunConfigBase.model_fields.items():
         sub = _submodel(field.annotation)

@@ -75,8 +75,53 @@ BUILT_IN_DISTRIBUTIONS = frozenset(
         *("mdf-sklearn", "mdf-static-scene", "mdf-table"),
     }
 )
+#: interface -> kind -> the built-in distribution that registers it: a config naming a kind
+#: whose distribution is not installed is told what to install
+BUILT_IN_KINDS: dict[str, dict[str, str]] = {
+    "motion": {
+        **dict.fromkeys(("cmu", "bvh"), "mdf-cmu"),
+        **dict.fromkeys(("c3d", "trc"), "mdf-c3d"),
+        "deepmimic": "mdf-deepmimic",
+        "kinect": "mdf-kinect",
+        "boulic": "mdf-mujoco",
+        "point_targets": "mdf-point-targets",
+        "table": "mdf-table",
+    },
+    "scatterers": {
+        "ellipsoid": "mdf-ellipsoid",
+        "mujoco_body": "mdf-mujoco",
+        "points": "mdf-point-targets",
+    },
+    "radar": {"lfm": "mdf-lfm", "fmcw": "mdf-fmcw", "cw": "mdf-cw"},
+    "classifier": {"knn": "mdf-knn", "sklearn": "mdf-sklearn"},
+    "effects": {
+        "antenna": "mdf-antenna",
+        "attenuation": "mdf-attenuation",
+        "clutter": "mdf-clutter",
+        "multipath": "mdf-multipath",
+        "noise": "mdf-noise",
+        "shadowing": "mdf-mujoco",
+        "static_scene": "mdf-static-scene",
+    },
+    "recording": {"radhar": "mdf-radhar"},
+}
 DISABLE_ENV = "MDFRAMEWORK_DISABLE_PLUGIN_AUTOLOAD"
 DISABLE_PLUGINS_ENV = "MDFRAMEWORK_DISABLE_PLUGINS"
+
+
+def _install_hint(interface: str, name: str) -> str:
+    """``"; it comes with mdf-x: pip install mdf-x"`` where ``name`` is a built-in kind whose
+    distribution is not installed, else ``""``."""
+    import importlib.metadata
+
+    dist = BUILT_IN_KINDS.get(interface, {}).get(name)
+    if dist is None:
+        return ""
+    try:
+        importlib.metadata.distribution(dist)
+    except importlib.metadata.PackageNotFoundError:
+        return f"; it comes with {dist}, which is not installed: pip install {dist}"
+    return ""  # installed, so disabled or broken: the disabled note says which
 
 
 class Interface(NamedTuple):
@@ -231,7 +276,9 @@ class Registry:
         interface = interface_name(interface)
         known = sorted(self.plugins[interface])
         installed = ", ".join(known) or "none"
-        msg = f"no {interface} plugin named {name!r}{suggest(name, known)}; installed: {installed}"
+        hint = _install_hint(interface, name)  # a built-in kind: no nearest name to suggest
+        near = "" if hint else suggest(name, known)
+        msg = f"no {interface} plugin named {name!r}{near}; installed: {installed}{hint}"
         return msg + self.disabled_note()
 
     def disabled_note(self) -> str:

@@ -118,7 +118,13 @@ class Randomization(StrictModel):
     speed: Distribution | None = Field(None, description="Motion speed factor.")
     body_scale: Distribution | None = Field(None, description="Body size factor.")
     mirror: float = Field(0.0, ge=0, le=1, description="Probability of the mirror image.")
-    time_warp: float = Field(0.0, ge=0, lt=1, description="Time-warp strength s (< 1).")
+    time_warp: float = Field(
+        0.0,
+        ge=0,
+        lt=1,
+        description="Time-warp strength s, dimensionless (0: none; three warp coefficients drawn "
+        "uniformly between -s/3 and s/3).",
+    )
 
     @field_validator("params")
     @classmethod

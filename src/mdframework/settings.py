@@ -235,7 +235,7 @@ class MotionConfig(PluginConfig):
     """Base of motion-source configs: every source can be cut to a time window, and its
     motion is checked for sanity after loading."""
 
-    start: Seconds = Field(0.0, description="Start of the window, s from the first frame.")
+    start: Seconds = Field(0.0, description="Start of the window [s], from the first frame.")
     duration: PositiveSeconds | None = Field(
         None, description="Length of the window [s]; default: to the end."
     )

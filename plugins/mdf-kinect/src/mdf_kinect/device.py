@@ -227,8 +227,11 @@ def initialize_openni(redist: str | None = None) -> Any:
     """Load OpenNI2 (``redist``, else ``OPENNI2_REDIST``, else the Debian folder); the module."""
     try:
         from openni import openni2
-    except ImportError as exc:  # pragma: no cover - a dependency of this distribution
-        raise DeviceError(f"the Python package 'openni' is missing: {exc}") from None
+    except ImportError as exc:  # a dependency of this distribution, uninstalled or broken
+        raise DeviceError(
+            f"mdf-kinect needs the Python package 'openni', which cannot be imported ({exc}): "
+            "pip install openni"
+        ) from None
     folder = redist or os.environ.get("OPENNI2_REDIST") or DEBIAN_OPENNI2
     try:
         openni2.initialize(folder)

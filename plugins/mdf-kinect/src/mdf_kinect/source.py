@@ -76,7 +76,7 @@ class KinectConfig(MotionConfig):
     file: DataPath = Field(description="The recording, relative to the config file's folder.")
     start: Seconds = Field(
         0.0,
-        description="Start of the window, s from the first frame in which a joint is tracked "
+        description="Start of the window [s], from the first frame in which a joint is tracked "
         "(the frames before it are left out, with a warning), within a segment from its first "
         "tracked frame.",
     )
