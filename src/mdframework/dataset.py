@@ -135,6 +135,10 @@ INDEX = "index.csv"
 MANIFEST = "dataset.json"
 #: the key of dataset.json that holds the SHA-256 of index.csv as the build wrote it
 INDEX_DIGEST = "index_sha256"
+#: the version of the dataset folder's format (``format_version`` in dataset.json; the
+#: datasets page describes it): raised when a file, column, key or array that a reader of an
+#: earlier version relies on is removed or changes its meaning, not when one is added
+DATASET_FORMAT = 1
 #: Records a worker task builds at most, and the share of the records left that a task takes
 #: (``1 / (threads * TASKS_PER_THREAD)``): see :func:`record_chunks`.
 MAX_RECORDS_PER_TASK = 8
@@ -2163,6 +2167,7 @@ def _write_index(
     else:
         (out / SKIPPED).unlink(missing_ok=True)
     manifest = {
+        "format_version": DATASET_FORMAT,
         "n_records": len(rows),
         "n_skipped": len(skipped),
         "skipped": skipped,
