@@ -25,6 +25,7 @@ from mdframework.dataset import (
     load_dataset_config,
     read_record,
 )
+from mdframework.errors import DataFileError
 
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "datasets.md"
 CMU = EXAMPLES / "data" / "cmu"
@@ -133,6 +134,26 @@ def test_dataset_json_names_the_format_version(spectrogram_set: Path) -> None:
     manifest = json.loads((spectrogram_set / "dataset.json").read_text())
     assert manifest["format_version"] == DATASET_FORMAT == 1
     assert f"`format_version` | {DATASET_FORMAT}" in format_section().replace("`,", "`")
+
+
+def test_a_dataset_of_a_newer_format_is_refused_and_one_of_before_formats_read(
+    spectrogram_set: Path, tmp_path: Path
+) -> None:
+    """A reader that does not know a format's meaning says so rather than misread it; a
+    folder built before format versions (no ``format_version``) is read as before."""
+    for name, version in (("newer", DATASET_FORMAT + 1), ("older", None)):
+        folder = tmp_path / name
+        shutil.copytree(spectrogram_set, folder)
+        manifest = json.loads((folder / "dataset.json").read_text())
+        if version is None:
+            del manifest["format_version"]
+        else:
+            manifest["format_version"] = version
+        (folder / "dataset.json").write_text(json.dumps(manifest))
+    with pytest.raises(DataFileError, match=r"format_version 2: a dataset of a newer format"):
+        load_dataset(tmp_path / "newer")
+    older = load_dataset(tmp_path / "older")
+    assert list(older.labels) == list(load_dataset(spectrogram_set).labels)
 
 
 def documented_reader() -> str:

@@ -2249,6 +2249,13 @@ def _verified_index(root: Path) -> str:
     digest = manifest.get(INDEX_DIGEST) if isinstance(manifest, dict) else None
     if not isinstance(manifest, dict) or (digest is not None and not isinstance(digest, str)):
         raise DataFileError(manifest_path, f"not the file a build writes; {rebuild}")
+    made = manifest.get("format_version", DATASET_FORMAT)  # absent: before format versions
+    if not isinstance(made, int) or made > DATASET_FORMAT:
+        raise DataFileError(
+            manifest_path,
+            f"format_version {made!r}: a dataset of a newer format than this mdframework reads "
+            f"({DATASET_FORMAT}); upgrade mdframework to read it",
+        )
     if digest is not None and hashlib.sha256(data).hexdigest() != digest:
         raise DataFileError(
             index,
