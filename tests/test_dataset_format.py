@@ -234,3 +234,38 @@ def test_the_documented_reader_detects_an_incomplete_or_edited_folder(
     for case in ("edited", "missing", "no_index"):
         done = run_reader(cases[case])
         assert done.returncode != 0, case
+
+
+@pytest.mark.parametrize("place", ["recording", "record"])
+def test_a_record_of_the_default_aspect_says_so(tmp_path: Path, place: str) -> None:
+    """A scene that names no aspect faces the person toward the radar (aspect 0): its records
+    are those of ``aspect_deg = [0.0]`` and index.csv says 0, not nothing; a scene placed by
+    ``heading_deg`` has no aspect, and its column stays empty."""
+    scenes = {
+        "default": "",
+        "zero": "[variations]\naspect_deg = [0.0]",
+        "heading": "[base.scene.person]\nheading_deg = 90.0",
+    }
+    tables = {}
+    for name, extra in scenes.items():
+        config = tmp_path / f"{name}.toml"
+        config.write_text(f"""
+seed = 5
+place = "{place}"
+[[sources]]
+label = "walk"
+motion = {{ kind = "cmu", file = "{CMU / "asf-amc" / "02_01.amc"}" }}
+max_records = 1
+[record_lengths]
+walk = 0.5
+[base.processing]
+window_length = 128
+hop = 32
+nfft = 128
+{extra}
+""")
+        build_dataset(*load_dataset_config(config), tmp_path / name, workers=1, progress=False)
+        tables[name] = load_dataset(tmp_path / name)
+    assert tables["default"].table["aspect_deg"][0] == 0.0 == tables["zero"].table["aspect_deg"][0]
+    np.testing.assert_array_equal(tables["default"].spectrograms, tables["zero"].spectrograms)
+    assert np.isnan(tables["heading"].table["aspect_deg"][0])

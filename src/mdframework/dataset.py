@@ -1129,6 +1129,8 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                     placing = _validate_planned(run, record, draws, origins, entry_no, plan)
                     run["scene"] = _place_record(run, placing, loaded)
                     asked = placing.scene.person.aspect_deg
+                    if asked is None and placing.scene.person.heading_deg is None:
+                        asked = 0.0  # the scene's default: facing the radar
                 run["seed"] = _record_seed(entropy)
                 content, naming = prints[key], meta
                 if draws and any(
@@ -1501,9 +1503,7 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         "dataset": spec.dataset,
         "start_s": cfg.motion.start,
         "duration_s": cfg.motion.duration,
-        "aspect_deg": (
-            spec.aspect_deg if cfg.scene.person.aspect_deg is None else cfg.scene.person.aspect_deg
-        ),
+        "aspect_deg": _aspect(spec, cfg.scene.person),
         "radar_position_m": list(cfg.scene.radar_position),
         "height_m": run_config["motion"].get("height"),
         "seed": cfg.seed,
@@ -1515,6 +1515,17 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         **extra_meta,
     }
     return _write_record(out_dir, spec, meta, {**spectrogram, "features": feats, **extra})
+
+
+def _aspect(spec: RecordSpec, person: Any) -> float | None:
+    """A simulated record's aspect angle [deg]: its scene's (a variation or draw), else the
+    one its placement was asked for (``place = "record"``), else 0 (the scene's default,
+    facing the radar) unless the scene gives a ``heading_deg`` instead (None)."""
+    if person.aspect_deg is not None:
+        return float(person.aspect_deg)
+    if spec.aspect_deg is not None:
+        return float(spec.aspect_deg)
+    return 0.0 if person.heading_deg is None else None
 
 
 def _write_record(
