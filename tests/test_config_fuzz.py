@@ -1,0 +1,51 @@
+"""Defects found by fuzzing every command's config one field at a time: each is one line on
+stderr naming the config field, exit code 2, and nothing written (or, for a config that
+``mdf check`` calls valid, a run that does not fail)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from conftest import EXAMPLES
+
+from mdframework import cli
+
+POINT = (
+    '[motion]\nkind = "point_targets"\nlength = 1.0\n'
+    "targets = [{ position = [100.0, 0.0, 0.0], velocity = [1.0, 0.0, 0.0], rcs = 1.0 }]\n"
+    '[scatterers]\nkind = "points"\n'
+)
+
+
+def one_error_line(args: list[str], capsys: pytest.CaptureFixture[str]) -> str:
+    """Run the CLI; it must fail with exit code 2 and one error line, which is returned."""
+    code = cli.main(args)
+    err = capsys.readouterr().err
+    lines = [line for line in err.strip().splitlines() if "warning" not in line]
+    assert code == 2, err
+    assert len(lines) == 1 and lines[0].startswith("mdf: error: "), err
+    return lines[0]
+
+
+def test_a_file_name_too_long_is_the_users_error(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(f'[motion]\nkind = "cmu"\nfile = "{tmp_path}/{"a" * 300}.amc"\n')
+    line = one_error_line(["check", str(cfg)], capsys)
+    assert f"{cfg}: motion.file: " in line and "cannot read: File name too long" in line
+    assert "plugin" not in line  # not blamed on the motion plugin
+    assert len(line) < 400  # the 300 characters are cut short
+
+
+@pytest.mark.parametrize("width", ["5e-324", "1e-9"])
+def test_a_tiny_outlier_bin_is_refused_before_it_allocates(
+    width: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # 1e-9 m bins took 37 s and 2.5 GB of memory for the shipped MSR recording (1e-10: 25 GB);
+    # a denormal width was an internal error (OverflowError)
+    config = str(EXAMPLES / "kinect_msr_boxing.toml")
+    line = one_error_line(["check", config, "--set", f"conditioning.outlier_bin_m={width}"], capsys)
+    assert f"--set conditioning.outlier_bin_m={width}: conditioning: outlier_bin_m: " in line
+    assert "histogram bins, more than 1,000,000: raise outlier_bin_m" in line
