@@ -49,3 +49,42 @@ def test_a_tiny_outlier_bin_is_refused_before_it_allocates(
     line = one_error_line(["check", config, "--set", f"conditioning.outlier_bin_m={width}"], capsys)
     assert f"--set conditioning.outlier_bin_m={width}: conditioning: outlier_bin_m: " in line
     assert "histogram bins, more than 1,000,000: raise outlier_bin_m" in line
+
+
+DATASET = (
+    '[[sources]]\nlabel = "walk"\nmotion = { kind = "boulic", n_cycles = 2 }\n'
+    "record_length = 1.0\nmax_records = 1\n"
+    "[variations]\naspect_deg = [0.0]\nradar_range = [6.0]\n"
+)
+
+
+@pytest.mark.parametrize(
+    ("scene", "expected"),
+    [
+        ("5", "scene: must be a table (got 5)"),
+        ('"x"', "scene: must be a table (got 'x')"),
+        ("{ person = 3 }", "scene.person: must be a table (got 3)"),
+        ("{ radar_position = 3 }", "scene.radar_position: must be a valid tuple (got 3)"),
+        ('{ person = { position = "ab" } }', "scene.person.position: must be a valid tuple"),
+    ],
+)
+def test_a_varied_scene_of_the_wrong_shape_is_named(
+    scene: str, expected: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the variations (aspect, radar range) were applied to the scene before it was validated
+    cfg = tmp_path / "d.toml"
+    cfg.write_text(f"{DATASET}[base]\nscene = {scene}\n")
+    line = one_error_line(["dataset", "check", str(cfg)], capsys)
+    assert line.startswith(f"mdf: error: {cfg}: sources[0] record 0: {expected}"), line
+
+
+def test_the_varied_default_scene_still_moves_the_radar(tmp_path: Path) -> None:
+    from mdframework.dataset import load_dataset_config, plan_records
+
+    cfg_path = tmp_path / "d.toml"
+    cfg_path.write_text(DATASET + "radar_height = [1.5]\n")
+    cfg, base = load_dataset_config(cfg_path)
+    (spec,) = plan_records(cfg, base)
+    scene = spec.run_config["scene"]
+    assert scene["radar_position"] == [6.0, 0.0, 1.5]  # from the default start (0, 0)
+    assert scene["person"] == {"aspect_deg": 0.0}

@@ -538,25 +538,44 @@ def _record_seed(key: list[int]) -> int:
     return int(np.random.SeedSequence(key).generate_state(1)[0])
 
 
-def _scene_for(base_scene: dict[str, Any], variation: dict[str, Any]) -> dict[str, Any]:
-    """The scene of one record: the (base) scene with only the varied fields replaced."""
+def _scene_for(base_scene: Any, variation: dict[str, Any]) -> Any:
+    """The scene of one record: the (base) scene with only the varied fields replaced. A scene,
+    person, position or radar position of the wrong shape is left as it is, for the record's
+    validation to name."""
+    if not isinstance(base_scene, dict):
+        return base_scene
     scene: dict[str, Any] = json.loads(json.dumps(base_scene))
-    if variation["aspect_deg"] is not None:
-        person = dict(scene.get("person", {}))
+    person = scene.get("person", {})
+    if variation["aspect_deg"] is not None and isinstance(person, dict):
+        person = dict(person)
         person.pop("heading_deg", None)  # the aspect replaces any fixed heading
         person["aspect_deg"] = variation["aspect_deg"]
         scene["person"] = person
     if variation["radar_position"] is not None:
         scene["radar_position"] = list(variation["radar_position"])
     if variation["radar_range"] is not None or variation["radar_height"] is not None:
-        start = scene.get("person", {}).get("position", (0.0, 0.0))
-        radar = list(scene.get("radar_position", (10.0, 0.0, 2.0)))
+        start: Any = person.get("position", [0.0, 0.0]) if isinstance(person, dict) else None
+        radar = scene.get("radar_position", [10.0, 0.0, 2.0])
+        if not _numbers(radar, 3) or (
+            variation["radar_range"] is not None and not _numbers(start, 2)
+        ):
+            return scene
+        radar = list(radar)
         if variation["radar_range"] is not None:
             radar[0], radar[1] = start[0] + variation["radar_range"], start[1]
         if variation["radar_height"] is not None:
             radar[2] = variation["radar_height"]
         scene["radar_position"] = radar
     return scene
+
+
+def _numbers(value: Any, n: int) -> bool:
+    """Whether ``value`` is a list of ``n`` numbers (not flags)."""
+    return (
+        isinstance(value, list | tuple)
+        and len(value) == n
+        and all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
+    )
 
 
 def _merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
