@@ -88,3 +88,18 @@ def test_the_varied_default_scene_still_moves_the_radar(tmp_path: Path) -> None:
     scene = spec.run_config["scene"]
     assert scene["radar_position"] == [6.0, 0.0, 1.5]  # from the default start (0, 0)
     assert scene["person"] == {"aspect_deg": 0.0}
+
+
+def test_dataset_check_plans_every_sources_first_record(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the second source of a label was never planned: check said valid, the build failed
+    cfg = tmp_path / "d.toml"
+    second = '[[sources]]\nlabel = "walk"\nmotion = { kind = "boulic", n_cycles = 2 }\n'
+    cfg.write_text(DATASET + second + "record_length = 0.01\nmax_records = 2\n")
+    line = one_error_line(["dataset", "check", str(cfg)], capsys)
+    assert line.startswith(f"mdf: error: {cfg}: record 00001-"), line
+    cause = "processing.window_length: the record has 25 samples (0.0104 s) but the STFT window"
+    assert cause in line
+    out = tmp_path / "out"
+    assert cause in one_error_line(["dataset", "build", str(cfg), "--out", str(out)], capsys)

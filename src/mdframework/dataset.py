@@ -367,6 +367,9 @@ class RecordSpec:
     length_field: str | None = None
     #: a recorded record's (file, start [s], duration [s]), named by its errors and skip row
     window: tuple[str, float, float] | None = None
+    #: a simulated record's source: its number in ``sources`` (``mdf dataset check`` plans the
+    #: first record of each)
+    source: int | None = None
 
 
 def load_dataset_config(
@@ -1157,7 +1160,8 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                     asked,
                     content,
                 )
-                specs.append(replace(spec, length_field=_length_field(config, entry_no, entry)))
+                length_field = _length_field(config, entry_no, entry)
+                specs.append(replace(spec, length_field=length_field, source=entry_no))
                 # every record's run config is valid before any file is written (with
                 # on_error = "skip" an invalid record is skipped by the build instead)
                 if config.on_error == "stop" or not points_checked:
