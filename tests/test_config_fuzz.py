@@ -103,3 +103,13 @@ def test_dataset_check_plans_every_sources_first_record(
     assert cause in line
     out = tmp_path / "out"
     assert cause in one_error_line(["dataset", "build", str(cfg), "--out", str(out)], capsys)
+
+
+def test_an_fmcw_slope_too_shallow_for_a_finite_range_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # mdf check called slope = 1e-300 valid; the run's range axis was infinite times zero
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(POINT + '[radar]\nkind = "fmcw"\nslope = 1e-300\n')
+    line = one_error_line(["check", str(cfg)], capsys)
+    assert f"{cfg}: radar.slope: must be at least 1e+06 (got 1e-300)" in line
