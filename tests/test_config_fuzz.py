@@ -113,3 +113,21 @@ def test_an_fmcw_slope_too_shallow_for_a_finite_range_is_refused(
     cfg.write_text(POINT + '[radar]\nkind = "fmcw"\nslope = 1e-300\n')
     line = one_error_line(["check", str(cfg)], capsys)
     assert f"{cfg}: radar.slope: must be at least 1e+06 (got 1e-300)" in line
+
+
+@pytest.mark.parametrize("kind", ["lfm", "cw", "fmcw"])
+def test_an_echo_too_strong_for_the_arithmetic_is_refused_by_check_and_run(
+    kind: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # gain_dbi = 300 (within the generic decibel range): mdf check said valid, the run was an
+    # internal error (an overflow in the radar's float32 amplitudes or in the spectrogram)
+    cfg = tmp_path / "c.toml"
+    near = "[scene]\nradar_position = [95.0, 0.0, 0.0]\n"  # within the FMCW radar's range
+    cfg.write_text(POINT + near + f'[radar]\nkind = "{kind}"\ngain_dbi = 300\n')
+    expected = f"{cfg}: radar.gain_dbi: the echo of 1 m^2 at 1 m would carry "
+    assert expected in one_error_line(["check", str(cfg)], capsys)
+    out = tmp_path / "out"
+    assert expected in one_error_line(["run", str(cfg), "--out", str(out)], capsys)
+    assert not out.exists()
+    cfg.write_text(POINT + near + f'[radar]\nkind = "{kind}"\ngain_dbi = 60\n')  # a real one
+    assert cli.main(["check", str(cfg)]) == 0

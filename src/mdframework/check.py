@@ -37,6 +37,7 @@ from .pipeline import (
     Stages,
     apply_effects,
     build_stages,
+    check_echo_power,
     effect_generators,
     frames_inside,
     gate_ranges,
@@ -230,6 +231,7 @@ def plan_run(
     t = record_pulses(wf, t_start, t_end)
     n_pulses = int(t.shape[0])
     geometry = spectrogram_geometry(wf, n_pulses, proc)
+    check_echo_power(wf)
     record_body = body.select_frames(frames_inside(body.time, t_start, t_end))
     start_record(stages, record_body, t, radar_pos)  # what the radar refuses before a pulse
 

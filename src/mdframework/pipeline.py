@@ -51,6 +51,7 @@ from .settings import (
     ConditioningConfig,
     PersonConfig,
     ProcessingConfig,
+    RadarPowerConfig,
     RunConfigBase,
     SanityConfig,
 )
@@ -386,6 +387,17 @@ def spectrogram_geometry(
     return geometry
 
 
+def check_echo_power(wf: RadarWaveform) -> None:
+    """Refuse a radar whose range equation makes echoes too strong for the pipeline's float32
+    arithmetic (:func:`limits.check_echo_power`: ``radar.gain_dbi`` of 300 dB, say), before any
+    pulse; ``mdf check`` refuses it too."""
+    cfg = getattr(wf, "config", None)
+    if isinstance(cfg, RadarPowerConfig) and cfg.amplitude == "range_equation":
+        wavelength = radar.wavelength(wf.carrier_frequency)
+        amplitude = cfg.amplitudes(np.ones(1), np.ones(1), wavelength)
+        limits.check_echo_power(float(amplitude[0]) ** 2)
+
+
 def processing_stft(
     signal: ComplexArray, sample_rate: float, proc: ProcessingConfig
 ) -> Spectrogram:
@@ -468,6 +480,7 @@ def _simulate_motion(
     )
     t = record_pulses(wf, t_start, t_end)
     spectrogram_geometry(wf, t.shape[0], proc)  # a record too short: refused before any pulse
+    check_echo_power(wf)
     frames = interpolation.window_frames(body.time, float(t[0]), float(t[-1]))
     near = body.select_frames(frames)
     refuse_untracked(near, float(t[0]), float(t[-1]), float(body.time[0]))
