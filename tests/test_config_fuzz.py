@@ -131,3 +131,16 @@ def test_an_echo_too_strong_for_the_arithmetic_is_refused_by_check_and_run(
     assert not out.exists()
     cfg.write_text(POINT + near + f'[radar]\nkind = "{kind}"\ngain_dbi = 60\n')  # a real one
     assert cli.main(["check", str(cfg)]) == 0
+
+
+@pytest.mark.parametrize("field", ["path", "config"])
+def test_a_dataset_path_with_a_nul_character_is_named(
+    field: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # dataset.path = "a\u0000b" was an internal error (ValueError: embedded null byte)
+    cfg = tmp_path / "e.toml"
+    cfg.write_text(f'[dataset]\n{field} = "a\\u0000b"\n')
+    out = tmp_path / "out"
+    line = one_error_line(["experiment", str(cfg), "--out", str(out)], capsys)
+    assert line == f"mdf: error: {cfg}: dataset.{field}: a file name cannot hold a NUL character"
+    assert not out.exists()
