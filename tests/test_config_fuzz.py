@@ -144,3 +144,27 @@ def test_a_dataset_path_with_a_nul_character_is_named(
     line = one_error_line(["experiment", str(cfg), "--out", str(out)], capsys)
     assert line == f"mdf: error: {cfg}: dataset.{field}: a file name cannot hold a NUL character"
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("setting", "expected"),
+    [
+        # pydantic said "Unable to parse input string as an integer, exceeded maximum size"
+        (
+            "processing.window_length=1e308",
+            "processing.window_length: must be a whole number within the field's range "
+            "(got 1e+308)",
+        ),
+        # pydantic said "Input is not a valid path for <class 'pathlib.Path'>"
+        ("motion.file=5", "motion.file: must be a path (text) (got 5)"),
+        # a kind in another case had no hint ('Lfm' had one, 'LFM' none)
+        ("radar.kind='LFM'", "radar.kind: no radar plugin named 'LFM' (did you mean 'lfm'?)"),
+        ("motion.kind='CMU'", "motion.kind: no motion plugin named 'CMU' (did you mean 'cmu'?)"),
+    ],
+)
+def test_field_errors_in_plain_words(
+    setting: str, expected: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    config = str(EXAMPLES / "cmu_walk.toml")
+    line = one_error_line(["check", config, "--set", setting], capsys)
+    assert line.startswith(f"mdf: error: --set {setting}: {expected}"), line

@@ -427,6 +427,10 @@ def _plain(error: Any, allowed: list[str] | None) -> str:
         return f"must be one of {expected}{got}{suggest(str(error.get('input')), options)}"
     if kind in ("model_type", "dict_type"):  # not pydantic's "instance of <class>"
         return f"must be a table{got}"
+    if kind == "int_parsing_size":  # pydantic: "Unable to parse input string as an integer"
+        return f"must be a whole number within the field's range{got}"
+    if kind == "path_type":  # pydantic: "Input is not a valid path for <class 'pathlib.Path'>"
+        return f"must be a path (text){got}"
     if kind in ("value_error", "assertion_error"):
         return str(msg.split(", ", 1)[1] if ", " in msg else msg)
     plain = str(msg).replace("Input should be", "must be").replace("Value error, ", "")

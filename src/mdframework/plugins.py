@@ -198,8 +198,11 @@ class _ByInterface(dict[str, dict[str, PluginInfo]]):
 
 
 def suggest(name: str, known: Iterable[str]) -> str:
-    """`` (did you mean 'x'?)`` for the closest of ``known`` to ``name``, or ``""``."""
-    close = difflib.get_close_matches(str(name), list(known), n=1, cutoff=0.6)
+    """`` (did you mean 'x'?)`` for the closest of ``known`` to ``name`` (first one that differs
+    only in case or surrounding blanks: ``'CW'`` for ``'cw'``), or ``""``."""
+    known = list(known)
+    same = [k for k in known if k.casefold() == str(name).strip().casefold()]
+    close = same or difflib.get_close_matches(str(name), known, n=1, cutoff=0.6)
     return f" (did you mean {close[0]!r}?)" if close else ""
 
 
