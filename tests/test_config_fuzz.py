@@ -168,3 +168,39 @@ def test_field_errors_in_plain_words(
     config = str(EXAMPLES / "cmu_walk.toml")
     line = one_error_line(["check", config, "--set", setting], capsys)
     assert line.startswith(f"mdf: error: --set {setting}: {expected}"), line
+
+
+BIG = "1" + "0" * 5000  # more digits than Python converts to an integer
+
+
+@pytest.mark.parametrize(
+    ("name", "text", "expected"),
+    [
+        (
+            "c.json",
+            '{"seed": ' + BIG + "}",
+            "invalid JSON: a whole number of more than 4300 digits",
+        ),
+        ("c.toml", f"seed = {BIG}\n", "invalid TOML: a whole number of more than 4300 digits"),
+        ("c.yaml", f"motion: {{}}\nseed: {BIG}\n", "invalid YAML: line 2: a whole number of more"),
+        (
+            "d.yaml",
+            "motion: {}\nseed: 2024-13-45\n",
+            "invalid YAML: line 2: month must be in 1..12",
+        ),
+    ],
+)
+def test_a_value_the_parser_cannot_make_is_named(
+    name: str, text: str, expected: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # each was an internal error (ValueError from int() or datetime.date())
+    cfg = tmp_path / name
+    cfg.write_text(text)
+    assert one_error_line(["check", str(cfg)], capsys).startswith(f"mdf: error: {cfg}: {expected}")
+
+
+def test_an_override_the_parser_cannot_make_is_named(capsys: pytest.CaptureFixture[str]) -> None:
+    config = str(EXAMPLES / "point_target.toml")
+    line = one_error_line(["check", config, "--set", f"seed={BIG}"], capsys)
+    assert line.endswith(": a whole number of more than 4300 digits")
+    assert line.startswith(f"mdf: error: --set seed={BIG[:20]}")

@@ -17,6 +17,7 @@ import difflib
 import json
 import re
 import stat
+import sys
 import tomllib
 from collections.abc import Hashable, Iterator, Sequence
 from contextlib import contextmanager
@@ -136,6 +137,14 @@ def _load_yaml(p: Path, text: str) -> Any:
     import yaml
 
     class Loader(yaml.SafeLoader):  # type: ignore[misc]  # PyYAML is untyped here
+        def construct_object(self, node: Any, deep: bool = False) -> Any:
+            try:
+                return super().construct_object(node, deep=deep)
+            except ValueError as exc:  # a date 2024-13-45, a number of 5000 digits
+                raise yaml.constructor.ConstructorError(
+                    problem=_value_problem(exc), problem_mark=node.start_mark
+                ) from None
+
         def construct_mapping(self, node: Any, deep: bool = False) -> Any:
             seen: set[Any] = set()
             for key_node, _ in node.value:
@@ -162,6 +171,13 @@ def _load_yaml(p: Path, text: str) -> Any:
         where = f"line {mark.line + 1}: " if mark is not None else ""
         problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
         raise ConfigError(f"{p}: invalid YAML: {where}{problem}") from None
+
+
+def _value_problem(exc: ValueError) -> str:
+    """A value a parser cannot make (``ValueError``) in plain words."""
+    if "integer string conversion" in str(exc):  # Python's limit, not the config's
+        return f"a whole number of more than {sys.get_int_max_str_digits()} digits"
+    return str(exc)  # "month must be in 1..12"
 
 
 class _RepeatedKey(ValueError):
@@ -315,6 +331,9 @@ def read_config_file(
         raise ConfigError(
             f"{p}: tables and lists are nested more than {limits.MAX_CONFIG_DEPTH} deep"
         ) from None
+    except ValueError as exc:  # a number of 5000 digits
+        what = {".toml": "TOML", ".json": "JSON"}.get(suffix, "YAML")
+        raise ConfigError(f"{p}: invalid {what}: {_value_problem(exc)}") from None
     if not isinstance(data, dict):
         raise ConfigError(f"{p}: the top level must be a table of sections")
     _check_depth(p, data)
@@ -623,7 +642,10 @@ def apply_overrides(data: dict[str, Any], overrides: Sequence[str]) -> dict[str,
     result: dict[str, Any] = copy.deepcopy(data)
     for item in overrides:
         parts, text = _override_key(item)
-        value = _override_value(text)
+        try:
+            value = _override_value(text)
+        except ValueError as exc:  # a number of 5000 digits
+            raise ConfigError(f"--set {item}: {_value_problem(exc)}") from None
         node: Any = result
         for depth, part in enumerate(parts):
             last = depth == len(parts) - 1
