@@ -204,3 +204,43 @@ def test_an_override_the_parser_cannot_make_is_named(capsys: pytest.CaptureFixtu
     line = one_error_line(["check", config, "--set", f"seed={BIG}"], capsys)
     assert line.endswith(": a whole number of more than 4300 digits")
     assert line.startswith(f"mdf: error: --set seed={BIG[:20]}")
+
+
+def test_a_null_kind_is_named(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # radar.kind = null said "radar: unknown kind None; Input tag 'None' found using 'kind'
+    # does not match any of the expected tags: ..."
+    cfg = tmp_path / "c.json"
+    cfg.write_text(
+        '{"motion": {"kind": "point_targets", "length": 1.0, "targets": [{"position": '
+        '[100.0, 0, 0]}]}, "scatterers": {"kind": "points"}, "radar": {"kind": null}}'
+    )
+    line = one_error_line(["check", str(cfg)], capsys)
+    assert line.startswith(f"mdf: error: {cfg}: radar.kind: null: say which radar plugin ("), line
+
+
+def _limit_memory() -> None:  # (in the child process)
+    import resource
+
+    resource.setrlimit(resource.RLIMIT_AS, (3 * 1024**3, 3 * 1024**3))
+
+
+def test_a_wide_analytic_margin_needs_no_table_of_margin_times_scatterers(tmp_path: Path) -> None:
+    # analytic_margin = 65536 (its bound) made a table of every chirp's scatterers x 131074
+    # bins: about 4.5 GB for the shipped FMCW walk (the run grew past 8 GB before it was
+    # stopped); every bin is near then, whatever the scatterers
+    import subprocess
+    import sys
+
+    out = tmp_path / "out"
+    args = ["run", str(EXAMPLES / "walk_side_by_side_fmcw.toml"), "--out", str(out)]
+    args += ["--no-figures", "--set", "motion.duration=0.5"]
+    args += ["--set", "radar.analytic_margin=65536"]
+    done = subprocess.run(
+        [sys.executable, "-m", "mdframework.cli", *args],
+        capture_output=True,
+        text=True,
+        preexec_fn=_limit_memory,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    assert (out / "result.npz").is_file()

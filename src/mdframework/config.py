@@ -571,6 +571,11 @@ def check_plugin_kinds(data: dict[str, Any], source: str, registry: Registry) ->
                 problem = f"must be a table with a kind (got {_short(section)})"
             raise ConfigError(f"{source}: {where}: {problem}{_kinds(registry, interface)}")
         kind = section.get("kind")
+        if kind is None and "kind" in section:  # YAML's null, JSON's null: not the default
+            raise ConfigError(
+                f"{source}: {where}.kind: null: say which {interface} plugin"
+                f"{_kinds(registry, interface)}"
+            )
         if kind is None:
             if len(registry.names(interface)) == 1:
                 continue  # the only plugin's config has its kind as default

@@ -490,7 +490,23 @@ def bins_near(ranges: FloatArray, seq: ChirpSequence, n_fft: int, margin: int) -
     """Range bins within ``margin`` bins of any of ``ranges`` [m] (after IF aliasing), sorted."""
     pos = np.mod(np.asarray(ranges, np.float64).ravel() / seq.max_range * n_fft, n_fft)
     base = np.floor(pos).astype(np.int64)
-    return _distinct_bins(base[:, None] + np.arange(-margin, margin + 2)[None, :], n_fft)
+    return _bins_around(base, -margin, margin + 1, n_fft)
+
+
+def _bins_around(base: IntArray, lo: int, hi: int, n: int) -> IntArray:
+    """The distinct values of ``(base + d) % n`` for every ``d`` in ``lo..hi``, sorted: each
+    base's run of bins marked as an interval, so that memory grows with ``base`` and ``n``, not
+    with ``hi - lo`` (a margin of 65536 bins around thousands of ranges)."""
+    width = hi - lo + 1
+    if width >= n:
+        return np.arange(n, dtype=np.int64)
+    start = np.mod(base + lo, n)
+    end = start + width  # exclusive; past n the run wraps to bin 0
+    wrapped = end[end > n] - n
+    edges = np.bincount(start, minlength=n + 1) - np.bincount(np.minimum(end, n), minlength=n + 1)
+    edges[0] += wrapped.size
+    edges -= np.bincount(wrapped, minlength=n + 1)
+    return np.flatnonzero(np.cumsum(edges[:n]) > 0).astype(np.int64)
 
 
 def _distinct_bins(bins: IntArray, n: int) -> IntArray:
