@@ -244,3 +244,16 @@ def test_a_wide_analytic_margin_needs_no_table_of_margin_times_scatterers(tmp_pa
     )
     assert done.returncode == 0, done.stderr
     assert (out / "result.npz").is_file()
+
+
+def test_a_hop_too_small_to_count_windows_is_named(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # hop = 1e-308 gave an infinite count of windows: OverflowError, with max_records too
+    cfg = tmp_path / "d.toml"
+    cfg.write_text(DATASET.replace("max_records = 1\n", "hop = 1e-308\n"))
+    line = one_error_line(["dataset", "check", str(cfg)], capsys)
+    assert line.startswith(f"mdf: error: {cfg}: sources[0]: 1.69e+308 windows x 1 variation(s)")
+    assert line.endswith("beyond the limit of 1,000,000 records; raise hop or set max_records")
+    cfg.write_text(DATASET.replace("max_records = 1\n", "hop = 1e-308\nmax_records = 2\n"))
+    assert cli.main(["dataset", "check", str(cfg)]) == 0

@@ -1080,16 +1080,18 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
         rz = _randomize(config, entry)
         origins = _draw_origins(config, entry_no, entry)
 
-        n_windows = int(np.ceil((duration - length + 1e-9) / hop))
+        windows = float(np.ceil((duration - length + 1e-9) / hop))  # inf for a hop of 1e-308
         if entry.max_records is not None:
-            n_windows = min(n_windows, entry.max_records)
+            windows = min(windows, entry.max_records)
         n_draws = rz.draws if rz.active() else 1
-        if len(specs) + n_windows * len(grid) * n_draws > limits.MAX_RECORDS:
+        if len(specs) + windows * len(grid) * n_draws > limits.MAX_RECORDS:
+            shown = f"{windows:,.0f}" if windows < 1e15 else f"{windows:.3g}"
             raise ConfigError(
-                f"sources[{entry_no}]: {n_windows:,} windows x {len(grid)} variation(s) x "
+                f"sources[{entry_no}]: {shown} windows x {len(grid)} variation(s) x "
                 f"{n_draws} draw(s) take the dataset beyond the limit of "
                 f"{limits.MAX_RECORDS:,} records; raise hop or set max_records"
             )
+        n_windows = int(windows)
         starts = span_start + np.arange(n_windows) * hop
         # a source is known by its motion's contents, wherever its file lies (and among
         # sources of one motion, by its place)
