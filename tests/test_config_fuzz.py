@@ -257,3 +257,52 @@ def test_a_hop_too_small_to_count_windows_is_named(
     assert line.endswith("beyond the limit of 1,000,000 records; raise hop or set max_records")
     cfg.write_text(DATASET.replace("max_records = 1\n", "hop = 1e-308\nmax_records = 2\n"))
     assert cli.main(["dataset", "check", str(cfg)]) == 0
+
+
+KERNEL = """
+import resource, sys
+import numpy as np
+from mdframework.physics import fmcw
+resource.setrlimit(resource.RLIMIT_AS, (600 * 1024**2, 600 * 1024**2))
+seq = fmcw.ChirpSequence(77e9, 70e12, 7e-6, 7e-6, 57.14e-6, 4.884e6, 240, 16, (0, 2, 1), 33.3e-3)
+delays = 2 * np.random.default_rng(1).uniform(0.5, 5.0, (64, 17)) / 299792458.0
+out = fmcw.analytic_range_profile(delays, np.ones((64, 17)), seq, "hann", 16384, np.arange(16384))
+print(out.shape)
+"""
+
+
+def test_the_analytic_range_profile_of_every_bin_fits_in_memory() -> None:
+    # a zero-padded range FFT (range_fft_size 16384) with a margin wide enough to keep every
+    # bin made a (chirps, scatterers, bins) kernel at once: 64 x 17 x 16384 here, 4.25 GiB for
+    # the shipped FMCW walk at range_fft_size = 65536 (a MemoryError, an internal error)
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+    done = subprocess.run(
+        [sys.executable, "-c", KERNEL], capture_output=True, text=True, env=env, timeout=300
+    )
+    assert done.returncode == 0, done.stderr[-500:]
+    assert done.stdout.strip() == "(64, 16384)"
+
+
+def test_the_analytic_range_profile_in_blocks_of_bins_is_the_whole(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import numpy as np
+
+    from mdframework.physics import fmcw
+
+    seq = fmcw.ChirpSequence(77e9, 70e12, 7e-6, 7e-6, 57.14e-6, 4.884e6, 240, 16, (0, 2, 1), 0.03)
+    rng = np.random.default_rng(2)
+    delays = 2 * rng.uniform(0.5, 5.0, (4, 3)) / 299792458.0
+    amplitudes = rng.uniform(0.5, 1.5, (4, 3))
+    phasors = np.exp(1j * rng.uniform(0, 6.3, (4, 2, 3)))
+    bins = np.arange(0, 512, 3)
+    whole = [fmcw.analytic_range_profile(delays, amplitudes, seq, "hann", 512, bins, p)
+             for p in (None, phasors)]  # fmt: skip
+    monkeypatch.setattr(fmcw, "_KERNEL_CELLS", 25)  # blocks of 2 bins (12 chirps x scatterers)
+    for p, expected in zip((None, phasors), whole, strict=True):
+        got = fmcw.analytic_range_profile(delays, amplitudes, seq, "hann", 512, bins, p)
+        np.testing.assert_array_equal(got, expected)

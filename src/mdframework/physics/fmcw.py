@@ -471,14 +471,29 @@ def analytic_range_profile(
             summed = summed[:, 0, :]
         total = _window_combine(name, seq.n_samples, summed, ext, sel)
         return np.asarray(total * scale, np.complex128)
-    nu = np.asarray(bins, np.float64)[None, None, :] / n_fft - x[:, :, None]
-    kern = window_transform(name, seq.n_samples, nu)
+    sel_bins = np.asarray(bins, np.float64)
     if separate:
+        nu = sel_bins[None, None, :] / n_fft - x[:, :, None]
+        kern = window_transform(name, seq.n_samples, nu)
         return np.asarray(coef[:, :, None] * kern * scale, np.complex128)
-    if phasors is None:
-        return np.asarray(np.einsum("cs,csk->ck", coef, kern) * scale, np.complex128)
-    total = np.einsum("crs,csk->crk", phasors * coef[:, None, :], kern)
-    return np.asarray(total * scale, np.complex128)
+    weights = coef if phasors is None else phasors * coef[:, None, :]
+    out = np.empty((*weights.shape[:-1], sel_bins.size), dtype=np.complex128)
+    # the kernel (n_chirps, n_scat, bins) a block of bins at a time: every bin of a 65536-point
+    # FFT (a wide analytic_margin) for every chirp and scatterer would take gigabytes
+    step = max(1, _KERNEL_CELLS // max(1, x.size))
+    for lo in range(0, sel_bins.size, step):
+        nu = sel_bins[None, None, lo : lo + step] / n_fft - x[:, :, None]
+        kern = window_transform(name, seq.n_samples, nu)
+        if phasors is None:
+            out[..., lo : lo + step] = np.einsum("cs,csk->ck", weights, kern)
+        else:
+            out[..., lo : lo + step] = np.einsum("crs,csk->crk", weights, kern)
+    out *= scale
+    return out
+
+
+#: most values of the kernel of :func:`analytic_range_profile` computed at once (64 MiB)
+_KERNEL_CELLS = 2**22
 
 
 def range_axis(seq: ChirpSequence, n_fft: int) -> FloatArray:
