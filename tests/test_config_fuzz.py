@@ -306,3 +306,39 @@ def test_the_analytic_range_profile_in_blocks_of_bins_is_the_whole(
     for p, expected in zip((None, phasors), whole, strict=True):
         got = fmcw.analytic_range_profile(delays, amplitudes, seq, "hann", 512, bins, p)
         np.testing.assert_array_equal(got, expected)
+
+
+@pytest.mark.parametrize(
+    ("setting", "expected"),
+    [
+        # pydantic: "List should have at least 1 item after validation, not 0"
+        ("motion.targets=[]", "motion.targets: must hold at least 1 item (got [])"),
+        # pydantic: "Tuple should have at most 3 items after validation, not 4"
+        (
+            "scene.radar_position=[1, 2, 3, 4]",
+            "scene.radar_position: must hold at most 3 items (got [1, 2, 3, 4])",
+        ),
+        # the whole name was shown, however long
+        (
+            f"radar.kind='{'x' * 300}'",
+            f"radar.kind: no radar plugin named '{'x' * 57}...'; installed: ",
+        ),
+    ],
+)
+def test_more_field_errors_in_plain_words(
+    setting: str, expected: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    config = str(EXAMPLES / "point_target.toml")
+    line = one_error_line(["check", config, "--set", setting], capsys)
+    assert f": {expected}" in line, line
+    assert len(line) < 2 * len(setting) + 200
+
+
+def test_a_yaml_key_that_is_not_text_is_named(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    cfg = tmp_path / "c.yaml"  # pydantic: "1: Keys should be strings"
+    cfg.write_text("motion: {kind: point_targets, length: 1.0, targets: [{position: [9, 0, 0]}]}\n"
+                   "scatterers: {kind: points}\n1: 2\n")  # fmt: skip
+    line = one_error_line(["check", str(cfg)], capsys)
+    assert line == f"mdf: error: {cfg}: 1: a key must be text (got 1)"

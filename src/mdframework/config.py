@@ -446,6 +446,12 @@ def _plain(error: Any, allowed: list[str] | None) -> str:
         return f"must be one of {expected}{got}{suggest(str(error.get('input')), options)}"
     if kind in ("model_type", "dict_type"):  # not pydantic's "instance of <class>"
         return f"must be a table{got}"
+    if kind in ("too_short", "too_long"):  # pydantic: "List should have at least 1 item ..."
+        least = "at least" if kind == "too_short" else "at most"
+        n = ctx.get("min_length" if kind == "too_short" else "max_length")
+        return f"must hold {least} {n} item{'' if n == 1 else 's'}{got}"
+    if kind == "invalid_key":  # a YAML key 1, true or null
+        return f"a key must be text{got}"
     if kind == "int_parsing_size":  # pydantic: "Unable to parse input string as an integer"
         return f"must be a whole number within the field's range{got}"
     if kind == "path_type":  # pydantic: "Input is not a valid path for <class 'pathlib.Path'>"

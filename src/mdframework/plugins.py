@@ -234,7 +234,8 @@ class Registry:
         interface = interface_name(interface)
         known = sorted(self.plugins[interface])
         installed = ", ".join(known) or "none"
-        msg = f"no {interface} plugin named {name!r}{suggest(name, known)}; installed: {installed}"
+        shown = repr(name) if len(name) <= 60 else repr(name[:57] + "...")
+        msg = f"no {interface} plugin named {shown}{suggest(name, known)}; installed: {installed}"
         return msg + self.disabled_note()
 
     def disabled_note(self) -> str:
