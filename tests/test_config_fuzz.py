@@ -58,6 +58,16 @@ DATASET = (
 )
 
 
+def dataset_check_error(
+    extra: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> tuple[Path, str]:
+    """``mdf dataset check`` of :data:`DATASET` with ``extra`` after it: the config and the
+    one error line."""
+    cfg = tmp_path / "d.toml"
+    cfg.write_text(DATASET + extra)
+    return cfg, one_error_line(["dataset", "check", str(cfg)], capsys)
+
+
 @pytest.mark.parametrize(
     ("scene", "expected"),
     [
@@ -72,9 +82,7 @@ def test_a_varied_scene_of_the_wrong_shape_is_named(
     scene: str, expected: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     # the variations (aspect, radar range) were applied to the scene before it was validated
-    cfg = tmp_path / "d.toml"
-    cfg.write_text(f"{DATASET}[base]\nscene = {scene}\n")
-    line = one_error_line(["dataset", "check", str(cfg)], capsys)
+    cfg, line = dataset_check_error(f"[base]\nscene = {scene}\n", tmp_path, capsys)
     assert line.startswith(f"mdf: error: {cfg}: sources[0] record 0: {expected}"), line
 
 
@@ -342,3 +350,21 @@ def test_a_yaml_key_that_is_not_text_is_named(
                    "scatterers: {kind: points}\n1: 2\n")  # fmt: skip
     line = one_error_line(["check", str(cfg)], capsys)
     assert line == f"mdf: error: {cfg}: 1: a key must be text (got 1)"
+
+
+@pytest.mark.parametrize(
+    ("setting", "field"),
+    [
+        ("atmospheric_loss_db = 400", "radar.atmospheric_loss_db"),
+        ("gain_dbi = -400", "radar.gain_dbi"),
+        ("transmit_power = 1e-300", "radar.transmit_power"),
+    ],
+)
+def test_an_echo_too_weak_for_the_arithmetic_is_refused_by_dataset_check(
+    setting: str, field: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # mdf dataset check called these valid; the build stopped at the first record: "the
+    # spectrogram is silent: no frame rises above the floor"
+    _, line = dataset_check_error(f'[base.radar]\nkind = "lfm"\n{setting}\n', tmp_path, capsys)
+    assert f": {field}: the echo of 1 m^2 at 1 m would carry " in line, line
+    assert "less than 1e-30 W, too weak for the arithmetic" in line
