@@ -637,7 +637,8 @@ def test_the_input_rules_page_states_the_radar_bounds_and_messages_of_the_code()
 
     page = " ".join((ROOT / "docs" / "input-rules.md").read_text().split())
     rows = {
-        "at most 1e15 Hz/s (1000 MHz/us)": w.MAX_SLOPE_HZ_PER_S == 1e15,
+        "at least 1e6 Hz/s (1 MHz/s), at most 1e15 Hz/s (1000 MHz/us)": w.MAX_SLOPE_HZ_PER_S == 1e15
+        and w.MIN_SLOPE_HZ_PER_S == 1e6,
         "| 0 .. 10 ms (the ramp > 0) |": w.MAX_CHIRP_TIME_S == 10e-3,
         "| > 0, at most 1 GHz |": w.MAX_ADC_RATE_HZ == 1e9,
         "| 2 .. 16384 |": w.MAX_SAMPLES == 16384,
@@ -652,6 +653,7 @@ def test_the_input_rules_page_states_the_radar_bounds_and_messages_of_the_code()
         assert text in page and matches, text
     schema = FmcwConfig.model_json_schema()["properties"]
     assert schema["slope"]["maximum"] == w.MAX_SLOPE_HZ_PER_S
+    assert schema["slope"]["minimum"] == w.MIN_SLOPE_HZ_PER_S
     assert schema["n_loops"]["maximum"] == w.MAX_LOOPS
     quoted = {
         "sample_rate": (1e6, "radar.ramp_end_time: the ADC samples until 247.000 us"),

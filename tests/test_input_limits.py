@@ -501,7 +501,7 @@ def test_the_documented_limits_are_the_code_s() -> None:
     from mdframework.cluster import SCHEDULER_TIMEOUT_S, scheduler_timeout
 
     page = (ROOT / "docs" / "input-rules.md").read_text()
-    rows = re.findall(r"^\| `([A-Z0-9_]+)` \| ([0-9.e+]+) \|", page, flags=re.M)
+    rows = re.findall(r"^\| `([A-Z0-9_]+)` \| ([0-9.e+-]+) \|", page, flags=re.M)
     names = {n for n in dir(limits) if n.isupper() and not n.startswith("_")}
     assert {name for name, _ in rows} == names  # every limit documented, nothing else
     for name, value in rows:

@@ -37,6 +37,7 @@ from .pipeline import (
     Stages,
     apply_effects,
     build_stages,
+    check_echo_power,
     effect_generators,
     frames_inside,
     gate_ranges,
@@ -234,6 +235,7 @@ def plan_run(
     t = record_pulses(wf, t_start, t_end)
     n_pulses = int(t.shape[0])
     geometry = spectrogram_geometry(wf, n_pulses, proc)
+    check_echo_power(wf)
     record_body = body.select_frames(frames_inside(body.time, t_start, t_end))
     # what the radar refuses (or warns about) before a pulse
     start_record(stages, record_body, t, radar_pos, config.scene.gate)
@@ -394,9 +396,10 @@ def plan_dataset(
 ) -> DatasetPlan:
     """Plan a dataset config (:class:`~mdframework.dataset.DatasetConfig`, its folder
     ``base_dir``) as a build does before its first record: every record's config is validated,
-    with its draws, and each label's first simulated record is planned (:func:`plan_run`), or
-    with ``every`` each simulated record (what a run refuses stops the plan, naming the record,
-    unless the config's ``on_error = "skip"``: then it is counted as the build would skip it)."""
+    with its draws, and each source's first simulated record that runs is planned
+    (:func:`plan_run`; the report shows each label's first), or with ``every`` each simulated
+    record (what a run refuses stops the plan, naming the record, unless the config's
+    ``on_error = "skip"``: then it is counted as the build would skip it)."""
     from .dataset import (
         is_record_failure,
         plan_records,
@@ -407,10 +410,11 @@ def plan_dataset(
 
     specs = plan_records(config, base_dir)
     plan = DatasetPlan(len(specs), {}, {}, None)
+    planned: set[int | None] = set()  # the sources of which a record is planned
     for spec in specs:
         label = spec.label
         plan.records[label] = plan.records.get(label, 0) + 1
-        if (label in plan.first and not every) or "recording" in spec.run_config:
+        if (spec.source in planned and not every) or "recording" in spec.run_config:
             continue
         where = f"record {spec.record_id}"
         try:
@@ -428,6 +432,7 @@ def plan_dataset(
             plan.n_skipped[label] = plan.n_skipped.get(label, 0) + 1
             continue
         plan.first.setdefault(label, p)
+        planned.add(spec.source)
         if every:
             plan.n_planned[label] = plan.n_planned.get(label, 0) + 1
             plan.n_aliasing[label] = plan.n_aliasing.get(label, 0) + int(p.aliasing)

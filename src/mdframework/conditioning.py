@@ -174,6 +174,11 @@ def bridge_gaps(time: FloatArray, positions: FloatArray, valid: BoolArray) -> Fl
 # --------------------------------------------------------------------------- 3. foot outliers
 
 
+#: most bins of the deviation histogram of :func:`histogram_threshold` (8 MB of counts): a bin
+#: width far below the deviations (``conditioning.outlier_bin_m``) would allocate gigabytes
+MAX_HISTOGRAM_BINS = 1_000_000
+
+
 def histogram_threshold(deviation: FloatArray, bin_width: float, minimum: float) -> float:
     """Adaptive outlier threshold from the histogram of deviations.
 
@@ -185,7 +190,14 @@ def histogram_threshold(deviation: FloatArray, bin_width: float, minimum: float)
     d = deviation[np.isfinite(deviation)]
     if d.size == 0:
         return float("inf")
-    n_bins = max(int(np.ceil(float(d.max()) / bin_width)) + 1, 1)
+    bins = np.ceil(float(d.max()) / bin_width) + 1  # float: inf for a denormal bin width
+    if not bins <= MAX_HISTOGRAM_BINS:
+        raise ValueError(
+            f"outlier_bin_m: deviations up to {float(d.max()):.3g} m in bins of {bin_width:g} m "
+            f"need {bins:.3g} histogram bins, more than {MAX_HISTOGRAM_BINS:,}: raise "
+            "outlier_bin_m (0.01 m is the default)"
+        )
+    n_bins = max(int(bins), 1)
     counts, edges = np.histogram(d, bins=n_bins, range=(0.0, n_bins * bin_width))
     mode = int(np.argmax(counts))
     empty = np.flatnonzero(counts[mode:] == 0)

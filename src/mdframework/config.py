@@ -17,6 +17,7 @@ import difflib
 import json
 import re
 import stat
+import sys
 import tomllib
 from collections.abc import Hashable, Iterator, Sequence
 from contextlib import contextmanager
@@ -136,6 +137,14 @@ def _load_yaml(p: Path, text: str) -> Any:
     import yaml
 
     class Loader(yaml.SafeLoader):  # type: ignore[misc]  # PyYAML is untyped here
+        def construct_object(self, node: Any, deep: bool = False) -> Any:
+            try:
+                return super().construct_object(node, deep=deep)
+            except ValueError as exc:  # a date 2024-13-45, a number of 5000 digits
+                raise yaml.constructor.ConstructorError(
+                    problem=_value_problem(exc), problem_mark=node.start_mark
+                ) from None
+
         def construct_mapping(self, node: Any, deep: bool = False) -> Any:
             seen: set[Any] = set()
             for key_node, _ in node.value:
@@ -162,6 +171,13 @@ def _load_yaml(p: Path, text: str) -> Any:
         where = f"line {mark.line + 1}: " if mark is not None else ""
         problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
         raise ConfigError(f"{p}: invalid YAML: {where}{problem}") from None
+
+
+def _value_problem(exc: ValueError) -> str:
+    """A value a parser cannot make (``ValueError``) in plain words."""
+    if "integer string conversion" in str(exc):  # Python's limit, not the config's
+        return f"a whole number of more than {sys.get_int_max_str_digits()} digits"
+    return str(exc)  # "month must be in 1..12"
 
 
 class _RepeatedKey(ValueError):
@@ -315,6 +331,9 @@ def read_config_file(
         raise ConfigError(
             f"{p}: tables and lists are nested more than {limits.MAX_CONFIG_DEPTH} deep"
         ) from None
+    except ValueError as exc:  # a number of 5000 digits
+        what = {".toml": "TOML", ".json": "JSON"}.get(suffix, "YAML")
+        raise ConfigError(f"{p}: invalid {what}: {_value_problem(exc)}") from None
     if not isinstance(data, dict):
         raise ConfigError(f"{p}: the top level must be a table of sections")
     _check_depth(p, data)
@@ -427,6 +446,16 @@ def _plain(error: Any, allowed: list[str] | None) -> str:
         return f"must be one of {expected}{got}{suggest(str(error.get('input')), options)}"
     if kind in ("model_type", "dict_type"):  # not pydantic's "instance of <class>"
         return f"must be a table{got}"
+    if kind in ("too_short", "too_long"):  # pydantic: "List should have at least 1 item ..."
+        least = "at least" if kind == "too_short" else "at most"
+        n = ctx.get("min_length" if kind == "too_short" else "max_length")
+        return f"must hold {least} {n} item{'' if n == 1 else 's'}{got}"
+    if kind == "invalid_key":  # a YAML key 1, true or null
+        return f"a key must be text{got}"
+    if kind == "int_parsing_size":  # pydantic: "Unable to parse input string as an integer"
+        return f"must be a whole number within the field's range{got}"
+    if kind == "path_type":  # pydantic: "Input is not a valid path for <class 'pathlib.Path'>"
+        return f"must be a path (text){got}"
     if kind in ("value_error", "assertion_error"):
         return str(msg.split(", ", 1)[1] if ", " in msg else msg)
     plain = str(msg).replace("Input should be", "must be").replace("Value error, ", "")
@@ -548,6 +577,11 @@ def check_plugin_kinds(data: dict[str, Any], source: str, registry: Registry) ->
                 problem = f"must be a table with a kind (got {_short(section)})"
             raise ConfigError(f"{source}: {where}: {problem}{_kinds(registry, interface)}")
         kind = section.get("kind")
+        if kind is None and "kind" in section:  # YAML's null, JSON's null: not the default
+            raise ConfigError(
+                f"{source}: {where}.kind: null: say which {interface} plugin"
+                f"{_kinds(registry, interface)}"
+            )
         if kind is None:
             if len(registry.names(interface)) == 1:
                 continue  # the only plugin's config has its kind as default
@@ -619,7 +653,10 @@ def apply_overrides(data: dict[str, Any], overrides: Sequence[str]) -> dict[str,
     result: dict[str, Any] = copy.deepcopy(data)
     for item in overrides:
         parts, text = _override_key(item)
-        value = _override_value(text)
+        try:
+            value = _override_value(text)
+        except ValueError as exc:  # a number of 5000 digits
+            raise ConfigError(f"--set {item}: {_value_problem(exc)}") from None
         node: Any = result
         for depth, part in enumerate(parts):
             last = depth == len(parts) - 1

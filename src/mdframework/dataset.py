@@ -384,6 +384,9 @@ class RecordSpec:
     length_field: str | None = None
     #: a recorded record's (file, start [s], duration [s]), named by its errors and skip row
     window: tuple[str, float, float] | None = None
+    #: a simulated record's source: its number in ``sources`` (``mdf dataset check`` plans the
+    #: first record of each)
+    source: int | None = None
 
 
 def load_dataset_config(
@@ -555,25 +558,44 @@ def _record_seed(key: list[int]) -> int:
     return int(np.random.SeedSequence(key).generate_state(1)[0])
 
 
-def _scene_for(base_scene: dict[str, Any], variation: dict[str, Any]) -> dict[str, Any]:
-    """The scene of one record: the (base) scene with only the varied fields replaced."""
+def _scene_for(base_scene: Any, variation: dict[str, Any]) -> Any:
+    """The scene of one record: the (base) scene with only the varied fields replaced. A scene,
+    person, position or radar position of the wrong shape is left as it is, for the record's
+    validation to name."""
+    if not isinstance(base_scene, dict):
+        return base_scene
     scene: dict[str, Any] = json.loads(json.dumps(base_scene))
-    if variation["aspect_deg"] is not None:
-        person = dict(scene.get("person", {}))
+    person = scene.get("person", {})
+    if variation["aspect_deg"] is not None and isinstance(person, dict):
+        person = dict(person)
         person.pop("heading_deg", None)  # the aspect replaces any fixed heading
         person["aspect_deg"] = variation["aspect_deg"]
         scene["person"] = person
     if variation["radar_position"] is not None:
         scene["radar_position"] = list(variation["radar_position"])
     if variation["radar_range"] is not None or variation["radar_height"] is not None:
-        start = scene.get("person", {}).get("position", (0.0, 0.0))
-        radar = list(scene.get("radar_position", (10.0, 0.0, 2.0)))
+        start: Any = person.get("position", [0.0, 0.0]) if isinstance(person, dict) else None
+        radar = scene.get("radar_position", [10.0, 0.0, 2.0])
+        if not _numbers(radar, 3) or (
+            variation["radar_range"] is not None and not _numbers(start, 2)
+        ):
+            return scene
+        radar = list(radar)
         if variation["radar_range"] is not None:
             radar[0], radar[1] = start[0] + variation["radar_range"], start[1]
         if variation["radar_height"] is not None:
             radar[2] = variation["radar_height"]
         scene["radar_position"] = radar
     return scene
+
+
+def _numbers(value: Any, n: int) -> bool:
+    """Whether ``value`` is a list of ``n`` numbers (not flags)."""
+    return (
+        isinstance(value, list | tuple)
+        and len(value) == n
+        and all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
+    )
 
 
 def _merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
@@ -1075,16 +1097,18 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
         rz = _randomize(config, entry)
         origins = _draw_origins(config, entry_no, entry)
 
-        n_windows = int(np.ceil((duration - length + 1e-9) / hop))
+        windows = float(np.ceil((duration - length + 1e-9) / hop))  # inf for a hop of 1e-308
         if entry.max_records is not None:
-            n_windows = min(n_windows, entry.max_records)
+            windows = min(windows, entry.max_records)
         n_draws = rz.draws if rz.active() else 1
-        if len(specs) + n_windows * len(grid) * n_draws > limits.MAX_RECORDS:
+        if len(specs) + windows * len(grid) * n_draws > limits.MAX_RECORDS:
+            shown = f"{windows:,.0f}" if windows < 1e15 else f"{windows:.3g}"
             raise ConfigError(
-                f"sources[{entry_no}]: {n_windows:,} windows x {len(grid)} variation(s) x "
+                f"sources[{entry_no}]: {shown} windows x {len(grid)} variation(s) x "
                 f"{n_draws} draw(s) take the dataset beyond the limit of "
                 f"{limits.MAX_RECORDS:,} records; raise hop or set max_records"
             )
+        n_windows = int(windows)
         starts = span_start + np.arange(n_windows) * hop
         # a source is known by its motion's contents, wherever its file lies (and among
         # sources of one motion, by its place)
@@ -1157,7 +1181,8 @@ def plan_records(config: DatasetConfig, base_dir: Path, *, workers: int = 1) -> 
                     asked,
                     content,
                 )
-                specs.append(replace(spec, length_field=_length_field(config, entry_no, entry)))
+                length_field = _length_field(config, entry_no, entry)
+                specs.append(replace(spec, length_field=length_field, source=entry_no))
                 # every record's run config is valid before any file is written (with
                 # on_error = "skip" an invalid record is skipped by the build instead)
                 if config.on_error == "stop" or not points_checked:

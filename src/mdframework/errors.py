@@ -11,7 +11,9 @@ from typing import Any
 def unnameable(path: str | Path) -> str | None:
     """Why this system cannot name the file ``path``: a character its file names cannot hold
     (a UTF-8 config naming a non-ASCII file, under an ASCII or Latin-1 locale without Python's
-    UTF-8 mode); None if it can."""
+    UTF-8 mode, or a NUL character); None if it can."""
+    if "\0" in str(path):
+        return "a file name cannot hold a NUL character"
     try:
         os.fsencode(path)
     except UnicodeEncodeError:

@@ -42,7 +42,7 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import Field, ValidationError, model_validator
+from pydantic import Field, ValidationError, field_validator, model_validator
 
 from . import limits
 from .classify import (
@@ -62,7 +62,7 @@ from .dataset import (
     load_dataset_config,
     record_arrays,
 )
-from .errors import ConfigError, DataFileError, MdfError
+from .errors import ConfigError, DataFileError, MdfError, unnameable
 from .features import FEATURE_NAMES
 from .interfaces import Classifier
 from .outdir import output_folder, safe_name
@@ -91,6 +91,14 @@ class DatasetRef(StrictModel):
 
     config: Path | None = Field(None, description="Dataset config file to build.")
     path: Path | None = Field(None, description="Folder of an already built dataset.")
+
+    @field_validator("config", "path")
+    @classmethod
+    def _nameable(cls, value: Path | None) -> Path | None:
+        why = None if value is None else unnameable(value)
+        if why is not None:
+            raise ValueError(why)
+        return value
 
     @model_validator(mode="after")
     def _one(self) -> DatasetRef:

@@ -55,6 +55,15 @@ MAX_PRF_HZ = 1e7
 MAX_PULSES = 5_000_000
 #: Largest radar cross section of a point [m^2].
 MAX_RCS_M2 = 1e6
+#: Largest echo power [W] of a 1 m^2 scatterer 1 m from the radar, the range equation's
+#: P G^2 lambda^2 / ((4 pi)^3 L) (a 1 MW radar with a 60 dBi antenna at 10 GHz: 4.5e11 W);
+#: stronger, the echoes of near, large scatterers overflow the float32 arithmetic of the radars
+#: and of the spectrogram.
+MAX_ECHO_POWER_W = 1e12
+#: Smallest such echo power [W] (-270 dBm; a 1 mW radar at 60 GHz with 0 dBi and 100 dB of
+#: losses gives 1.3e-21 W): weaker, every echo vanishes below float32's smallest numbers and
+#: the spectrogram is silent (which stops a dataset build).
+MIN_ECHO_POWER_W = 1e-30
 #: Largest speed of a generated target or walker [m/s].
 MAX_TARGET_SPEED_MPS = 1_000.0
 MAX_PERSON_SPEED_MPS = 15.0
@@ -147,6 +156,25 @@ def check_pulses(
             f"{where}: a record of {duration_s:g} s at {prf_hz:g} pulses/s is {n:.4g} pulses "
             f"(about {need} of memory{kept}); the limit is {MAX_PULSES:,} pulses: shorten the "
             "record or lower the pulse rate (the PRF; FMCW: the chirps per second)"
+        )
+
+
+def check_echo_power(power_w: float, field: str = "radar.gain_dbi") -> None:
+    """Refuse a radar whose range equation gives a 1 m^2 scatterer at 1 m an echo of
+    ``power_w`` [W] above :data:`MAX_ECHO_POWER_W` or below :data:`MIN_ECHO_POWER_W`, naming
+    ``field`` (the setting most to blame)."""
+    what = (
+        f"the echo of 1 m^2 at 1 m would carry {power_w:.3g} W (transmit_power x gain^2 x "
+        "wavelength^2 / ((4 pi)^3 x losses))"
+    )
+    if not power_w <= MAX_ECHO_POWER_W:
+        raise SceneError(
+            f"{field}: {what}, more than {MAX_ECHO_POWER_W:g} W: lower gain_dbi or transmit_power"
+        )
+    if not power_w >= MIN_ECHO_POWER_W:
+        raise SceneError(
+            f"{field}: {what}, less than {MIN_ECHO_POWER_W:g} W, too weak for the "
+            "arithmetic: raise gain_dbi or transmit_power, or lower the losses"
         )
 
 

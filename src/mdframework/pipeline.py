@@ -51,6 +51,7 @@ from .settings import (
     ConditioningConfig,
     PersonConfig,
     ProcessingConfig,
+    RadarPowerConfig,
     RunConfigBase,
     SanityConfig,
 )
@@ -386,6 +387,26 @@ def spectrogram_geometry(
     return geometry
 
 
+def check_echo_power(wf: RadarWaveform) -> None:
+    """Refuse a radar whose range equation makes echoes too strong or too weak for the
+    pipeline's float32 arithmetic (:func:`limits.check_echo_power`: ``radar.gain_dbi`` of 300 dB,
+    or 400 dB of losses, say), before any pulse; ``mdf check`` refuses it too."""
+    cfg = getattr(wf, "config", None)
+    if isinstance(cfg, RadarPowerConfig) and cfg.amplitude == "range_equation":
+        wavelength = radar.wavelength(wf.carrier_frequency)
+        power = float(cfg.amplitudes(np.ones(1), np.ones(1), wavelength)[0]) ** 2
+        # the setting most to blame: the largest term of the range equation in dB (the
+        # smallest for too weak an echo)
+        terms = {
+            "radar.gain_dbi": 2.0 * cfg.gain_dbi,
+            "radar.transmit_power": 10.0 * float(np.log10(cfg.transmit_power)),
+            "radar.system_loss_db": -cfg.system_loss_db,
+            "radar.atmospheric_loss_db": -cfg.atmospheric_loss_db,
+        }
+        pick = max if power > limits.MAX_ECHO_POWER_W else min
+        limits.check_echo_power(power, pick(terms, key=terms.__getitem__))
+
+
 def processing_stft(
     signal: ComplexArray, sample_rate: float, proc: ProcessingConfig
 ) -> Spectrogram:
@@ -468,6 +489,7 @@ def _simulate_motion(
     )
     t = record_pulses(wf, t_start, t_end)
     spectrogram_geometry(wf, t.shape[0], proc)  # a record too short: refused before any pulse
+    check_echo_power(wf)
     frames = interpolation.window_frames(body.time, float(t[0]), float(t[-1]))
     near = body.select_frames(frames)
     refuse_untracked(near, float(t[0]), float(t[-1]), float(body.time[0]))

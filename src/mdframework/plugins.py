@@ -243,8 +243,11 @@ class _ByInterface(dict[str, dict[str, PluginInfo]]):
 
 
 def suggest(name: str, known: Iterable[str]) -> str:
-    """`` (did you mean 'x'?)`` for the closest of ``known`` to ``name``, or ``""``."""
-    close = difflib.get_close_matches(str(name), list(known), n=1, cutoff=0.6)
+    """`` (did you mean 'x'?)`` for the closest of ``known`` to ``name`` (first one that differs
+    only in case or surrounding blanks: ``'CW'`` for ``'cw'``), or ``""``."""
+    known = list(known)
+    same = [k for k in known if k.casefold() == str(name).strip().casefold()]
+    close = same or difflib.get_close_matches(str(name), known, n=1, cutoff=0.6)
     return f" (did you mean {close[0]!r}?)" if close else ""
 
 
@@ -278,7 +281,8 @@ class Registry:
         installed = ", ".join(known) or "none"
         hint = _install_hint(interface, name)  # a built-in kind: no nearest name to suggest
         near = "" if hint else suggest(name, known)
-        msg = f"no {interface} plugin named {name!r}{near}; installed: {installed}{hint}"
+        shown = repr(name) if len(name) <= 60 else repr(name[:57] + "...")
+        msg = f"no {interface} plugin named {shown}{near}; installed: {installed}{hint}"
         return msg + self.disabled_note()
 
     def disabled_note(self) -> str:

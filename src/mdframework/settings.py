@@ -17,6 +17,7 @@ numeric field is bounded on both sides. The shared bounded types below (:data:`C
 
 from __future__ import annotations
 
+import stat
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -73,6 +74,12 @@ LegLength = Annotated[float, Field(ge=0, le=100)]
 Workers = Annotated[int, Field(ge=1, le=1024)]
 
 
+def _short_path(path: Path) -> str:
+    """A path as an error shows it: at most 200 characters (the middle cut out)."""
+    text = str(path)
+    return text if len(text) <= 200 else f"{text[:100]}...{text[-97:]}"
+
+
 def _resolve_path(value: Path, info: ValidationInfo) -> Path:
     base = (info.context or {}).get("base_dir")
     path = Path(value).expanduser()
@@ -81,9 +88,13 @@ def _resolve_path(value: Path, info: ValidationInfo) -> Path:
     why = unnameable(path)
     if why is not None:
         raise ValueError(f"{path}: {why}")
-    if not path.exists():
-        raise ValueError(f"file not found: {path}")
-    if path.is_dir():
+    try:
+        mode = path.stat().st_mode
+    except FileNotFoundError:
+        raise ValueError(f"file not found: {path}") from None
+    except OSError as exc:  # a name too long, a folder on the way that cannot be read
+        raise ValueError(f"{_short_path(path)}: cannot read: {exc.strerror or exc}") from None
+    if stat.S_ISDIR(mode):
         raise ValueError(f"{path} is a folder; name a file in it")
     return path.absolute()  # a resolved config read from anywhere names the same file
 

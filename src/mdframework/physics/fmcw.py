@@ -471,14 +471,29 @@ def analytic_range_profile(
             summed = summed[:, 0, :]
         total = _window_combine(name, seq.n_samples, summed, ext, sel)
         return np.asarray(total * scale, np.complex128)
-    nu = np.asarray(bins, np.float64)[None, None, :] / n_fft - x[:, :, None]
-    kern = window_transform(name, seq.n_samples, nu)
+    sel_bins = np.asarray(bins, np.float64)
     if separate:
+        nu = sel_bins[None, None, :] / n_fft - x[:, :, None]
+        kern = window_transform(name, seq.n_samples, nu)
         return np.asarray(coef[:, :, None] * kern * scale, np.complex128)
-    if phasors is None:
-        return np.asarray(np.einsum("cs,csk->ck", coef, kern) * scale, np.complex128)
-    total = np.einsum("crs,csk->crk", phasors * coef[:, None, :], kern)
-    return np.asarray(total * scale, np.complex128)
+    weights = coef if phasors is None else phasors * coef[:, None, :]
+    out = np.empty((*weights.shape[:-1], sel_bins.size), dtype=np.complex128)
+    # the kernel (n_chirps, n_scat, bins) a block of bins at a time: every bin of a 65536-point
+    # FFT (a wide analytic_margin) for every chirp and scatterer would take gigabytes
+    step = max(1, _KERNEL_CELLS // max(1, x.size))
+    for lo in range(0, sel_bins.size, step):
+        nu = sel_bins[None, None, lo : lo + step] / n_fft - x[:, :, None]
+        kern = window_transform(name, seq.n_samples, nu)
+        if phasors is None:
+            out[..., lo : lo + step] = np.einsum("cs,csk->ck", weights, kern)
+        else:
+            out[..., lo : lo + step] = np.einsum("crs,csk->crk", weights, kern)
+    out *= scale
+    return out
+
+
+#: most values of the kernel of :func:`analytic_range_profile` computed at once (64 MiB)
+_KERNEL_CELLS = 2**22
 
 
 def range_axis(seq: ChirpSequence, n_fft: int) -> FloatArray:
@@ -490,7 +505,23 @@ def bins_near(ranges: FloatArray, seq: ChirpSequence, n_fft: int, margin: int) -
     """Range bins within ``margin`` bins of any of ``ranges`` [m] (after IF aliasing), sorted."""
     pos = np.mod(np.asarray(ranges, np.float64).ravel() / seq.max_range * n_fft, n_fft)
     base = np.floor(pos).astype(np.int64)
-    return _distinct_bins(base[:, None] + np.arange(-margin, margin + 2)[None, :], n_fft)
+    return _bins_around(base, -margin, margin + 1, n_fft)
+
+
+def _bins_around(base: IntArray, lo: int, hi: int, n: int) -> IntArray:
+    """The distinct values of ``(base + d) % n`` for every ``d`` in ``lo..hi``, sorted: each
+    base's run of bins marked as an interval, so that memory grows with ``base`` and ``n``, not
+    with ``hi - lo`` (a margin of 65536 bins around thousands of ranges)."""
+    width = hi - lo + 1
+    if width >= n:
+        return np.arange(n, dtype=np.int64)
+    start = np.mod(base + lo, n)
+    end = start + width  # exclusive; past n the run wraps to bin 0
+    wrapped = end[end > n] - n
+    edges = np.bincount(start, minlength=n + 1) - np.bincount(np.minimum(end, n), minlength=n + 1)
+    edges[0] += wrapped.size
+    edges -= np.bincount(wrapped, minlength=n + 1)
+    return np.flatnonzero(np.cumsum(edges[:n]) > 0).astype(np.int64)
 
 
 def _distinct_bins(bins: IntArray, n: int) -> IntArray:

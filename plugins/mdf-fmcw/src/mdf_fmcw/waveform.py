@@ -62,6 +62,9 @@ KT0 = 1.380649e-23 * 290.0
 # they describe (TI's mmWaveLink profile and frame limits in brackets; docs/input-rules.md).
 #: Steepest chirp [Hz/s], 1000 MHz/us (TI: 100 MHz/us at 77 GHz, 250 MHz/us at 60 GHz).
 MAX_SLOPE_HZ_PER_S = 1e15
+#: Shallowest chirp [Hz/s], 1 MHz/s (1e-6 MHz/us), far below any sensor's; a slope near 1e-300
+#: Hz/s made the maximum range ``sample_rate c / (2 slope)`` infinite.
+MIN_SLOPE_HZ_PER_S = 1e6
 #: Longest idle time, ADC start and ramp [s], 10 ms (TI: 5.24 ms, 41 us and 5 ms).
 MAX_CHIRP_TIME_S = 10e-3
 #: Fastest complex ADC [Hz], 1 GHz (TI: 37.5 Msps real or complex 2x, 18.75 Msps complex 1x).
@@ -107,7 +110,9 @@ class FmcwConfig(RadarPowerConfig):
         le=limits.MAX_CARRIER_HZ,
         description="Chirp start frequency f0 [Hz].",
     )
-    slope: float = Field(30e12, gt=0, le=MAX_SLOPE_HZ_PER_S, description="Chirp slope S [Hz/s].")
+    slope: float = Field(
+        30e12, ge=MIN_SLOPE_HZ_PER_S, le=MAX_SLOPE_HZ_PER_S, description="Chirp slope S [Hz/s]."
+    )
     idle_time: float = Field(
         10e-6, ge=0, le=MAX_CHIRP_TIME_S, description="Idle time before each ramp [s]."
     )
