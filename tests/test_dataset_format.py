@@ -236,6 +236,27 @@ def test_the_documented_reader_detects_an_incomplete_or_edited_folder(
         assert done.returncode != 0, case
 
 
+def walk_config(path: Path, extra: str = "", place: str = "recording", records: int = 1) -> Path:
+    """Write ``path``: a dataset config of ``records`` half-second CMU walk records with a small
+    spectrogram, whose scene names no aspect, then ``extra``."""
+    path.write_text(f"""
+seed = 5
+place = "{place}"
+[[sources]]
+label = "walk"
+motion = {{ kind = "cmu", file = "{CMU / "asf-amc" / "02_01.amc"}" }}
+max_records = {records}
+[record_lengths]
+walk = 0.5
+[base.processing]
+window_length = 128
+hop = 32
+nfft = 128
+{extra}
+""")
+    return path
+
+
 @pytest.mark.parametrize("place", ["recording", "record"])
 def test_a_record_of_the_default_aspect_says_so(tmp_path: Path, place: str) -> None:
     """A scene that names no aspect faces the person toward the radar (aspect 0): its records
@@ -248,24 +269,32 @@ def test_a_record_of_the_default_aspect_says_so(tmp_path: Path, place: str) -> N
     }
     tables = {}
     for name, extra in scenes.items():
-        config = tmp_path / f"{name}.toml"
-        config.write_text(f"""
-seed = 5
-place = "{place}"
-[[sources]]
-label = "walk"
-motion = {{ kind = "cmu", file = "{CMU / "asf-amc" / "02_01.amc"}" }}
-max_records = 1
-[record_lengths]
-walk = 0.5
-[base.processing]
-window_length = 128
-hop = 32
-nfft = 128
-{extra}
-""")
+        config = walk_config(tmp_path / f"{name}.toml", extra, place)
         build_dataset(*load_dataset_config(config), tmp_path / name, workers=1, progress=False)
         tables[name] = load_dataset(tmp_path / name)
     assert tables["default"].table["aspect_deg"][0] == 0.0 == tables["zero"].table["aspect_deg"][0]
     np.testing.assert_array_equal(tables["default"].spectrograms, tables["zero"].spectrograms)
     assert np.isnan(tables["heading"].table["aspect_deg"][0])
+
+
+def test_a_resumed_build_of_before_format_versions_says_the_default_aspect_too(
+    tmp_path: Path,
+) -> None:
+    """Records written before the default aspect was written as 0 (their ``aspect_deg`` null)
+    that a build resumes and keeps say 0 in index.csv and their ``meta`` like the records it
+    computes: the index of a format 1 folder does not mix 0 and empty for the same scene."""
+    config = walk_config(tmp_path / "ds.toml", records=2)
+    out = tmp_path / "out"
+    build_dataset(*load_dataset_config(config), out, workers=1, progress=False)
+    first = load_dataset(out).table
+    records = sorted((out / "records").glob("*.npz"))
+    assert len(records) == 2
+    arrays, meta = read_record(records[0])  # as the previous version wrote it
+    np.savez(records[0], **arrays, meta=np.array(json.dumps({**meta, "aspect_deg": None})))
+    records[1].unlink()  # a build stopped before its last record
+    build_dataset(*load_dataset_config(config), out, workers=1, progress=False)
+    table = load_dataset(out).table
+    assert list(table["id"]) == list(first["id"])  # the same records, none recomputed afresh
+    assert list(table["seed"]) == list(first["seed"])
+    assert list(table["aspect_deg"]) == [0.0, 0.0]
+    assert read_record(records[0])[1]["aspect_deg"] == 0.0

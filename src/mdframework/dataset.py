@@ -1528,7 +1528,9 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
         "dataset": spec.dataset,
         "start_s": cfg.motion.start,
         "duration_s": cfg.motion.duration,
-        "aspect_deg": _aspect(spec, cfg.scene.person),
+        "aspect_deg": _aspect(
+            spec.aspect_deg, cfg.scene.person.aspect_deg, cfg.scene.person.heading_deg
+        ),
         "radar_position_m": list(cfg.scene.radar_position),
         "height_m": run_config["motion"].get("height"),
         "seed": cfg.seed,
@@ -1542,15 +1544,15 @@ def _build_record(spec: RecordSpec, out_dir: str) -> dict[str, Any]:
     return _write_record(out_dir, spec, meta, {**spectrogram, "features": feats, **extra})
 
 
-def _aspect(spec: RecordSpec, person: Any) -> float | None:
-    """A simulated record's aspect angle [deg]: its scene's (a variation or draw), else the
-    one its placement was asked for (``place = "record"``), else 0 (the scene's default,
-    facing the radar) unless the scene gives a ``heading_deg`` instead (None)."""
-    if person.aspect_deg is not None:
-        return float(person.aspect_deg)
-    if spec.aspect_deg is not None:
-        return float(spec.aspect_deg)
-    return 0.0 if person.heading_deg is None else None
+def _aspect(asked: float | None, aspect: float | None, heading: float | None) -> float | None:
+    """A simulated record's aspect angle [deg]: its scene's ``aspect`` (a variation or draw),
+    else the one its placement was ``asked`` for (``place = "record"``), else 0 (the scene's
+    default, facing the radar) unless the scene gives a ``heading`` instead (None)."""
+    if aspect is not None:
+        return float(aspect)
+    if asked is not None:
+        return float(asked)
+    return 0.0 if heading is None else None
 
 
 def _write_record(
@@ -1690,10 +1692,11 @@ def _complete(
     short, corrupt, or whose metadata lacks a field or names another record is removed. A
     record whose label, group, subject, recording or dataset differ from ``spec``'s (the
     config changed only those) is kept and rewritten with the new ones (atomically; its arrays
-    are not recomputed), and so is its row. A record that cannot be read for want of
-    permission, or because the disk fails to give it (an ``OSError`` with an errno, such as
-    EIO or NFS's ESTALE), is an error (it is not removed). A record computed by other
-    software versions than this process's is kept, its id, its versions (``None``: a record
+    are not recomputed), and so is its row; so is one written before dataset format 1 whose
+    ``aspect_deg`` is null for the scene's default aspect (now 0). A record that cannot be
+    read for want of permission, or because the disk fails to give it (an ``OSError`` with an
+    errno, such as EIO or NFS's ESTALE), is an error (it is not removed). A record computed by
+    other software versions than this process's is kept, its id, its versions (``None``: a record
     written before records named theirs) and this process's added to ``other_versions``."""
     import zipfile
 
@@ -1713,6 +1716,12 @@ def _complete(
         if made_by != now:
             other_versions[spec.record_id] = (made_by, now)
         planned = _planned_meta(spec)
+        run = meta.get("run_config")
+        if meta["aspect_deg"] is None and run is not None:  # written before format 1, which
+            person = run["scene"]["person"]  # writes the scene's default aspect as 0
+            aspect = _aspect(spec.aspect_deg, person["aspect_deg"], person["heading_deg"])
+            if aspect is not None:
+                planned["aspect_deg"] = aspect
         renamed = any(meta.get(k) != v for k, v in planned.items())
         meta.update(planned)
         row = _row(meta, arrays["features"])  # (a field missing: a corrupt record)
