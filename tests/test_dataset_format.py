@@ -156,6 +156,21 @@ def test_a_dataset_of_a_newer_format_is_refused_and_one_of_before_formats_read(
     assert list(older.labels) == list(load_dataset(spectrogram_set).labels)
 
 
+@pytest.mark.parametrize("version", ["1", True, 0, 1.5, None])
+def test_a_format_version_that_is_no_formats_number_is_not_called_newer(
+    spectrogram_set: Path, tmp_path: Path, version: object
+) -> None:
+    # "1" (text) was refused as "a dataset of a newer format ... (1)"; true was read as 1
+    folder = tmp_path / "edited"
+    shutil.copytree(spectrogram_set, folder)
+    manifest = json.loads((folder / "dataset.json").read_text())
+    (folder / "dataset.json").write_text(json.dumps({**manifest, "format_version": version}))
+    with pytest.raises(DataFileError) as info:
+        load_dataset(folder)
+    assert f"format_version {version!r} is not a format's number (1, 2, ...); " in str(info.value)
+    assert "newer" not in str(info.value)
+
+
 def documented_reader() -> str:
     """The section's Python block: the reader that uses numpy, json, csv and hashlib only."""
     blocks = re.findall(r"```python\n(.*?)```", format_section(), flags=re.S)

@@ -2295,7 +2295,12 @@ def _verified_index(root: Path) -> str:
     if not isinstance(manifest, dict) or (digest is not None and not isinstance(digest, str)):
         raise DataFileError(manifest_path, f"not the file a build writes; {rebuild}")
     made = manifest.get("format_version", DATASET_FORMAT)  # absent: before format versions
-    if not isinstance(made, int) or made > DATASET_FORMAT:
+    if isinstance(made, bool) or not isinstance(made, int) or made < 1:  # not "newer"
+        raise DataFileError(
+            manifest_path,
+            f"format_version {made!r} is not a format's number (1, 2, ...); {rebuild}",
+        )
+    if made > DATASET_FORMAT:
         raise DataFileError(
             manifest_path,
             f"format_version {made!r}: a dataset of a newer format than this mdframework reads "
