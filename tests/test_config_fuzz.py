@@ -6,10 +6,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 from conftest import EXAMPLES
 
-from mdframework import cli
+from mdframework import cli, limits
 
 POINT = (
     '[motion]\nkind = "point_targets"\nlength = 1.0\n'
@@ -368,3 +369,26 @@ def test_an_echo_too_weak_for_the_arithmetic_is_refused_by_dataset_check(
     _, line = dataset_check_error(f'[base.radar]\nkind = "lfm"\n{setting}\n', tmp_path, capsys)
     assert f": {field}: the echo of 1 m^2 at 1 m would carry " in line, line
     assert "less than 1e-30 W, too weak for the arithmetic" in line
+
+
+@pytest.mark.parametrize(
+    ("carrier", "power", "gain"),
+    [
+        (2.38e9, 1e6, 73.0),  # an S-band 305 m dish planetary radar (Arecibo: 1 MW)
+        (8.56e9, 5e5, 74.0),  # an X-band 70 m dish planetary radar (Goldstone DSS-14)
+        (10e9, 2.5e5, 67.0),  # an X-band 37 m dish imaging radar (HUSIR)
+        (1.25e9, 1.54e7, 51.0),  # an L-band 29 m phased array (Cobra Dane: 15.4 MW peak)
+    ],
+)
+def test_a_real_high_power_radar_is_not_refused_as_too_strong(
+    carrier: float, power: float, gain: float, tmp_path: Path
+) -> None:
+    # these were refused (echo of 1 m^2 at 1 m above 1e12 W), though the float32 arithmetic
+    # holds echoes 1e8 times stronger (a 1e6 m^2 point at 0.5 m in a 65536-point STFT)
+    echo = power * 10 ** (gain / 5) * (299_792_458.0 / carrier) ** 2 / (4 * np.pi) ** 3
+    assert 1e12 < echo <= limits.MAX_ECHO_POWER_W
+    cfg = tmp_path / "c.toml"
+    radar = f'kind = "cw"\ncarrier_frequency = {carrier}\ntransmit_power = {power}\n'
+    cfg.write_text(POINT + f"[radar]\n{radar}gain_dbi = {gain}\n")
+    assert cli.main(["check", str(cfg)]) == 0
+    assert cli.main(["run", str(cfg), "--out", str(tmp_path / "out")]) == 0

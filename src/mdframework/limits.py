@@ -56,10 +56,11 @@ MAX_PULSES = 5_000_000
 #: Largest radar cross section of a point [m^2].
 MAX_RCS_M2 = 1e6
 #: Largest echo power [W] of a 1 m^2 scatterer 1 m from the radar, the range equation's
-#: P G^2 lambda^2 / ((4 pi)^3 L) (a 1 MW radar with a 60 dBi antenna at 10 GHz: 4.5e11 W);
-#: stronger, the echoes of near, large scatterers overflow the float32 arithmetic of the radars
-#: and of the spectrogram.
-MAX_ECHO_POWER_W = 1e12
+#: P G^2 lambda^2 / ((4 pi)^3 L) (a 1 MW planetary radar with a 73 dBi dish at 2.4 GHz,
+#: Arecibo's: 3.2e15 W; a 1 MW radar with a 60 dBi antenna at 10 GHz: 4.5e11 W); far stronger
+#: (1e20 W still runs with a 1e6 m^2 point at 0.5 m in a 65536-point STFT), the echoes of near,
+#: large scatterers overflow the float32 arithmetic of the radars and of the spectrogram.
+MAX_ECHO_POWER_W = 1e16
 #: Smallest such echo power [W] (-270 dBm; a 1 mW radar at 60 GHz with 0 dBi and 100 dB of
 #: losses gives 1.3e-21 W): weaker, every echo vanishes below float32's smallest numbers and
 #: the spectrogram is silent (which stops a dataset build).
