@@ -185,12 +185,16 @@ BIG = "1" + "0" * 5000  # more digits than Python converts to an integer
 @pytest.mark.parametrize(
     ("name", "text", "expected"),
     [
-        (
+        (  # the line: a config of many numbers has one that is too long
             "c.json",
-            '{"seed": ' + BIG + "}",
-            "invalid JSON: a whole number of more than 4300 digits",
+            '{"motion": {},\n "seed": ' + BIG + "}",
+            "invalid JSON: line 2: a whole number of more than 4300 digits",
         ),
-        ("c.toml", f"seed = {BIG}\n", "invalid TOML: a whole number of more than 4300 digits"),
+        (
+            "c.toml",
+            f"[motion]\nkind = 'cmu'\n[processing]\nnfft = 1_{BIG}\n",
+            "invalid TOML: line 4: a whole number of more than 4300 digits",
+        ),
         ("c.yaml", f"motion: {{}}\nseed: {BIG}\n", "invalid YAML: line 2: a whole number of more"),
         (
             "d.yaml",

@@ -180,6 +180,16 @@ def _value_problem(exc: ValueError) -> str:
     return str(exc)  # "month must be in 1..12"
 
 
+def _long_number_line(text: str) -> int | None:
+    """The line of ``text`` of its first run of more digits than Python converts to an integer
+    (TOML's ``_`` between them counted out), or None."""
+    limit = sys.get_int_max_str_digits()  # 0: no limit
+    for number in re.finditer(r"[0-9][0-9_]*", text):
+        if limit and len(number.group().replace("_", "")) > limit:
+            return text.count("\n", 0, number.start()) + 1
+    return None
+
+
 class _RepeatedKey(ValueError):
     """A key given twice in one JSON object (``line``: where that object starts)."""
 
@@ -333,7 +343,9 @@ def read_config_file(
         ) from None
     except ValueError as exc:  # a number of 5000 digits
         what = {".toml": "TOML", ".json": "JSON"}.get(suffix, "YAML")
-        raise ConfigError(f"{p}: invalid {what}: {_value_problem(exc)}") from None
+        line = _long_number_line(text)
+        where = f"line {line}: " if line is not None else ""
+        raise ConfigError(f"{p}: invalid {what}: {where}{_value_problem(exc)}") from None
     if not isinstance(data, dict):
         raise ConfigError(f"{p}: the top level must be a table of sections")
     _check_depth(p, data)
