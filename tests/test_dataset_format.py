@@ -25,7 +25,7 @@ from mdframework.dataset import (
     load_dataset_config,
     read_record,
 )
-from mdframework.errors import DataFileError
+from mdframework.errors import DataFileError, OutputError
 
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "datasets.md"
 CMU = EXAMPLES / "data" / "cmu"
@@ -313,3 +313,19 @@ def test_a_resumed_build_of_before_format_versions_says_the_default_aspect_too(
     assert list(table["seed"]) == list(first["seed"])
     assert list(table["aspect_deg"]) == [0.0, 0.0]
     assert read_record(records[0])[1]["aspect_deg"] == 0.0
+
+
+def test_a_build_does_not_rewrite_a_folder_of_a_newer_format_as_its_own(tmp_path: Path) -> None:
+    """A build by this version into a folder that a newer mdframework built (a format it cannot
+    read) stops before it writes: it kept the newer records and relabelled the folder as its
+    own format, which readers of that format then misread."""
+    config = walk_config(tmp_path / "ds.toml")
+    out = tmp_path / "out"
+    build_dataset(*load_dataset_config(config), out, workers=1, progress=False)
+    manifest = json.loads((out / "dataset.json").read_text())
+    newer = json.dumps({**manifest, "format_version": DATASET_FORMAT + 1})
+    (out / "dataset.json").write_text(newer)
+    for force in (False, True):
+        with pytest.raises(OutputError, match=r"format_version 2, newer than this mdframework"):
+            build_dataset(*load_dataset_config(config), out, workers=1, progress=False, force=force)
+        assert (out / "dataset.json").read_text() == newer

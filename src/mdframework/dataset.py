@@ -2050,6 +2050,7 @@ def build_dataset(
     check_scheduler_address(scheduler_address(scheduler))
     with dataset_folder(out_dir, force=force) as folder:
         _refuse_names_in_the_way(folder.path)
+        _refuse_newer_format(folder.path)
         note("planning the records (reading each recording once)", progress)
         _forget_loaded()  # every file is read afresh: one changed since is seen
         # errors in the config stop before any file. Records name their files, and are
@@ -2143,6 +2144,22 @@ def build_dataset(
 #: (:func:`atomic_savez`'s temporary file): the only files of ``records/`` a build removes
 _RECORD_NAME = re.compile(r"\d{5,}-[0-9a-f]{10}\.npz")
 _PARTIAL_NAME = re.compile(r"\.tmp-\w+\.(part|npz)")  # .npz: earlier versions
+
+
+def _refuse_newer_format(out: Path) -> None:
+    """:class:`OutputError` for a folder whose ``dataset.json`` a newer mdframework wrote (a
+    ``format_version`` above :data:`DATASET_FORMAT`), with ``--force`` too: a build would keep
+    its records, which this version cannot read, and relabel the folder as its own format."""
+    try:
+        manifest = json.loads(limits.read_file_bytes(out / MANIFEST).decode("utf-8"))
+    except (OSError, DataFileError, ValueError):  # none, or not the file a build writes
+        return
+    made = manifest.get("format_version") if isinstance(manifest, dict) else None
+    if isinstance(made, int) and not isinstance(made, bool) and made > DATASET_FORMAT:
+        raise OutputError(
+            f"--out {out}: holds a dataset of format_version {made}, newer than this mdframework "
+            f"writes ({DATASET_FORMAT}); upgrade mdframework, or build into another folder"
+        )
 
 
 def _refuse_names_in_the_way(out: Path) -> None:
