@@ -62,8 +62,9 @@ MAX_RCS_M2 = 1e6
 #: large scatterers overflow the float32 arithmetic of the radars and of the spectrogram.
 MAX_ECHO_POWER_W = 1e16
 #: Smallest such echo power [W] (-270 dBm; a 1 mW radar at 60 GHz with 0 dBi and 100 dB of
-#: losses gives 1.3e-21 W): weaker, every echo vanishes below float32's smallest numbers and
-#: the spectrogram is silent (which stops a dataset build).
+#: losses gives 1.3e-21 W): far weaker (about 1e-44 W for a walk 6 m away; a walk 10 km away
+#: still runs at 2e-31 W), every echo vanishes below float32's smallest numbers and the
+#: spectrogram is silent (which stops a dataset build).
 MIN_ECHO_POWER_W = 1e-30
 #: Largest speed of a generated target or walker [m/s].
 MAX_TARGET_SPEED_MPS = 1_000.0
