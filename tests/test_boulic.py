@@ -22,6 +22,7 @@ from mdframework.physics.body import LEG_FRACTION
 from mdframework.physics.radar import wavelength
 from mdframework.pipeline import RunResult, simulate
 from mdframework.plugins import Registry, build_registry
+from mdframework.settings import SanityConfig
 
 J = {n: i for i, n in enumerate(CANONICAL_JOINTS)}
 RADAR = np.array([10.0, 0.0, 2.0])
@@ -570,3 +571,19 @@ def test_a_check_across_the_walkers_fields_names_the_field(
     with pytest.raises(ConfigError) as err:
         validate_run_config({"motion": {"kind": "boulic", **motion}}, registry=registry)
     assert str(err.value).startswith(f"<config>: {start}"), str(err.value)
+
+
+def test_the_config_reference_gives_the_walkers_sanity_defaults() -> None:
+    """The config reference's row of the walker's ``sanity`` says which checks it leaves off
+    (its table of ``[motion.sanity]`` gives every source's defaults, cadence = true and size =
+    'warn', which the walker does not use): the row read as every source's."""
+    import re
+
+    from mdframework.docgen import render
+
+    row = next(line for line in render().splitlines() if "cadence = " in line)
+    found = re.search(r"\(cadence = (\w+), size = '(\w+)'\)", row)
+    assert found is not None, row
+    sanity = BoulicConfig().sanity
+    assert (found[1], found[2]) == (str(sanity.cadence).lower(), sanity.size)
+    assert (sanity.cadence, sanity.size) != (SanityConfig().cadence, SanityConfig().size)

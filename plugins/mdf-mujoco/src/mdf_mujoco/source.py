@@ -73,6 +73,12 @@ class BoulicConfig(MotionConfig):
         "lower-leg ellipsoid) for side-by-side comparison.",
     )
     activity: str = Field("walk", description="Activity label recorded with the run.")
+    sanity: SanityConfig = Field(
+        default_factory=SanityConfig,  # the validator below gives the walker's
+        description="Motion sanity checks, with the cadence and size checks off unless set "
+        "here (cadence = false, size = 'ignore'): the walker's cadence and legs follow from rv "
+        "and height.",
+    )
 
     @model_validator(mode="before")
     @classmethod
