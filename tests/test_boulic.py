@@ -22,6 +22,7 @@ from mdframework.physics.body import LEG_FRACTION
 from mdframework.physics.radar import wavelength
 from mdframework.pipeline import RunResult, simulate
 from mdframework.plugins import Registry, build_registry
+from mdframework.settings import SanityConfig
 
 J = {n: i for i, n in enumerate(CANONICAL_JOINTS)}
 RADAR = np.array([10.0, 0.0, 2.0])
@@ -498,20 +499,23 @@ def test_walker_is_not_blamed_for_its_time_base_or_unit(
 
 
 @pytest.mark.parametrize(
-    ("motion", "what"),
+    ("motion", "field", "what"),
     [
-        ({"n_cycles": 10_000, "nt": 65536}, "655,360,001 frames"),  # 200 GiB of joints
-        ({"rv": 5e-324}, r"of 6\.0\d+e\+161 s"),  # an overflow, reported as an internal error
-        ({"rv": 1e-9}, r"3 cycle\(s\) of 4\.256e\+04 s"),  # 3 cycles of 11.8 h
+        ({"n_cycles": 10_000, "nt": 65536}, "n_cycles", "655,360,001 frames"),  # 200 GiB
+        ({"rv": 5e-324}, "rv", r"of 6\.0\d+e\+161 s"),  # an overflow: an internal error
+        ({"rv": 1e-9}, "rv", r"3 cycle\(s\) of 4\.256e\+04 s"),  # 3 cycles of 11.8 h
+        ({"rv": 1e-9, "duration": 86400.0}, "duration", r"3 cycle\(s\) of 4\.256e\+04 s"),
     ],
 )
 def test_walks_beyond_the_limits_are_refused_before_loading(
-    registry: Registry, motion: dict[str, Any], what: str
+    registry: Registry, motion: dict[str, Any], field: str, what: str
 ) -> None:
     """The walker computes every frame from its start: a walk beyond the project's limits (a
     day, 10 million frames) is refused as a config error, as the deepmimic source's repeated
-    clips are, instead of exhausting memory or overflowing in ``mdf check``."""
-    with pytest.raises(ConfigError, match=rf"motion: the walk is .*{what}.*beyond the limits"):
+    clips are, instead of exhausting memory or overflowing in ``mdf check``; the error names
+    the field that set the walk's length (it read 'motion: the walk is ...')."""
+    match = rf"^<config>: motion\.{field}: the walk is .*{what}.*beyond the limits"
+    with pytest.raises(ConfigError, match=match):
         validate_run_config({"motion": {"kind": "boulic", **motion}}, registry=registry)
     slow = BoulicConfig(rv=1e-9, duration=1.0)  # one cycle: within the limits
     assert BoulicWalker(slow).n_cycles(BoulicWalker(slow).gait()) == 1
@@ -542,7 +546,44 @@ def test_a_window_beyond_the_cycles_names_n_cycles(registry: Registry) -> None:
     """n_cycles = 1 at rv = 1 is 1.346 s: a 3 s window was refused as 'motion.duration: the
     window 0..3 s ends after the recording', not naming the field that set the walk's length."""
     cfg = {"motion": {"kind": "boulic", "n_cycles": 1, "start": 1.0, "duration": 2.0}}
-    with pytest.raises(ConfigError, match=r"n_cycles = 1 .* set n_cycles to at least 3"):
+    match = r"^<config>: motion\.n_cycles: .*n_cycles = 1 .* set n_cycles to at least 3"
+    with pytest.raises(ConfigError, match=match):
         validate_run_config(cfg, registry=registry)
     cfg["motion"]["n_cycles"] = 3
     validate_run_config(cfg, registry=registry)
+
+
+@pytest.mark.parametrize(
+    ("motion", "start"),
+    [
+        ({"nt": 34, "n_cycles": 1, "start": 1.0, "duration": 2.0}, "motion.n_cycles: start"),
+        ({"nt": 33}, "motion.nt: must be even"),
+        ({"rv": 1.0, "speed": 1.0}, "motion.speed: give rv or speed"),
+        ({"speed": 15.0}, "motion.speed: 15.0 m/s gives rv = 16.97"),
+    ],
+)
+def test_a_check_across_the_walkers_fields_names_the_field(
+    registry: Registry, motion: dict[str, Any], start: str
+) -> None:
+    """The walker's checks across its fields name the field they blame, as every field error
+    does ('motion.n_cycles: ...'); they read 'motion: ...' (the window longer than n_cycles'
+    walk, an odd nt, rv with speed, a speed beyond rv 3)."""
+    with pytest.raises(ConfigError) as err:
+        validate_run_config({"motion": {"kind": "boulic", **motion}}, registry=registry)
+    assert str(err.value).startswith(f"<config>: {start}"), str(err.value)
+
+
+def test_the_config_reference_gives_the_walkers_sanity_defaults() -> None:
+    """The config reference's row of the walker's ``sanity`` says which checks it leaves off
+    (its table of ``[motion.sanity]`` gives every source's defaults, cadence = true and size =
+    'warn', which the walker does not use): the row read as every source's."""
+    import re
+
+    from mdframework.docgen import render
+
+    row = next(line for line in render().splitlines() if "cadence = " in line)
+    found = re.search(r"\(cadence = (\w+), size = '(\w+)'\)", row)
+    assert found is not None, row
+    sanity = BoulicConfig().sanity
+    assert (found[1], found[2]) == (str(sanity.cadence).lower(), sanity.size)
+    assert (sanity.cadence, sanity.size) != (SanityConfig().cadence, SanityConfig().size)

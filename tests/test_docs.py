@@ -754,3 +754,24 @@ def _parse_each(shown: list[tuple[str, str, list[str]]], monkeypatch: pytest.Mon
                 module.main()
             except SystemExit as exc:
                 pytest.fail(f"{where}: `{script} {shlex.join(args)}` does not parse ({exc})")
+
+
+def test_a_field_whose_default_differs_from_its_tables_defaults_says_so() -> None:
+    """The FMCW radar's cfar_range defaults to mode 'so' with 4 guard cells, while a
+    ``[radar.cfar_range]`` table that sets only threshold_db gets the table's own defaults,
+    mode 'ca' with 2 guard cells: the reference's table of it gave those alone, so a user
+    changing the threshold changed the detector without knowing it. The subsection says
+    both."""
+    from mdf_fmcw.waveform import FmcwConfig
+
+    default, partial = (
+        FmcwConfig().cfar_range,
+        FmcwConfig(cfar_range={"threshold_db": 12}).cfar_range,
+    )
+    assert default is not None and partial is not None
+    assert (default.mode, default.guard, partial.mode, partial.guard) == ("so", 4, "ca", 2)
+    line = (
+        'Without a `[radar.cfar_range]` table the field\'s default applies (mode = "so", '
+        "guard = 4, the rest as below); a table gives each field it leaves out the default below."
+    )
+    assert line in render().splitlines()

@@ -163,3 +163,33 @@ def test_static_reflectors_away_from_the_gate_are_no_target_lost(
         text = text.replace("[radar]\n", "[radar]\nsample_rate = 10e6\n")  # 50 m maximum range
     code, err, _ = run(tmp_path, text, capsys)
     assert code == 0 and err == "", err
+
+
+@pytest.mark.parametrize("max_range", [None, 62.46e3, 12.49])
+def test_the_tracking_gate_advice_names_the_maximum_range_only_when_the_body_reaches_it(
+    max_range: float | None,
+) -> None:
+    """Three point targets at 2.5-8 m with the gate tracking the first: two of three returns
+    are outside the gate. The advice said 'or beyond the radar's maximum range ... bring the
+    body within the maximum range' on every such run, an LFM radar's (62.46 km away) and a
+    CW-like radar's (none) alike; it names the maximum range only when the body reaches it
+    (an FMCW radar that lets ranges alias, maximum range 12.49 m, with the body at 13.5-14 m),
+    and then not the gate's width."""
+    echo = np.ones(10, np.complex128)
+    near = Losses(300, 200, 0, (2.5, 8.0), (2.5, 3.0))
+    why = empty_result(echo, near, max_lost_fraction=0.5, fixed_gate=False, max_range=max_range)
+    assert why is not None and "67 % are outside the range gate" in why
+    assert "maximum range" not in why
+    assert why.endswith(
+        "narrower than the body's spread in range (2.5-8 m): lengthen the radar's pulse, "
+        "or choose a wider gate response or gate (an FMCW radar's radar.gate_width)"
+    )
+    far = Losses(300, 300, 0, (13.5, 14.0), (13.5, 14.0))
+    why = empty_result(echo, far, max_lost_fraction=0.5, fixed_gate=False, max_range=max_range)
+    assert why is not None
+    reaches = (
+        "the body (at 13.5-14 m) reaches beyond the radar's maximum range 12.49 m, where its "
+        "range bins fold back and the tracking gate cannot follow it: bring the body within "
+        "the maximum range"
+    )
+    assert why.endswith(reaches) == (max_range == 12.49), why

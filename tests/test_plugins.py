@@ -827,3 +827,30 @@ def test_a_kind_whose_distribution_is_not_installed_says_what_to_install(
     )
     assert "pip install" not in registry.unknown_kind_message("radar", "sonar")
     assert "pip install" not in registry.unknown_kind_message("motion", "cmu")  # installed here
+
+
+def test_a_third_party_radar_with_a_prf_claims_no_unambiguous_range() -> None:
+    """A radar's ``prf`` does not give its unambiguous range: the quad radar sends four pulses
+    per slow-time sample (its pulse interval is a quarter of 1 / prf), and the CW radar of the
+    plugin guide calls its I/Q rate ``prf``. ``mdf check`` reported c / (2 prf) = 1499 m for
+    the quad radar at prf 100 kHz (four times its pulse interval's 375 m) and warned about a
+    fixed gate at 2 km as beyond it; a radar that does not say has none, and the LFM radar
+    keeps its c / (2 prf)."""
+    import warnings
+
+    from mdframework.check import plan_run
+    from mdframework.config import validate_run_config
+
+    registry = build_registry([_radar_module(declared=True)])
+    cfg = {
+        "motion": {"kind": "point_targets", "length": 0.5, "targets": [{"position": [50, 0, 0]}]},
+        "scatterers": {"kind": "points"},
+        "radar": {"kind": "quad", "prf": 1e5},
+        "scene": {"gate": 2000.0},
+    }
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        plan = plan_run(validate_run_config(cfg, registry=registry), registry)
+    assert plan.max_range_m is None
+    lfm = registry.get("radar", "lfm")
+    assert lfm(lfm.Config(prf=1e4)).unambiguous_range() == pytest.approx(14989.6, abs=0.1)

@@ -92,8 +92,8 @@ class RunPlan:
     faster_sampling: str
     memory_mib: float
     memory_terms_mib: dict[str, float] = field(default_factory=dict)
-    #: ``c / (2 B)`` and the largest unambiguous range (a pulse radar's ``c / (2 prf)``, an
-    #: FMCW radar's maximum range); None for a radar without range (CW)
+    #: ``c / (2 B)`` and the largest unambiguous range (the LFM radar's ``c / (2 prf)``, the
+    #: FMCW radar's maximum range); None for a radar without range (CW) or that gives none
     range_resolution_m: float | None = None
     max_range_m: float | None = None
 

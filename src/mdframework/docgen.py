@@ -148,13 +148,35 @@ def model_sections(
             continue
         path = f"{section}.{name}" if section else name
         seen[sub] = path
-        subs.append((path, get_origin(field.annotation) is list, sub))
+        subs.append((path, get_origin(field.annotation) is list, sub, field.default))
     out = [model_table(model, skip, section, seen), ""]
-    for path, is_list, sub in subs:
+    for path, is_list, sub, default in subs:
         out += [f"{'#' * level} `{f'[[{path}]]' if is_list else f'[{path}]'}`", ""]
         out += [_summary(sub), ""]
+        out += _own_default(path, sub, default)
         out += model_sections(sub, path, level + 1, seen=seen)
     return out
+
+
+def _own_default(path: str, sub: type[BaseModel], default: Any) -> list[str]:
+    """For a field whose default is a ``sub`` other than the one ``sub``'s own defaults make
+    (the FMCW radar's ``cfar_range``): a line saying that a table it gives leaves the fields it
+    omits at the table's defaults below, not at the field's."""
+    if not isinstance(default, sub):
+        return []
+    differ = [
+        f"{name} = {_default(FieldInfo(default=getattr(default, name)), '').strip('`')}"
+        for name, f in sub.model_fields.items()
+        if not f.is_required()
+        and getattr(default, name) != f.get_default(call_default_factory=True)
+    ]
+    if not differ:
+        return []
+    return [
+        f"Without a `[{path}]` table the field's default applies ({', '.join(differ)}, the "
+        "rest as below); a table gives each field it leaves out the default below.",
+        "",
+    ]
 
 
 def _summary(model: type[BaseModel]) -> str:

@@ -92,18 +92,23 @@ def count_losses(
     )
 
 
-def _gate_advice(losses: Losses, fixed_gate: bool) -> str:
+def _gate_advice(losses: Losses, fixed_gate: bool, max_range: float | None) -> str:
     lo, hi = losses.range_m
     if fixed_gate:
         return (
             f"the fixed range gate at {losses.gate_m[0]:.4g} m misses the scatterers (at "
             f"{lo:.4g}-{hi:.4g} m): set scene.gate = 'track', or a gate within their ranges"
         )
+    if max_range is not None and hi >= max_range:
+        return (
+            f"the body (at {lo:.4g}-{hi:.4g} m) reaches beyond the radar's maximum range "
+            f"{max_range:.4g} m, where its range bins fold back and the tracking gate cannot "
+            "follow it: bring the body within the maximum range"
+        )
     return (
         f"the range gate (tracking the body) is narrower than the body's spread in range "
-        f"({lo:.4g}-{hi:.4g} m), or beyond the radar's maximum range: lengthen the radar's "
-        "pulse, choose a wider gate response or gate (an FMCW radar's radar.gate_width), or "
-        "bring the body within the maximum range"
+        f"({lo:.4g}-{hi:.4g} m): lengthen the radar's pulse, or choose a wider gate response "
+        "or gate (an FMCW radar's radar.gate_width)"
     )
 
 
@@ -119,18 +124,21 @@ def empty_result(
     *,
     max_lost_fraction: float,
     fixed_gate: bool,
+    max_range: float | None = None,
 ) -> str | None:
     """Why a record is empty, with what to change; None when it is not.
 
     ``echo`` (n_pulses,) complex [sqrt(W)]: the target's received signal before received-stage
     effects (noise); ``losses``: :func:`count_losses` over the whole record;
     ``max_lost_fraction``: the largest acceptable share of lost scatterer returns;
-    ``fixed_gate``: whether the range gate is fixed (else it tracks the body).
+    ``fixed_gate``: whether the range gate is fixed (else it tracks the body);
+    ``max_range``: the radar's unambiguous range [m] (None: none), named when the body reaches
+    it.
     """
     all_gated = losses.total > 0 and losses.gated == losses.total
     all_cut = losses.total > 0 and losses.gated + losses.cut == losses.total
     if all_gated:
-        cause = _gate_advice(losses, fixed_gate)
+        cause = _gate_advice(losses, fixed_gate, max_range)
     elif all_cut:
         cause = _CUT_ADVICE
     else:
@@ -151,7 +159,7 @@ def empty_result(
     if gated + cut > max_lost_fraction:
         if gated >= cut:
             why = f"{100 * gated:.0f} % are outside the range gate: "
-            why += _gate_advice(losses, fixed_gate)
+            why += _gate_advice(losses, fixed_gate, max_range)
         else:
             why = f"{100 * cut:.0f} % are lost: {_CUT_ADVICE}"
         return (

@@ -537,13 +537,12 @@ class RadarWaveform(Plugin):
 
     def unambiguous_range(self) -> float | None:
         """Largest range [m] the radar measures without ambiguity, or ``None`` for a radar
-        without range (CW): ``mdf check`` reports it. Default: ``c / (2 prf)`` when the
-        config has a ``prf`` (a pulse radar: an echo from farther arrives after the next
-        pulse), else ``None``; the FMCW radar's is its maximum range."""
-        from .constants import SPEED_OF_LIGHT
-
-        prf = getattr(self.config, "prf", None)
-        return None if prf is None else SPEED_OF_LIGHT / (2.0 * float(prf))
+        without range (CW) or one that does not say: ``mdf check`` reports it, and a fixed
+        ``scene.gate`` beyond it is warned about. Default ``None``: a ``prf`` does not tell
+        (a CW radar's I/Q rate is called that too, and a pulse radar sending several pulses
+        per slow-time sample has a shorter pulse interval). The LFM radar's is
+        ``c / (2 prf)``, the FMCW radar's its maximum range."""
+        return None
 
     @property
     def max_unambiguous_velocity(self) -> float:

@@ -505,7 +505,7 @@ def _simulate_motion(
         near = placed(near, where)
         resample = interpolation.TrackResampler(near.time, near.positions, near.valid, method)
     record_body = near.select_frames(frames_inside(near.time, t_start, t_end))
-    start_record(stages, record_body, t, radar_pos, sc.gate)
+    farthest = start_record(stages, record_body, t, radar_pos, sc.gate)
     timings["prepare"] = time.perf_counter() - clock
 
     n = t.shape[0]
@@ -574,7 +574,7 @@ def _simulate_motion(
         radar_pos, wf.prf, wf.carrier_frequency, t, stream.gate, None, wf, rng, echo=echo
     )
     received = apply_effects(stages, "received", received, context, generators, handed)
-    _check_empty(echo, losses, proc, fixed_gate=sc.gate != "track")
+    _check_empty(echo, losses, proc, fixed_gate=sc.gate != "track", max_range=farthest)
     effects_ran = _describe(stages, "scatterers") + _describe(stages, "received")
     timings["received_effects"] = time.perf_counter() - clock
 
@@ -624,16 +624,18 @@ def start_record(
     t: FloatArray,
     radar_pos: FloatArray,
     gate: float | str = "track",
-) -> None:
+) -> float | None:
     """Tell the scatterer model, the radar and the effects the record about to be simulated:
     the placed body at its frame times within the record, the pulse times ``t`` (n_pulses,) [s]
     and the radar position (3,) [m]. The radar refuses here what it cannot simulate (an FMCW
     scatterer beyond its maximum range, range-Doppler maps over the product limit). A fixed
-    ``gate`` [m] (``scene.gate``) beyond the radar's unambiguous range is warned about."""
+    ``gate`` [m] (``scene.gate``) beyond the radar's unambiguous range is warned about.
+    Returns that range [m] (None: the radar has none)."""
     with blame(stages.model, "start_record"):
         stages.model.start_record(record_body)
     with blame(stages.radar, "start_record"):
         stages.radar.start_record(t, _range_span(record_body, radar_pos))
+    with blame(stages.radar, "unambiguous_range"):
         farthest = stages.radar.unambiguous_range()
     if not isinstance(gate, str) and farthest is not None and gate >= farthest:
         warnings.warn(
@@ -647,14 +649,25 @@ def start_record(
     for effect in stages.effects:
         with blame(effect, "start_record"):
             effect.start_record(record_body, radar_pos)
+    return farthest
 
 
 def _check_empty(
-    echo: NDArray[np.complex128], losses: emptiness.Losses, proc: Any, *, fixed_gate: bool
+    echo: NDArray[np.complex128],
+    losses: emptiness.Losses,
+    proc: Any,
+    *,
+    fixed_gate: bool,
+    max_range: float | None,
 ) -> None:
-    """Warn (or stop, with ``processing.empty = "error"``) when the record is empty."""
+    """Warn (or stop, with ``processing.empty = "error"``) when the record is empty;
+    ``max_range``: the radar's unambiguous range [m] or None."""
     why = emptiness.empty_result(
-        echo, losses, max_lost_fraction=proc.max_lost_fraction, fixed_gate=fixed_gate
+        echo,
+        losses,
+        max_lost_fraction=proc.max_lost_fraction,
+        fixed_gate=fixed_gate,
+        max_range=max_range,
     )
     if why is None:
         return

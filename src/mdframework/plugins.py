@@ -64,17 +64,6 @@ from .interfaces import (
     ScattererModel,
 )
 
-#: the distributions of the built-in plugins (``plugins/`` of this repository): a kind one of
-#: them registers stays theirs when a third party's plugin claims it too (that plugin is
-#: switched off)
-BUILT_IN_DISTRIBUTIONS = frozenset(
-    {
-        *("mdf-antenna", "mdf-attenuation", "mdf-c3d", "mdf-clutter", "mdf-cmu", "mdf-cw"),
-        *("mdf-deepmimic", "mdf-ellipsoid", "mdf-fmcw", "mdf-kinect", "mdf-knn", "mdf-lfm"),
-        *("mdf-mujoco", "mdf-multipath", "mdf-noise", "mdf-point-targets", "mdf-radhar"),
-        *("mdf-sklearn", "mdf-static-scene", "mdf-table"),
-    }
-)
 #: interface -> kind -> the built-in distribution that registers it: a config naming a kind
 #: whose distribution is not installed is told what to install
 BUILT_IN_KINDS: dict[str, dict[str, str]] = {
@@ -105,6 +94,10 @@ BUILT_IN_KINDS: dict[str, dict[str, str]] = {
     },
     "recording": {"radhar": "mdf-radhar"},
 }
+#: the distributions of the built-in plugins (``plugins/`` of this repository): a kind one of
+#: them registers stays theirs when a third party's plugin claims it too (that plugin is
+#: switched off)
+BUILT_IN_DISTRIBUTIONS = frozenset(d for kinds in BUILT_IN_KINDS.values() for d in kinds.values())
 DISABLE_ENV = "MDFRAMEWORK_DISABLE_PLUGIN_AUTOLOAD"
 DISABLE_PLUGINS_ENV = "MDFRAMEWORK_DISABLE_PLUGINS"
 

@@ -127,6 +127,10 @@ class LfmPulseDoppler(RadarWaveform):
         shape as ``ranges``."""
         return self.config.amplitudes(rcs, ranges, radar.wavelength(self.config.carrier_frequency))
 
+    def unambiguous_range(self) -> float:
+        """``c / (2 prf)`` [m]: an echo from farther arrives after the next pulse has gone out."""
+        return SPEED_OF_LIGHT / (2.0 * self.config.prf)
+
     def start_record(self, times: np.ndarray, range_span: tuple[float, float]) -> None:
         """Fix the raw path's range-time window for the record: the joints' range span plus
         ``range_margin`` on either side. Warn, naming ``radar.prf``, when the farthest joint
@@ -134,7 +138,7 @@ class LfmPulseDoppler(RadarWaveform):
         pulse has gone out (a real radar sees it nearer, at its range modulo that one)."""
         self._span = range_span
         prf, far = self.config.prf, range_span[1]
-        unambiguous = SPEED_OF_LIGHT / (2.0 * prf)
+        unambiguous = self.unambiguous_range()
         if far > unambiguous:
             warnings.warn(
                 f"radar.prf: the farthest joint at {far:.4g} m is beyond the unambiguous range "

@@ -63,6 +63,11 @@ TRACK_NAMES: tuple[str, ...] = (
 )
 
 
+def cycle_duration(rv: float) -> float:
+    """Dc = RLc / rv [s] of the relative velocity ``rv`` [1/s], RLc = 1.346 sqrt(rv)."""
+    return 1.346 * float(np.sqrt(rv)) / rv
+
+
 def gait_class(rv: float) -> GaitClass:
     """Boulic's gait class for the relative velocity ``rv`` [1/s]: ``a`` below 0.5, ``b`` below
     1.3, ``c`` up to 3. Raises ``ValueError`` outside ``0 < rv <= 3``."""
@@ -146,7 +151,7 @@ class Gait:
     @property
     def cycle_duration(self) -> float:
         """Dc = RLc / rv [s]."""
-        return self.relative_cycle_length / self.rv
+        return cycle_duration(self.rv)
 
     @property
     def support_duration(self) -> float:

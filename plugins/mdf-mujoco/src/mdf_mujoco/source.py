@@ -27,7 +27,7 @@ from mdframework.physics.body import LEG_FRACTION
 from mdframework.settings import SanityConfig
 
 from .body_model import WalkerBody
-from .gait import Gait
+from .gait import Gait, cycle_duration
 
 #: Sanity options the walker sets unless the config gives them (see ``BoulicConfig``).
 _WALKER_SANITY: dict[str, Any] = {"cadence": False, "size": "ignore"}
@@ -73,6 +73,12 @@ class BoulicConfig(MotionConfig):
         "lower-leg ellipsoid) for side-by-side comparison.",
     )
     activity: str = Field("walk", description="Activity label recorded with the run.")
+    sanity: SanityConfig = Field(
+        default_factory=SanityConfig,  # the validator below gives the walker's
+        description="Motion sanity checks, with the cadence and size checks off unless set "
+        "here (cadence = false, size = 'ignore'): the walker's cadence and legs follow from rv "
+        "and height.",
+    )
 
     @model_validator(mode="before")
     @classmethod
@@ -96,29 +102,33 @@ class BoulicConfig(MotionConfig):
     @model_validator(mode="after")
     def _check(self) -> BoulicConfig:
         if self.nt % 2:
-            raise ValueError(f"nt must be even (the left side is the right rolled by nt/2), "
+            raise ValueError(f"nt: must be even (the left side is the right rolled by nt/2), "
                              f"got {self.nt}")  # fmt: skip
         if self.rv is not None and self.speed is not None:
-            raise ValueError("give rv or speed, not both")
+            raise ValueError("speed: give rv or speed, not both")
         rv = self.relative_velocity
         if not 0 < rv <= 3:
             raise ValueError(
-                f"speed {self.speed} m/s gives rv = {rv:.4g}, outside Boulic's 0 < rv <= 3 "
+                f"speed: {self.speed} m/s gives rv = {rv:.4g}, outside Boulic's 0 < rv <= 3 "
                 f"(H_t = {LEG_FRACTION * self.height:.4g} m)"
             )
-        dc = 1.346 / math.sqrt(rv)  # Gait.cycle_duration
+        dc = cycle_duration(rv)
         n = self.cycles(dc)
         end = self.start + (self.duration or 0.0)
         if self.n_cycles is not None and end > n * dc + 1e-9:
             raise ValueError(
-                f"start + duration = {end:g} s is longer than the walk of n_cycles = {n} "
+                f"n_cycles: start + duration = {end:g} s is longer than the walk of n_cycles = {n} "
                 f"cycle(s) of {dc:.4g} s (rv = {rv:.4g}): {n * dc:.4g} s; set n_cycles to at "
                 f"least {math.ceil(end / dc - 1e-9)}, or leave it out (enough cycles for the "
                 "window)"
             )
         if n * dc > limits.MAX_DURATION_S or n * self.nt + 1 > limits.MAX_FRAMES:
+            # the field that set the number of cycles, else the cycle's length
+            field = "n_cycles" if self.n_cycles is not None else "duration"
+            if self.n_cycles is None and self.duration is None:
+                field = "rv" if self.speed is None else "speed"
             raise ValueError(
-                f"the walk is {n} cycle(s) of {dc:.4g} s (rv = {rv:.4g}) from its start, "
+                f"{field}: the walk is {n} cycle(s) of {dc:.4g} s (rv = {rv:.4g}) from its start, "
                 f"{n * dc:.4g} s and {n * self.nt + 1:,} frames (nt = {self.nt} per cycle), "
                 f"beyond the limits of {limits.MAX_DURATION_S:g} s and {limits.MAX_FRAMES:,} "
                 "frames: walk fewer cycles (n_cycles, or an earlier start + duration), a smaller "
