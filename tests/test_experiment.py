@@ -363,6 +363,18 @@ def _experiment(dataset: Path, tmp_path: Path, body: str) -> Path:
     return p
 
 
+def _groups_and_train_test(dataset: Path, tmp_path: Path) -> dict[str, Any]:
+    """Leave-subjects-out on ``dataset`` (kinect_dataset's) and a train/test of subjects s01,
+    s02 -> s03, all features, reported into ``tmp_path / "o"``; returns the summary."""
+    body = (
+        '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\n'
+        '[train_test]\ntrain = { subject = ["s01", "s02"] }\ntest = { subject = "s03" }\n'
+    )
+    e = _experiment(dataset, tmp_path, body)
+    with pytest.warns(exp.ExperimentWarning):  # punch: one subject
+        return exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+
+
 def _one_class_per_subject() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """One feature; class a: subjects s1-s3 at 0 (each recognised when held out); class b: s4
     at 10 and s5 at 3. Held out, s4 is still nearest to s5's b records (recall 1); held out,
@@ -602,6 +614,13 @@ def test_per_record_predictions_match_the_matrices(kinect_dataset: Path, tmp_pat
     )
     assert np.allclose(got, summary["train_test"]["confusion"])
     assert "predicted" not in summary["train_test"] and "predictions" not in within
+    # the counts too (a results section gives both), and the accuracy they make
+    tt_classes = summary["train_test"]["classes"]
+    counts = np.zeros((len(tt_classes), len(tt_classes)), dtype=int)
+    for r in tt:
+        counts[tt_classes.index(r["true"]), tt_classes.index(r["predicted"])] += 1
+    assert np.array_equal(summary["train_test"]["confusion_counts"], counts)
+    assert summary["train_test"]["accuracy"] == pytest.approx(np.trace(counts) / len(tt))
 
 
 def test_more_folds_than_subjects_warns_on_stderr(
@@ -783,13 +802,7 @@ def test_every_confusion_matrix_is_captioned(
         titles[Path(path).name] = title
 
     monkeypatch.setattr(figures, "plot_confusion", record)
-    body = (
-        '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\n'
-        '[train_test]\ntrain = { subject = ["s01", "s02"] }\ntest = { subject = "s03" }\n'
-    )
-    e = _experiment(kinect_dataset, tmp_path, body)
-    with pytest.warns(exp.ExperimentWarning):  # punch: one subject
-        exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+    _groups_and_train_test(kinect_dataset, tmp_path)
     assert set(captions) == {"within_kinect_confusion.png", "train_test_confusion.png"}
     for name, caption in captions.items():
         parts = (
@@ -1073,3 +1086,102 @@ def test_an_error_in_the_dataset_config_names_that_file(
         f"mdf: error: {tmp_path / 'e.toml'}: {tmp_path / 'd.toml'}: sources[0].motion.kind: no "
         "motion plugin named 'cmux' (did you mean 'cmu'?)"
     ), err
+
+
+def test_counts_precision_recall_f1_agree_with_the_predictions(
+    kinect_dataset: Path, tmp_path: Path
+) -> None:
+    """A results section needs the confusion counts and per-class precision, recall and F1, not
+    only the row-normalised rates: within_<group>_confusion_counts.csv sums every split's
+    scored test predictions (recomputed here from within_<group>_predictions.csv with
+    scikit-learn), per_class.csv gives the pooled precision, recall and F1 of those counts, and
+    summary.json the counts and the pooled accuracy (trace over total)."""
+    from sklearn.metrics import confusion_matrix as sk_confusion
+    from sklearn.metrics import precision_recall_fscore_support
+
+    e = _experiment(
+        kinect_dataset,
+        tmp_path,
+        '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\nby = "subject"\n',
+    )
+    with pytest.warns(exp.ExperimentWarning):  # punch: one subject, not evaluated
+        summary = exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+    within = summary["within"]["kinect"]
+    classes = within["classes"]
+    with (tmp_path / "o" / "within_kinect_predictions.csv").open() as fh:
+        rows = [r for r in csv.DictReader(fh) if r["true"] != "punch"]  # never scored
+    truth, pred = [r["true"] for r in rows], [r["predicted"] for r in rows]
+    expected = sk_confusion(truth, pred, labels=classes)
+    counts = np.array(within["confusion_counts"])
+    assert counts.dtype.kind == "i" and np.array_equal(counts, expected)
+    assert counts.sum() == len(rows)
+    assert within["accuracy"] == pytest.approx(np.trace(expected) / len(rows), abs=1e-12)
+    with (tmp_path / "o" / "within_kinect_confusion_counts.csv").open() as fh:
+        written = list(csv.DictReader(fh))
+    assert [r["true"] for r in written] == classes
+    assert np.array_equal([[int(r[c]) for c in classes] for r in written], expected)
+    scored = ["boxing", "jog"]
+    p, r, f, support = precision_recall_fscore_support(truth, pred, labels=scored, zero_division=0)
+    with (tmp_path / "o" / "within_kinect_per_class.csv").open() as fh:
+        per = {row["class"]: row for row in csv.DictReader(fh)}
+    for i, c in enumerate(scored):
+        assert int(per[c]["test_records"]) == support[i]
+        for key, value in (("precision", p[i]), ("recall", r[i]), ("f1", f[i])):
+            assert float(per[c][key]) == pytest.approx(value, abs=1e-12), (c, key)
+    assert per["punch"]["test_records"] == "0" and per["punch"]["f1"] == "nan"
+
+
+def test_summary_config_names_the_classifiers_defaults(
+    kinect_dataset: Path, tmp_path: Path
+) -> None:
+    """summary.json's config has "every default filled in" (docs/experiments.md), the
+    classifier's too: a [classifier] of kind = "knn" alone still records k, the metric and the
+    tie rule the run used, which a paper's methods section must state."""
+    e = _experiment(
+        kinect_dataset,
+        tmp_path,
+        '[classifier]\nkind = "knn"\n[selection]\nmethod = "none"\n[evaluation]\nrepeats = 2\n',
+    )
+    exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+    written = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert written["config"]["classifier"] == {
+        "kind": "knn",
+        "k": 5,
+        "metric": "euclidean",
+        "tie_rule": "nearest",
+    }
+    exp.ExperimentConfig.model_validate(written["config"])  # still a config that repeats it
+
+
+def test_feature_statistics_name_the_variances_unit(kinect_dataset: Path, tmp_path: Path) -> None:
+    """feature_stats.md gives each mean in m/s and each variance in (m/s)^2: its header said
+    '[m/s]' over both."""
+    e = _experiment(
+        kinect_dataset, tmp_path, '[selection]\nmethod = "none"\n[evaluation]\nrepeats = 2\n'
+    )
+    exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+    md = (tmp_path / "o" / "feature_stats.md").read_text()
+    assert md.startswith("mean [m/s] (variance [(m/s)²])\n")
+    assert "| feature |" in md and "feature [m/s]" not in md
+
+
+def test_every_output_key_and_column_is_documented(kinect_dataset: Path, tmp_path: Path) -> None:
+    """docs/experiments.md names every key of summary.json (top level, a within-source result,
+    a train/test result) and every column of the per-class and feature-statistics CSV files:
+    a results section cites them without reading the code (splits_tested, repeats, subsets...
+    were named nowhere)."""
+    doc = (Path(__file__).parents[1] / "docs" / "experiments.md").read_text(encoding="utf-8")
+    _groups_and_train_test(kinect_dataset, tmp_path)
+    out = tmp_path / "o"
+    written = json.loads((out / "summary.json").read_text())
+    keys = {*written, *written["within"]["kinect"], *written["train_test"]}
+    with (out / "within_kinect_per_class.csv").open() as fh:
+        keys |= set(next(csv.reader(fh)))
+    missing = sorted(k for k in keys if f"`{k}`" not in doc)
+    assert not missing, f"not in docs/experiments.md: {missing}"
+    with (out / "feature_stats.csv").open() as fh:
+        columns = next(csv.reader(fh))
+    assert {c for c in columns if c.endswith(("_mean", "_var"))} == {
+        f"{f}_{s}" for f in exp.FEATURE_NAMES for s in ("mean", "var")
+    }
+    assert "`<feature>_mean` [m/s]" in doc and "`<feature>_var` [(m/s)²]" in doc

@@ -626,6 +626,39 @@ def _too_few_classes(untested: dict[str, str]) -> MdfError:
     )
 
 
+def confusion_counts(
+    y_true: NDArray[Any], y_pred: NDArray[Any], classes: Sequence[str]
+) -> NDArray[np.int64]:
+    """The confusion matrix of counts (n_classes, n_classes), int64: row = true class, column =
+    predicted class, each cell the number of test records (a prediction outside ``classes`` is
+    not counted)."""
+    idx = {c: i for i, c in enumerate(classes)}
+    counts = np.zeros((len(classes), len(classes)), dtype=np.int64)
+    for t, p in zip(y_true.tolist(), y_pred.tolist(), strict=True):
+        if t in idx and p in idx:
+            counts[idx[t], idx[p]] += 1
+    return counts
+
+
+def pooled_scores(
+    counts: NDArray[np.int64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Per-class precision, recall and F1 (each (n_classes,)) of a matrix of counts (rows:
+    true class, columns: predicted): the diagonal over the column sum, over the row sum, and
+    their harmonic mean; NaN for a class with no test record (an empty row), 0 where the
+    class is never predicted or never right (scikit-learn's ``zero_division=0``)."""
+    c = counts.astype(np.float64)
+    diag, tested, called = np.diagonal(c), c.sum(axis=1), c.sum(axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        precision = np.where(called > 0, diag / called, 0.0)
+        recall = np.where(tested > 0, diag / tested, np.nan)
+        total = precision + recall
+        f1 = np.where(total > 0, 2 * precision * recall / total, 0.0)
+    precision[tested == 0] = np.nan
+    f1[tested == 0] = np.nan
+    return precision, recall, f1
+
+
 def within_source(
     cfg: ExperimentConfig,
     factory: Callable[[], Classifier],
@@ -686,7 +719,7 @@ def within_source(
         splits = _record_splits(ev, x, y, cfg.seed)
     if len(classes) - len(untested) < 2:
         raise _too_few_classes(untested)
-    mats, optimistic, subsets, tested = [], [], [], []
+    mats, optimistic, subsets, tested, tallies = [], [], [], [], []
     predictions: list[tuple[int, NDArray[np.intp], NDArray[Any]]] = []
     bar = tqdm_bar(
         splits,
@@ -707,6 +740,9 @@ def within_source(
         mat = confusion_matrix(y[test], pred, classes)
         mat[untrained] = np.nan
         mats.append(mat)
+        tally = confusion_counts(y[test], pred, classes)
+        tally[untrained] = 0  # not scored, as the matrix's row
+        tallies.append(tally)
         tested.append(np.isin(classes, y[test]))
         subsets.append([names[i] for i in sel.subset])
         if cfg.selection.optimistic and cfg.selection.method == "wrapper":
@@ -743,10 +779,14 @@ def within_source(
         spread, over = float(np.std(per_split)), "splits"
     else:
         spread, over = float(np.std(recall)), "classes"
+    counts_sum = np.sum(tallies, axis=0)
+    counts_sum[~rows] = 0  # a class never scored: its row is not counted
     return {
         "classes": classes,
         "confusion_mean": mean,
         "confusion_std": std,
+        "confusion_counts": counts_sum,
+        "accuracy": float(np.trace(counts_sum) / counts_sum.sum()),
         "balanced_accuracy_mean": float(np.mean(recall)),
         "balanced_accuracy_std": spread,
         "balanced_accuracy_std_over": over,
@@ -829,9 +869,12 @@ def _train_then_test(
         units=None if units is None else units[train],
     )
     pred = _fit_predict(factory, x[train], labels[train], x[test], sel.subset)
+    counts = confusion_counts(labels[test], pred, shared)
     return {
         "classes": shared,
         "confusion": confusion_matrix(labels[test], pred, shared),
+        "confusion_counts": counts,
+        "accuracy": float(np.trace(counts) / counts.sum()),
         "balanced_accuracy": balanced_accuracy(labels[test], pred),
         "subset": [names[i] for i in sel.subset],
         "train_counts": {c: int(np.sum(labels[train] == c)) for c in shared},
@@ -876,13 +919,13 @@ def _matrix_rows(classes: list[str], matrix: NDArray[np.float64]) -> list[dict[s
 def _stats_markdown(rows: list[dict[str, Any]]) -> str:
     cols = [f"{r['label']} ({r['group']}, n={r['n']})" for r in rows]
     lines = [
-        "| feature [m/s] | " + " | ".join(cols) + " |",
+        "| feature | " + " | ".join(cols) + " |",
         "|---|" + "---|" * len(cols),
     ]
     for name in FEATURE_NAMES:
         cells = [f"{r[f'{name}_mean']:.4g} ({r[f'{name}_var']:.3g})" for r in rows]
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
-    return "mean (variance)\n\n" + "\n".join(lines) + "\n"
+    return "mean [m/s] (variance [(m/s)²])\n\n" + "\n".join(lines) + "\n"
 
 
 def classifier_inputs(
@@ -1079,6 +1122,17 @@ def _report(
             _csv(_matrix_rows(classes, res["confusion_std"])),
             encoding="utf-8",
         )
+        counts = res["confusion_counts"]
+        (out / f"{stem}_confusion_counts.csv").write_text(
+            _csv(
+                [
+                    {"true": c, **dict(zip(classes, map(int, row), strict=True))}
+                    for c, row in zip(classes, counts, strict=True)
+                ]
+            ),
+            encoding="utf-8",
+        )
+        precision, recall, f_score = pooled_scores(counts)
         (out / f"{stem}_per_class.csv").write_text(
             _csv(
                 [
@@ -1088,6 +1142,10 @@ def _report(
                         "rate_mean": float(res["confusion_mean"][i, i]),
                         "rate_std": float(res["confusion_std"][i, i]),
                         "splits_scored": res["splits_scored"][c],
+                        "test_records": int(counts[i].sum()),
+                        "precision": float(precision[i]),
+                        "recall": float(recall[i]),
+                        "f1": float(f_score[i]),
                     }
                     for i, c in enumerate(classes)
                 ]
@@ -1120,9 +1178,11 @@ def _report(
         summary["within"][group] = {
             k: v
             for k, v in res.items()
-            if k not in ("confusion_mean", "confusion_std", "predictions")
+            if k not in ("confusion_mean", "confusion_std", "confusion_counts", "predictions")
         }
         summary["within"][group]["confusion_mean"] = res["confusion_mean"].tolist()
+        summary["within"][group]["confusion_std"] = res["confusion_std"].tolist()
+        summary["within"][group]["confusion_counts"] = counts.tolist()
         opt = res["optimistic_accuracy_mean"]
         report += [
             f"## Within-source: {group}",
@@ -1241,6 +1301,7 @@ def _report(
     (out / "report.md").write_text("\n".join(report), encoding="utf-8")
     config = cfg.model_dump(mode="json")  # its dataset read from any folder, not only this one
     config["dataset"] = {k: v and os.path.abspath(v) for k, v in config["dataset"].items()}
+    config["classifier"] = _classifier_settings(factory, config["classifier"])
     summary["config"] = config
     summary["versions"] = versions(registry)
     (out / "summary.json").write_text(
@@ -1248,6 +1309,21 @@ def _report(
         encoding="utf-8",
     )
     return summary
+
+
+def _classifier_settings(
+    factory: Callable[[], Classifier], section: dict[str, Any]
+) -> dict[str, Any]:
+    """The [classifier] section with every default of its plugin filled in (the validated
+    plugin config a classifier holds as ``config``), so that summary.json names the
+    hyper-parameters the run used; ``section`` as given for a plugin that keeps no such
+    config."""
+    from pydantic import BaseModel
+
+    settings = getattr(factory(), "config", None)
+    if isinstance(settings, BaseModel):
+        return {**section, **settings.model_dump(mode="json")}
+    return section
 
 
 def _write_predictions(path: Path, data: Dataset, res: dict[str, Any]) -> None:
@@ -1265,7 +1341,11 @@ def _without_predictions(res: dict[str, Any]) -> dict[str, Any]:
     """A train/test result for summary.json: the matrix as lists, the per-record predictions
     left to their CSV file."""
     kept = {k: v for k, v in res.items() if k not in ("test_index", "true", "predicted")}
-    return {**kept, "confusion": res["confusion"].tolist()}
+    return {
+        **kept,
+        "confusion": res["confusion"].tolist(),
+        "confusion_counts": res["confusion_counts"].tolist(),
+    }
 
 
 def _strict_json(value: Any) -> Any:
