@@ -82,6 +82,8 @@ EXPERIMENT_FILES = (
     "train_test_confusion.*",
     "feature_stats.*",
     "scatter_*.png",
+    "scatter_*.pdf",
+    "scatter_*.svg",
     "dataset",
 )
 
@@ -214,6 +216,19 @@ class ReportConfig(StrictModel):
         [("torso_mean", "upper_max"), ("lower_min", "total_bandwidth")],
         description="Feature pairs to scatter-plot.",
     )
+    figure_formats: list[Literal["png", "pdf", "svg"]] = Field(
+        ["png"],
+        description="Formats of every figure: 'png' (shown in report.md), and also 'pdf' or "
+        "'svg' (vector, text as text, for print).",
+    )
+
+    @field_validator("figure_formats")
+    @classmethod
+    def _png_included(cls, value: list[str]) -> list[str]:
+        """report.md shows the PNGs: they are always written."""
+        if "png" not in value:
+            raise ValueError("must include 'png' (report.md shows the PNGs), e.g. ['png', 'pdf']")
+        return list(dict.fromkeys(value))
 
 
 class ExperimentConfig(StrictModel):
@@ -1059,6 +1074,7 @@ def _report(
     from .figures import plot_confusion, plot_feature_scatter
 
     figures: list[Callable[[], None]] = []  # drawn at the end
+    extra = tuple(f for f in cfg.report.figure_formats if f != "png")  # also written
 
     index = limits.read_file_bytes(Path(data_dir) / INDEX)
     summary: dict[str, Any] = {
@@ -1162,6 +1178,7 @@ def _report(
                 title=f"{group}: within-source",
                 caption=f"{caption}; mean ± std over "
                 f"{_caption_splits(cfg.evaluation, res['n_splits'])}",
+                also=extra,
             )
         )
         ids, truth = data.table["id"][mask], data.labels[mask]
@@ -1218,6 +1235,7 @@ def _report(
                 None,
                 title=f"train {cfg.cross_source.train} -> test {cfg.cross_source.test}",
                 caption=f"{caption}; features {res['subset']}",
+                also=extra,
             )
         )
         _write_predictions(out / "cross_predictions.csv", data, res)
@@ -1252,6 +1270,7 @@ def _report(
             title=f"train {selector_words(cfg.train_test.train)} -> test "
             f"{selector_words(cfg.train_test.test)}",
             caption=f"{caption}; features {res['subset']}",
+            also=extra,
         )
         _write_predictions(out / "train_test_predictions.csv", data, res)
         summary["train_test"] = _without_predictions(res)
@@ -1293,6 +1312,7 @@ def _report(
                 f2,
                 title=f"{f1} vs {f2}",
                 caption=caption,
+                also=extra,
             )
         )
         report += [f"![{f1} vs {f2}]({name})", ""]
