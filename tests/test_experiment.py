@@ -1212,3 +1212,32 @@ def test_figures_also_in_vector_formats_for_print(kinect_dataset: Path, tmp_path
     e.write_text(e.read_text().replace('figure_formats = ["pdf"]\n', ""))
     exp.run_experiment(exp.load_experiment_config(e), tmp_path / "p", progress=False)
     assert not list((tmp_path / "p").glob("*.pdf")) and not list((tmp_path / "p").glob("*.svg"))
+
+
+def test_per_split_scores_and_counts_are_written(kinect_dataset: Path, tmp_path: Path) -> None:
+    """summary.json gives each split's balanced accuracy and its training and test records per
+    class, so that a paper can state the records per split and compute its own uncertainty: here
+    recomputed with scikit-learn from within_<group>_predictions.csv; their mean and population
+    standard deviation are the reported balanced accuracy and its spread."""
+    e = _experiment(
+        kinect_dataset,
+        tmp_path,
+        '[selection]\nmethod = "none"\n[evaluation]\nrepeats = 4\n',
+    )
+    summary = exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+    written = json.loads((tmp_path / "o" / "summary.json").read_text())["within"]["kinect"]
+    with (tmp_path / "o" / "within_kinect_predictions.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    per_split = written["balanced_accuracy_per_split"]
+    counts = written["split_counts"]
+    assert len(per_split) == len(counts) == written["n_splits"] == 4
+    for k in range(4):
+        fold = [r for r in rows if r["split"] == str(k)]
+        truth, pred = [r["true"] for r in fold], [r["predicted"] for r in fold]
+        assert per_split[k] == pytest.approx(balanced_accuracy_score(truth, pred), abs=1e-12)
+        assert counts[k]["test"] == {c: truth.count(c) for c in written["classes"]}
+        for c in written["classes"]:
+            assert counts[k]["train"][c] + counts[k]["test"][c] == written["class_counts"][c]
+    assert np.mean(per_split) == pytest.approx(written["balanced_accuracy_mean"], abs=1e-12)
+    assert np.std(per_split) == pytest.approx(written["balanced_accuracy_std"], abs=1e-12)
+    assert summary["within"]["kinect"]["balanced_accuracy_std_over"] == "splits"

@@ -699,7 +699,11 @@ def within_source(
     accuracy when every split scores every class (then the mean of those equals
     ``balanced_accuracy_mean``), else (e.g. leave-subjects-out folds that hold one class only)
     the standard deviation over the scored classes of their recall;
-    ``balanced_accuracy_std_over`` says which ("splits" or "classes")."""
+    ``balanced_accuracy_std_over`` says which ("splits" or "classes");
+    ``balanced_accuracy_per_split`` gives each split's (NaN: it scores no class).
+    ``confusion_counts`` (int64) sums the splits' scored rows of counts; ``accuracy`` is its
+    trace over its total; ``split_counts`` gives each split's training and test records per
+    class."""
     classes = sorted(set(y.tolist()))
     ev = cfg.evaluation
     untested: dict[str, str] = {}
@@ -735,6 +739,7 @@ def within_source(
     if len(classes) - len(untested) < 2:
         raise _too_few_classes(untested)
     mats, optimistic, subsets, tested, tallies = [], [], [], [], []
+    split_counts: list[dict[str, dict[str, int]]] = []  # per split: train/test records per class
     predictions: list[tuple[int, NDArray[np.intp], NDArray[Any]]] = []
     bar = tqdm_bar(
         splits,
@@ -755,6 +760,12 @@ def within_source(
         mat = confusion_matrix(y[test], pred, classes)
         mat[untrained] = np.nan
         mats.append(mat)
+        split_counts.append(
+            {
+                side: {c: int(np.sum(y[idx] == c)) for c in classes}
+                for side, idx in (("train", train), ("test", test))
+            }
+        )
         tally = confusion_counts(y[test], pred, classes)
         tally[untrained] = 0  # not scored, as the matrix's row
         tallies.append(tally)
@@ -789,8 +800,11 @@ def within_source(
     if optimistic:  # the same measure as the result: mean per-class recall of the mean matrix
         opt_stack = np.stack(optimistic)[:, rows]
         opt_mean = float(np.mean(np.diagonal(np.nanmean(opt_stack, axis=0)[:, rows])))
+    diagonals = np.diagonal(stack, axis1=1, axis2=2)[:, rows]  # (n_splits, evaluated classes)
+    per_split = np.full(len(stack), np.nan)  # each split's mean recall of the classes it scores
+    some = ~np.all(np.isnan(diagonals), axis=1)
+    per_split[some] = np.nanmean(diagonals[some], axis=1)
     if scored[:, rows].all():  # every split scores every class: spread over splits
-        per_split = np.diagonal(stack, axis1=1, axis2=2)[:, rows].mean(axis=1)
         spread, over = float(np.std(per_split)), "splits"
     else:
         spread, over = float(np.std(recall)), "classes"
@@ -805,6 +819,8 @@ def within_source(
         "balanced_accuracy_mean": float(np.mean(recall)),
         "balanced_accuracy_std": spread,
         "balanced_accuracy_std_over": over,
+        "balanced_accuracy_per_split": per_split.tolist(),
+        "split_counts": split_counts,
         "n_splits": len(splits),
         "splits_tested": {c: int(n) for c, n in zip(classes, np.sum(tested, axis=0), strict=True)},
         "splits_scored": {c: int(scored[:, i].sum()) for i, c in enumerate(classes)},
