@@ -412,6 +412,12 @@ def test_leave_subjects_out_accuracy_is_the_mean_recall_of_the_matrix() -> None:
     assert res["balanced_accuracy_std_over"] == "classes"
     assert res["balanced_accuracy_std"] == pytest.approx(0.25, abs=1e-12)
     assert res["splits_tested"] == {"a": 3, "b": 2} and res["not_evaluated"] == {}
+    # each row's mean ± std is over the folds that score its class (3 and 2), not over all 5:
+    # the caption and the report say so (they said "mean ± std over 5 ... folds")
+    splits = exp._splits_words(cfg.evaluation, res["n_splits"])
+    words = " (each row over the folds that score its class: a 3, b 2)"
+    assert exp._rows_scored_words(res, cfg.evaluation) == words
+    assert exp._spread_words(res, splits, words).endswith(f"mean ± std over {splits}{words}")
 
 
 def test_the_optimistic_bound_is_scored_as_the_result_is() -> None:

@@ -1139,6 +1139,7 @@ def _report(
             continue
         classes = res["classes"]
         splits = _splits_words(cfg.evaluation, res["n_splits"])
+        rows = _rows_scored_words(res, cfg.evaluation)
         for c, why in res["not_evaluated"].items():
             warnings.warn(
                 f"within-source {group}: class {c!r} not evaluated: {why}",
@@ -1193,7 +1194,7 @@ def _report(
                 res["confusion_std"],
                 title=f"{group}: within-source",
                 caption=f"{caption}; mean ± std over "
-                f"{_caption_splits(cfg.evaluation, res['n_splits'])}",
+                f"{_caption_splits(cfg.evaluation, res['n_splits'])}{rows}",
                 also=extra,
             )
         )
@@ -1221,7 +1222,8 @@ def _report(
             f"## Within-source: {group}",
             "",
             f"Balanced accuracy {res['balanced_accuracy_mean']:.3f} "
-            f"({_spread_words(res, splits)}); classes and records: {res['class_counts']}.",
+            f"({_spread_words(res, splits, rows)}); classes and records: "
+            f"{res['class_counts']}.",
             "",
             *_not_evaluated_markdown(res, splits),
             *_held_out_markdown(res),
@@ -1409,14 +1411,26 @@ def _nothing_evaluated(ev: EvaluationConfig, within: dict[str, dict[str, Any]]) 
     return f"evaluation.split = {ev.split!r}: nothing could be evaluated (within-source {reasons})"
 
 
-def _spread_words(res: dict[str, Any], splits: str) -> str:
-    """What a within-source balanced accuracy is and what its spread is, in words."""
+def _rows_scored_words(res: dict[str, Any], ev: EvaluationConfig) -> str:
+    """Words to follow 'mean ± std over N splits' where some evaluated class is not scored in
+    every split: each row of the matrix is over the splits that score its class, so many."""
+    scored = {c: k for c, k in res["splits_scored"].items() if c not in res["not_evaluated"]}
+    if all(k == res["n_splits"] for k in scored.values()):
+        return ""
+    what = "folds" if ev.split == "groups" else "splits"
+    counts = ", ".join(f"{c} {k}" for c, k in scored.items())
+    return f" (each row over the {what} that score its class: {counts})"
+
+
+def _spread_words(res: dict[str, Any], splits: str, rows: str = "") -> str:
+    """What a within-source balanced accuracy is and what its spread is, in words; ``rows``:
+    :func:`_rows_scored_words`."""
     std = res["balanced_accuracy_std"]
     if res["balanced_accuracy_std_over"] == "splits":
         return f"std {std:.3f} over {splits}; the mean per-class recall of the matrix below"
     return (
         f"std {std:.3f} over the classes' recalls, as not every split scores every class; the "
-        f"mean per-class recall of the matrix below, mean ± std over {splits}"
+        f"mean per-class recall of the matrix below, mean ± std over {splits}{rows}"
     )
 
 
