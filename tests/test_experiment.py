@@ -1157,6 +1157,8 @@ def test_summary_config_names_the_classifiers_defaults(
         "tie_rule": "nearest",
     }
     exp.ExperimentConfig.model_validate(written["config"])  # still a config that repeats it
+    header = 'Classifier: `{"kind": "knn", "k": 5, "metric": "euclidean", "tie_rule": "nearest"}`'
+    assert header in (tmp_path / "o" / "report.md").read_text()  # the report too
 
 
 def test_feature_statistics_name_the_variances_unit(kinect_dataset: Path, tmp_path: Path) -> None:

@@ -1093,6 +1093,7 @@ def _report(
     extra = tuple(f for f in cfg.report.figure_formats if f != "png")  # also written
 
     index = limits.read_file_bytes(Path(data_dir) / INDEX)
+    settings = _classifier_settings(factory, cfg.classifier)  # every default filled in
     summary: dict[str, Any] = {
         "dataset": str(data_dir),
         # which dataset: its index names every record (an id digests what makes its arrays)
@@ -1105,7 +1106,7 @@ def _report(
         "# Experiment report",
         "",
         f"Dataset: `{data_dir}` ({len(data.labels)} records).",
-        f"Input: {cfg.input}. Classifier: `{json.dumps(cfg.classifier)}`; selection: "
+        f"Input: {cfg.input}. Classifier: `{json.dumps(settings)}`; selection: "
         f"{cfg.selection.method} (sizes {cfg.selection.sizes}); "
         f"evaluation: {protocol(cfg.evaluation)}.",
         "",
@@ -1339,7 +1340,7 @@ def _report(
     (out / "report.md").write_text("\n".join(report), encoding="utf-8")
     config = cfg.model_dump(mode="json")  # its dataset read from any folder, not only this one
     config["dataset"] = {k: v and os.path.abspath(v) for k, v in config["dataset"].items()}
-    config["classifier"] = _classifier_settings(factory, config["classifier"])
+    config["classifier"] = settings
     summary["config"] = config
     summary["versions"] = versions(registry)
     (out / "summary.json").write_text(
