@@ -858,6 +858,7 @@ def test_summary_json_holds_what_repeats_the_experiment(
     versions = written["versions"]
     assert versions["mdframework"] == importlib.metadata.version("mdframework")
     assert versions["scikit-learn"] == importlib.metadata.version("scikit-learn")
+    assert versions["matplotlib"] == importlib.metadata.version("matplotlib")  # drew the figures
     assert f"mdf-sklearn {importlib.metadata.version('mdf-sklearn')}" in versions["plugins"]
     monkeypatch.chdir(kinect_dataset)
     again = exp.ExperimentConfig.model_validate(written["config"])

@@ -1342,7 +1342,13 @@ def _report(
     config["dataset"] = {k: v and os.path.abspath(v) for k, v in config["dataset"].items()}
     config["classifier"] = settings
     summary["config"] = config
-    summary["versions"] = versions(registry)
+    import importlib.metadata
+
+    # the figures' renderer too (the numbers do not depend on it)
+    summary["versions"] = {
+        **versions(registry),
+        "matplotlib": importlib.metadata.version("matplotlib"),
+    }
     (out / "summary.json").write_text(
         json.dumps(_strict_json(summary), indent=2, default=str, allow_nan=False) + "\n",
         encoding="utf-8",
