@@ -363,6 +363,18 @@ def _experiment(dataset: Path, tmp_path: Path, body: str) -> Path:
     return p
 
 
+def _groups_and_train_test(dataset: Path, tmp_path: Path) -> dict[str, Any]:
+    """Leave-subjects-out on ``dataset`` (kinect_dataset's) and a train/test of subjects s01,
+    s02 -> s03, all features, reported into ``tmp_path / "o"``; returns the summary."""
+    body = (
+        '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\n'
+        '[train_test]\ntrain = { subject = ["s01", "s02"] }\ntest = { subject = "s03" }\n'
+    )
+    e = _experiment(dataset, tmp_path, body)
+    with pytest.warns(exp.ExperimentWarning):  # punch: one subject
+        return exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+
+
 def _one_class_per_subject() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """One feature; class a: subjects s1-s3 at 0 (each recognised when held out); class b: s4
     at 10 and s5 at 3. Held out, s4 is still nearest to s5's b records (recall 1); held out,
@@ -400,6 +412,12 @@ def test_leave_subjects_out_accuracy_is_the_mean_recall_of_the_matrix() -> None:
     assert res["balanced_accuracy_std_over"] == "classes"
     assert res["balanced_accuracy_std"] == pytest.approx(0.25, abs=1e-12)
     assert res["splits_tested"] == {"a": 3, "b": 2} and res["not_evaluated"] == {}
+    # each row's mean ± std is over the folds that score its class (3 and 2), not over all 5:
+    # the caption and the report say so (they said "mean ± std over 5 ... folds")
+    splits = exp._splits_words(cfg.evaluation, res["n_splits"])
+    words = " (each row over the folds that score its class: a 3, b 2)"
+    assert exp._rows_scored_words(res, cfg.evaluation) == words
+    assert exp._spread_words(res, splits, words).endswith(f"mean ± std over {splits}{words}")
 
 
 def test_the_optimistic_bound_is_scored_as_the_result_is() -> None:
@@ -602,6 +620,13 @@ def test_per_record_predictions_match_the_matrices(kinect_dataset: Path, tmp_pat
     )
     assert np.allclose(got, summary["train_test"]["confusion"])
     assert "predicted" not in summary["train_test"] and "predictions" not in within
+    # the counts too (a results section gives both), and the accuracy they make
+    tt_classes = summary["train_test"]["classes"]
+    counts = np.zeros((len(tt_classes), len(tt_classes)), dtype=int)
+    for r in tt:
+        counts[tt_classes.index(r["true"]), tt_classes.index(r["predicted"])] += 1
+    assert np.array_equal(summary["train_test"]["confusion_counts"], counts)
+    assert summary["train_test"]["accuracy"] == pytest.approx(np.trace(counts) / len(tt))
 
 
 def test_more_folds_than_subjects_warns_on_stderr(
@@ -778,18 +803,12 @@ def test_every_confusion_matrix_is_captioned(
     captions: dict[str, str] = {}
     titles: dict[str, str] = {}
 
-    def record(path: Path, *args: object, caption: str = "", title: str = "") -> None:
+    def record(path: Path, *args: object, caption: str = "", title: str = "", **_: object) -> None:
         captions[Path(path).name] = caption
         titles[Path(path).name] = title
 
     monkeypatch.setattr(figures, "plot_confusion", record)
-    body = (
-        '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\n'
-        '[train_test]\ntrain = { subject = ["s01", "s02"] }\ntest = { subject = "s03" }\n'
-    )
-    e = _experiment(kinect_dataset, tmp_path, body)
-    with pytest.warns(exp.ExperimentWarning):  # punch: one subject
-        exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+    _groups_and_train_test(kinect_dataset, tmp_path)
     assert set(captions) == {"within_kinect_confusion.png", "train_test_confusion.png"}
     for name, caption in captions.items():
         parts = (
@@ -839,6 +858,7 @@ def test_summary_json_holds_what_repeats_the_experiment(
     versions = written["versions"]
     assert versions["mdframework"] == importlib.metadata.version("mdframework")
     assert versions["scikit-learn"] == importlib.metadata.version("scikit-learn")
+    assert versions["matplotlib"] == importlib.metadata.version("matplotlib")  # drew the figures
     assert f"mdf-sklearn {importlib.metadata.version('mdf-sklearn')}" in versions["plugins"]
     monkeypatch.chdir(kinect_dataset)
     again = exp.ExperimentConfig.model_validate(written["config"])
@@ -1073,3 +1093,160 @@ def test_an_error_in_the_dataset_config_names_that_file(
         f"mdf: error: {tmp_path / 'e.toml'}: {tmp_path / 'd.toml'}: sources[0].motion.kind: no "
         "motion plugin named 'cmux' (did you mean 'cmu'?)"
     ), err
+
+
+def test_counts_precision_recall_f1_agree_with_the_predictions(
+    kinect_dataset: Path, tmp_path: Path
+) -> None:
+    """A results section needs the confusion counts and per-class precision, recall and F1, not
+    only the row-normalised rates: within_<group>_confusion_counts.csv sums every split's
+    scored test predictions (recomputed here from within_<group>_predictions.csv with
+    scikit-learn), per_class.csv gives the pooled precision, recall and F1 of those counts, and
+    summary.json the counts and the pooled accuracy (trace over total)."""
+    from sklearn.metrics import confusion_matrix as sk_confusion
+    from sklearn.metrics import precision_recall_fscore_support
+
+    e = _experiment(
+        kinect_dataset,
+        tmp_path,
+        '[selection]\nmethod = "none"\n[evaluation]\nsplit = "groups"\nby = "subject"\n',
+    )
+    with pytest.warns(exp.ExperimentWarning):  # punch: one subject, not evaluated
+        summary = exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+    within = summary["within"]["kinect"]
+    classes = within["classes"]
+    with (tmp_path / "o" / "within_kinect_predictions.csv").open() as fh:
+        rows = [r for r in csv.DictReader(fh) if r["true"] != "punch"]  # never scored
+    truth, pred = [r["true"] for r in rows], [r["predicted"] for r in rows]
+    expected = sk_confusion(truth, pred, labels=classes)
+    counts = np.array(within["confusion_counts"])
+    assert counts.dtype.kind == "i" and np.array_equal(counts, expected)
+    assert counts.sum() == len(rows)
+    assert within["accuracy"] == pytest.approx(np.trace(expected) / len(rows), abs=1e-12)
+    with (tmp_path / "o" / "within_kinect_confusion_counts.csv").open() as fh:
+        written = list(csv.DictReader(fh))
+    assert [r["true"] for r in written] == classes
+    assert np.array_equal([[int(r[c]) for c in classes] for r in written], expected)
+    scored = ["boxing", "jog"]
+    p, r, f, support = precision_recall_fscore_support(truth, pred, labels=scored, zero_division=0)
+    with (tmp_path / "o" / "within_kinect_per_class.csv").open() as fh:
+        per = {row["class"]: row for row in csv.DictReader(fh)}
+    for i, c in enumerate(scored):
+        assert int(per[c]["test_records"]) == support[i]
+        for key, value in (("precision", p[i]), ("recall", r[i]), ("f1", f[i])):
+            assert float(per[c][key]) == pytest.approx(value, abs=1e-12), (c, key)
+    assert per["punch"]["test_records"] == "0" and per["punch"]["f1"] == "nan"
+
+
+def test_summary_config_names_the_classifiers_defaults(
+    kinect_dataset: Path, tmp_path: Path
+) -> None:
+    """summary.json's config has "every default filled in" (docs/experiments.md), the
+    classifier's too: a [classifier] of kind = "knn" alone still records k, the metric and the
+    tie rule the run used, which a paper's methods section must state."""
+    e = _experiment(
+        kinect_dataset,
+        tmp_path,
+        '[classifier]\nkind = "knn"\n[selection]\nmethod = "none"\n[evaluation]\nrepeats = 2\n',
+    )
+    exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+    written = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert written["config"]["classifier"] == {
+        "kind": "knn",
+        "k": 5,
+        "metric": "euclidean",
+        "tie_rule": "nearest",
+    }
+    exp.ExperimentConfig.model_validate(written["config"])  # still a config that repeats it
+    header = 'Classifier: `{"kind": "knn", "k": 5, "metric": "euclidean", "tie_rule": "nearest"}`'
+    assert header in (tmp_path / "o" / "report.md").read_text()  # the report too
+
+
+def test_feature_statistics_name_the_variances_unit(kinect_dataset: Path, tmp_path: Path) -> None:
+    """feature_stats.md gives each mean in m/s and each variance in (m/s)^2: its header said
+    '[m/s]' over both."""
+    e = _experiment(
+        kinect_dataset, tmp_path, '[selection]\nmethod = "none"\n[evaluation]\nrepeats = 2\n'
+    )
+    exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+    md = (tmp_path / "o" / "feature_stats.md").read_text()
+    assert md.startswith("mean [m/s] (variance [(m/s)²])\n")
+    assert "| feature |" in md and "feature [m/s]" not in md
+
+
+def test_every_output_key_and_column_is_documented(kinect_dataset: Path, tmp_path: Path) -> None:
+    """docs/experiments.md names every key of summary.json (top level, a within-source result,
+    a train/test result) and every column of the per-class and feature-statistics CSV files:
+    a results section cites them without reading the code (splits_tested, repeats, subsets...
+    were named nowhere)."""
+    doc = (Path(__file__).parents[1] / "docs" / "experiments.md").read_text(encoding="utf-8")
+    _groups_and_train_test(kinect_dataset, tmp_path)
+    out = tmp_path / "o"
+    written = json.loads((out / "summary.json").read_text())
+    keys = {*written, *written["within"]["kinect"], *written["train_test"]}
+    with (out / "within_kinect_per_class.csv").open() as fh:
+        keys |= set(next(csv.reader(fh)))
+    missing = sorted(k for k in keys if f"`{k}`" not in doc)
+    assert not missing, f"not in docs/experiments.md: {missing}"
+    with (out / "feature_stats.csv").open() as fh:
+        columns = next(csv.reader(fh))
+    assert {c for c in columns if c.endswith(("_mean", "_var"))} == {
+        f"{f}_{s}" for f in exp.FEATURE_NAMES for s in ("mean", "var")
+    }
+    assert "`<feature>_mean` [m/s]" in doc and "`<feature>_var` [(m/s)²]" in doc
+
+
+def test_figures_also_in_vector_formats_for_print(kinect_dataset: Path, tmp_path: Path) -> None:
+    """[report] figure_formats = ["png", "pdf", "svg"] writes every figure of the report also as
+    a PDF and an SVG (vector, for print: the PNGs are 110 dpi), with their text as text (no
+    Type 3 fonts, which publishers refuse); the default writes PNGs only, and a list without
+    "png" (the report shows the PNGs) is a config error naming the field."""
+    body = (
+        '[selection]\nmethod = "none"\n[evaluation]\nrepeats = 2\n'
+        '[report]\nscatter_pairs = [["torso_mean", "upper_max"]]\n'
+        'figure_formats = ["png", "pdf", "svg"]\n'
+    )
+    e = _experiment(kinect_dataset, tmp_path, body)
+    exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+    out = tmp_path / "o"
+    for stem in ("within_kinect_confusion", "scatter_torso_mean_upper_max"):
+        assert (out / f"{stem}.png").read_bytes().startswith(b"\x89PNG")
+        pdf = (out / f"{stem}.pdf").read_bytes()
+        assert pdf.startswith(b"%PDF") and b"/Type3" not in pdf  # TrueType: publishers take it
+        svg = (out / f"{stem}.svg").read_text()
+        assert "<svg" in svg and ("predicted" in svg or "torso_mean" in svg)  # text, not paths
+    e.write_text(e.read_text().replace('["png", "pdf", "svg"]', '["pdf"]'))
+    with pytest.raises(ConfigError, match=r"report\.figure_formats.*png"):
+        exp.load_experiment_config(e)
+    e.write_text(e.read_text().replace('figure_formats = ["pdf"]\n', ""))
+    exp.run_experiment(exp.load_experiment_config(e), tmp_path / "p", progress=False)
+    assert not list((tmp_path / "p").glob("*.pdf")) and not list((tmp_path / "p").glob("*.svg"))
+
+
+def test_per_split_scores_and_counts_are_written(kinect_dataset: Path, tmp_path: Path) -> None:
+    """summary.json gives each split's balanced accuracy and its training and test records per
+    class, so that a paper can state the records per split and compute its own uncertainty: here
+    recomputed with scikit-learn from within_<group>_predictions.csv; their mean and population
+    standard deviation are the reported balanced accuracy and its spread."""
+    e = _experiment(
+        kinect_dataset,
+        tmp_path,
+        '[selection]\nmethod = "none"\n[evaluation]\nrepeats = 4\n',
+    )
+    summary = exp.run_experiment(exp.load_experiment_config(e), tmp_path / "o", progress=False)
+    written = json.loads((tmp_path / "o" / "summary.json").read_text())["within"]["kinect"]
+    with (tmp_path / "o" / "within_kinect_predictions.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    per_split = written["balanced_accuracy_per_split"]
+    counts = written["split_counts"]
+    assert len(per_split) == len(counts) == written["n_splits"] == 4
+    for k in range(4):
+        fold = [r for r in rows if r["split"] == str(k)]
+        truth, pred = [r["true"] for r in fold], [r["predicted"] for r in fold]
+        assert per_split[k] == pytest.approx(balanced_accuracy_score(truth, pred), abs=1e-12)
+        assert counts[k]["test"] == {c: truth.count(c) for c in written["classes"]}
+        for c in written["classes"]:
+            assert counts[k]["train"][c] + counts[k]["test"][c] == written["class_counts"][c]
+    assert np.mean(per_split) == pytest.approx(written["balanced_accuracy_mean"], abs=1e-12)
+    assert np.std(per_split) == pytest.approx(written["balanced_accuracy_std"], abs=1e-12)
+    assert summary["within"]["kinect"]["balanced_accuracy_std_over"] == "splits"

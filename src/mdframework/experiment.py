@@ -82,6 +82,8 @@ EXPERIMENT_FILES = (
     "train_test_confusion.*",
     "feature_stats.*",
     "scatter_*.png",
+    "scatter_*.pdf",
+    "scatter_*.svg",
     "dataset",
 )
 
@@ -214,6 +216,19 @@ class ReportConfig(StrictModel):
         [("torso_mean", "upper_max"), ("lower_min", "total_bandwidth")],
         description="Feature pairs to scatter-plot.",
     )
+    figure_formats: list[Literal["png", "pdf", "svg"]] = Field(
+        ["png"],
+        description="Formats of every figure: 'png' (shown in report.md), and also 'pdf' or "
+        "'svg' (vector, text as text, for print).",
+    )
+
+    @field_validator("figure_formats")
+    @classmethod
+    def _png_included(cls, value: list[str]) -> list[str]:
+        """report.md shows the PNGs: they are always written."""
+        if "png" not in value:
+            raise ValueError("must include 'png' (report.md shows the PNGs), e.g. ['png', 'pdf']")
+        return list(dict.fromkeys(value))
 
 
 class ExperimentConfig(StrictModel):
@@ -626,6 +641,39 @@ def _too_few_classes(untested: dict[str, str]) -> MdfError:
     )
 
 
+def confusion_counts(
+    y_true: NDArray[Any], y_pred: NDArray[Any], classes: Sequence[str]
+) -> NDArray[np.int64]:
+    """The confusion matrix of counts (n_classes, n_classes), int64: row = true class, column =
+    predicted class, each cell the number of test records (a prediction outside ``classes`` is
+    not counted)."""
+    idx = {c: i for i, c in enumerate(classes)}
+    counts = np.zeros((len(classes), len(classes)), dtype=np.int64)
+    for t, p in zip(y_true.tolist(), y_pred.tolist(), strict=True):
+        if t in idx and p in idx:
+            counts[idx[t], idx[p]] += 1
+    return counts
+
+
+def pooled_scores(
+    counts: NDArray[np.int64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Per-class precision, recall and F1 (each (n_classes,)) of a matrix of counts (rows:
+    true class, columns: predicted): the diagonal over the column sum, over the row sum, and
+    their harmonic mean; NaN for a class with no test record (an empty row), 0 where the
+    class is never predicted or never right (scikit-learn's ``zero_division=0``)."""
+    c = counts.astype(np.float64)
+    diag, tested, called = np.diagonal(c), c.sum(axis=1), c.sum(axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        precision = np.where(called > 0, diag / called, 0.0)
+        recall = np.where(tested > 0, diag / tested, np.nan)
+        total = precision + recall
+        f1 = np.where(total > 0, 2 * precision * recall / total, 0.0)
+    precision[tested == 0] = np.nan
+    f1[tested == 0] = np.nan
+    return precision, recall, f1
+
+
 def within_source(
     cfg: ExperimentConfig,
     factory: Callable[[], Classifier],
@@ -651,7 +699,11 @@ def within_source(
     accuracy when every split scores every class (then the mean of those equals
     ``balanced_accuracy_mean``), else (e.g. leave-subjects-out folds that hold one class only)
     the standard deviation over the scored classes of their recall;
-    ``balanced_accuracy_std_over`` says which ("splits" or "classes")."""
+    ``balanced_accuracy_std_over`` says which ("splits" or "classes");
+    ``balanced_accuracy_per_split`` gives each split's (NaN: it scores no class).
+    ``confusion_counts`` (int64) sums the splits' scored rows of counts; ``accuracy`` is its
+    trace over its total; ``split_counts`` gives each split's training and test records per
+    class."""
     classes = sorted(set(y.tolist()))
     ev = cfg.evaluation
     untested: dict[str, str] = {}
@@ -686,7 +738,8 @@ def within_source(
         splits = _record_splits(ev, x, y, cfg.seed)
     if len(classes) - len(untested) < 2:
         raise _too_few_classes(untested)
-    mats, optimistic, subsets, tested = [], [], [], []
+    mats, optimistic, subsets, tested, tallies = [], [], [], [], []
+    split_counts: list[dict[str, dict[str, int]]] = []  # per split: train/test records per class
     predictions: list[tuple[int, NDArray[np.intp], NDArray[Any]]] = []
     bar = tqdm_bar(
         splits,
@@ -707,6 +760,15 @@ def within_source(
         mat = confusion_matrix(y[test], pred, classes)
         mat[untrained] = np.nan
         mats.append(mat)
+        split_counts.append(
+            {
+                side: {c: int(np.sum(y[idx] == c)) for c in classes}
+                for side, idx in (("train", train), ("test", test))
+            }
+        )
+        tally = confusion_counts(y[test], pred, classes)
+        tally[untrained] = 0  # not scored, as the matrix's row
+        tallies.append(tally)
         tested.append(np.isin(classes, y[test]))
         subsets.append([names[i] for i in sel.subset])
         if cfg.selection.optimistic and cfg.selection.method == "wrapper":
@@ -738,18 +800,27 @@ def within_source(
     if optimistic:  # the same measure as the result: mean per-class recall of the mean matrix
         opt_stack = np.stack(optimistic)[:, rows]
         opt_mean = float(np.mean(np.diagonal(np.nanmean(opt_stack, axis=0)[:, rows])))
+    diagonals = np.diagonal(stack, axis1=1, axis2=2)[:, rows]  # (n_splits, evaluated classes)
+    per_split = np.full(len(stack), np.nan)  # each split's mean recall of the classes it scores
+    some = ~np.all(np.isnan(diagonals), axis=1)
+    per_split[some] = np.nanmean(diagonals[some], axis=1)
     if scored[:, rows].all():  # every split scores every class: spread over splits
-        per_split = np.diagonal(stack, axis1=1, axis2=2)[:, rows].mean(axis=1)
         spread, over = float(np.std(per_split)), "splits"
     else:
         spread, over = float(np.std(recall)), "classes"
+    counts_sum = np.sum(tallies, axis=0)
+    counts_sum[~rows] = 0  # a class never scored: its row is not counted
     return {
         "classes": classes,
         "confusion_mean": mean,
         "confusion_std": std,
+        "confusion_counts": counts_sum,
+        "accuracy": float(np.trace(counts_sum) / counts_sum.sum()),
         "balanced_accuracy_mean": float(np.mean(recall)),
         "balanced_accuracy_std": spread,
         "balanced_accuracy_std_over": over,
+        "balanced_accuracy_per_split": per_split.tolist(),
+        "split_counts": split_counts,
         "n_splits": len(splits),
         "splits_tested": {c: int(n) for c, n in zip(classes, np.sum(tested, axis=0), strict=True)},
         "splits_scored": {c: int(scored[:, i].sum()) for i, c in enumerate(classes)},
@@ -829,9 +900,12 @@ def _train_then_test(
         units=None if units is None else units[train],
     )
     pred = _fit_predict(factory, x[train], labels[train], x[test], sel.subset)
+    counts = confusion_counts(labels[test], pred, shared)
     return {
         "classes": shared,
         "confusion": confusion_matrix(labels[test], pred, shared),
+        "confusion_counts": counts,
+        "accuracy": float(np.trace(counts) / counts.sum()),
         "balanced_accuracy": balanced_accuracy(labels[test], pred),
         "subset": [names[i] for i in sel.subset],
         "train_counts": {c: int(np.sum(labels[train] == c)) for c in shared},
@@ -876,13 +950,13 @@ def _matrix_rows(classes: list[str], matrix: NDArray[np.float64]) -> list[dict[s
 def _stats_markdown(rows: list[dict[str, Any]]) -> str:
     cols = [f"{r['label']} ({r['group']}, n={r['n']})" for r in rows]
     lines = [
-        "| feature [m/s] | " + " | ".join(cols) + " |",
+        "| feature | " + " | ".join(cols) + " |",
         "|---|" + "---|" * len(cols),
     ]
     for name in FEATURE_NAMES:
         cells = [f"{r[f'{name}_mean']:.4g} ({r[f'{name}_var']:.3g})" for r in rows]
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
-    return "mean (variance)\n\n" + "\n".join(lines) + "\n"
+    return "mean [m/s] (variance [(m/s)²])\n\n" + "\n".join(lines) + "\n"
 
 
 def classifier_inputs(
@@ -1016,8 +1090,10 @@ def _report(
     from .figures import plot_confusion, plot_feature_scatter
 
     figures: list[Callable[[], None]] = []  # drawn at the end
+    extra = tuple(f for f in cfg.report.figure_formats if f != "png")  # also written
 
     index = limits.read_file_bytes(Path(data_dir) / INDEX)
+    settings = _classifier_settings(factory, cfg.classifier)  # every default filled in
     summary: dict[str, Any] = {
         "dataset": str(data_dir),
         # which dataset: its index names every record (an id digests what makes its arrays)
@@ -1030,7 +1106,7 @@ def _report(
         "# Experiment report",
         "",
         f"Dataset: `{data_dir}` ({len(data.labels)} records).",
-        f"Input: {cfg.input}. Classifier: `{json.dumps(cfg.classifier)}`; selection: "
+        f"Input: {cfg.input}. Classifier: `{json.dumps(settings)}`; selection: "
         f"{cfg.selection.method} (sizes {cfg.selection.sizes}); "
         f"evaluation: {protocol(cfg.evaluation)}.",
         "",
@@ -1064,6 +1140,7 @@ def _report(
             continue
         classes = res["classes"]
         splits = _splits_words(cfg.evaluation, res["n_splits"])
+        rows = _rows_scored_words(res, cfg.evaluation)
         for c, why in res["not_evaluated"].items():
             warnings.warn(
                 f"within-source {group}: class {c!r} not evaluated: {why}",
@@ -1079,6 +1156,17 @@ def _report(
             _csv(_matrix_rows(classes, res["confusion_std"])),
             encoding="utf-8",
         )
+        counts = res["confusion_counts"]
+        (out / f"{stem}_confusion_counts.csv").write_text(
+            _csv(
+                [
+                    {"true": c, **dict(zip(classes, map(int, row), strict=True))}
+                    for c, row in zip(classes, counts, strict=True)
+                ]
+            ),
+            encoding="utf-8",
+        )
+        precision, recall, f_score = pooled_scores(counts)
         (out / f"{stem}_per_class.csv").write_text(
             _csv(
                 [
@@ -1088,6 +1176,10 @@ def _report(
                         "rate_mean": float(res["confusion_mean"][i, i]),
                         "rate_std": float(res["confusion_std"][i, i]),
                         "splits_scored": res["splits_scored"][c],
+                        "test_records": int(counts[i].sum()),
+                        "precision": float(precision[i]),
+                        "recall": float(recall[i]),
+                        "f1": float(f_score[i]),
                     }
                     for i, c in enumerate(classes)
                 ]
@@ -1103,7 +1195,8 @@ def _report(
                 res["confusion_std"],
                 title=f"{group}: within-source",
                 caption=f"{caption}; mean ± std over "
-                f"{_caption_splits(cfg.evaluation, res['n_splits'])}",
+                f"{_caption_splits(cfg.evaluation, res['n_splits'])}{rows}",
+                also=extra,
             )
         )
         ids, truth = data.table["id"][mask], data.labels[mask]
@@ -1120,15 +1213,18 @@ def _report(
         summary["within"][group] = {
             k: v
             for k, v in res.items()
-            if k not in ("confusion_mean", "confusion_std", "predictions")
+            if k not in ("confusion_mean", "confusion_std", "confusion_counts", "predictions")
         }
         summary["within"][group]["confusion_mean"] = res["confusion_mean"].tolist()
+        summary["within"][group]["confusion_std"] = res["confusion_std"].tolist()
+        summary["within"][group]["confusion_counts"] = counts.tolist()
         opt = res["optimistic_accuracy_mean"]
         report += [
             f"## Within-source: {group}",
             "",
             f"Balanced accuracy {res['balanced_accuracy_mean']:.3f} "
-            f"({_spread_words(res, splits)}); classes and records: {res['class_counts']}.",
+            f"({_spread_words(res, splits, rows)}); classes and records: "
+            f"{res['class_counts']}.",
             "",
             *_not_evaluated_markdown(res, splits),
             *_held_out_markdown(res),
@@ -1158,6 +1254,7 @@ def _report(
                 None,
                 title=f"train {cfg.cross_source.train} -> test {cfg.cross_source.test}",
                 caption=f"{caption}; features {res['subset']}",
+                also=extra,
             )
         )
         _write_predictions(out / "cross_predictions.csv", data, res)
@@ -1192,6 +1289,7 @@ def _report(
             title=f"train {selector_words(cfg.train_test.train)} -> test "
             f"{selector_words(cfg.train_test.test)}",
             caption=f"{caption}; features {res['subset']}",
+            also=extra,
         )
         _write_predictions(out / "train_test_predictions.csv", data, res)
         summary["train_test"] = _without_predictions(res)
@@ -1233,6 +1331,7 @@ def _report(
                 f2,
                 title=f"{f1} vs {f2}",
                 caption=caption,
+                also=extra,
             )
         )
         report += [f"![{f1} vs {f2}]({name})", ""]
@@ -1241,13 +1340,35 @@ def _report(
     (out / "report.md").write_text("\n".join(report), encoding="utf-8")
     config = cfg.model_dump(mode="json")  # its dataset read from any folder, not only this one
     config["dataset"] = {k: v and os.path.abspath(v) for k, v in config["dataset"].items()}
+    config["classifier"] = settings
     summary["config"] = config
-    summary["versions"] = versions(registry)
+    import importlib.metadata
+
+    # the figures' renderer too (the numbers do not depend on it)
+    summary["versions"] = {
+        **versions(registry),
+        "matplotlib": importlib.metadata.version("matplotlib"),
+    }
     (out / "summary.json").write_text(
         json.dumps(_strict_json(summary), indent=2, default=str, allow_nan=False) + "\n",
         encoding="utf-8",
     )
     return summary
+
+
+def _classifier_settings(
+    factory: Callable[[], Classifier], section: dict[str, Any]
+) -> dict[str, Any]:
+    """The [classifier] section with every default of its plugin filled in (the validated
+    plugin config a classifier holds as ``config``), so that summary.json names the
+    hyper-parameters the run used; ``section`` as given for a plugin that keeps no such
+    config."""
+    from pydantic import BaseModel
+
+    settings = getattr(factory(), "config", None)
+    if isinstance(settings, BaseModel):
+        return {**section, **settings.model_dump(mode="json")}
+    return section
 
 
 def _write_predictions(path: Path, data: Dataset, res: dict[str, Any]) -> None:
@@ -1265,7 +1386,11 @@ def _without_predictions(res: dict[str, Any]) -> dict[str, Any]:
     """A train/test result for summary.json: the matrix as lists, the per-record predictions
     left to their CSV file."""
     kept = {k: v for k, v in res.items() if k not in ("test_index", "true", "predicted")}
-    return {**kept, "confusion": res["confusion"].tolist()}
+    return {
+        **kept,
+        "confusion": res["confusion"].tolist(),
+        "confusion_counts": res["confusion_counts"].tolist(),
+    }
 
 
 def _strict_json(value: Any) -> Any:
@@ -1293,14 +1418,26 @@ def _nothing_evaluated(ev: EvaluationConfig, within: dict[str, dict[str, Any]]) 
     return f"evaluation.split = {ev.split!r}: nothing could be evaluated (within-source {reasons})"
 
 
-def _spread_words(res: dict[str, Any], splits: str) -> str:
-    """What a within-source balanced accuracy is and what its spread is, in words."""
+def _rows_scored_words(res: dict[str, Any], ev: EvaluationConfig) -> str:
+    """Words to follow 'mean ± std over N splits' where some evaluated class is not scored in
+    every split: each row of the matrix is over the splits that score its class, so many."""
+    scored = {c: k for c, k in res["splits_scored"].items() if c not in res["not_evaluated"]}
+    if all(k == res["n_splits"] for k in scored.values()):
+        return ""
+    what = "folds" if ev.split == "groups" else "splits"
+    counts = ", ".join(f"{c} {k}" for c, k in scored.items())
+    return f" (each row over the {what} that score its class: {counts})"
+
+
+def _spread_words(res: dict[str, Any], splits: str, rows: str = "") -> str:
+    """What a within-source balanced accuracy is and what its spread is, in words; ``rows``:
+    :func:`_rows_scored_words`."""
     std = res["balanced_accuracy_std"]
     if res["balanced_accuracy_std_over"] == "splits":
         return f"std {std:.3f} over {splits}; the mean per-class recall of the matrix below"
     return (
         f"std {std:.3f} over the classes' recalls, as not every split scores every class; the "
-        f"mean per-class recall of the matrix below, mean ± std over {splits}"
+        f"mean per-class recall of the matrix below, mean ± std over {splits}{rows}"
     )
 
 

@@ -16,7 +16,7 @@ matplotlib is imported inside the functions that draw, never at import time.
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -44,6 +44,8 @@ _RC: dict[str, Any] = {
     "image.interpolation": "nearest",
     "axes.grid": False,
     "figure.facecolor": "white",
+    "pdf.fonttype": 42,  # TrueType, not Type 3 (which publishers refuse)
+    "svg.fonttype": "none",  # text as text
 }
 _CAPTION_SIZE = 7.5
 
@@ -131,10 +133,13 @@ def wrap_caption(caption: str, fig: Any, fontsize: float = _CAPTION_SIZE) -> str
     return "\n".join(out)
 
 
-def save(fig: Any, path: Path, caption: str = "", *, title: str = "") -> None:
+def save(
+    fig: Any, path: Path, caption: str = "", *, title: str = "", also: Sequence[str] = ()
+) -> None:
     """Save ``fig`` (made with constrained layout under :func:`style`, or by :func:`subplots`)
     with ``title`` over its first axes and ``caption`` set in small type below the axes, then
-    close it."""
+    close it. ``also``: more formats to write the same figure in, beside ``path`` with their
+    suffix (``"pdf"``, ``"svg"``: vector, fonts embedded as TrueType or kept as text)."""
     if title:
         fig.axes[0].set_title(title)
     if caption:
@@ -147,6 +152,8 @@ def save(fig: Any, path: Path, caption: str = "", *, title: str = "") -> None:
             engine.set(rect=(0.0, bottom, 1.0, 1.0 - bottom))
         fig.text(0.01, 0.01, caption, ha="left", va="bottom", fontsize=_CAPTION_SIZE, color="0.25")
     fig.savefig(path)
+    for suffix in also:
+        fig.savefig(Path(path).with_suffix(f".{suffix}"))
     if getattr(fig.canvas, "manager", None) is not None:  # made by pyplot: release it there
         _pyplot().close(fig)
 
@@ -321,10 +328,11 @@ def plot_confusion(
     *,
     title: str = "",
     caption: str = "",
+    also: Sequence[str] = (),
 ) -> None:
     """Save a row-normalised confusion matrix (true class down, predicted across); ``mean``
     and ``std`` (n_classes, n_classes) rates in [0, 1] (a NaN row: a class not evaluated,
-    shown as n/a)."""
+    shown as n/a). ``also``: more formats, as :func:`save`'s."""
     n = len(classes)
     with _rc_context():
         fig, ax = subplots(figsize=(1.3 * n + 2.5, 1.1 * n + 1.8), layout="constrained")
@@ -351,7 +359,7 @@ def plot_confusion(
         ax.set_xlabel("predicted")
         ax.set_ylabel("true")
         fig.colorbar(im, ax=ax, label="rate")
-        save(fig, path, caption, title=title)
+        save(fig, path, caption, title=title, also=also)
 
 
 def scatter_marks(
@@ -377,11 +385,12 @@ def plot_feature_scatter(
     *,
     title: str = "",
     caption: str = "",
+    also: Sequence[str] = (),
 ) -> None:
     """Scatter plot of two features [m/s], colour = activity, marker = source group. Records of
     one activity and group at the same point are one mark of area proportional to their number,
     and larger marks are drawn behind smaller ones, so an activity whose records coincide with
-    another's stays visible (:func:`scatter_marks`)."""
+    another's stays visible (:func:`scatter_marks`). ``also``: more formats, as :func:`save`'s."""
     from matplotlib.lines import Line2D
 
     markers = "o^sDvP*X"
@@ -426,7 +435,7 @@ def plot_feature_scatter(
         if stacked:
             note = "marker area: number of records at the point"
             caption = f"{caption}; {note}" if caption else note
-        save(fig, path, caption, title=title)
+        save(fig, path, caption, title=title, also=also)
 
 
 def plot_range_doppler(
