@@ -360,6 +360,10 @@ def test_the_datasets_page_shows_what_mdf_dataset_check_prints() -> None:
     lines = [line for line in shown.group(1).splitlines() if line.strip() != "..."]
     assert len(lines) >= 3
     assert all(line in printed for line in lines), (lines, printed)
+    # the records are stored uncompressed (the page's format section): the size is no
+    # "before compression" estimate of a smaller file
+    size = [line for line in printed if line.startswith("  spectrograms about")]
+    assert size and "uncompressed" in size[0] and "before compression" not in size[0], size
 
 
 def test_the_getting_started_page_lists_the_exit_codes_mdf_help_lists() -> None:

@@ -472,6 +472,7 @@ def format_dataset_plan(plan: DatasetPlan, source: str) -> str:
             )
     if plan.spectrogram_mib:
         lines.append(
-            f"  spectrograms about {_mib(plan.spectrogram_mib)} MiB (float32, before compression)"
+            f"  spectrograms about {_mib(plan.spectrogram_mib)} MiB "
+            "(float32; records are stored uncompressed)"
         )
     return "\n".join(lines)
