@@ -358,6 +358,27 @@ def test_a_yaml_key_that_is_not_text_is_named(
 
 
 @pytest.mark.parametrize(
+    ("value", "expected"),
+    [
+        ("on", "must be text, not a flag (true): quote it"),
+        ("1:30", "must be text, not a number (90): quote it"),
+        ("2024-01-01", "must be text, not a date (2024-01-01): quote it"),
+    ],
+)
+def test_yaml_text_read_as_a_flag_number_or_date_says_to_quote_it(
+    value: str, expected: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """docs/input-rules.md: YAML 1.1 reads unquoted yes/no/on/off as flags, 1:30 as 90 and
+    2024-01-01 as a date, so quote them where text is meant; a text field given one said
+    "must be a valid string (got True)" or "(got datetime.date(2024, 1, 1))"."""
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(f"motion: {{kind: point_targets, length: 1.0, label: {value}, "
+                   "targets: [{position: [9, 0, 0]}]}\nscatterers: {kind: points}\n")  # fmt: skip
+    line = one_error_line(["check", str(cfg)], capsys)
+    assert line == f"mdf: error: {cfg}: motion.label: {expected}"
+
+
+@pytest.mark.parametrize(
     ("setting", "field"),
     [
         ("atmospheric_loss_db = 400", "radar.atmospheric_loss_db"),

@@ -466,6 +466,18 @@ def _plain(error: Any, allowed: list[str] | None) -> str:
         return f"a key must be text{got}"
     if kind == "int_parsing_size":  # pydantic: "Unable to parse input string as an integer"
         return f"must be a whole number within the field's range{got}"
+    if kind == "string_type" and isinstance(error.get("input"), (bool, int, float, datetime.date)):
+        # YAML 1.1 reads unquoted yes/no/on/off as flags, 1:30 as 90, 2024-01-01 as a date
+        value = error["input"]
+        what = (
+            "a flag"
+            if isinstance(value, bool)
+            else "a date"
+            if isinstance(value, datetime.date)
+            else "a number"
+        )
+        shown = value.isoformat() if isinstance(value, datetime.date) else _short(value).lower()
+        return f"must be text, not {what} ({shown}): quote it"
     if kind == "path_type":  # pydantic: "Input is not a valid path for <class 'pathlib.Path'>"
         return f"must be a path (text){got}"
     if kind in ("value_error", "assertion_error"):
