@@ -443,7 +443,8 @@ def _load_entry_points(
             dist_name, version = _name_and_version(ep.dist)
             dist = f"{dist_name} {version}"
         if {ep.name, dist_name} & off:
-            _disabled(pm)[ep.name] = f"{dist}, disabled by {DISABLE_PLUGINS_ENV}"
+            why = f"disabled by --disable-plugin or {DISABLE_PLUGINS_ENV}"  # the CLI sets it
+            _disabled(pm)[ep.name] = f"{dist}, {why}"
             continue
         clock = time.perf_counter()
         try:
