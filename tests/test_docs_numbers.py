@@ -547,3 +547,42 @@ def test_the_effects_page_quotes_how_much_shadowing_hides_on_the_side_view_walk(
     assert quoted is not None
     measured = [round(100 * v) for v in (direct["torso"], image["torso"], more)]
     assert [int(q) for q in quoted.groups()] == measured
+
+
+def test_the_input_rules_page_quotes_the_echo_powers_of_its_example_radars() -> None:
+    """docs/input-rules.md's MAX_ECHO_POWER_W and MIN_ECHO_POWER_W rows give the range
+    equation's echo of 1 m^2 at 1 m for three radars: each is that formula's value."""
+    import numpy as np
+
+    from mdframework import limits
+
+    page = (ROOT / "docs" / "input-rules.md").read_text()
+    rows = {
+        name: next(line for line in page.splitlines() if line.startswith(f"| `{name}` |"))
+        for name in ("MAX_ECHO_POWER_W", "MIN_ECHO_POWER_W")
+    }
+
+    def echo(power_w: float, gain_dbi: float, carrier_hz: float, losses_db: float) -> float:
+        wavelength = 299_792_458.0 / carrier_hz
+        return (
+            power_w
+            * 10 ** (gain_dbi / 5)
+            * wavelength**2
+            / ((4 * np.pi) ** 3 * 10 ** (losses_db / 10))
+        )
+
+    quoted = [
+        (rows["MAX_ECHO_POWER_W"], "a 1 MW planetary radar with a 73 dBi dish at 2.38 GHz, "
+         "Arecibo's: {:.2g}", echo(1e6, 73.0, 2.38e9, 0.0)),
+        (rows["MAX_ECHO_POWER_W"], "a 1 MW radar with a 60 dBi antenna at 10 GHz: {:.2g}",
+         echo(1e6, 60.0, 10e9, 0.0)),
+        (rows["MIN_ECHO_POWER_W"], "a 1 mW radar at 60 GHz with 0 dBi and 100 dB of losses: "
+         "{:.2g}", echo(1e-3, 0.0, 60e9, 100.0)),
+    ]  # fmt: skip
+    for row, text, value in quoted:
+        shown = text.format(value).replace("e+", "e")  # 3.2e15, as the page writes it
+        assert shown in row, (shown, row)
+    assert limits.MAX_ECHO_POWER_W > echo(1e6, 73.0, 2.38e9, 0.0)
+    assert limits.MIN_ECHO_POWER_W < echo(1e-3, 0.0, 60e9, 100.0)
+    dbm = 10 * np.log10(limits.MIN_ECHO_POWER_W / 1e-3)
+    assert f"({dbm:.0f} dBm;" in rows["MIN_ECHO_POWER_W"]

@@ -56,7 +56,7 @@ MAX_PULSES = 5_000_000
 #: Largest radar cross section of a point [m^2].
 MAX_RCS_M2 = 1e6
 #: Largest echo power [W] of a 1 m^2 scatterer 1 m from the radar, the range equation's
-#: P G^2 lambda^2 / ((4 pi)^3 L) (a 1 MW planetary radar with a 73 dBi dish at 2.4 GHz,
+#: P G^2 lambda^2 / ((4 pi)^3 L) (a 1 MW planetary radar with a 73 dBi dish at 2.38 GHz,
 #: Arecibo's: 3.2e15 W; a 1 MW radar with a 60 dBi antenna at 10 GHz: 4.5e11 W); far stronger
 #: (1e20 W still runs with a 1e6 m^2 point at 0.5 m in a 65536-point STFT), the echoes of near,
 #: large scatterers overflow the float32 arithmetic of the radars and of the spectrogram.
