@@ -586,3 +586,49 @@ def test_the_input_rules_page_quotes_the_echo_powers_of_its_example_radars() -> 
     assert limits.MIN_ECHO_POWER_W < echo(1e-3, 0.0, 60e9, 100.0)
     dbm = 10 * np.log10(limits.MIN_ECHO_POWER_W / 1e-3)
     assert f"({dbm:.0f} dBm;" in rows["MIN_ECHO_POWER_W"]
+
+
+def test_the_fmcw_page_shows_what_mdf_check_prints_and_its_formulas_give() -> None:
+    """docs/fmcw.md names the lines of `mdf check` that report its table's quantities and shows
+    them for examples/fmcw_walk.toml: each shown line is printed, and its numbers are the
+    table's formulas for the preset's chirp (the loop rate 1 / (n_tx T_c), the maximum range
+    c sample_rate / (2 S), ...)."""
+    import subprocess
+    import sys
+
+    page = (ROOT / "docs" / "fmcw.md").read_text()
+    shown = re.search(r"```text\n(  carrier .*?)```", page, re.S)
+    assert shown is not None
+    done = subprocess.run(
+        [sys.executable, "-m", "mdframework.cli", "check", "examples/fmcw_walk.toml"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    lines = shown.group(1).splitlines()
+    assert lines and all(line in done.stdout.splitlines() for line in lines), done.stdout
+    text = " ".join(lines)
+    c = 299_792_458.0
+    from mdf_fmcw.presets import PRESETS
+
+    chirp = PRESETS["iwr1443_short_range_3d"]  # the example's preset, no field overridden
+    f0, slope, idle, adc = (
+        chirp[k] for k in ("start_frequency", "slope", "idle_time", "adc_start_time")
+    )
+    ramp, fs, n, loops = (
+        chirp[k] for k in ("ramp_end_time", "sample_rate", "n_samples", "n_loops")
+    )
+    n_tx = len(chirp["tdm_order"])
+    t_c = idle + ramp
+    wavelength = c / (f0 + slope * (adc + (n - 1) / (2 * fs)))
+    quoted = {
+        "wavelength {:.3g} cm": 100 * wavelength,
+        "slow time {:.4g} kHz": 1e-3 / (n_tx * t_c),
+        "window 325 Hz = {:.3g} m/s": wavelength / (2 * loops * n_tx * t_c),
+        "unambiguous +-{:.3g} m/s": wavelength / (4 * n_tx * t_c),
+        "range resolution {:.3g} m": c / (2 * slope * n / fs),
+        "unambiguous to {:.4g} m": c * fs / (2 * slope),
+    }  # fmt: skip
+    for words, value in quoted.items():
+        assert words.format(value) in text.replace("range       ", "range "), words.format(value)
