@@ -22,6 +22,21 @@ def _script(name: str) -> types.ModuleType:
     return module
 
 
+def _mdf(*args: str) -> Any:
+    """``mdf ARGS`` run from the repository's root as a reader runs it (a separate process),
+    which must succeed: its CompletedProcess (text)."""
+    import subprocess
+    import sys
+
+    return subprocess.run(
+        [sys.executable, "-m", "mdframework.cli", *args],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+
+
 def test_the_reproduction_page_quotes_the_held_out_recordings_experiment(tmp_path: Path) -> None:
     """The page's accuracy with whole CMU recordings held out is what the script that the page
     names measures (the page once quoted a number no config reproduced)."""
@@ -343,19 +358,10 @@ def test_the_validation_page_quotes_the_walks_step_times() -> None:
 def test_the_datasets_page_shows_what_mdf_dataset_check_prints() -> None:
     """docs/datasets.md shows `mdf dataset check examples/datasets/cmu.toml`, abridged (`...`):
     each line it shows is a line the command prints."""
-    import subprocess
-    import sys
-
     page = (ROOT / "docs" / "datasets.md").read_text()
     shown = re.search(r"```text\n(examples/datasets/cmu\.toml: valid.*?)```", page, re.S)
     assert shown is not None
-    done = subprocess.run(
-        [sys.executable, "-m", "mdframework.cli", "dataset", "check", "examples/datasets/cmu.toml"],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        check=True,
-    )
+    done = _mdf("dataset", "check", "examples/datasets/cmu.toml")
     printed = done.stdout.splitlines()
     lines = [line for line in shown.group(1).splitlines() if line.strip() != "..."]
     assert len(lines) >= 3
@@ -491,21 +497,12 @@ def test_the_getting_started_page_names_the_commands_that_stage_their_files() ->
 def test_the_getting_started_page_shows_what_mdf_check_prints() -> None:
     """docs/getting-started.md shows `mdf check examples/point_target.toml` and what it
     prints: the very lines, in order (the docs' other tests only run the command)."""
-    import subprocess
-    import sys
-
     page = (ROOT / "docs" / "getting-started.md").read_text()
     shown = re.search(
         r"```sh\nmdf check examples/point_target\.toml\n```\n\n```text\n(.*?)```", page, re.S
     )
     assert shown is not None
-    done = subprocess.run(
-        [sys.executable, "-m", "mdframework.cli", "check", "examples/point_target.toml"],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        check=True,
-    )
+    done = _mdf("check", "examples/point_target.toml")
     assert done.stdout == shown.group(1)
 
 
@@ -593,19 +590,10 @@ def test_the_fmcw_page_shows_what_mdf_check_prints_and_its_formulas_give() -> No
     them for examples/fmcw_walk.toml: each shown line is printed, and its numbers are the
     table's formulas for the preset's chirp (the loop rate 1 / (n_tx T_c), the maximum range
     c sample_rate / (2 S), ...)."""
-    import subprocess
-    import sys
-
     page = (ROOT / "docs" / "fmcw.md").read_text()
     shown = re.search(r"```text\n(  carrier .*?)```", page, re.S)
     assert shown is not None
-    done = subprocess.run(
-        [sys.executable, "-m", "mdframework.cli", "check", "examples/fmcw_walk.toml"],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        check=True,
-    )
+    done = _mdf("check", "examples/fmcw_walk.toml")
     lines = shown.group(1).splitlines()
     assert lines and all(line in done.stdout.splitlines() for line in lines), done.stdout
     text = " ".join(lines)
