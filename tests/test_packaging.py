@@ -219,6 +219,33 @@ def test_a_plugin_has_a_package_page(folder: Path) -> None:
     assert re.findall(r"\]\((?!https?://)[^)]*\)", readme) == []
 
 
+@pytest.mark.parametrize("folder", PLUGINS, ids=[p.name for p in PLUGINS])
+def test_a_plugin_page_names_its_entry_point_and_documentation_as_they_are(folder: Path) -> None:
+    """A plugin's README names its entry point and module as its pyproject declares them (the
+    name --disable-plugin takes), and the documentation's pages and Config reference sections
+    it sends the reader to by their titles (it cannot link them): each is a page's title (its
+    heading or its name in the site's menu) or a section of that page."""
+    import re
+
+    project = tomllib.loads((folder / "pyproject.toml").read_text(encoding="utf-8"))
+    points = project["project"]["entry-points"]["mdframework"]
+    flat = " ".join((folder / "README.md").read_text(encoding="utf-8").split())
+    for name, module in points.items():
+        assert f"Entry point `{name}` (module `{module}`)" in flat
+    docs = ROOT / "docs"
+    titles = {
+        p.read_text(encoding="utf-8").splitlines()[0].removeprefix("# ") for p in docs.glob("*.md")
+    }
+    menu = (ROOT / "mkdocs.yml").read_text(encoding="utf-8")
+    titles |= set(re.findall(r"^  - (.+?): \S+\.md$", menu, re.M))
+    cited = re.findall(r'page "([^"]+)"', flat)
+    assert "Config reference" in cited and set(cited) <= titles, set(cited) - titles
+    reference = (docs / "config-reference.md").read_text(encoding="utf-8")
+    headings = set(re.findall(r"^#+ (kind = `\w+`)", reference, re.M))
+    sections = re.findall(r'"(kind = `\w+`)"', flat)
+    assert sections and set(sections) <= headings, set(sections) - headings
+
+
 def test_the_core_package_page_has_no_relative_link() -> None:
     """The core's README is its package page too, where a link to docs/... or examples/...
     leads nowhere (it linked to docs/getting-started.md, docs/kinect.md and docs/index.md): it
