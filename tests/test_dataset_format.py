@@ -329,3 +329,27 @@ def test_a_build_does_not_rewrite_a_folder_of_a_newer_format_as_its_own(tmp_path
         with pytest.raises(OutputError, match=r"format_version 2, newer than this mdframework"):
             build_dataset(*load_dataset_config(config), out, workers=1, progress=False, force=force)
         assert (out / "dataset.json").read_text() == newer
+
+
+def test_the_page_quotes_the_size_of_a_record_of_the_cmu_dataset(tmp_path: Path) -> None:
+    """docs/datasets.md: a record of examples/datasets/cmu.toml takes 153 KiB (its 512 x 68
+    float32 map 136 KiB, meta 11 KiB), the 280 records 43 MB (the first source's first record,
+    built; the count is what `mdf dataset check` prints, tested with the page's output)."""
+    page = " ".join(DOCS.read_text().split())
+    config, base = load_dataset_config(EXAMPLES / "datasets" / "cmu.toml")
+    first = config.sources[0].model_copy(update={"max_records": 1})
+    lengths = {"walk": config.record_lengths["walk"]}
+    config = config.model_copy(update={"sources": [first], "record_lengths": lengths})
+    build_dataset(config, base, tmp_path / "out", workers=1, progress=False)
+    path = tmp_path / "out" / "records" / f"{_first_id(tmp_path / 'out')}.npz"
+    with np.load(path, allow_pickle=False) as data:
+        shape, map_bytes = data["spectrogram_db"].shape, data["spectrogram_db"].nbytes
+        meta_bytes = data["meta"].nbytes
+    size = path.stat().st_size
+    quoted = (
+        f"takes {size / 1024:.0f} KiB (its {shape[0]} x {shape[1]} float32 map "
+        f"{map_bytes / 1024:.0f} KiB, `meta` {meta_bytes / 1024:.0f} KiB), the 280 records "
+        f"{280 * size / 1e6:.0f} MB"
+    )
+    assert quoted in page, quoted
+    assert "examples/datasets/cmu.toml: valid, 280 records" in DOCS.read_text()
