@@ -255,6 +255,9 @@ def test_the_core_package_page_has_no_relative_link() -> None:
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
     assert re.findall(r"\]\((?!https?://)[^)]*\)", readme) == []
     assert "pip install mdframework mdf-cmu mdf-ellipsoid mdf-lfm" in readme
+    # "the table above names them all": the plugins its layout table names
+    layout = readme[readme.index("## Layout") : readme.index("## Documentation")]
+    assert all(f"`{folder.name}`" in layout for folder in PLUGINS)
 
 
 @pytest.mark.parametrize("folder", DISTRIBUTIONS, ids=[p.name for p in DISTRIBUTIONS])
