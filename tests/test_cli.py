@@ -509,7 +509,7 @@ def test_version(capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(SystemExit) as info:
         cli.main(["--version"])
     assert info.value.code == 0
-    assert capsys.readouterr().out.startswith("mdf (mdframework) 0.2.1, Python 3.")
+    assert capsys.readouterr().out.startswith("mdf (mdframework) 0.2.2, Python 3.")
 
 
 @pytest.mark.parametrize("where", ["first", "after the command", "last"])
