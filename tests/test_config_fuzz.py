@@ -361,6 +361,7 @@ def test_a_yaml_key_that_is_not_text_is_named(
     ("setting", "field"),
     [
         ("atmospheric_loss_db = 400", "radar.atmospheric_loss_db"),
+        ("system_loss_db = 400", "radar.system_loss_db"),
         ("gain_dbi = -400", "radar.gain_dbi"),
         ("transmit_power = 1e-300", "radar.transmit_power"),
     ],

@@ -193,3 +193,7 @@ def test_the_tracking_gate_advice_names_the_maximum_range_only_when_the_body_rea
         "the maximum range"
     )
     assert why.endswith(reaches) == (max_range == 12.49), why
+    # a body that only reaches past it (12-14 m) reaches it too
+    spread = Losses(300, 300, 0, (12.0, 14.0), (12.0, 14.0))
+    why = empty_result(echo, spread, max_lost_fraction=0.5, fixed_gate=False, max_range=max_range)
+    assert why is not None and ("reaches beyond" in why) == (max_range == 12.49), why
