@@ -222,3 +222,16 @@ def test_a_pulse_radars_spread_body_beyond_c_over_2_prf_is_told_of_its_spread(
     assert code == 0
     assert "67 % are outside the range gate: the range gate (tracking the body) is narrower" in err
     assert "maximum range" not in err, err
+
+
+def test_an_fmcw_body_beyond_the_maximum_range_is_told_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An FMCW radar of maximum range 49.97 m that lets ranges alias, its gate tracking a
+    target at 60-61 m: the target's beat frequency folds to 10 m, away from the gate, and the
+    run's advice names the maximum range (the radar's range FFT folds there)."""
+    point = POINT.format(x=60.0, gate='"track"', empty="warn")
+    radar = '[radar]\nkind = "fmcw"\nsample_rate = 10e6\nbeyond_max_range = "alias"\n'
+    code, err, _ = run(tmp_path, point + radar, capsys)
+    assert code == 0
+    assert "reaches beyond the radar's maximum range 49.97 m, where its range bins fold" in err
