@@ -502,6 +502,7 @@ def test_walker_is_not_blamed_for_its_time_base_or_unit(
     ("motion", "field", "what"),
     [
         ({"n_cycles": 10_000, "nt": 65536}, "n_cycles", "655,360,001 frames"),  # 200 GiB
+        ({"n_cycles": 10_000, "nt": 1000}, "n_cycles", "10,000,001 frames"),  # one too many
         ({"rv": 5e-324}, "rv", r"of 6\.0\d+e\+161 s"),  # an overflow: an internal error
         ({"rv": 1e-9}, "rv", r"3 cycle\(s\) of 4\.256e\+04 s"),  # 3 cycles of 11.8 h
         ({"rv": 1e-9, "duration": 86400.0}, "duration", r"3 cycle\(s\) of 4\.256e\+04 s"),
@@ -549,6 +550,9 @@ def test_a_window_beyond_the_cycles_names_n_cycles(registry: Registry) -> None:
     match = r"^<config>: motion\.n_cycles: .*n_cycles = 1 .* set n_cycles to at least 3"
     with pytest.raises(ConfigError, match=match):
         validate_run_config(cfg, registry=registry)
+    cfg["motion"]["n_cycles"] = 2  # 2.69 s: still short of the window's end
+    with pytest.raises(ConfigError, match=r"n_cycles = 2 .* set n_cycles to at least 3"):
+        validate_run_config(cfg, registry=registry)
     cfg["motion"]["n_cycles"] = 3
     validate_run_config(cfg, registry=registry)
 
@@ -587,3 +591,12 @@ def test_the_config_reference_gives_the_walkers_sanity_defaults() -> None:
     sanity = BoulicConfig().sanity
     assert (found[1], found[2]) == (str(sanity.cadence).lower(), sanity.size)
     assert (sanity.cadence, sanity.size) != (SanityConfig().cadence, SanityConfig().size)
+
+
+def test_a_sanity_config_object_keeps_the_walkers_defaults_for_what_it_does_not_set() -> None:
+    """A SanityConfig passed from Python (not a table) sets only the checks it names: the
+    walker's cadence = false and size = 'ignore' stay for the others, and a check it sets
+    explicitly is kept."""
+    assert BoulicConfig(sanity=SanityConfig()).sanity.cadence is False
+    on = BoulicConfig(sanity=SanityConfig(cadence=True)).sanity
+    assert on.cadence is True and on.size == "ignore"

@@ -382,6 +382,7 @@ def test_yaml_text_read_as_a_flag_number_or_date_says_to_quote_it(
     ("setting", "field"),
     [
         ("atmospheric_loss_db = 400", "radar.atmospheric_loss_db"),
+        ("system_loss_db = 400", "radar.system_loss_db"),
         ("gain_dbi = -400", "radar.gain_dbi"),
         ("transmit_power = 1e-300", "radar.transmit_power"),
     ],

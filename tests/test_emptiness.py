@@ -193,3 +193,45 @@ def test_the_tracking_gate_advice_names_the_maximum_range_only_when_the_body_rea
         "the maximum range"
     )
     assert why.endswith(reaches) == (max_range == 12.49), why
+    # a body that only reaches past it (12-14 m) reaches it too
+    spread = Losses(300, 300, 0, (12.0, 14.0), (12.0, 14.0))
+    why = empty_result(echo, spread, max_lost_fraction=0.5, fixed_gate=False, max_range=max_range)
+    assert why is not None and ("reaches beyond" in why) == (max_range == 12.49), why
+
+
+@pytest.mark.parametrize("prf", [1e6, 1e5])
+def test_a_pulse_radars_spread_body_beyond_c_over_2_prf_is_told_of_its_spread(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], prf: float
+) -> None:
+    """Three point targets at 200-240 m, a 50 MHz LFM radar's tracking gate on one: two of
+    three returns are lost to the gate's width, at PRF 1 MHz (c / (2 prf) = 149.9 m, nearer
+    than the body) as at 100 kHz (1.5 km). The advice blamed the maximum range at 1 MHz ('its
+    range bins fold back ... bring the body within the maximum range'), but the LFM radar's
+    simulation gates every echo at its true range (its own warning says so): nearer, the same
+    two returns are lost. The advice names the gate's width at either PRF."""
+    targets = ", ".join(
+        f"{{ position = [{x}, 0.0, 0.0], velocity = [1.0, 0.0, 0.0], rcs = 1.0 }}"
+        for x in (200.0, 220.0, 240.0)
+    )
+    text = (
+        f'[motion]\nkind = "point_targets"\nlength = 0.2\ntargets = [{targets}]\n'
+        '[scatterers]\nkind = "points"\n[scene]\nradar_position = [0.0, 0.0, 0.0]\n'
+        f'[radar]\nkind = "lfm"\nprf = {prf}\nbandwidth = 50e6\npulse_width = 1e-7\n'
+    )
+    code, err, _ = run(tmp_path, text, capsys)
+    assert code == 0
+    assert "67 % are outside the range gate: the range gate (tracking the body) is narrower" in err
+    assert "maximum range" not in err, err
+
+
+def test_an_fmcw_body_beyond_the_maximum_range_is_told_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An FMCW radar of maximum range 49.97 m that lets ranges alias, its gate tracking a
+    target at 60-61 m: the target's beat frequency folds to 10 m, away from the gate, and the
+    run's advice names the maximum range (the radar's range FFT folds there)."""
+    point = POINT.format(x=60.0, gate='"track"', empty="warn")
+    radar = '[radar]\nkind = "fmcw"\nsample_rate = 10e6\nbeyond_max_range = "alias"\n'
+    code, err, _ = run(tmp_path, point + radar, capsys)
+    assert code == 0
+    assert "reaches beyond the radar's maximum range 49.97 m, where its range bins fold" in err

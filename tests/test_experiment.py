@@ -627,6 +627,18 @@ def test_per_record_predictions_match_the_matrices(kinect_dataset: Path, tmp_pat
         counts[tt_classes.index(r["true"]), tt_classes.index(r["predicted"])] += 1
     assert np.array_equal(summary["train_test"]["confusion_counts"], counts)
     assert summary["train_test"]["accuracy"] == pytest.approx(np.trace(counts) / len(tt))
+    # summary.json holds them as numbers (an array left in would be written as its text), and
+    # the within-source spread as within_<group>_confusion_std.csv does
+    written = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert written["train_test"]["confusion_counts"] == counts.tolist()
+    with (tmp_path / "o" / "within_kinect_confusion_std.csv").open() as fh:
+        std = [[float(r[c]) for c in classes] for r in csv.DictReader(fh)]
+    assert np.allclose(
+        np.array(written["within"]["kinect"]["confusion_std"], dtype=float),
+        std,
+        atol=1e-6,
+        equal_nan=True,
+    )
 
 
 def test_more_folds_than_subjects_warns_on_stderr(
@@ -1214,10 +1226,14 @@ def test_figures_also_in_vector_formats_for_print(kinect_dataset: Path, tmp_path
         pdf = (out / f"{stem}.pdf").read_bytes()
         assert pdf.startswith(b"%PDF") and b"/Type3" not in pdf  # TrueType: publishers take it
         svg = (out / f"{stem}.svg").read_text()
-        assert "<svg" in svg and ("predicted" in svg or "torso_mean" in svg)  # text, not paths
+        assert "<svg" in svg and ("predicted" in svg or "torso_mean" in svg)
+        assert "<text" in svg  # text as text, not glyph paths (whose comments name it too)
     e.write_text(e.read_text().replace('["png", "pdf", "svg"]', '["pdf"]'))
     with pytest.raises(ConfigError, match=r"report\.figure_formats.*png"):
         exp.load_experiment_config(e)
+    with pytest.raises(ValueError, match="must include 'png'"):
+        exp.ReportConfig(figure_formats=[])
+    assert exp.ReportConfig(figure_formats=["png", "svg", "png"]).figure_formats == ["png", "svg"]
     e.write_text(e.read_text().replace('figure_formats = ["pdf"]\n', ""))
     exp.run_experiment(exp.load_experiment_config(e), tmp_path / "p", progress=False)
     assert not list((tmp_path / "p").glob("*.pdf")) and not list((tmp_path / "p").glob("*.svg"))
@@ -1250,3 +1266,68 @@ def test_per_split_scores_and_counts_are_written(kinect_dataset: Path, tmp_path:
     assert np.mean(per_split) == pytest.approx(written["balanced_accuracy_mean"], abs=1e-12)
     assert np.std(per_split) == pytest.approx(written["balanced_accuracy_std"], abs=1e-12)
     assert summary["within"]["kinect"]["balanced_accuracy_std_over"] == "splits"
+
+
+def test_pooled_scores_of_classes_never_predicted_never_right_or_never_tested() -> None:
+    """per_class.csv's pooled precision, recall and F1 are scikit-learn's with
+    ``zero_division=0`` for every class with test records: b is never predicted (precision 0,
+    not NaN), c is predicted but never right (0); a class without test records (d, though
+    predicted) reads NaN in all three, as docs/experiments.md says. A prediction outside the
+    classes is not counted."""
+    from sklearn.metrics import precision_recall_fscore_support
+
+    classes = ["a", "b", "c", "d"]
+    truth = np.array(["a"] * 4 + ["b"] * 2 + ["c"] * 3)
+    pred = np.array(["a", "a", "a", "c", "a", "d", "a", "a", "a"])
+    counts = exp.confusion_counts(truth, pred, classes)
+    assert counts.tolist() == [[3, 0, 1, 0], [1, 0, 0, 1], [3, 0, 0, 0], [0, 0, 0, 0]]
+    precision, recall, f1 = exp.pooled_scores(counts)
+    p, r, f, _ = precision_recall_fscore_support(truth, pred, labels=classes[:3], zero_division=0)
+    assert np.allclose(precision[:3], p, rtol=0, atol=1e-12)
+    assert np.allclose(recall[:3], r, rtol=0, atol=1e-12)
+    assert np.allclose(f1[:3], f, rtol=0, atol=1e-12)
+    assert precision[1] == 0.0 and f1[1] == 0.0 and precision[2] == 0.0
+    assert np.isnan([precision[3], recall[3], f1[3]]).all()
+    outside = exp.confusion_counts(np.array(["a", "b"]), np.array(["a", "z"]), ["a", "b"])
+    assert outside.tolist() == [[1, 0], [0, 0]]
+
+
+def test_per_split_scores_and_counts_of_folds_of_one_class() -> None:
+    """Leave-subjects-out where every fold holds one class (_one_class_per_subject, plus c of
+    one subject, s6, never scored): each fold's balanced accuracy is the recall of the class it
+    scores (a's folds 1, s4's 1, s5's 0), the fold of c alone scores nothing (null in
+    summary.json), and the pooled counts hold a's and b's 20 test records only: accuracy
+    16 / 20, precision of a 12 / 16."""
+    x, y, subjects = _one_class_per_subject()
+    x = np.concatenate([x, np.full((4, 7), 0.0)])
+    x[-4:, 0] = -20.0 + np.arange(4) * 0.01
+    y = np.concatenate([y, ["c"] * 4])
+    subjects = np.concatenate([subjects, ["s6"] * 4])
+    cfg = _cfg({"split": "groups", "by": "subject"})
+    res = exp.within_source(cfg, exp.classifier_factory(cfg.classifier, "t"), x, y, subjects)
+    assert list(res["not_evaluated"]) == ["c"]
+    per = res["balanced_accuracy_per_split"]
+    assert len(per) == res["n_splits"] == 6
+    assert sum(np.isnan(per)) == 1 and sorted(v for v in per if not np.isnan(v)) == [
+        0.0,
+        1.0,
+        1.0,
+        1.0,
+        1.0,
+    ]
+    assert None in exp._strict_json(per)  # written as null
+    assert res["confusion_counts"].tolist() == [[12, 0, 0], [4, 4, 0], [0, 0, 0]]
+    assert res["accuracy"] == pytest.approx(16 / 20, abs=1e-12)
+    precision, recall, _ = exp.pooled_scores(res["confusion_counts"])
+    assert precision[:2] == pytest.approx([12 / 16, 1.0]) and recall[:2] == pytest.approx([1, 0.5])
+
+
+def test_rows_scored_words_name_each_class_where_some_split_leaves_one_out() -> None:
+    """The caption's '(each row over the splits that score its class: ...)' appears as soon as
+    one evaluated class is not scored in every split, though another is."""
+    res = {"splits_scored": {"a": 5, "b": 3, "c": 0}, "not_evaluated": {"c": "x"}, "n_splits": 5}
+    ev = exp.EvaluationConfig(split="groups", by="subject")
+    words = " (each row over the folds that score its class: a 5, b 3)"
+    assert exp._rows_scored_words(res, ev) == words
+    res["splits_scored"]["b"] = 5
+    assert exp._rows_scored_words(res, ev) == ""

@@ -1100,13 +1100,18 @@ def test_a_fixed_gate_that_misses_the_target_is_an_empty_result(gate: float) -> 
 
 def test_a_target_beyond_the_unambiguous_range_of_the_prf_is_warned_about() -> None:
     """An X-band pulse-Doppler radar at PRF 1 MHz has the unambiguous range
-    c / (2 PRF) = 149.9 m: a target at 300 m returns after the next pulse has gone out (a real
-    radar sees it at 150 m). The run warns naming radar.prf, the range and the PRF that
-    reaches it; at PRF 10 kHz (14.99 km) it does not."""
+    c / (2 PRF) = 149.9 m: a target at 300 m returns two pulses later (a real radar sees it at
+    300 m modulo 149.9 m, 0.2 m). The run warns naming radar.prf, the range and the PRF that
+    reaches it, and so it does for a target at 200 m (seen at 50.1 m); at PRF 10 kHz (14.99 km)
+    it does not."""
     target = [{"position": [300.0, 0.0, 0.0], "velocity": [-2.0, 0.0, 0.0]}]
     radar_ = {"kind": "lfm", "carrier_frequency": 10e9, "bandwidth": 1e6, "pulse_width": 1e-6}
-    with pytest.warns(UserWarning, match=r"radar\.prf: .* 300(\.0)? m .* 149\.9 m .* 499\.7 kHz"):
+    seen = r"radar\.prf: .* 300(\.0)? m .* 149\.9 m .* sees it at 0\.2075 m .* 499\.7 kHz"
+    with pytest.warns(UserWarning, match=seen):
         point_run(target, duration=0.05, radar={**radar_, "prf": 1e6})
+    nearer = [{"position": [200.0, 0.0, 0.0], "velocity": [-2.0, 0.0, 0.0]}]
+    with pytest.warns(UserWarning, match=r"radar\.prf: .* 200(\.0)? m .* sees it at 50\.1 m"):
+        point_run(nearer, duration=0.05, radar={**radar_, "prf": 1e6})
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         point_run(target, duration=0.05, radar={**radar_, "prf": 1e4})
@@ -1139,3 +1144,21 @@ def test_inconsistent_pulse_and_fft_settings_name_their_field(
     msg = str(err.value)
     assert msg.startswith(f"run.toml: {start}"), msg
     assert "\n" not in msg
+
+
+def test_the_gate_gain_folds_ranges_as_the_range_fft_does() -> None:
+    """The empty-result check's gate_gain (maximum range 49.97 m, resolution 0.195 m, the
+    margin 3 resolutions, a 2 m gate): a scatterer within the margin of the bins the gate reads
+    reaches it, one farther does not; a range beyond the maximum counts where its beat
+    frequency folds (120 m reads as 20 m), the range FFT is cyclic (0.05 m is next to the
+    last bin, 49.77 m), and a gate beyond the axis reads its nearest bin."""
+    wf = FmcwRadar(FmcwConfig(sample_rate=10e6))
+    assert wf.sequence.max_range == pytest.approx(49.965, abs=1e-3)
+
+    def gain(at: float, gate: float) -> float:
+        return float(wf.gate_gain(np.array([[at]]), np.array([gate]))[0, 0])
+
+    assert gain(20.3, 20.0) == 1.0 and gain(25.0, 20.0) == 0.0
+    assert gain(120.0, 20.0) == 1.0 and gain(125.0, 20.0) == 0.0  # folded: 20.0 and 25.0 m
+    assert gain(0.05, 49.9) == 1.0  # cyclic: across the end of the axis
+    assert gain(49.7, 60.0) == 1.0 and gain(45.0, 60.0) == 0.0  # the last bin, 49.77 m

@@ -646,3 +646,14 @@ def test_check_file_size_allows_the_limit_itself_and_names_a_file_it_cannot_exam
     assert str(err.value) == f"{path}: 100 bytes is beyond the limit of 99 bytes for a BVH file"
     with pytest.raises(DataFileError, match=r"missing\.bvh: cannot read"):
         limits.check_file_size(tmp_path / "missing.bvh", "a BVH file", 100)
+
+
+def test_the_echo_power_limits_are_inclusive_and_refuse_nan() -> None:
+    """limits.check_echo_power takes echoes from MIN_ECHO_POWER_W to MAX_ECHO_POWER_W, both
+    included, and refuses anything beyond either (1.01 times the largest, 0.99 times the
+    smallest) and NaN, naming the field it is given."""
+    for power in (limits.MAX_ECHO_POWER_W, limits.MIN_ECHO_POWER_W, 1.0):
+        limits.check_echo_power(power)
+    for power in (1.01 * limits.MAX_ECHO_POWER_W, 0.99 * limits.MIN_ECHO_POWER_W, math.nan):
+        with pytest.raises(SceneError, match=r"^radar\.transmit_power: the echo of 1 m\^2 at 1 m"):
+            limits.check_echo_power(power, "radar.transmit_power")

@@ -839,8 +839,9 @@ def test_a_third_party_radar_with_a_prf_claims_no_unambiguous_range() -> None:
     fixed gate at 2 km as beyond it; a radar that does not say has none, and the LFM radar
     keeps its c / (2 prf)."""
     import warnings
+    from dataclasses import replace
 
-    from mdframework.check import plan_run
+    from mdframework.check import _metres, format_plan, plan_run
     from mdframework.config import validate_run_config
 
     registry = build_registry([_radar_module(declared=True)])
@@ -854,5 +855,9 @@ def test_a_third_party_radar_with_a_prf_claims_no_unambiguous_range() -> None:
         warnings.simplefilter("error")
         plan = plan_run(validate_run_config(cfg, registry=registry), registry)
     assert plan.max_range_m is None
+    assert "unambiguous to" not in format_plan(plan, "quad.toml")  # no range to state
+    # nor for a radar that gives a range resolution but no unambiguous range
+    assert "unambiguous to" not in format_plan(replace(plan, range_resolution_m=0.15), "q.toml")
+    assert _metres(1499.0, 4) == "1.499 km" and _metres(12.49, 4) == "12.49 m"
     lfm = registry.get("radar", "lfm")
     assert lfm(lfm.Config(prf=1e4)).unambiguous_range() == pytest.approx(14989.6, abs=0.1)

@@ -132,8 +132,9 @@ def empty_result(
     effects (noise); ``losses``: :func:`count_losses` over the whole record;
     ``max_lost_fraction``: the largest acceptable share of lost scatterer returns;
     ``fixed_gate``: whether the range gate is fixed (else it tracks the body);
-    ``max_range``: the radar's unambiguous range [m] (None: none), named when the body reaches
-    it.
+    ``max_range``: the range [m] at which the radar's range gate folds ranges back (an FMCW
+    radar's maximum range; None: it does not, as the LFM radar's simulated gate does not),
+    named when the body reaches it.
     """
     all_gated = losses.total > 0 and losses.gated == losses.total
     all_cut = losses.total > 0 and losses.gated + losses.cut == losses.total

@@ -574,7 +574,8 @@ def _simulate_motion(
         radar_pos, wf.prf, wf.carrier_frequency, t, stream.gate, None, wf, rng, echo=echo
     )
     received = apply_effects(stages, "received", received, context, generators, handed)
-    _check_empty(echo, losses, proc, fixed_gate=sc.gate != "track", max_range=farthest)
+    folds = _folding_range(wf, farthest)
+    _check_empty(echo, losses, proc, fixed_gate=sc.gate != "track", max_range=folds)
     effects_ran = _describe(stages, "scatterers") + _describe(stages, "received")
     timings["received_effects"] = time.perf_counter() - clock
 
@@ -652,6 +653,20 @@ def start_record(
     return farthest
 
 
+def _folding_range(wf: RadarWaveform, farthest: float | None) -> float | None:
+    """``farthest``, the radar's unambiguous range [m], where its range gate folds ranges at it
+    as an FMCW radar's cyclic range FFT does (a scatterer that far beyond the gate reaches the
+    gate), else None: the LFM radar's simulation gates every echo at its true range, so a body
+    beyond ``c / (2 prf)`` loses nothing to it and the empty-result advice must not blame it."""
+    if farthest is None:
+        return None
+    gate = np.array([0.5 * farthest])
+    with blame(wf, "gate_gain"):
+        gain = wf.gate_gain(gate[:, None] + farthest, gate)
+        folded = gain is not None and float(np.asarray(gain).ravel()[0]) > emptiness.LOST_GAIN
+    return farthest if folded else None
+
+
 def _check_empty(
     echo: NDArray[np.complex128],
     losses: emptiness.Losses,
@@ -661,7 +676,8 @@ def _check_empty(
     max_range: float | None,
 ) -> None:
     """Warn (or stop, with ``processing.empty = "error"``) when the record is empty;
-    ``max_range``: the radar's unambiguous range [m] or None."""
+    ``max_range``: the range [m] at which the radar's gate folds ranges (:func:`_folding_range`),
+    or None."""
     why = emptiness.empty_result(
         echo,
         losses,
