@@ -856,8 +856,9 @@ def test_a_third_party_radar_with_a_prf_claims_no_unambiguous_range() -> None:
         plan = plan_run(validate_run_config(cfg, registry=registry), registry)
     assert plan.max_range_m is None
     assert "unambiguous to" not in format_plan(plan, "quad.toml")  # no range to state
-    # nor for a radar that gives a range resolution but no unambiguous range
-    assert "unambiguous to" not in format_plan(replace(plan, range_resolution_m=0.15), "q.toml")
+    # a radar that gives a range resolution but no unambiguous range: the resolution alone
+    text = format_plan(replace(plan, range_resolution_m=0.15), "q.toml")
+    assert "\n  range       resolution 0.15 m\n" in text and "unambiguous to" not in text
     assert _metres(1499.0, 4) == "1.499 km" and _metres(12.49, 4) == "12.49 m"
     lfm = registry.get("radar", "lfm")
     assert lfm(lfm.Config(prf=1e4)).unambiguous_range() == pytest.approx(14989.6, abs=0.1)

@@ -351,11 +351,11 @@ def format_plan(plan: RunPlan, source: str) -> str:
         f"  {'unambiguous':<12}+-{p.max_unambiguous_velocity_mps:.3g} m/s "
         f"(+-{p.prf_hz / 2:.4g} Hz)",
     ]
-    if p.range_resolution_m is not None and p.max_range_m is not None:
-        lines.append(
-            f"  {'range':<12}resolution {_metres(p.range_resolution_m, 3)}, unambiguous to "
-            f"{_metres(p.max_range_m, 4)}"
+    if p.range_resolution_m is not None:  # a radar without a range has no range line
+        unambiguous = (
+            "" if p.max_range_m is None else f", unambiguous to {_metres(p.max_range_m, 4)}"
         )
+        lines.append(f"  {'range':<12}resolution {_metres(p.range_resolution_m, 3)}{unambiguous}")
     speed = f"fastest joint {p.max_joint_radial_speed_mps:.3g} m/s radially"
     if p.aliasing:
         lines.append(f"  {'aliasing':<12}LIKELY: {speed}; {p.faster_sampling}")
