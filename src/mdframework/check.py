@@ -238,7 +238,7 @@ def plan_run(
     check_echo_power(wf)
     record_body = body.select_frames(frames_inside(body.time, t_start, t_end))
     # what the radar refuses (or warns about) before a pulse
-    start_record(stages, record_body, t, radar_pos, config.scene.gate)
+    max_range = start_record(stages, record_body, t, radar_pos, config.scene.gate)
 
     inside = (body.time >= t_start - 1e-9) & (body.time <= t_end + 1e-9)
     # a joint nearer than scene.min_range: refused as the run refuses the scatterer there
@@ -302,7 +302,7 @@ def plan_run(
         memory_mib=sum(terms.values()),
         memory_terms_mib=terms,
         range_resolution_m=wf.range_resolution,
-        max_range_m=wf.unambiguous_range(),
+        max_range_m=max_range,
     )
 
 

@@ -90,16 +90,26 @@ def balanced_accuracy(y_true: NDArray[np.str_], y_pred: NDArray[np.str_]) -> flo
     return float(np.mean([np.mean(y_pred[y_true == c] == c) for c in classes]))
 
 
+def confusion_counts(
+    y_true: NDArray[Any], y_pred: NDArray[Any], classes: Sequence[str]
+) -> NDArray[np.int64]:
+    """The confusion matrix of counts (n_classes, n_classes), int64: row = true class, column =
+    predicted class, each cell the number of test records (a prediction outside ``classes`` is
+    not counted)."""
+    idx = {c: i for i, c in enumerate(classes)}
+    counts = np.zeros((len(classes), len(classes)), dtype=np.int64)
+    for t, p in zip(np.asarray(y_true).tolist(), np.asarray(y_pred).tolist(), strict=True):
+        if t in idx and p in idx:
+            counts[idx[t], idx[p]] += 1
+    return counts
+
+
 def confusion_matrix(
     y_true: NDArray[np.str_], y_pred: NDArray[np.str_], classes: Sequence[str]
 ) -> FloatArray:
     """Row-normalised confusion matrix (n_classes, n_classes): row = true class, column =
     predicted class; rows of classes absent from ``y_true`` are NaN."""
-    idx = {c: i for i, c in enumerate(classes)}
-    counts = np.zeros((len(classes), len(classes)))
-    for t, p in zip(y_true, y_pred, strict=True):
-        if p in idx:
-            counts[idx[t], idx[p]] += 1
+    counts = confusion_counts(y_true, y_pred, classes).astype(np.float64)
     totals = np.array([np.sum(y_true == c) for c in classes], dtype=np.float64)
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.asarray(counts / totals[:, None])

@@ -48,6 +48,7 @@ from . import limits
 from .classify import (
     Selection,
     balanced_accuracy,
+    confusion_counts,
     confusion_matrix,
     fit_predict,
     optimistic_select,
@@ -639,20 +640,6 @@ def _too_few_classes(untested: dict[str, str]) -> MdfError:
         "fewer than two classes can be evaluated: "
         + "; ".join(f"{c}: {why}" for c, why in untested.items())
     )
-
-
-def confusion_counts(
-    y_true: NDArray[Any], y_pred: NDArray[Any], classes: Sequence[str]
-) -> NDArray[np.int64]:
-    """The confusion matrix of counts (n_classes, n_classes), int64: row = true class, column =
-    predicted class, each cell the number of test records (a prediction outside ``classes`` is
-    not counted)."""
-    idx = {c: i for i, c in enumerate(classes)}
-    counts = np.zeros((len(classes), len(classes)), dtype=np.int64)
-    for t, p in zip(y_true.tolist(), y_pred.tolist(), strict=True):
-        if t in idx and p in idx:
-            counts[idx[t], idx[p]] += 1
-    return counts
 
 
 def pooled_scores(
